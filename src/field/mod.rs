@@ -1,0 +1,302 @@
+//! The implicit cloud field: ellipsoids and spheres blended with Wyvill's cubic kernel,
+//! hard clips from cut strokes, and the capped density grid the renderer samples.
+//!
+//! Kernel (Wyvill, Wyvill & McPheeters' "soft object" function, cubic in r²): for a primitive
+//! of influence radius R and s = r²/R² < 1,
+//! `w(s) = 1 − 4/9 s³ + 17/9 s² − 22/9 s`, else 0. The field is Σ strength·w. The visible
+//! surface is the iso-level [`ISO`] = 0.5, and w(1/4) = 0.5 exactly, so an isolated primitive of
+//! visible radius r gets R = 2r: its surface lies exactly at r.
+
+mod grid;
+
+pub use grid::{FieldGrid, GridParams, bake};
+
+use glam::{Mat3, Vec2, Vec3};
+
+use crate::scene::{Ellipsoid, Scene};
+
+/// Iso-level of the visible surface.
+pub const ISO: f32 = 0.5;
+/// Influence radius over visible radius.
+pub const SUPPORT: f32 = 2.0;
+/// How far (in visible radii) the field can reach the surface level once blended; grid bounds
+/// use it so nothing visible is cut off while the grid stays tight.
+pub const BOUNDS_MARGIN: f32 = 1.6;
+/// Most primitives in one field (sketches make many spheres; the cap keeps baking bounded).
+pub const MAX_PRIMITIVES: usize = 20_000;
+
+/// Wyvill's kernel as a function of s = r²/R².
+#[inline]
+pub fn wyvill(s: f32) -> f32 {
+    if s >= 1.0 {
+        0.0
+    } else {
+        let s2 = s * s;
+        1.0 - (4.0 / 9.0) * s2 * s + (17.0 / 9.0) * s2 - (22.0 / 9.0) * s
+    }
+}
+
+/// A blended primitive, ready for evaluation.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Blob {
+    /// Centre.
+    pub center: Vec3,
+    /// Maps `p − center` to a space where the influence region is the unit ball.
+    pub to_unit: Mat3,
+    /// Field weight.
+    pub strength: f32,
+    /// Half-extent (world) of the visible radius per axis.
+    pub extent: Vec3,
+}
+
+impl Blob {
+    /// A sphere of visible radius `radius`.
+    pub fn sphere(center: Vec3, radius: f32) -> Self {
+        let r = radius.max(1e-4);
+        Self { center, to_unit: Mat3::from_diagonal(Vec3::splat(1.0 / (SUPPORT * r))), strength: 1.0, extent: Vec3::splat(r) }
+    }
+
+    /// An ellipsoid primitive of the document.
+    pub fn ellipsoid(e: &Ellipsoid) -> Self {
+        let radii = e.radii.max(Vec3::splat(1e-4));
+        let rot = Mat3::from_quat(e.rotation.normalize());
+        let to_unit = Mat3::from_diagonal(1.0 / (SUPPORT * radii)) * rot.transpose();
+        // Axis-aligned half extents of the rotated ellipsoid.
+        let abs = Mat3::from_cols(rot.x_axis.abs(), rot.y_axis.abs(), rot.z_axis.abs());
+        Self { center: e.center, to_unit, strength: e.strength, extent: abs * radii }
+    }
+
+    /// This primitive's field contribution at `p`.
+    #[inline]
+    pub fn value(&self, p: Vec3) -> f32 {
+        self.strength * wyvill((self.to_unit * (p - self.center)).length_squared())
+    }
+}
+
+/// A cut stroke: nothing of the cloud survives below its line, within its footprint.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Clip {
+    /// Origin of the cut's plane.
+    pub origin: Vec3,
+    /// Plane x axis (unit).
+    pub right: Vec3,
+    /// Plane y axis (unit); "below" is −up.
+    pub up: Vec3,
+    /// The cut line in plane coordinates, sorted by x.
+    pub line: Vec<Vec2>,
+}
+
+impl Clip {
+    /// Whether `p` is removed by this cut.
+    pub fn removes(&self, p: Vec3) -> bool {
+        let d = p - self.origin;
+        let (x, y) = (d.dot(self.right), d.dot(self.up));
+        match line_height(&self.line, x) {
+            Some(h) => y < h,
+            None => false,
+        }
+    }
+}
+
+/// Height of a polyline (sorted by x) at `x`, or `None` outside its x-range.
+fn line_height(line: &[Vec2], x: f32) -> Option<f32> {
+    let (first, last) = (line.first()?, line.last()?);
+    if x < first.x || x > last.x {
+        return None;
+    }
+    let i = line.partition_point(|p| p.x < x);
+    if i == 0 {
+        return Some(first.y);
+    }
+    let (a, b) = (line[i - 1], line[i.min(line.len() - 1)]);
+    let t = if b.x > a.x { (x - a.x) / (b.x - a.x) } else { 0.0 };
+    Some(a.y + (b.y - a.y) * t)
+}
+
+/// Everything in a document that the baked grid depends on; equal inputs give equal grids.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FieldInputs {
+    /// The document's ellipsoids.
+    pub ellipsoids: Vec<Ellipsoid>,
+    /// Grid resolution and lighting.
+    pub grid: GridParams,
+    /// Seed of the document's random choices.
+    pub seed: u64,
+}
+
+impl FieldInputs {
+    /// The inputs of `scene`.
+    pub fn of(scene: &Scene) -> Self {
+        Self {
+            ellipsoids: scene.ellipsoids.clone(),
+            grid: GridParams {
+                resolution: scene.render.field_resolution,
+                sun_dir: scene.light.sun_direction(),
+                extinction: scene.render.opacity,
+                softness: scene.render.softness,
+            },
+            seed: scene.seed,
+        }
+    }
+}
+
+/// The whole field: blended primitives minus clips.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Field {
+    /// Positive primitives.
+    pub blobs: Vec<Blob>,
+    /// Hard clips.
+    pub clips: Vec<Clip>,
+}
+
+impl Field {
+    /// The field a document describes: its ellipsoids plus the spheres and cuts of its planes.
+    pub fn from_scene(scene: &Scene) -> Self {
+        let mut field = Field { blobs: scene.ellipsoids.iter().map(Blob::ellipsoid).collect(), clips: Vec::new() };
+        field.blobs.truncate(MAX_PRIMITIVES);
+        field
+    }
+
+    /// Field value at `p`.
+    pub fn value(&self, p: Vec3) -> f32 {
+        if self.clips.iter().any(|c| c.removes(p)) {
+            return 0.0;
+        }
+        self.blobs.iter().map(|b| b.value(p)).sum()
+    }
+
+    /// Whether `p` is inside the visible surface.
+    pub fn inside(&self, p: Vec3) -> bool {
+        self.value(p) >= ISO
+    }
+
+    /// Axis-aligned box holding everything visible, or `None` for an empty field.
+    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        let mut it = self.blobs.iter().map(|b| (b.center - b.extent * BOUNDS_MARGIN, b.center + b.extent * BOUNDS_MARGIN));
+        let first = it.next()?;
+        Some(it.fold(first, |(lo, hi), (a, b)| (lo.min(a), hi.max(b))))
+    }
+
+    /// Bounding sphere (centre, radius) of [`Field::bounds`].
+    pub fn bounding_sphere(&self) -> Option<(Vec3, f32)> {
+        self.bounds().map(|(lo, hi)| ((lo + hi) * 0.5, (hi - lo).length() * 0.5))
+    }
+
+    /// First point where a ray enters the visible surface, marching in steps of `step`.
+    pub fn raycast(&self, ray: &crate::scene::Ray, step: f32) -> Option<Vec3> {
+        let (lo, hi) = self.bounds()?;
+        let (t0, t1) = ray_box(ray.origin, ray.dir, lo, hi)?;
+        let step = step.max((hi - lo).max_element() / 4096.0);
+        let mut t = t0.max(0.0);
+        let mut prev = t;
+        while t <= t1 {
+            if self.inside(ray.at(t)) {
+                // Refine between the last outside sample and this one.
+                let (mut a, mut b) = (prev, t);
+                for _ in 0..20 {
+                    let m = 0.5 * (a + b);
+                    if self.inside(ray.at(m)) { b = m } else { a = m }
+                }
+                return Some(ray.at(b));
+            }
+            prev = t;
+            t += step;
+        }
+        None
+    }
+}
+
+/// Slab test: entry and exit parameters of a ray through a box.
+pub fn ray_box(origin: Vec3, dir: Vec3, lo: Vec3, hi: Vec3) -> Option<(f32, f32)> {
+    let inv = dir.recip();
+    let (a, b) = ((lo - origin) * inv, (hi - origin) * inv);
+    let (tmin, tmax) = (a.min(b), a.max(b));
+    let (t0, t1) = (tmin.max_element(), tmax.min_element());
+    (t1 >= t0.max(0.0)).then_some((t0, t1))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Ray;
+    use glam::Quat;
+
+    #[test]
+    fn kernel_is_calibrated_to_the_visible_radius() {
+        assert_eq!(wyvill(0.0), 1.0);
+        assert!((wyvill(0.25) - ISO).abs() < 1e-6);
+        assert_eq!(wyvill(1.0), 0.0);
+        // Monotone decreasing.
+        let mut prev = 2.0;
+        for i in 0..=100 {
+            let v = wyvill(i as f32 / 100.0);
+            assert!(v <= prev);
+            prev = v;
+        }
+        let b = Blob::sphere(Vec3::new(1.0, 2.0, 3.0), 1.7);
+        for dir in [Vec3::X, Vec3::NEG_Y, Vec3::new(1.0, 1.0, 1.0).normalize()] {
+            assert!((b.value(b.center + dir * 1.7) - ISO).abs() < 1e-5);
+        }
+    }
+
+    #[test]
+    fn ellipsoid_surface_lies_on_its_radii_even_rotated() {
+        let e = Ellipsoid {
+            center: Vec3::new(0.5, 1.0, -2.0),
+            radii: Vec3::new(3.0, 1.0, 2.0),
+            rotation: Quat::from_rotation_y(0.7) * Quat::from_rotation_x(0.3),
+            strength: 1.0,
+        };
+        let b = Blob::ellipsoid(&e);
+        for (axis, r) in [(Vec3::X, 3.0), (Vec3::Y, 1.0), (Vec3::Z, 2.0)] {
+            let p = e.center + e.rotation * axis * r;
+            assert!((b.value(p) - ISO).abs() < 1e-4, "{axis}");
+        }
+        let f = Field { blobs: vec![b], clips: vec![] };
+        let (lo, hi) = f.bounds().unwrap();
+        for axis in [Vec3::X, Vec3::Y, Vec3::Z] {
+            let p = e.center + e.rotation * axis * [3.0, 1.0, 2.0][axis.abs().max_position()];
+            assert!(p.cmpge(lo).all() && p.cmple(hi).all());
+        }
+    }
+
+    #[test]
+    fn blending_grows_the_union() {
+        let a = Blob::sphere(Vec3::ZERO, 1.0);
+        let b = Blob::sphere(Vec3::new(2.2, 0.0, 0.0), 1.0);
+        let f = Field { blobs: vec![a, b], clips: vec![] };
+        // The midpoint is outside both spheres alone but the blend bridges them.
+        assert!(f.inside(Vec3::new(1.1, 0.0, 0.0)));
+    }
+
+    #[test]
+    fn clip_removes_below_its_line_within_its_footprint() {
+        let clip = Clip { origin: Vec3::ZERO, right: Vec3::X, up: Vec3::Y, line: vec![Vec2::new(-1.0, 0.0), Vec2::new(1.0, 0.5)] };
+        assert!(clip.removes(Vec3::new(0.0, 0.2, 5.0)));
+        assert!(!clip.removes(Vec3::new(0.0, 0.3, 0.0)));
+        assert!(!clip.removes(Vec3::new(2.0, -10.0, 0.0)), "outside the footprint");
+        let f = Field { blobs: vec![Blob::sphere(Vec3::ZERO, 1.0)], clips: vec![clip] };
+        assert!(!f.inside(Vec3::new(0.0, -0.5, 0.0)));
+        assert!(f.inside(Vec3::new(0.0, 0.5, 0.0)));
+    }
+
+    #[test]
+    fn raycast_finds_the_surface() {
+        let f = Field { blobs: vec![Blob::sphere(Vec3::ZERO, 2.0)], clips: vec![] };
+        let ray = Ray { origin: Vec3::new(0.0, 0.0, 10.0), dir: Vec3::NEG_Z };
+        let hit = f.raycast(&ray, 0.05).unwrap();
+        assert!((hit.z - 2.0).abs() < 1e-3, "{hit}");
+        let miss = Ray { origin: Vec3::new(5.0, 0.0, 10.0), dir: Vec3::NEG_Z };
+        assert!(f.raycast(&miss, 0.05).is_none());
+        assert!(Field::default().raycast(&ray, 0.05).is_none());
+    }
+
+    #[test]
+    fn default_scene_field_is_bounded() {
+        let f = Field::from_scene(&Scene::default());
+        let (c, r) = f.bounding_sphere().unwrap();
+        assert!(r > 2.0 && r < 20.0, "{r}");
+        assert!(f.inside(Vec3::new(0.0, 2.5, 0.0)));
+        assert!(c.is_finite());
+    }
+}

@@ -1,0 +1,92 @@
+//! The periodic noise volume the slice shader samples for its octaves (pure CPU code).
+//!
+//! Gradient (Perlin) noise on a lattice that wraps, so the texture tiles seamlessly with a
+//! repeating sampler; values are rescaled to fill [0, 1]. Deterministic for a given seed.
+
+/// Texels along each side of the noise volume.
+pub const NOISE_SIZE: u32 = 32;
+/// Lattice cells along each side (the noise's period inside the texture).
+const LATTICE: u32 = 8;
+
+/// A small, fast, well-mixed integer hash (SplitMix64 finaliser).
+pub fn hash64(mut x: u64) -> u64 {
+    x = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    x = (x ^ (x >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    x = (x ^ (x >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    x ^ (x >> 31)
+}
+
+fn gradient(seed: u64, x: u32, y: u32, z: u32) -> [f32; 3] {
+    let h = hash64(seed ^ hash64(((x as u64) << 42) | ((y as u64) << 21) | z as u64));
+    // A uniformly distributed unit vector from two hashed angles.
+    let u = (h & 0xFFFF_FFFF) as f32 / u32::MAX as f32;
+    let v = (h >> 32) as f32 / u32::MAX as f32;
+    let z = 2.0 * u - 1.0;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = std::f32::consts::TAU * v;
+    [r * phi.cos(), r * phi.sin(), z]
+}
+
+fn fade(t: f32) -> f32 {
+    t * t * t * (t * (t * 6.0 - 15.0) + 10.0)
+}
+
+/// Tileable gradient noise at a lattice-space point.
+fn perlin(seed: u64, p: [f32; 3]) -> f32 {
+    let cell = p.map(|v| v.floor());
+    let f = [p[0] - cell[0], p[1] - cell[1], p[2] - cell[2]];
+    let c = cell.map(|v| v as i64);
+    let mut sum = 0.0;
+    for corner in 0..8u32 {
+        let o = [corner & 1, (corner >> 1) & 1, (corner >> 2) & 1];
+        let l = |i: usize| (c[i] + o[i] as i64).rem_euclid(LATTICE as i64) as u32;
+        let g = gradient(seed, l(0), l(1), l(2));
+        let d = [f[0] - o[0] as f32, f[1] - o[1] as f32, f[2] - o[2] as f32];
+        let w = (0..3).map(|i| if o[i] == 1 { fade(f[i]) } else { 1.0 - fade(f[i]) }).product::<f32>();
+        sum += w * (g[0] * d[0] + g[1] * d[1] + g[2] * d[2]);
+    }
+    sum
+}
+
+/// `NOISE_SIZE³` bytes of tileable noise in [0, 255], x fastest.
+pub fn noise_volume(seed: u64) -> Vec<u8> {
+    let n = NOISE_SIZE;
+    let scale = LATTICE as f32 / n as f32;
+    let mut values = Vec::with_capacity((n * n * n) as usize);
+    for z in 0..n {
+        for y in 0..n {
+            for x in 0..n {
+                values.push(perlin(seed, [x as f32 * scale, y as f32 * scale, z as f32 * scale]));
+            }
+        }
+    }
+    let (lo, hi) = values.iter().fold((f32::MAX, f32::MIN), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+    let span = (hi - lo).max(1e-6);
+    values.iter().map(|v| ((v - lo) / span * 255.0).round() as u8).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn deterministic_full_range_and_seed_dependent() {
+        let a = noise_volume(7);
+        assert_eq!(a, noise_volume(7));
+        assert_ne!(a, noise_volume(8));
+        assert_eq!(a.len(), (NOISE_SIZE * NOISE_SIZE * NOISE_SIZE) as usize);
+        assert_eq!(*a.iter().min().unwrap(), 0);
+        assert_eq!(*a.iter().max().unwrap(), 255);
+        let mean = a.iter().map(|&v| v as f64).sum::<f64>() / a.len() as f64;
+        assert!((mean - 127.5).abs() < 30.0, "{mean}");
+    }
+
+    #[test]
+    fn tiles_seamlessly() {
+        // The lattice wraps: noise at p and p + LATTICE agree.
+        for p in [[0.3, 1.7, 2.2], [7.9, 0.1, 5.5]] {
+            let q = p.map(|v| v + LATTICE as f32);
+            assert!((perlin(3, p) - perlin(3, q)).abs() < 1e-5);
+        }
+    }
+}

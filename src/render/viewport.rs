@@ -1,0 +1,73 @@
+//! The egui paint callback that runs the volume renderer inside the app's viewport.
+//!
+//! The renderer lives in egui-wgpu's callback resources (created once at start-up); each frame
+//! the app hands over a plain `Send + Sync` snapshot: the volume, the job and which target to
+//! show.
+
+use std::sync::Arc;
+
+use super::volume::{SliceJob, VolumeData, VolumeRenderer, accumulation_format};
+
+/// What one frame of the viewport draws.
+pub struct ViewportPaint {
+    /// The baked volume (uploaded only when its generation changes).
+    pub volume: Arc<VolumeData>,
+    /// Volume work for this frame.
+    pub job: Option<SliceJob>,
+    /// Accumulation target to composite into the frame.
+    pub display: Option<usize>,
+}
+
+impl egui_wgpu::CallbackTrait for ViewportPaint {
+    fn prepare(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        _screen: &egui_wgpu::ScreenDescriptor,
+        encoder: &mut wgpu::CommandEncoder,
+        resources: &mut egui_wgpu::CallbackResources,
+    ) -> Vec<wgpu::CommandBuffer> {
+        if let Some(renderer) = resources.get_mut::<VolumeRenderer>() {
+            renderer.upload(device, queue, &self.volume);
+            if let Some(job) = &self.job {
+                renderer.draw_slices(device, queue, encoder, job);
+            }
+        }
+        Vec::new()
+    }
+
+    fn paint(&self, _info: egui::PaintCallbackInfo, pass: &mut wgpu::RenderPass<'static>, resources: &egui_wgpu::CallbackResources) {
+        if let (Some(renderer), Some(target)) = (resources.get::<VolumeRenderer>(), self.display) {
+            renderer.composite(pass, target);
+        }
+    }
+}
+
+/// The active graphics backend, as the page and the panel name it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct BackendInfo {
+    /// `webgpu`, `webgl2`, `vulkan`, `metal`, `dx12` or `gl`.
+    pub backend: &'static str,
+    /// Adapter name as the driver reports it.
+    pub adapter: String,
+}
+
+/// Creates the renderer in egui-wgpu's callback resources; returns what is in use.
+pub fn install(render_state: &egui_wgpu::RenderState) -> BackendInfo {
+    let format = accumulation_format(&render_state.adapter);
+    let renderer = VolumeRenderer::new(&render_state.device, render_state.target_format, format);
+    render_state.renderer.write().callback_resources.insert(renderer);
+    let info = render_state.adapter.get_info();
+    let backend = match info.backend {
+        wgpu::Backend::BrowserWebGpu => "webgpu",
+        wgpu::Backend::Gl if cfg!(target_arch = "wasm32") => "webgl2",
+        wgpu::Backend::Gl => "gl",
+        wgpu::Backend::Vulkan => "vulkan",
+        wgpu::Backend::Metal => "metal",
+        wgpu::Backend::Dx12 => "dx12",
+        _ => "other",
+    };
+    let adapter = if info.name.is_empty() { format!("{:?}", info.backend) } else { info.name.clone() };
+    log::info!("graphics: {backend} on {adapter} (volume accumulates in {format:?})");
+    BackendInfo { backend, adapter }
+}

@@ -1,0 +1,231 @@
+//! The orbit camera (Blender-like: orbit around a target, pan, zoom, frame).
+
+use glam::{Mat4, Vec2, Vec3, Vec4Swizzles};
+use serde::{Deserialize, Serialize};
+
+use super::finite_or;
+
+/// A camera orbiting a target point, stored in the document.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct OrbitCamera {
+    /// The point the camera looks at and orbits around.
+    pub target: Vec3,
+    /// Rotation around the world's up axis in degrees; 0 looks along −z.
+    pub yaw_deg: f32,
+    /// Angle above the horizon in degrees.
+    pub pitch_deg: f32,
+    /// Distance from the target.
+    pub distance: f32,
+    /// Vertical field of view in degrees.
+    pub fov_y_deg: f32,
+}
+
+impl Default for OrbitCamera {
+    fn default() -> Self {
+        Self { target: Vec3::new(0.0, 3.0, 0.0), yaw_deg: 0.0, pitch_deg: 8.0, distance: 19.0, fov_y_deg: 45.0 }
+    }
+}
+
+/// A ray in world space.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ray {
+    /// Start point.
+    pub origin: Vec3,
+    /// Unit direction.
+    pub dir: Vec3,
+}
+
+impl Ray {
+    /// The point at parameter `t`.
+    pub fn at(&self, t: f32) -> Vec3 {
+        self.origin + self.dir * t
+    }
+
+    /// Intersection parameter with the plane through `point` with normal `normal`, if in front.
+    pub fn hit_plane(&self, point: Vec3, normal: Vec3) -> Option<f32> {
+        let denom = self.dir.dot(normal);
+        if denom.abs() < 1e-6 {
+            return None;
+        }
+        let t = (point - self.origin).dot(normal) / denom;
+        (t > 0.0).then_some(t)
+    }
+}
+
+/// Pitch is kept just short of the poles so "up" stays defined.
+const PITCH_LIMIT: f32 = 89.0;
+/// Zoom range.
+const DISTANCE_RANGE: (f32, f32) = (0.05, 1.0e4);
+
+impl OrbitCamera {
+    /// Camera position.
+    pub fn eye(&self) -> Vec3 {
+        self.target + self.back() * self.distance
+    }
+
+    /// Unit vector from the target toward the eye.
+    fn back(&self) -> Vec3 {
+        let (yaw, pitch) = (self.yaw_deg.to_radians(), self.pitch_deg.to_radians());
+        Vec3::new(pitch.cos() * yaw.sin(), pitch.sin(), pitch.cos() * yaw.cos())
+    }
+
+    /// Unit view direction.
+    pub fn forward(&self) -> Vec3 {
+        -self.back()
+    }
+
+    /// Unit right vector of the image plane.
+    pub fn right(&self) -> Vec3 {
+        self.forward().cross(Vec3::Y).normalize_or(Vec3::X)
+    }
+
+    /// Unit up vector of the image plane.
+    pub fn up(&self) -> Vec3 {
+        self.right().cross(self.forward())
+    }
+
+    /// Near and far clip distances.
+    pub fn clip_range(&self) -> (f32, f32) {
+        (self.distance * 0.01, self.distance * 20.0 + 100.0)
+    }
+
+    /// World → view matrix.
+    pub fn view(&self) -> Mat4 {
+        Mat4::look_at_rh(self.eye(), self.target, Vec3::Y)
+    }
+
+    /// View → clip matrix (wgpu depth range 0..1).
+    pub fn projection(&self, aspect: f32) -> Mat4 {
+        let (near, far) = self.clip_range();
+        Mat4::perspective_rh(self.fov_y_deg.to_radians(), aspect.max(1e-3), near, far)
+    }
+
+    /// World → clip matrix.
+    pub fn view_projection(&self, aspect: f32) -> Mat4 {
+        self.projection(aspect) * self.view()
+    }
+
+    /// The ray through a point of the image given in normalised device coordinates
+    /// (x right, y up, both in −1..1).
+    pub fn ray(&self, ndc: Vec2, aspect: f32) -> Ray {
+        let tan = (self.fov_y_deg.to_radians() * 0.5).tan();
+        let dir = self.forward() + self.right() * (ndc.x * tan * aspect.max(1e-3)) + self.up() * (ndc.y * tan);
+        Ray { origin: self.eye(), dir: dir.normalize() }
+    }
+
+    /// Projects a world point to normalised device coordinates; `None` behind the camera.
+    pub fn project(&self, point: Vec3, aspect: f32) -> Option<Vec2> {
+        let clip = self.view_projection(aspect) * point.extend(1.0);
+        (clip.w > 1e-6).then(|| clip.xy() / clip.w)
+    }
+
+    /// Orbits by a pointer movement in pixels (drag right turns the view right).
+    pub fn orbit(&mut self, delta_px: Vec2) {
+        const DEG_PER_PX: f32 = 0.35;
+        self.yaw_deg = (self.yaw_deg - delta_px.x * DEG_PER_PX).rem_euclid(360.0);
+        self.pitch_deg = (self.pitch_deg + delta_px.y * DEG_PER_PX).clamp(-PITCH_LIMIT, PITCH_LIMIT);
+    }
+
+    /// Pans so the point under the pointer follows it; `viewport_height_px` scales pixels to world.
+    pub fn pan(&mut self, delta_px: Vec2, viewport_height_px: f32) {
+        let world_per_px = 2.0 * self.distance * (self.fov_y_deg.to_radians() * 0.5).tan() / viewport_height_px.max(1.0);
+        self.target += (-self.right() * delta_px.x + self.up() * delta_px.y) * world_per_px;
+    }
+
+    /// Multiplies the distance by `factor` (< 1 moves closer).
+    pub fn zoom(&mut self, factor: f32) {
+        if factor.is_finite() && factor > 0.0 {
+            self.distance = (self.distance * factor).clamp(DISTANCE_RANGE.0, DISTANCE_RANGE.1);
+        }
+    }
+
+    /// Centres a bounding sphere and sets the distance so it fills the view.
+    pub fn frame(&mut self, center: Vec3, radius: f32, aspect: f32) {
+        let half_fov_y = self.fov_y_deg.to_radians() * 0.5;
+        let half_fov_x = (half_fov_y.tan() * aspect.clamp(0.1, 10.0)).atan();
+        let half = half_fov_y.min(half_fov_x).max(0.05);
+        self.target = center;
+        self.distance = (radius.max(1e-3) / half.sin() * 1.05).clamp(DISTANCE_RANGE.0, DISTANCE_RANGE.1);
+    }
+
+    pub(super) fn sanitize(&mut self) {
+        let d = Self::default();
+        if !self.target.is_finite() {
+            self.target = d.target;
+        }
+        self.yaw_deg = finite_or(self.yaw_deg, d.yaw_deg).rem_euclid(360.0);
+        self.pitch_deg = finite_or(self.pitch_deg, d.pitch_deg).clamp(-PITCH_LIMIT, PITCH_LIMIT);
+        self.distance = finite_or(self.distance, d.distance).clamp(DISTANCE_RANGE.0, DISTANCE_RANGE.1);
+        self.fov_y_deg = finite_or(self.fov_y_deg, d.fov_y_deg).clamp(5.0, 120.0);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn basis_is_orthonormal_and_looks_at_target() {
+        let cam = OrbitCamera { yaw_deg: 37.0, pitch_deg: -20.0, ..Default::default() };
+        let (f, r, u) = (cam.forward(), cam.right(), cam.up());
+        for v in [f, r, u] {
+            assert!((v.length() - 1.0).abs() < 1e-5);
+        }
+        assert!(f.dot(r).abs() < 1e-5 && f.dot(u).abs() < 1e-5 && r.dot(u).abs() < 1e-5);
+        assert!((cam.eye() + f * cam.distance).abs_diff_eq(cam.target, 1e-4));
+    }
+
+    #[test]
+    fn target_projects_to_centre_and_ray_round_trips() {
+        let cam = OrbitCamera { yaw_deg: 123.0, pitch_deg: 30.0, ..Default::default() };
+        let aspect = 1.6;
+        let c = cam.project(cam.target, aspect).unwrap();
+        assert!(c.length() < 1e-5, "{c}");
+        let ndc = Vec2::new(0.4, -0.7);
+        let ray = cam.ray(ndc, aspect);
+        let p = ray.at(7.0);
+        assert!(cam.project(p, aspect).unwrap().abs_diff_eq(ndc, 1e-4));
+    }
+
+    #[test]
+    fn orbit_keeps_distance_and_clamps_pitch() {
+        let mut cam = OrbitCamera::default();
+        let d = cam.eye().distance(cam.target);
+        cam.orbit(Vec2::new(100.0, 10_000.0));
+        assert!((cam.eye().distance(cam.target) - d).abs() < 1e-3);
+        assert!(cam.pitch_deg <= PITCH_LIMIT);
+        assert!(cam.up().is_finite());
+    }
+
+    #[test]
+    fn pan_moves_target_in_image_plane() {
+        let mut cam = OrbitCamera::default();
+        let before = cam.target;
+        cam.pan(Vec2::new(50.0, 0.0), 500.0);
+        let moved = cam.target - before;
+        assert!(moved.dot(cam.forward()).abs() < 1e-4);
+        assert!(moved.dot(cam.right()) < 0.0, "drag right moves the scene right, so the target goes left");
+    }
+
+    #[test]
+    fn zoom_and_frame() {
+        let mut cam = OrbitCamera::default();
+        cam.zoom(0.5);
+        assert!((cam.distance - 9.5).abs() < 1e-4);
+        cam.zoom(f32::NAN);
+        assert!((cam.distance - 9.5).abs() < 1e-4);
+        cam.frame(Vec3::new(1.0, 2.0, 3.0), 2.0, 1.0);
+        assert_eq!(cam.target, Vec3::new(1.0, 2.0, 3.0));
+        // The framed sphere fits: its silhouette angle is within the half field of view.
+        assert!((2.0f32 / cam.distance).asin() <= cam.fov_y_deg.to_radians() * 0.5 + 1e-4);
+    }
+
+    #[test]
+    fn plane_hit() {
+        let ray = Ray { origin: Vec3::ZERO, dir: Vec3::NEG_Z };
+        assert_eq!(ray.hit_plane(Vec3::new(0.0, 0.0, -5.0), Vec3::Z), Some(5.0));
+        assert_eq!(ray.hit_plane(Vec3::new(0.0, 0.0, 5.0), Vec3::Z), None);
+        assert_eq!(ray.hit_plane(Vec3::new(0.0, 0.0, -5.0), Vec3::X), None);
+    }
+}

@@ -1,0 +1,356 @@
+//! The scene document: the only state a user makes.
+//!
+//! Plain serde data, versioned, with no GPU or UI types. Everything the app shows (the
+//! blended field, sphere primitives, GPU buffers) is derived from it deterministically.
+
+mod camera;
+mod edit;
+mod pointer;
+
+pub use camera::{OrbitCamera, Ray};
+pub use edit::{Edit, History};
+pub use pointer::{SetError, set_by_pointer};
+
+use glam::{Quat, Vec3};
+use serde::{Deserialize, Serialize};
+
+/// Version written by this build. Older documents are upgraded on load; newer ones are refused.
+pub const SCENE_VERSION: u32 = 1;
+
+/// Most ellipsoids a document may hold (bad files must not exhaust memory).
+pub const MAX_ELLIPSOIDS: usize = 4096;
+
+/// Errors when reading a scene document.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// Not JSON, or JSON of the wrong shape.
+    #[error("not a cloudsketch scene: {0}")]
+    Parse(#[from] serde_json::Error),
+    /// Written by a newer build.
+    #[error("scene version {found} is newer than this build supports (up to {SCENE_VERSION})")]
+    TooNew {
+        /// Version found in the document.
+        found: u32,
+    },
+    /// Values outside the allowed ranges.
+    #[error("invalid scene: {0}")]
+    Invalid(String),
+}
+
+/// The whole document.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Scene {
+    /// Document format version ([`SCENE_VERSION`] when written by this build).
+    pub version: u32,
+    /// Seed for every random choice derived from the document (noise, 3D extension).
+    pub seed: u64,
+    /// The view the document opens with.
+    pub camera: OrbitCamera,
+    /// Sun, sky and background.
+    pub light: Lighting,
+    /// Render quality and cloud media settings.
+    pub render: RenderSettings,
+    /// Implicit ellipsoids blended into the cloud field.
+    pub ellipsoids: Vec<Ellipsoid>,
+}
+
+impl Default for Scene {
+    fn default() -> Self {
+        Self::preset(Preset::Cumulus)
+    }
+}
+
+/// Named starting points for `cloudsketch new --preset` and `?preset=` in the page.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Preset {
+    /// A fair-weather cumulus of a few blended ellipsoids (the default).
+    Cumulus,
+    /// Nothing but sky: for sketching from scratch.
+    Empty,
+}
+
+impl Preset {
+    /// All presets with their names.
+    pub const ALL: [(Preset, &'static str); 2] = [(Preset::Cumulus, "cumulus"), (Preset::Empty, "empty")];
+
+    /// Looks a preset up by name.
+    pub fn from_name(name: &str) -> Option<Preset> {
+        Self::ALL.iter().find(|(_, n)| n.eq_ignore_ascii_case(name)).map(|(p, _)| *p)
+    }
+
+    /// The preset's name.
+    pub fn name(self) -> &'static str {
+        Self::ALL.iter().find(|(p, _)| *p == self).map(|(_, n)| *n).unwrap_or("cumulus")
+    }
+}
+
+impl Scene {
+    /// A new document from a preset.
+    pub fn preset(preset: Preset) -> Self {
+        let ellipsoids = match preset {
+            Preset::Cumulus => vec![
+                Ellipsoid::new(Vec3::new(0.0, 1.6, 0.0), Vec3::new(4.2, 1.5, 3.0)),
+                Ellipsoid::new(Vec3::new(-2.0, 2.7, 0.3), Vec3::new(2.2, 1.9, 2.0)),
+                Ellipsoid::new(Vec3::new(1.4, 3.2, -0.3), Vec3::new(2.5, 2.4, 2.2)),
+                Ellipsoid::new(Vec3::new(0.1, 4.7, 0.1), Vec3::new(1.8, 1.7, 1.7)),
+                Ellipsoid::new(Vec3::new(3.4, 2.3, 0.5), Vec3::new(1.5, 1.3, 1.4)),
+                Ellipsoid::new(Vec3::new(-3.6, 2.0, -0.4), Vec3::new(1.3, 1.1, 1.2)),
+            ],
+            Preset::Empty => Vec::new(),
+        };
+        Scene {
+            version: SCENE_VERSION,
+            seed: 1,
+            camera: OrbitCamera::default(),
+            light: Lighting::default(),
+            render: RenderSettings::default(),
+            ellipsoids,
+        }
+    }
+
+    /// Parses a document, upgrading older versions and checking every limit.
+    pub fn from_json(text: &str) -> Result<Self, SceneError> {
+        let value: serde_json::Value = serde_json::from_str(text)?;
+        Self::from_value(value)
+    }
+
+    /// Like [`Scene::from_json`] for an already parsed value.
+    pub fn from_value(value: serde_json::Value) -> Result<Self, SceneError> {
+        let found = value.get("version").and_then(|v| v.as_u64()).unwrap_or(SCENE_VERSION as u64);
+        if found > SCENE_VERSION as u64 {
+            return Err(SceneError::TooNew { found: found.min(u32::MAX as u64) as u32 });
+        }
+        let mut scene: Scene = serde_json::from_value(value)?;
+        scene.version = SCENE_VERSION;
+        scene.validate()?;
+        Ok(scene)
+    }
+
+    /// Pretty JSON of the document.
+    pub fn to_json(&self) -> String {
+        // Serializing plain data with string keys cannot fail.
+        serde_json::to_string_pretty(self).unwrap_or_default()
+    }
+
+    /// Checks sizes and ranges; clamps what can be clamped, refuses what cannot.
+    pub fn validate(&mut self) -> Result<(), SceneError> {
+        if self.ellipsoids.len() > MAX_ELLIPSOIDS {
+            return Err(SceneError::Invalid(format!(
+                "{} ellipsoids (at most {MAX_ELLIPSOIDS})",
+                self.ellipsoids.len()
+            )));
+        }
+        for (i, e) in self.ellipsoids.iter().enumerate() {
+            if !(e.center.is_finite() && e.radii.is_finite() && e.rotation.is_finite() && e.strength.is_finite()) {
+                return Err(SceneError::Invalid(format!("ellipsoid {i} has a non-finite value")));
+            }
+            if e.radii.min_element() <= 0.0 {
+                return Err(SceneError::Invalid(format!("ellipsoid {i} has a radius ≤ 0")));
+            }
+        }
+        self.camera.sanitize();
+        self.light.sanitize();
+        self.render.sanitize();
+        Ok(())
+    }
+}
+
+/// An implicit ellipsoid: Wyvill's kernel on the ellipsoid-normalised distance.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Ellipsoid {
+    /// Centre in world units (y up).
+    pub center: Vec3,
+    /// Semi-axes of the visible surface of the ellipsoid alone.
+    pub radii: Vec3,
+    /// Orientation of the semi-axes.
+    pub rotation: Quat,
+    /// Field weight; 1 is a plain primitive.
+    pub strength: f32,
+}
+
+impl Default for Ellipsoid {
+    fn default() -> Self {
+        Self::new(Vec3::ZERO, Vec3::ONE)
+    }
+}
+
+impl Ellipsoid {
+    /// An axis-aligned ellipsoid of unit strength.
+    pub fn new(center: Vec3, radii: Vec3) -> Self {
+        Self { center, radii, rotation: Quat::IDENTITY, strength: 1.0 }
+    }
+}
+
+/// Sun, sky and background. Colours are sRGB-encoded in [0, 1], as artists pick them.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Lighting {
+    /// Sun azimuth in degrees: 0 = +x (right in the default view), 90 = +z (toward the viewer).
+    pub sun_azimuth_deg: f32,
+    /// Sun elevation above the horizon in degrees.
+    pub sun_elevation_deg: f32,
+    /// Sun colour.
+    pub sun_color: [f32; 3],
+    /// Sun intensity multiplier.
+    pub sun_intensity: f32,
+    /// Ambient sky light colour (fills the shadowed side).
+    pub sky_color: [f32; 3],
+    /// Ambient intensity multiplier.
+    pub ambient: f32,
+    /// Background colour behind the cloud.
+    pub background: [f32; 3],
+}
+
+impl Default for Lighting {
+    fn default() -> Self {
+        Self {
+            sun_azimuth_deg: 20.0,
+            sun_elevation_deg: 35.0,
+            sun_color: [1.0, 0.97, 0.9],
+            sun_intensity: 1.6,
+            sky_color: [0.55, 0.66, 0.85],
+            ambient: 0.45,
+            background: [0.33, 0.52, 0.78],
+        }
+    }
+}
+
+impl Lighting {
+    /// Unit vector pointing from the scene toward the sun.
+    pub fn sun_direction(&self) -> Vec3 {
+        let (az, el) = (self.sun_azimuth_deg.to_radians(), self.sun_elevation_deg.to_radians());
+        Vec3::new(el.cos() * az.cos(), el.sin(), el.cos() * az.sin()).normalize_or(Vec3::Y)
+    }
+
+    fn sanitize(&mut self) {
+        self.sun_elevation_deg = finite_or(self.sun_elevation_deg, 35.0).clamp(-89.0, 89.0);
+        self.sun_azimuth_deg = finite_or(self.sun_azimuth_deg, 20.0).rem_euclid(360.0);
+        self.sun_intensity = finite_or(self.sun_intensity, 1.6).clamp(0.0, 20.0);
+        self.ambient = finite_or(self.ambient, 0.45).clamp(0.0, 5.0);
+        for c in [&mut self.sun_color, &mut self.sky_color, &mut self.background] {
+            for v in c.iter_mut() {
+                *v = finite_or(*v, 0.5).clamp(0.0, 1.0);
+            }
+        }
+    }
+}
+
+/// Render quality and cloud media (the seed of Schpok et al.'s Table 2 controls).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct RenderSettings {
+    /// Quality: number of view-aligned slices at full quality.
+    pub slices: u32,
+    /// Opacity: extinction per world unit of the densest cloud.
+    pub opacity: f32,
+    /// Resolution of the baked field grid along its longest side.
+    pub field_resolution: u32,
+    /// How far noise moves the cloud's surface (0 = smooth blobs).
+    pub noise_amount: f32,
+    /// Size of the first noise octave in world units.
+    pub noise_scale: f32,
+    /// Octaves of noise summed per sample.
+    pub noise_octaves: u32,
+    /// Lacunarity: frequency step between octaves (the Detail control).
+    pub detail: f32,
+    /// Width of the soft edge around the surface, in field units.
+    pub softness: f32,
+}
+
+/// Bounds of the render settings, shared by the UI sliders and validation.
+pub mod limits {
+    /// Slice count range.
+    pub const SLICES: (u32, u32) = (8, 512);
+    /// Field grid resolution range.
+    pub const FIELD_RESOLUTION: (u32, u32) = (16, 128);
+    /// Noise octaves range.
+    pub const OCTAVES: (u32, u32) = (0, 4);
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        Self {
+            slices: 128,
+            opacity: 2.5,
+            field_resolution: 64,
+            noise_amount: 0.35,
+            noise_scale: 3.0,
+            noise_octaves: 3,
+            detail: 2.2,
+            softness: 0.12,
+        }
+    }
+}
+
+impl RenderSettings {
+    fn sanitize(&mut self) {
+        self.slices = self.slices.clamp(limits::SLICES.0, limits::SLICES.1);
+        self.field_resolution = self.field_resolution.clamp(limits::FIELD_RESOLUTION.0, limits::FIELD_RESOLUTION.1);
+        self.noise_octaves = self.noise_octaves.clamp(limits::OCTAVES.0, limits::OCTAVES.1);
+        self.opacity = finite_or(self.opacity, 2.5).clamp(0.0, 100.0);
+        self.noise_amount = finite_or(self.noise_amount, 0.35).clamp(0.0, 1.0);
+        self.noise_scale = finite_or(self.noise_scale, 3.0).clamp(0.05, 1000.0);
+        self.detail = finite_or(self.detail, 2.2).clamp(1.1, 4.0);
+        self.softness = finite_or(self.softness, 0.12).clamp(0.005, 0.5);
+    }
+}
+
+pub(crate) fn finite_or(v: f32, fallback: f32) -> f32 {
+    if v.is_finite() { v } else { fallback }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn json_round_trip_is_lossless() {
+        let scene = Scene::default();
+        let back = Scene::from_json(&scene.to_json()).expect("round trip");
+        assert_eq!(scene, back);
+    }
+
+    #[test]
+    fn missing_fields_take_defaults() {
+        let s = Scene::from_json(r#"{"version":1,"ellipsoids":[]}"#).unwrap();
+        assert_eq!(s.render, RenderSettings::default());
+        assert!(s.ellipsoids.is_empty());
+    }
+
+    #[test]
+    fn newer_versions_are_refused() {
+        let err = Scene::from_json(r#"{"version":99}"#).unwrap_err();
+        assert!(err.to_string().contains("newer"), "{err}");
+    }
+
+    #[test]
+    fn malformed_documents_give_errors_not_panics() {
+        for text in ["", "[]", "{", r#"{"ellipsoids": 3}"#, r#"{"ellipsoids":[{"radii":[0,1,1]}]}"#] {
+            assert!(Scene::from_json(text).is_err(), "{text:?} accepted");
+        }
+    }
+
+    #[test]
+    fn out_of_range_settings_are_clamped() {
+        let s = Scene::from_json(r#"{"render":{"slices":100000,"field_resolution":3}}"#).unwrap();
+        assert_eq!(s.render.slices, limits::SLICES.1);
+        assert_eq!(s.render.field_resolution, limits::FIELD_RESOLUTION.0);
+    }
+
+    #[test]
+    fn sun_direction_follows_angles() {
+        let mut l = Lighting { sun_azimuth_deg: 0.0, sun_elevation_deg: 0.0, ..Default::default() };
+        assert!(l.sun_direction().abs_diff_eq(Vec3::X, 1e-6));
+        l.sun_elevation_deg = 90.0;
+        assert!(l.sun_direction().abs_diff_eq(Vec3::Y, 1e-6));
+    }
+
+    #[test]
+    fn presets_by_name() {
+        assert_eq!(Preset::from_name("EMPTY"), Some(Preset::Empty));
+        assert!(Scene::preset(Preset::Empty).ellipsoids.is_empty());
+        assert_eq!(Preset::from_name("nope"), None);
+    }
+}

@@ -1,0 +1,116 @@
+//! Everything wasm-only: start-up in the page, URL options, the page's test contract and the
+//! on-page error box. The one place `cfg(target_arch = "wasm32")` code lives.
+//!
+//! Test contract: `<body>` carries `data-ready` (first full-quality image shown),
+//! `data-backend` (`webgpu` | `webgl2`), `data-adapter` and `data-quality`
+//! (e.g. `full 640x480x128`); `window.cloudsketch.state()` returns the document and view.
+
+use std::cell::RefCell;
+
+use wasm_bindgen::JsCast as _;
+use wasm_bindgen::prelude::*;
+
+use crate::scene::{Preset, Scene};
+use crate::ui::{CloudApp, Host, PageStatus, StartOptions};
+
+thread_local! {
+    static STATE: RefCell<String> = const { RefCell::new(String::new()) };
+}
+
+/// Starts the app in the page's `#cloudsketch_canvas`.
+pub fn start() {
+    let _ = eframe::WebLogger::init(log::LevelFilter::Info);
+    let previous = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        show_error(&format!("cloudsketch stopped after an internal error: {info}"));
+        previous(info);
+    }));
+    install_state_accessor();
+    let options = StartOptions { scene: scene_from_url(), host: Some(Box::new(WebHost)), initial_cost: 4e-8 };
+    wasm_bindgen_futures::spawn_local(async move {
+        if let Err(message) = run(options).await {
+            log::error!("{message}");
+            show_error(&message);
+        }
+    });
+}
+
+async fn run(options: StartOptions) -> Result<(), String> {
+    let document = web_sys::window().and_then(|w| w.document()).ok_or("no document")?;
+    let canvas = document
+        .get_element_by_id("cloudsketch_canvas")
+        .and_then(|e| e.dyn_into::<web_sys::HtmlCanvasElement>().ok())
+        .ok_or("the page has no <canvas id=\"cloudsketch_canvas\">")?;
+    let runner = eframe::WebRunner::new();
+    runner
+        .start(canvas, eframe::WebOptions::default(), Box::new(move |cc| Ok(Box::new(CloudApp::new(cc, options)))))
+        .await
+        .map_err(|e| {
+            format!(
+                "This browser offers neither WebGPU nor WebGL2, which cloudsketch needs to draw clouds. \
+                 Try a current Chrome, Edge, Firefox or Safari with hardware acceleration on. ({})",
+                e.as_string().unwrap_or_else(|| format!("{e:?}"))
+            )
+        })?;
+    if let Some(loading) = document.get_element_by_id("loading") {
+        loading.remove();
+    }
+    Ok(())
+}
+
+/// `?preset=NAME` picks the starting document.
+fn scene_from_url() -> Scene {
+    let search = web_sys::window().and_then(|w| w.location().search().ok()).unwrap_or_default();
+    let params = web_sys::UrlSearchParams::new_with_str(&search).ok();
+    match params.and_then(|p| p.get("preset")) {
+        Some(name) => Preset::from_name(&name).map(Scene::preset).unwrap_or_else(|| {
+            log::warn!("unknown preset {name:?}; opening the default scene");
+            Scene::default()
+        }),
+        None => Scene::default(),
+    }
+}
+
+/// Shows a message in the page's error box (and keeps the page usable as a page).
+fn show_error(message: &str) {
+    let Some(document) = web_sys::window().and_then(|w| w.document()) else { return };
+    if let Some(loading) = document.get_element_by_id("loading") {
+        loading.remove();
+    }
+    if let Some(el) = document.get_element_by_id("error") {
+        el.set_text_content(Some(message));
+        let _ = el.set_attribute("style", "display:block");
+    }
+}
+
+/// `window.cloudsketch.state()`.
+fn install_state_accessor() {
+    let Some(window) = web_sys::window() else { return };
+    let state = Closure::<dyn Fn() -> JsValue>::new(|| {
+        STATE.with(|s| js_sys::JSON::parse(&s.borrow()).unwrap_or(JsValue::NULL))
+    });
+    let api = js_sys::Object::new();
+    let _ = js_sys::Reflect::set(&api, &"state".into(), state.as_ref());
+    let _ = js_sys::Reflect::set(&window, &"cloudsketch".into(), &api);
+    state.forget(); // lives as long as the page
+}
+
+struct WebHost;
+
+impl Host for WebHost {
+    fn publish(&mut self, status: &PageStatus) {
+        STATE.with(|s| s.replace(status.state.clone()));
+        let Some(body) = web_sys::window().and_then(|w| w.document()).and_then(|d| d.body()) else { return };
+        let set = |name: &str, value: &str| {
+            if body.get_attribute(name).as_deref() != Some(value) {
+                let _ = body.set_attribute(name, value);
+            }
+        };
+        if status.ready {
+            set("data-ready", "true");
+        }
+        set("data-backend", &status.backend);
+        set("data-adapter", &status.adapter);
+        set("data-quality", &status.quality);
+    }
+}
