@@ -69,6 +69,56 @@ fn render_frame(offscreen: &mut Offscreen) -> Result<BenchResult, String> {
     ))
 }
 
+/// A 500-point cloud-like outline (flat base, bumpy top) for the sketch benchmark.
+pub fn bench_outline() -> Vec<[f64; 2]> {
+    let n = 500;
+    (0..n)
+        .map(|i| {
+            let a = i as f64 / n as f64 * std::f64::consts::TAU;
+            let bumps = 1.0 + 0.15 * (a * 7.0).sin() + 0.07 * (a * 13.0).cos();
+            let y = a.sin().max(-0.35) * 3.5 * bumps;
+            [5.0 * a.cos() * bumps, -y]
+        })
+        .collect()
+}
+
+/// Stroke → spheres (clean, triangulate, chordal axis, spheres, 3D extension) for a 500-point
+/// stroke, against spade's constrained Delaunay triangulation alone on the same polygon.
+fn sketch_pipeline() -> Result<BenchResult, String> {
+    use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation as _};
+    const RUNS: usize = 31;
+    let stroke = bench_outline();
+    let params = crate::sketch::SketchParams::default();
+    let time = |f: &mut dyn FnMut()| {
+        f();
+        let v: Vec<f64> = (0..RUNS)
+            .map(|_| {
+                let t = std::time::Instant::now();
+                f();
+                t.elapsed().as_secs_f64()
+            })
+            .collect();
+        median(v)
+    };
+    let mut failed = None;
+    let ours = time(&mut || {
+        if let Err(e) = crate::sketch::interpret(&stroke, true, &params, 1) {
+            failed = Some(e.to_string());
+        }
+    });
+    if let Some(e) = failed {
+        return Err(format!("sketch benchmark stroke refused: {e}"));
+    }
+    let n = stroke.len();
+    let cdt = time(&mut || {
+        let vertices: Vec<Point2<f64>> = stroke.iter().map(|&[x, y]| Point2::new(x, y)).collect();
+        let edges: Vec<[usize; 2]> = (0..n).map(|i| [i, (i + 1) % n]).collect();
+        let t = ConstrainedDelaunayTriangulation::<Point2<f64>>::try_bulk_load_cdt(vertices, edges, |_| {});
+        std::hint::black_box(t.map(|t| t.num_inner_faces()).unwrap_or(0));
+    });
+    Ok(result("sketch_500_point_stroke_to_spheres", ours * 1e3, "ms", "spade_cdt_500_point_polygon", cdt * 1e3))
+}
+
 /// Runs the suite and prints it.
 pub fn run(json: bool) -> Result<(), String> {
     let mut offscreen = Offscreen::new().map_err(|e| e.to_string())?;
@@ -79,7 +129,7 @@ pub fn run(json: bool) -> Result<(), String> {
         std::env::consts::ARCH,
         offscreen.adapter_name()
     );
-    let results = vec![render_frame(&mut offscreen)?];
+    let results = vec![sketch_pipeline()?, render_frame(&mut offscreen)?];
     let report = BenchReport { machine, results };
     if json {
         println!("{}", serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?);

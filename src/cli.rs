@@ -45,6 +45,27 @@ enum Command {
         #[arg(long = "set", value_name = "PATH=VALUE")]
         set: Vec<String>,
     },
+    /// Turn drawn outlines into a scene (one drawing plane per stroke), headless.
+    Sketch {
+        /// Stroke files: {"points": [[x, y], ...], "closed": true|false}, y pointing down.
+        #[arg(required = true)]
+        strokes: Vec<PathBuf>,
+        /// Where to write the scene JSON.
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Also write the first stroke's final spheres, in its own units and axes.
+        #[arg(long)]
+        spheres_out: Option<PathBuf>,
+        /// Inflation slider t in [0, 1] (0 keeps the maximal balls).
+        #[arg(long, default_value_t = 0.0)]
+        inflate: f64,
+        /// Turn the automatic 3D extension off.
+        #[arg(long)]
+        no_extend: bool,
+        /// Seed of the 3D extension.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+    },
     /// Run the benchmark suite.
     Bench {
         /// Print one JSON object instead of a table.
@@ -61,6 +82,9 @@ pub fn main() -> ExitCode {
         None => run_desktop(),
         Some(Command::New { preset, output }) => new_scene(&preset, &output),
         Some(Command::Render { scene, output, size, set }) => render(scene.as_deref(), &output, &size, &set),
+        Some(Command::Sketch { strokes, output, spheres_out, inflate, no_extend, seed }) => {
+            sketch(&strokes, &output, spheres_out.as_deref(), inflate, !no_extend, seed)
+        }
         Some(Command::Bench { json }) => crate::bench::run(json),
     };
     match result {
@@ -158,4 +182,80 @@ mod tests {
             assert!(parse_size(bad).is_err(), "{bad}");
         }
     }
+}
+
+/// A stroke file.
+#[derive(serde::Deserialize)]
+struct StrokeFile {
+    points: Vec<[f64; 2]>,
+    #[serde(default = "yes")]
+    closed: bool,
+}
+
+fn yes() -> bool {
+    true
+}
+
+/// World height the strokes are scaled to, so the default camera frames them.
+const SKETCH_WORLD_HEIGHT: f64 = 6.0;
+
+fn sketch(paths: &[PathBuf], output: &Path, spheres_out: Option<&Path>, inflate: f64, extend: bool, seed: u64) -> Result<(), String> {
+    use crate::scene::{DrawingPlane, MAX_PLANES, StrokeKind};
+    use crate::sketch::{SketchParams, interpret};
+    if !(0.0..=1.0).contains(&inflate) {
+        return Err(format!("--inflate {inflate} is outside 0..=1"));
+    }
+    if paths.len() > MAX_PLANES {
+        return Err(format!("{} strokes (at most {MAX_PLANES})", paths.len()));
+    }
+    let params = SketchParams { inflate, extend, ..Default::default() };
+    let mut strokes = Vec::new();
+    for path in paths {
+        let file: StrokeFile = serde_json::from_str(&read_capped(path)?)
+            .map_err(|e| format!("{}: not a stroke file ({{\"points\": [[x, y], ...]}}): {e}", path.display()))?;
+        // y down → y up, so the plane's points read like the world.
+        let points: Vec<[f64; 2]> = file.points.iter().map(|&[x, y]| [x, -y]).collect();
+        let sketch = interpret(&points, file.closed, &params, seed.wrapping_add(strokes.len() as u64))
+            .map_err(|e| format!("{}: {e}", path.display()))?;
+        for w in &sketch.warnings {
+            eprintln!("warning: {}: {w}", path.display());
+        }
+        strokes.push((points, file.closed, sketch));
+    }
+    // One frame for all strokes (they were drawn on one canvas): fit their box to the view.
+    let all: Vec<glam::DVec2> = strokes.iter().flat_map(|(_, _, s)| s.outline.points.iter().copied()).collect();
+    let (lo, hi) = all.iter().fold((glam::DVec2::MAX, glam::DVec2::MIN), |(a, b), &q| (a.min(q), b.max(q)));
+    let scale = SKETCH_WORLD_HEIGHT / (hi.y - lo.y).max((hi.x - lo.x) * 0.5).max(1e-9);
+    let mut scene = Scene::preset(crate::scene::Preset::Empty);
+    let target = scene.camera.target.as_dvec3();
+    let centre = (lo + hi) * 0.5;
+    for (i, (points, closed, _)) in strokes.iter().enumerate() {
+        let c = crate::scene::centre_of(&points.iter().map(|&[x, y]| glam::DVec2::new(x, y)).collect::<Vec<_>>());
+        let origin = target + ((c - centre) * scale).extend(0.0);
+        scene.planes.push(DrawingPlane {
+            name: format!("Outline {}", i + 1),
+            kind: StrokeKind::Outline,
+            origin: origin.as_vec3(),
+            points: points.iter().map(|&[x, y]| ((glam::DVec2::new(x, y) - c) * scale).as_vec2()).collect(),
+            closed: *closed,
+            sketch: params.clone(),
+            seed: seed.wrapping_add(i as u64),
+            ..Default::default()
+        });
+    }
+    scene.validate().map_err(|e| e.to_string())?;
+    write(output, scene.to_json().as_bytes())?;
+    if let Some(path) = spheres_out {
+        let spheres: Vec<serde_json::Value> = strokes[0]
+            .2
+            .spheres
+            .iter()
+            .map(|s| serde_json::json!({"center": [s.center.x, -s.center.y, s.center.z], "radius": s.radius}))
+            .collect();
+        let text = serde_json::to_string_pretty(&serde_json::json!({ "spheres": spheres })).map_err(|e| e.to_string())?;
+        write(path, text.as_bytes())?;
+    }
+    let total: usize = strokes.iter().map(|s| s.2.spheres.len()).sum();
+    eprintln!("{} stroke(s) → {total} spheres → {}", strokes.len(), output.display());
+    Ok(())
 }

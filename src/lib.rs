@@ -4,6 +4,7 @@
 //! window and a headless CLI). See ARCHITECTURE.md for the map; in short:
 //!
 //! - [`scene`]: the document, the only state a user makes (pure);
+//! - [`sketch`]: stroke → skeleton → spheres (pure);
 //! - [`field`]: the blended implicit field and its baked grid (pure);
 //! - [`render`]: the only user of wgpu;
 //! - [`ui`]: the eframe app;
@@ -12,6 +13,7 @@
 pub mod field;
 pub mod render;
 pub mod scene;
+pub mod sketch;
 pub mod ui;
 
 #[cfg(not(target_arch = "wasm32"))]

@@ -13,7 +13,7 @@ pub use grid::{FieldGrid, GridParams, bake};
 
 use glam::{Mat3, Vec2, Vec3};
 
-use crate::scene::{Ellipsoid, Scene};
+use crate::scene::{DrawingPlane, Ellipsoid, Scene, StrokeKind};
 
 /// Iso-level of the visible surface.
 pub const ISO: f32 = 0.5;
@@ -118,6 +118,8 @@ fn line_height(line: &[Vec2], x: f32) -> Option<f32> {
 pub struct FieldInputs {
     /// The document's ellipsoids.
     pub ellipsoids: Vec<Ellipsoid>,
+    /// The document's drawing planes (their spheres and cuts).
+    pub planes: Vec<DrawingPlane>,
     /// Grid resolution and lighting.
     pub grid: GridParams,
     /// Seed of the document's random choices.
@@ -129,6 +131,7 @@ impl FieldInputs {
     pub fn of(scene: &Scene) -> Self {
         Self {
             ellipsoids: scene.ellipsoids.clone(),
+            planes: scene.planes.clone(),
             grid: GridParams {
                 resolution: scene.render.field_resolution,
                 sun_dir: scene.light.sun_direction(),
@@ -141,10 +144,17 @@ impl FieldInputs {
 }
 
 /// The whole field: blended primitives minus clips.
+///
+/// Ellipsoids are summed (Wyvill blending). The spheres of one sketched outline are first
+/// combined by their maximum, so the outline's dense spheres give exactly their union (its
+/// silhouette is the drawn outline); those per-outline fields are then summed like any other
+/// primitive, so outlines and ellipsoids blend into one cloud.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Field {
-    /// Positive primitives.
+    /// Positive primitives, summed.
     pub blobs: Vec<Blob>,
+    /// Sphere groups (one per sketched outline): max within a group, summed across.
+    pub groups: Vec<Vec<Blob>>,
     /// Hard clips.
     pub clips: Vec<Clip>,
 }
@@ -152,9 +162,39 @@ pub struct Field {
 impl Field {
     /// The field a document describes: its ellipsoids plus the spheres and cuts of its planes.
     pub fn from_scene(scene: &Scene) -> Self {
-        let mut field = Field { blobs: scene.ellipsoids.iter().map(Blob::ellipsoid).collect(), clips: Vec::new() };
+        let mut field = Field { blobs: scene.ellipsoids.iter().map(Blob::ellipsoid).collect(), groups: Vec::new(), clips: Vec::new() };
         field.blobs.truncate(MAX_PRIMITIVES);
+        let mut budget = MAX_PRIMITIVES.saturating_sub(field.blobs.len());
+        for plane in &scene.planes {
+            match plane.kind {
+                StrokeKind::Outline => {
+                    // Planes are validated when made; a stroke that no longer interprets adds nothing.
+                    let Ok(sketch) = crate::sketch::interpret(&plane.stroke(), plane.closed, &plane.sketch, plane.seed) else {
+                        continue;
+                    };
+                    let group: Vec<Blob> = sketch
+                        .spheres
+                        .iter()
+                        .take(budget)
+                        .map(|s| Blob::sphere(plane.to_world(s.center.as_vec3()), s.radius as f32))
+                        .collect();
+                    budget -= group.len();
+                    field.groups.push(group);
+                }
+                StrokeKind::Cut => {
+                    if let Ok(line) = crate::sketch::cut_line(&plane.stroke()) {
+                        let line = line.into_iter().map(|p| p.as_vec2()).collect();
+                        field.clips.push(Clip { origin: plane.origin, right: plane.right(), up: plane.up(), line });
+                    }
+                }
+            }
+        }
         field
+    }
+
+    /// Every primitive, summed ones and grouped ones.
+    pub fn all_blobs(&self) -> impl Iterator<Item = &Blob> {
+        self.blobs.iter().chain(self.groups.iter().flatten())
     }
 
     /// Field value at `p`.
@@ -162,7 +202,9 @@ impl Field {
         if self.clips.iter().any(|c| c.removes(p)) {
             return 0.0;
         }
-        self.blobs.iter().map(|b| b.value(p)).sum()
+        let summed: f32 = self.blobs.iter().map(|b| b.value(p)).sum();
+        let grouped: f32 = self.groups.iter().map(|g| g.iter().map(|b| b.value(p)).fold(0.0, f32::max)).sum();
+        summed + grouped
     }
 
     /// Whether `p` is inside the visible surface.
@@ -172,7 +214,7 @@ impl Field {
 
     /// Axis-aligned box holding everything visible, or `None` for an empty field.
     pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
-        let mut it = self.blobs.iter().map(|b| (b.center - b.extent * BOUNDS_MARGIN, b.center + b.extent * BOUNDS_MARGIN));
+        let mut it = self.all_blobs().map(|b| (b.center - b.extent * BOUNDS_MARGIN, b.center + b.extent * BOUNDS_MARGIN));
         let first = it.next()?;
         Some(it.fold(first, |(lo, hi), (a, b)| (lo.min(a), hi.max(b))))
     }
@@ -252,7 +294,7 @@ mod tests {
             let p = e.center + e.rotation * axis * r;
             assert!((b.value(p) - ISO).abs() < 1e-4, "{axis}");
         }
-        let f = Field { blobs: vec![b], clips: vec![] };
+        let f = Field { blobs: vec![b], ..Default::default() };
         let (lo, hi) = f.bounds().unwrap();
         for axis in [Vec3::X, Vec3::Y, Vec3::Z] {
             let p = e.center + e.rotation * axis * [3.0, 1.0, 2.0][axis.abs().max_position()];
@@ -264,7 +306,7 @@ mod tests {
     fn blending_grows_the_union() {
         let a = Blob::sphere(Vec3::ZERO, 1.0);
         let b = Blob::sphere(Vec3::new(2.2, 0.0, 0.0), 1.0);
-        let f = Field { blobs: vec![a, b], clips: vec![] };
+        let f = Field { blobs: vec![a, b], ..Default::default() };
         // The midpoint is outside both spheres alone but the blend bridges them.
         assert!(f.inside(Vec3::new(1.1, 0.0, 0.0)));
     }
@@ -275,14 +317,14 @@ mod tests {
         assert!(clip.removes(Vec3::new(0.0, 0.2, 5.0)));
         assert!(!clip.removes(Vec3::new(0.0, 0.3, 0.0)));
         assert!(!clip.removes(Vec3::new(2.0, -10.0, 0.0)), "outside the footprint");
-        let f = Field { blobs: vec![Blob::sphere(Vec3::ZERO, 1.0)], clips: vec![clip] };
+        let f = Field { blobs: vec![Blob::sphere(Vec3::ZERO, 1.0)], groups: vec![], clips: vec![clip] };
         assert!(!f.inside(Vec3::new(0.0, -0.5, 0.0)));
         assert!(f.inside(Vec3::new(0.0, 0.5, 0.0)));
     }
 
     #[test]
     fn raycast_finds_the_surface() {
-        let f = Field { blobs: vec![Blob::sphere(Vec3::ZERO, 2.0)], clips: vec![] };
+        let f = Field { blobs: vec![Blob::sphere(Vec3::ZERO, 2.0)], ..Default::default() };
         let ray = Ray { origin: Vec3::new(0.0, 0.0, 10.0), dir: Vec3::NEG_Z };
         let hit = f.raycast(&ray, 0.05).unwrap();
         assert!((hit.z - 2.0).abs() < 1e-3, "{hit}");

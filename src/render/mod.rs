@@ -18,7 +18,7 @@ pub mod offscreen;
 
 use std::sync::Arc;
 
-pub use volume::{SliceJob, VolumeData, VolumeRenderer};
+pub use volume::{SliceJob, VolumeData, VolumeRenderer, shaders};
 
 use crate::field::{Field, FieldInputs, bake};
 use crate::scene::Scene;

@@ -4,7 +4,7 @@
 //! the exception (views are not undone, as in Blender) and go through [`Edit::SetCamera`] with
 //! `record = false`.
 
-use super::{Ellipsoid, Lighting, OrbitCamera, RenderSettings, Scene};
+use super::{DrawingPlane, Ellipsoid, Lighting, OrbitCamera, RenderSettings, Scene};
 
 /// Most undo steps kept.
 pub const MAX_UNDO: usize = 200;
@@ -20,6 +20,8 @@ pub enum Edit {
     SetRender(RenderSettings),
     /// Replace the ellipsoid list.
     SetEllipsoids(Vec<Ellipsoid>),
+    /// Replace the drawing planes (add, change, duplicate or delete a sketched stroke).
+    SetPlanes(Vec<DrawingPlane>),
     /// Replace the whole document (open, new, preset).
     Replace(Box<Scene>),
 }
@@ -32,6 +34,12 @@ impl Edit {
             Edit::SetLight(l) => scene.light = l,
             Edit::SetRender(r) => scene.render = r,
             Edit::SetEllipsoids(e) => scene.ellipsoids = e,
+            Edit::SetPlanes(p) => {
+                if p.len() > super::MAX_PLANES {
+                    return false;
+                }
+                scene.planes = p
+            }
             Edit::Replace(s) => *scene = *s,
         }
         true
@@ -146,7 +154,8 @@ mod tests {
     fn no_op_and_invalid_edits_record_nothing() {
         let mut scene = Scene::default();
         let mut h = History::default();
-        assert!(!h.apply(&mut scene, Edit::SetRender(scene.render.clone()), None));
+        let same = scene.render.clone();
+        assert!(!h.apply(&mut scene, Edit::SetRender(same), None));
         assert_eq!(h.undo_len(), 0);
     }
 

@@ -5,10 +5,12 @@
 
 mod camera;
 mod edit;
+mod plane;
 mod pointer;
 
 pub use camera::{OrbitCamera, Ray};
 pub use edit::{Edit, History};
+pub use plane::{DrawingPlane, MAX_PLANE_POINTS, MAX_PLANES, StrokeKind, centre_of};
 pub use pointer::{SetError, set_by_pointer};
 
 use glam::{Quat, Vec3};
@@ -53,6 +55,8 @@ pub struct Scene {
     pub render: RenderSettings,
     /// Implicit ellipsoids blended into the cloud field.
     pub ellipsoids: Vec<Ellipsoid>,
+    /// Drawing planes, each holding one sketched stroke (outline or cut).
+    pub planes: Vec<DrawingPlane>,
 }
 
 impl Default for Scene {
@@ -106,6 +110,7 @@ impl Scene {
             light: Lighting::default(),
             render: RenderSettings::default(),
             ellipsoids,
+            planes: Vec::new(),
         }
     }
 
@@ -117,6 +122,9 @@ impl Scene {
 
     /// Like [`Scene::from_json`] for an already parsed value.
     pub fn from_value(value: serde_json::Value) -> Result<Self, SceneError> {
+        if !value.is_object() {
+            return Err(SceneError::Invalid("a scene document is a JSON object".into()));
+        }
         let found = value.get("version").and_then(|v| v.as_u64()).unwrap_or(SCENE_VERSION as u64);
         if found > SCENE_VERSION as u64 {
             return Err(SceneError::TooNew { found: found.min(u32::MAX as u64) as u32 });
@@ -148,6 +156,12 @@ impl Scene {
             if e.radii.min_element() <= 0.0 {
                 return Err(SceneError::Invalid(format!("ellipsoid {i} has a radius ≤ 0")));
             }
+        }
+        if self.planes.len() > MAX_PLANES {
+            return Err(SceneError::Invalid(format!("{} drawing planes (at most {MAX_PLANES})", self.planes.len())));
+        }
+        for (i, plane) in self.planes.iter_mut().enumerate() {
+            plane.validate(i).map_err(SceneError::Invalid)?;
         }
         self.camera.sanitize();
         self.light.sanitize();

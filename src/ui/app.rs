@@ -63,6 +63,8 @@ pub struct CloudApp {
     pub(super) frame_seconds: Option<f64>,
     /// Set by panels; applied to the camera once the viewport's size is known.
     pub(super) frame_request: bool,
+    /// Sketch tools, plane selection and messages.
+    pub(super) sketch: super::sketch_tool::SketchUi,
 }
 
 impl CloudApp {
@@ -87,6 +89,7 @@ impl CloudApp {
             viewport_px: [0, 0],
             frame_seconds: None,
             frame_request: false,
+            sketch: Default::default(),
         }
     }
 
@@ -135,7 +138,8 @@ impl CloudApp {
             self.frame_request = false;
             self.frame_cloud(rect.aspect_ratio());
         }
-        super::camera_input::handle(ui, &response, &mut self.scene.camera, true);
+        let drawing = self.sketch_input(ui, &response, rect);
+        super::camera_input::handle(ui, &response, &mut self.scene.camera, !drawing);
 
         let painter = ui.painter_at(rect);
         let [r, g, b] = self.scene.light.background.map(|v| (v * 255.0).round() as u8);
@@ -169,6 +173,7 @@ impl CloudApp {
             ui.ctx().request_repaint();
         }
         self.overlay(ui, rect);
+        self.sketch_overlay(ui, rect);
     }
 
     fn overlay(&self, ui: &egui::Ui, rect: egui::Rect) {
@@ -179,7 +184,7 @@ impl CloudApp {
         } else if let Some(p) = self.refining {
             text.push_str(&format!("refining {:.0}%", p * 100.0));
         }
-        if self.scene.ellipsoids.is_empty() {
+        if self.scene.ellipsoids.is_empty() && self.scene.planes.is_empty() {
             text.push_str("Empty scene: open Scene ▸ New cumulus, or sketch a cloud.");
         }
         if !text.is_empty() {
@@ -206,6 +211,10 @@ impl CloudApp {
                 "adapter": backend.adapter,
                 "undo": self.history.undo_len(),
                 "redo": self.history.redo_len(),
+                "tool": self.sketch.tool.name(),
+                "selected_plane": self.sketch.selected,
+                "guides_hidden": self.sketch.hide_guides,
+                "notice": self.sketch.notice.as_ref().map(|n| serde_json::json!({"text": n.text, "error": n.error})),
             }
         })
         .to_string();
@@ -231,6 +240,7 @@ impl eframe::App for CloudApp {
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         let ctx = ui.ctx().clone();
         self.shortcuts(&ctx);
+        self.sketch_shortcuts(&ctx);
         egui::Panel::right("controls").resizable(true).default_size(270.0).show(ui, |ui| {
             egui::ScrollArea::vertical().show(ui, |ui| self.side_panel(ui));
         });

@@ -15,10 +15,13 @@ pub fn handle(ui: &egui::Ui, response: &Response, camera: &mut OrbitCamera, orbi
         ui.input(|i| (i.modifiers, i.multi_touch(), i.smooth_scroll_delta, i.zoom_delta()));
     let delta = response.drag_delta();
     let delta = Vec2::new(delta.x, delta.y);
+    // While a drawing tool owns the primary button, the middle button orbits instead of panning.
+    let middle_orbits = !orbit_with_primary && !modifiers.shift;
     let pan = response.dragged_by(PointerButton::Secondary)
-        || response.dragged_by(PointerButton::Middle)
-        || (response.dragged_by(PointerButton::Primary) && modifiers.shift);
-    let primary_orbit = response.dragged_by(PointerButton::Primary) && (orbit_with_primary || modifiers.alt);
+        || (response.dragged_by(PointerButton::Middle) && !middle_orbits)
+        || (response.dragged_by(PointerButton::Primary) && modifiers.shift && orbit_with_primary);
+    let primary_orbit = (response.dragged_by(PointerButton::Primary) && (orbit_with_primary || modifiers.alt))
+        || (response.dragged_by(PointerButton::Middle) && middle_orbits);
 
     if let Some(touch) = multi_touch.filter(|_| response.hovered() || response.is_pointer_button_down_on()) {
         // Two fingers: orbit with their common motion; pinch arrives as zoom below.

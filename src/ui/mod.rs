@@ -5,5 +5,7 @@
 mod app;
 mod camera_input;
 mod panels;
+mod sketch_tool;
 
 pub use app::{CloudApp, Host, PageStatus, StartOptions};
+pub use sketch_tool::Tool;

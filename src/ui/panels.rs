@@ -36,6 +36,7 @@ impl CloudApp {
             }
         });
         ui.separator();
+        self.sketch_group(ui);
         self.render_group(ui);
         self.light_group(ui);
         self.scene_group(ui);

@@ -1,0 +1,8 @@
+#!/usr/bin/env bash
+# Sets up whatever is missing (scripts/setup.sh), builds the web app and serves it at
+# http://127.0.0.1:8080 (rebuilding on changes).
+set -euo pipefail
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+cd "$ROOT"
+bash scripts/setup.sh
+exec trunk serve --release --address 127.0.0.1 --port 8080

@@ -1,0 +1,355 @@
+//! From a raw pointer stroke to a clean simple polygon: drop bad points, close, repair
+//! self-intersections (keep the largest simple piece), simplify (Douglas–Peucker with a
+//! tolerance relative to the outline's size) and resample evenly, keeping the corners.
+
+use glam::DVec2;
+
+use super::SketchError;
+
+/// Most points a stroke may have; longer strokes are thinned evenly first.
+pub const MAX_STROKE_POINTS: usize = 20_000;
+/// Most vertices of the resampled outline that goes to the triangulation.
+pub const MAX_OUTLINE_POINTS: usize = 320;
+/// Fewest vertices of the resampled outline.
+const MIN_OUTLINE_POINTS: usize = 24;
+
+/// A clean outline and what was repaired on the way.
+#[derive(Clone, Debug)]
+pub struct Outline {
+    /// Simple polygon, counter-clockwise (positive area), no repeated closing point.
+    pub points: Vec<DVec2>,
+    /// Its area.
+    pub area: f64,
+    /// Repairs made, in words.
+    pub warnings: Vec<String>,
+}
+
+/// Signed area (shoelace), positive for counter-clockwise in a y-up frame.
+pub fn signed_area(p: &[DVec2]) -> f64 {
+    let n = p.len();
+    (0..n).map(|i| p[i].perp_dot(p[(i + 1) % n])).sum::<f64>() * 0.5
+}
+
+/// Perimeter of a closed polygon.
+pub fn perimeter(p: &[DVec2]) -> f64 {
+    let n = p.len();
+    (0..n).map(|i| p[i].distance(p[(i + 1) % n])).sum()
+}
+
+/// Diagonal of the bounding box.
+pub fn diagonal(p: &[DVec2]) -> f64 {
+    let (lo, hi) = p.iter().fold((DVec2::splat(f64::MAX), DVec2::splat(f64::MIN)), |(a, b), &q| (a.min(q), b.max(q)));
+    (hi - lo).length()
+}
+
+/// Distance from `q` to the segment `a`–`b`.
+pub fn segment_distance(q: DVec2, a: DVec2, b: DVec2) -> f64 {
+    let ab = b - a;
+    let len2 = ab.length_squared();
+    let t = if len2 > 0.0 { ((q - a).dot(ab) / len2).clamp(0.0, 1.0) } else { 0.0 };
+    q.distance(a + ab * t)
+}
+
+/// Distance from `q` to a closed polygon's boundary.
+pub fn boundary_distance(q: DVec2, p: &[DVec2]) -> f64 {
+    let n = p.len();
+    (0..n).map(|i| segment_distance(q, p[i], p[(i + 1) % n])).fold(f64::INFINITY, f64::min)
+}
+
+/// Even–odd point-in-polygon test.
+pub fn contains(p: &[DVec2], q: DVec2) -> bool {
+    let n = p.len();
+    let mut inside = false;
+    let mut j = n - 1;
+    for i in 0..n {
+        let (a, b) = (p[i], p[j]);
+        if (a.y > q.y) != (b.y > q.y) && q.x < (b.x - a.x) * (q.y - a.y) / (b.y - a.y) + a.x {
+            inside = !inside;
+        }
+        j = i;
+    }
+    inside
+}
+
+/// Cleans a stroke into an outline. `simplify` is the Douglas–Peucker tolerance as a fraction
+/// of the outline's bounding-box diagonal.
+pub fn clean(raw: &[[f64; 2]], closed: bool, simplify: f64) -> Result<Outline, SketchError> {
+    let mut warnings = Vec::new();
+    let finite: Vec<DVec2> = raw.iter().map(|&[x, y]| DVec2::new(x, y)).filter(|p| p.is_finite()).collect();
+    if finite.len() < raw.len() {
+        warnings.push(format!("ignored {} points that were not numbers", raw.len() - finite.len()));
+    }
+    let mut points = if finite.len() > MAX_STROKE_POINTS {
+        warnings.push(format!("the stroke had {} points; thinned to {MAX_STROKE_POINTS}", finite.len()));
+        let step = finite.len() as f64 / MAX_STROKE_POINTS as f64;
+        (0..MAX_STROKE_POINTS).map(|i| finite[(i as f64 * step) as usize]).collect()
+    } else {
+        finite
+    };
+    if points.len() < 3 {
+        return Err(SketchError::TooFewPoints(points.len()));
+    }
+    let size = diagonal(&points);
+    if !(size > 0.0) || !size.is_finite() {
+        return Err(SketchError::NoArea);
+    }
+    // Coordinates far from the origin lose precision in the triangulation: work around the centre.
+    let eps = size * 1e-7;
+    dedup(&mut points, eps);
+    if points.len() < 3 {
+        return Err(SketchError::TooFewPoints(points.len()));
+    }
+    if !closed {
+        let gap = points[0].distance(points[points.len() - 1]);
+        if gap > 0.2 * size {
+            warnings.push("the stroke was open; closed it by joining its ends".to_string());
+        }
+    }
+
+    // Simplify first so the self-intersection repair works on few vertices.
+    let tolerance = simplify.clamp(0.0, 0.2) * size;
+    let mut simple = douglas_peucker_closed(&points, tolerance.max(eps * 10.0));
+    dedup(&mut simple, eps);
+    if simple.len() < 3 || signed_area(&simple).abs() < size * size * 1e-6 {
+        return Err(SketchError::NoArea);
+    }
+
+    let mut loops = split_self_intersections(simple);
+    for l in &mut loops {
+        dedup(l, eps);
+    }
+    loops.retain(|l| l.len() >= 3);
+    let total: f64 = loops.iter().map(|l| signed_area(l).abs()).sum();
+    let best = loops
+        .into_iter()
+        .max_by(|a, b| signed_area(a).abs().total_cmp(&signed_area(b).abs()))
+        .ok_or(SketchError::NoArea)?;
+    let kept = signed_area(&best).abs();
+    if kept < total * 0.99 {
+        warnings.push(format!(
+            "the stroke crossed itself; kept the largest enclosed part ({:.0}% of the drawn area)",
+            100.0 * kept / total
+        ));
+    }
+    let mut best = best;
+    if signed_area(&best) < 0.0 {
+        best.reverse();
+    }
+    if kept < size * size * 1e-4 {
+        return Err(SketchError::NoArea);
+    }
+
+    let mut points = resample(&best, tolerance);
+    dedup(&mut points, eps);
+    // Resampling a simple polygon along its own edges keeps it simple.
+    let area = signed_area(&points);
+    if points.len() < 3 || area <= 0.0 {
+        return Err(SketchError::NoArea);
+    }
+    Ok(Outline { points, area, warnings })
+}
+
+/// Removes consecutive points closer than `eps` (the polygon is closed: last vs first too).
+fn dedup(points: &mut Vec<DVec2>, eps: f64) {
+    points.dedup_by(|b, a| a.distance(*b) <= eps);
+    while points.len() > 1 && points[0].distance(points[points.len() - 1]) <= eps {
+        points.pop();
+    }
+}
+
+/// Douglas–Peucker on a closed polygon: split at the two mutually far points, simplify each half.
+fn douglas_peucker_closed(p: &[DVec2], tolerance: f64) -> Vec<DVec2> {
+    let n = p.len();
+    if n <= 4 {
+        return p.to_vec();
+    }
+    let far = (1..n).max_by(|&a, &b| p[0].distance_squared(p[a]).total_cmp(&p[0].distance_squared(p[b]))).unwrap_or(n / 2);
+    let mut keep = vec![false; n];
+    keep[0] = true;
+    keep[far] = true;
+    let first: Vec<usize> = (0..=far).collect();
+    let second: Vec<usize> = (far..n).chain(std::iter::once(0)).collect();
+    for chain in [first, second] {
+        let mut stack = vec![(0usize, chain.len() - 1)];
+        while let Some((a, b)) = stack.pop() {
+            if b <= a + 1 {
+                continue;
+            }
+            let (pa, pb) = (p[chain[a]], p[chain[b]]);
+            let (mut worst, mut at) = (0.0, a);
+            for (i, &c) in chain.iter().enumerate().take(b).skip(a + 1) {
+                let d = segment_distance(p[c], pa, pb);
+                if d > worst {
+                    worst = d;
+                    at = i;
+                }
+            }
+            if worst > tolerance {
+                keep[chain[at]] = true;
+                stack.push((a, at));
+                stack.push((at, b));
+            }
+        }
+    }
+    (0..n).filter(|&i| keep[i]).map(|i| p[i]).collect()
+}
+
+/// Resamples a closed polygon evenly, keeping every vertex (the corners of the simplified outline).
+fn resample(p: &[DVec2], tolerance: f64) -> Vec<DVec2> {
+    let total = perimeter(p);
+    let target = (total / (tolerance * 2.0).max(total / MAX_OUTLINE_POINTS as f64)).round() as usize;
+    let count = target.clamp(MIN_OUTLINE_POINTS, MAX_OUTLINE_POINTS).max(p.len());
+    let spacing = total / count as f64;
+    let n = p.len();
+    let mut out = Vec::with_capacity(count + n);
+    for i in 0..n {
+        let (a, b) = (p[i], p[(i + 1) % n]);
+        let pieces = ((a.distance(b) / spacing).round() as usize).max(1);
+        for k in 0..pieces {
+            out.push(a.lerp(b, k as f64 / pieces as f64));
+        }
+        if out.len() > MAX_OUTLINE_POINTS * 2 {
+            break;
+        }
+    }
+    out
+}
+
+fn orient(a: DVec2, b: DVec2, c: DVec2) -> f64 {
+    (b - a).perp_dot(c - a)
+}
+
+/// Where segments `a`–`b` and `c`–`d` meet, touching and overlapping included.
+fn intersection(a: DVec2, b: DVec2, c: DVec2, d: DVec2) -> Option<DVec2> {
+    let (d1, d2, d3, d4) = (orient(c, d, a), orient(c, d, b), orient(a, b, c), orient(a, b, d));
+    if ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0)) && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0)) {
+        let t = d1 / (d1 - d2);
+        return Some(a + (b - a) * t);
+    }
+    let on = |p: DVec2, q: DVec2, r: DVec2| {
+        // r on segment p–q (collinear and within its box)
+        r.x >= p.x.min(q.x) && r.x <= p.x.max(q.x) && r.y >= p.y.min(q.y) && r.y <= p.y.max(q.y)
+    };
+    if d1 == 0.0 && on(c, d, a) {
+        return Some(a);
+    }
+    if d2 == 0.0 && on(c, d, b) {
+        return Some(b);
+    }
+    if d3 == 0.0 && on(a, b, c) {
+        return Some(c);
+    }
+    if d4 == 0.0 && on(a, b, d) {
+        return Some(d);
+    }
+    None
+}
+
+/// First pair of non-adjacent edges (i < j) that meet, with the meeting point.
+fn first_crossing(p: &[DVec2]) -> Option<(usize, usize, DVec2)> {
+    let n = p.len();
+    for i in 0..n {
+        let (a, b) = (p[i], p[(i + 1) % n]);
+        let (lo, hi) = (a.min(b), a.max(b));
+        for j in i + 2..n {
+            if i == 0 && j == n - 1 {
+                continue; // adjacent through the closing edge
+            }
+            let (c, d) = (p[j], p[(j + 1) % n]);
+            if c.max(d).cmplt(lo).any() || c.min(d).cmpgt(hi).any() {
+                continue;
+            }
+            if let Some(x) = intersection(a, b, c, d) {
+                return Some((i, j, x));
+            }
+        }
+    }
+    None
+}
+
+/// Splits a closed polygon at its self-intersections into simple loops.
+fn split_self_intersections(polygon: Vec<DVec2>) -> Vec<Vec<DVec2>> {
+    let mut out = Vec::new();
+    let mut stack = vec![polygon];
+    let mut budget = 4 * MAX_OUTLINE_POINTS.max(64);
+    while let Some(p) = stack.pop() {
+        if p.len() < 3 {
+            continue;
+        }
+        budget = budget.saturating_sub(1);
+        match first_crossing(&p).filter(|_| budget > 0) {
+            None => out.push(p),
+            Some((i, j, x)) => {
+                let mut a: Vec<DVec2> = p[..=i].to_vec();
+                a.push(x);
+                a.extend_from_slice(&p[j + 1..]);
+                let mut b = vec![x];
+                b.extend_from_slice(&p[i + 1..=j]);
+                for l in [a, b] {
+                    let mut l = l;
+                    dedup(&mut l, 0.0);
+                    if l.len() >= 3 && l.len() < p.len() + 1 {
+                        stack.push(l);
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn square(n: usize) -> Vec<[f64; 2]> {
+        let mut v = Vec::new();
+        for k in 0..4 {
+            for i in 0..n {
+                let t = i as f64 / n as f64;
+                v.push(match k {
+                    0 => [t, 0.0],
+                    1 => [1.0, t],
+                    2 => [1.0 - t, 1.0],
+                    _ => [0.0, 1.0 - t],
+                });
+            }
+        }
+        v
+    }
+
+    #[test]
+    fn square_stays_a_square() {
+        let o = clean(&square(50), true, 0.01).unwrap();
+        assert!((o.area - 1.0).abs() < 1e-9);
+        assert!(o.warnings.is_empty(), "{:?}", o.warnings);
+        assert!(o.points.len() >= MIN_OUTLINE_POINTS);
+    }
+
+    #[test]
+    fn figure_eight_keeps_the_larger_lobe() {
+        // Lemniscate of Gerono with one lobe scaled 3×: lobes of area 6 and 2/3 crossing at 0.
+        let n = 400;
+        let pts: Vec<[f64; 2]> = (0..n)
+            .map(|i| {
+                let t = (i as f64 + 0.5) / n as f64 * std::f64::consts::TAU;
+                let k = if t < std::f64::consts::PI { 3.0 } else { 1.0 };
+                [k * t.sin(), k * t.sin() * t.cos()]
+            })
+            .collect();
+        let o = clean(&pts, true, 0.002).unwrap();
+        assert!(o.area > 5.6 && o.area < 6.2, "{}", o.area);
+        assert!(o.warnings.iter().any(|w| w.contains("crossed itself")));
+        assert!(first_crossing(&o.points).is_none());
+    }
+
+    #[test]
+    fn degenerate_strokes_are_refused() {
+        assert!(matches!(clean(&[], true, 0.01), Err(SketchError::TooFewPoints(0))));
+        assert!(matches!(clean(&[[1.0, 1.0], [2.0, 2.0]], true, 0.01), Err(SketchError::TooFewPoints(2))));
+        assert!(clean(&[[1.0, 1.0]; 50], true, 0.01).is_err());
+        let line: Vec<[f64; 2]> = (0..50).map(|i| [i as f64, 2.0 * i as f64]).collect();
+        assert!(matches!(clean(&line, false, 0.01), Err(SketchError::NoArea)));
+        assert!(clean(&[[f64::NAN, 0.0], [0.0, f64::INFINITY], [1.0, 1.0]], true, 0.01).is_err());
+    }
+}

@@ -1,0 +1,468 @@
+//! The chordal axis transform (Prasad 1997) of a simple polygon, as Wither et al. §3.1 use it:
+//! constrained Delaunay triangulation (spade), triangles classified by their internal edges
+//! (terminal: 1, sleeve: 2, junction: 3), pruning of insignificant terminal branches by area,
+//! the skeleton as polylines with maximal-ball radii, and the map from outline edges to
+//! skeleton segments.
+
+use glam::DVec2;
+use spade::{ConstrainedDelaunayTriangulation, HasPosition, Point2, Triangulation};
+
+use super::SketchError;
+use super::outline::{Outline, boundary_distance, contains};
+
+#[derive(Clone, Copy, Debug)]
+struct Vertex {
+    pos: Point2<f64>,
+    index: usize,
+}
+
+impl HasPosition for Vertex {
+    type Scalar = f64;
+    fn position(&self) -> Point2<f64> {
+        self.pos
+    }
+}
+
+/// A triangle of the outline's constrained Delaunay triangulation (vertex indices into the outline).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Triangle {
+    /// Outline vertex indices, counter-clockwise.
+    pub v: [usize; 3],
+    /// Area.
+    pub area: f64,
+}
+
+/// Kind of a triangle by its number of internal (non-outline) edges.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TriangleKind {
+    /// The whole outline is one triangle.
+    Isolated,
+    /// One internal edge: the tip of a feature.
+    Terminal,
+    /// Two internal edges: along a limb.
+    Sleeve,
+    /// Three internal edges: where limbs meet.
+    Junction,
+}
+
+/// A skeleton node: a point on the chordal axis with its maximal-ball radius.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Node {
+    /// Position in the outline's plane.
+    pub pos: DVec2,
+    /// Distance to the outline (radius of the largest disc centred here inside the outline).
+    pub radius: f64,
+}
+
+/// Whether a branch ends freely or joins others at both ends.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BranchKind {
+    /// Connected at one end only (a feature: points toward a curvature maximum).
+    Terminal,
+    /// Connected at both ends.
+    Body,
+}
+
+/// A skeleton polyline between two nodes of degree ≠ 2.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Branch {
+    /// Node indices in order. For terminal branches the free end comes last.
+    pub nodes: Vec<usize>,
+    /// Terminal or body.
+    pub kind: BranchKind,
+}
+
+/// The pruned chordal axis of an outline.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Skeleton {
+    /// The triangulation of the outline's inside.
+    pub triangles: Vec<Triangle>,
+    /// Kind of each triangle before pruning.
+    pub kinds: Vec<TriangleKind>,
+    /// Nodes of the skeleton graph.
+    pub nodes: Vec<Node>,
+    /// Segments (node index pairs) of the skeleton graph, a tree.
+    pub segments: Vec<[usize; 2]>,
+    /// Polylines between branching points and free ends.
+    pub branches: Vec<Branch>,
+    /// For each outline edge `i` (vertex `i` to `i + 1`), the skeleton segment it maps to.
+    pub edge_to_segment: Vec<usize>,
+}
+
+impl Skeleton {
+    /// Free ends of the pruned skeleton (each is the tip of a terminal branch).
+    pub fn terminal_count(&self) -> usize {
+        self.degrees().iter().filter(|&&d| d == 1).count()
+    }
+
+    /// Branching points of the pruned skeleton.
+    pub fn junction_count(&self) -> usize {
+        self.degrees().iter().filter(|&&d| d >= 3).count()
+    }
+
+    fn degrees(&self) -> Vec<usize> {
+        let mut deg = vec![0; self.nodes.len()];
+        for s in &self.segments {
+            deg[s[0]] += 1;
+            deg[s[1]] += 1;
+        }
+        deg
+    }
+}
+
+/// Key of an undirected edge.
+fn key(a: usize, b: usize) -> (usize, usize) {
+    (a.min(b), a.max(b))
+}
+
+/// Triangulates `outline` and computes its pruned chordal axis. A terminal branch is removed
+/// when it adds less than `prune` × the outline's area (Wither et al. use 2%) beyond the
+/// maximal discs of the body around the junction it hangs from (so a rectangle's corners go,
+/// a star's arms stay).
+pub fn chordal_axis(outline: &Outline, prune: f64) -> Result<Skeleton, SketchError> {
+    let p = &outline.points;
+    let n = p.len();
+    let vertices: Vec<Vertex> = p.iter().enumerate().map(|(index, q)| Vertex { pos: Point2::new(q.x, q.y), index }).collect();
+    let edges: Vec<[usize; 2]> = (0..n).map(|i| [i, (i + 1) % n]).collect();
+    let mut conflicts = 0usize;
+    let cdt = ConstrainedDelaunayTriangulation::<Vertex>::try_bulk_load_cdt(vertices, edges, |_| conflicts += 1)
+        .map_err(|e| SketchError::Triangulation(e.to_string()))?;
+    if conflicts > 0 || cdt.num_vertices() != n {
+        return Err(SketchError::Triangulation(format!("{conflicts} crossing edges, {} of {n} vertices", cdt.num_vertices())));
+    }
+
+    let mut triangles = Vec::new();
+    for face in cdt.inner_faces() {
+        let v = face.vertices().map(|h| h.data().index);
+        let [a, b, c] = v.map(|i| p[i]);
+        let area = 0.5 * (b - a).perp_dot(c - a);
+        // Slivers of collinear outline points carry no inside (and their long edge lies on the outline).
+        if area.abs() <= outline.area * 1e-9 || !contains(p, (a + b + c) / 3.0) {
+            continue;
+        }
+        let v = if area > 0.0 { v } else { [v[0], v[2], v[1]] };
+        triangles.push(Triangle { v, area: area.abs() });
+    }
+    if triangles.is_empty() {
+        return Err(SketchError::NoArea);
+    }
+
+    // Dual tree: triangles adjacent across internal edges.
+    let is_boundary = |a: usize, b: usize| (a + 1) % n == b || (b + 1) % n == a;
+    let mut by_edge: std::collections::BTreeMap<(usize, usize), Vec<usize>> = Default::default();
+    for (t, tri) in triangles.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (tri.v[k], tri.v[(k + 1) % 3]);
+            if !is_boundary(a, b) {
+                by_edge.entry(key(a, b)).or_default().push(t);
+            }
+        }
+    }
+    let mut adj: Vec<Vec<(usize, (usize, usize))>> = vec![Vec::new(); triangles.len()];
+    for (&e, ts) in &by_edge {
+        if let [s, t] = ts[..] {
+            adj[s].push((t, e));
+            adj[t].push((s, e));
+        }
+    }
+    let kinds: Vec<TriangleKind> = adj
+        .iter()
+        .map(|a| match a.len() {
+            0 => TriangleKind::Isolated,
+            1 => TriangleKind::Terminal,
+            2 => TriangleKind::Sleeve,
+            _ => TriangleKind::Junction,
+        })
+        .collect();
+
+    // Pruning: repeatedly remove the smallest terminal branch below the area threshold.
+    let threshold = prune.max(0.0) * outline.area;
+    let mut alive = vec![true; triangles.len()];
+    let mut owner: Vec<usize> = (0..triangles.len()).collect(); // pruned triangle → absorbing triangle
+    let mut disc_cache: std::collections::BTreeMap<usize, (DVec2, f64)> = Default::default();
+    let mut absorbed = vec![false; triangles.len()];
+    loop {
+        let degree = |t: usize, alive: &[bool]| adj[t].iter().filter(|(s, _)| alive[*s]).count();
+        if !(0..triangles.len()).any(|t| alive[t] && degree(t, &alive) >= 3) {
+            break;
+        }
+        let mut best: Option<(f64, Vec<usize>, usize)> = None;
+        for start in 0..triangles.len() {
+            if !alive[start] || degree(start, &alive) != 1 {
+                continue;
+            }
+            let (mut chain, mut prev, mut cur) = (vec![start], usize::MAX, start);
+            let end = loop {
+                let next = adj[cur].iter().map(|(s, _)| *s).find(|&s| alive[s] && s != prev);
+                let Some(next) = next else { break None };
+                if degree(next, &alive) >= 3 {
+                    break Some(next);
+                }
+                chain.push(next);
+                prev = cur;
+                cur = next;
+            };
+            // Significance: the branch's area outside the junction's maximal disc, i.e. what
+            // the feature adds to the shape beyond the body it hangs from.
+            let significance = end.map(|j| {
+                // The body near the junction: live triangles within a few steps, off the chain.
+                let mut near = vec![j];
+                let mut frontier = vec![j];
+                for _ in 0..3 {
+                    let mut next = Vec::new();
+                    for &u in &frontier {
+                        for &(v, _) in &adj[u] {
+                            if alive[v] && !chain.contains(&v) && !near.contains(&v) {
+                                near.push(v);
+                                next.push(v);
+                            }
+                        }
+                    }
+                    frontier = next;
+                }
+                let discs: Vec<(DVec2, f64)> =
+                    near.iter().map(|&t| *disc_cache.entry(t).or_insert_with(|| largest_disc(&triangles[t], p))).collect();
+                chain.iter().map(|&t| triangles[t].area * outside_fraction(&triangles[t], p, &discs)).sum::<f64>()
+            });
+            if let (Some(junction), Some(area)) = (end, significance)
+                && area < threshold
+                && best.as_ref().is_none_or(|(a, _, _)| area < *a)
+            {
+                best = Some((area, chain, junction));
+            }
+        }
+        let Some((_, chain, junction)) = best else { break };
+        for t in chain {
+            alive[t] = false;
+            owner[t] = junction;
+        }
+        absorbed[junction] = true;
+    }
+    let resolve = |mut t: usize| {
+        while owner[t] != t {
+            t = owner[t];
+        }
+        t
+    };
+
+    // Skeleton graph: midpoints of live internal edges, centroids of live junctions, tips of terminals.
+    let mut nodes: Vec<Node> = Vec::new();
+    let mut node_of_edge: std::collections::BTreeMap<(usize, usize), usize> = Default::default();
+    let node = |nodes: &mut Vec<Node>, pos: DVec2| {
+        nodes.push(Node { pos, radius: boundary_distance(pos, p) });
+        nodes.len() - 1
+    };
+    for (&e, ts) in &by_edge {
+        if ts.len() == 2 && alive[ts[0]] && alive[ts[1]] {
+            let id = node(&mut nodes, (p[e.0] + p[e.1]) * 0.5);
+            node_of_edge.insert(e, id);
+        }
+    }
+    let mut segments = Vec::new();
+    let mut segments_of_triangle: Vec<Vec<usize>> = vec![Vec::new(); triangles.len()];
+    // Visit triangles in a fixed order so the result does not depend on hash order.
+    let live_edges_of = |t: usize| -> Vec<usize> {
+        let mut v: Vec<((usize, usize), usize)> =
+            adj[t].iter().filter(|(s, _)| alive[*s]).map(|(_, e)| (*e, node_of_edge[e])).collect();
+        v.sort();
+        v.into_iter().map(|(_, id)| id).collect()
+    };
+    for t in 0..triangles.len() {
+        if !alive[t] {
+            continue;
+        }
+        let tri = &triangles[t];
+        let [a, b, c] = tri.v.map(|i| p[i]);
+        let mids = live_edges_of(t);
+        let mut add = |segments: &mut Vec<[usize; 2]>, s: [usize; 2]| {
+            segments.push(s);
+            segments_of_triangle[t].push(segments.len() - 1);
+        };
+        match mids.len() {
+            0 => {
+                // A lone triangle: its incentre is the skeleton.
+                let (la, lb, lc) = (b.distance(c), c.distance(a), a.distance(b));
+                let centre = (a * la + b * lb + c * lc) / (la + lb + lc);
+                let id = node(&mut nodes, centre);
+                add(&mut segments, [id, id]);
+            }
+            1 => {
+                // Terminal: from the chord's midpoint halfway toward the opposite vertex.
+                let m = nodes[mids[0]].pos;
+                let apex = tri.v.iter().map(|&i| p[i]).max_by(|x, y| x.distance_squared(m).total_cmp(&y.distance_squared(m))).unwrap_or(a);
+                let tip = node(&mut nodes, m.lerp(apex, 0.5));
+                add(&mut segments, [mids[0], tip]);
+            }
+            2 if !absorbed[t] => add(&mut segments, [mids[0], mids[1]]),
+            _ => {
+                // Junctions (and former junctions whose small branches were pruned) pass through
+                // their largest inscribed disc, which covers what the pruned branches held.
+                let refined = disc_cache.get(&t).copied().unwrap_or_else(|| largest_disc(tri, p)).0;
+                // Only where the way from each chord to it stays well inside the outline.
+                let r_refined = boundary_distance(refined, p);
+                let inside = |q: DVec2| {
+                    let floor = 0.5 * boundary_distance(q, p).min(r_refined);
+                    (0..=16).all(|k| {
+                        let x = q.lerp(refined, k as f64 / 16.0);
+                        contains(p, x) && boundary_distance(x, p) >= floor
+                    })
+                };
+                let centre = if mids.iter().all(|&m| inside(nodes[m].pos)) { refined } else { sampled_disc(tri, p).0 };
+                let centre = node(&mut nodes, centre);
+                for &m in &mids {
+                    add(&mut segments, [centre, m]);
+                }
+            }
+        }
+    }
+    segments.retain(|s| s[0] != s[1] || nodes.len() == 1);
+
+    // Outline edge → the nearest segment of the (absorbing) triangle it borders.
+    let mut triangle_of_edge = vec![usize::MAX; n];
+    for (t, tri) in triangles.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (tri.v[k], tri.v[(k + 1) % 3]);
+            if (a + 1) % n == b {
+                triangle_of_edge[a] = t;
+            }
+        }
+    }
+    let segments_of_triangle: Vec<Vec<usize>> = segments_of_triangle
+        .into_iter()
+        .map(|v| v.into_iter().filter(|&s| s < segments.len()).collect())
+        .collect();
+    let edge_to_segment = (0..n)
+        .map(|i| {
+            let mid = (p[i] + p[(i + 1) % n]) * 0.5;
+            let t = triangle_of_edge[i];
+            let candidates: Vec<usize> = if t != usize::MAX && !segments_of_triangle[resolve(t)].is_empty() {
+                segments_of_triangle[resolve(t)].clone()
+            } else {
+                (0..segments.len()).collect()
+            };
+            candidates
+                .into_iter()
+                .min_by(|&x, &y| seg_dist(mid, &nodes, segments[x]).total_cmp(&seg_dist(mid, &nodes, segments[y])))
+                .unwrap_or(0)
+        })
+        .collect();
+
+    let branches = branches(&nodes, &segments);
+    Ok(Skeleton { triangles, kinds, nodes, segments, branches, edge_to_segment })
+}
+
+/// The largest disc centred in triangle `t`, from a fixed set of samples in it.
+fn sampled_disc(t: &Triangle, p: &[DVec2]) -> (DVec2, f64) {
+    const N: usize = 5;
+    let [a, b, c] = t.v.map(|i| p[i]);
+    let mut best = ((a + b + c) / 3.0, boundary_distance((a + b + c) / 3.0, p));
+    for i in 0..=N {
+        for j in 0..=N - i {
+            let q = a + (b - a) * (i as f64 / N as f64) + (c - a) * (j as f64 / N as f64);
+            let r = boundary_distance(q, p);
+            if r > best.1 && i + j < N && i > 0 && j > 0 {
+                best = (q, r);
+            }
+        }
+    }
+    best
+}
+
+/// The largest disc inside the outline centred near triangle `t` (samples, then refined).
+fn largest_disc(t: &Triangle, p: &[DVec2]) -> (DVec2, f64) {
+    const N: usize = 5;
+    let [a, b, c] = t.v.map(|i| p[i]);
+    let mut best = ((a + b + c) / 3.0, boundary_distance((a + b + c) / 3.0, p));
+    for i in 0..=N {
+        for j in 0..=N - i {
+            let q = a + (b - a) * (i as f64 / N as f64) + (c - a) * (j as f64 / N as f64);
+            let r = boundary_distance(q, p);
+            if r > best.1 {
+                best = (q, r);
+            }
+        }
+    }
+    // Refine by compass search (the maximal disc's centre may lie just outside the triangle).
+    let mut step = a.distance(b).max(b.distance(c)).max(c.distance(a)) * 0.25;
+    for _ in 0..16 {
+        let mut moved = false;
+        for d in [DVec2::X, DVec2::NEG_X, DVec2::Y, DVec2::NEG_Y] {
+            let q = best.0 + d * step;
+            let r = boundary_distance(q, p);
+            if r > best.1 && contains(p, q) {
+                best = (q, r);
+                moved = true;
+            }
+        }
+        if !moved {
+            step *= 0.5;
+        }
+    }
+    best
+}
+
+/// Fraction of a triangle lying outside every disc, from a fixed set of samples.
+fn outside_fraction(t: &Triangle, p: &[DVec2], discs: &[(DVec2, f64)]) -> f64 {
+    const N: usize = 6;
+    let [a, b, c] = t.v.map(|i| p[i]);
+    let (mut outside, mut total) = (0usize, 0usize);
+    for i in 0..N {
+        for j in 0..N - i {
+            let (u, v) = ((i as f64 + 1.0 / 3.0) / N as f64, (j as f64 + 1.0 / 3.0) / N as f64);
+            let q = a + (b - a) * u + (c - a) * v;
+            total += 1;
+            outside += discs.iter().all(|(c, r)| q.distance_squared(*c) > r * r) as usize;
+        }
+    }
+    outside as f64 / total.max(1) as f64
+}
+
+fn seg_dist(q: DVec2, nodes: &[Node], s: [usize; 2]) -> f64 {
+    super::outline::segment_distance(q, nodes[s[0]].pos, nodes[s[1]].pos)
+}
+
+/// Splits the skeleton tree into polylines between nodes of degree ≠ 2.
+fn branches(nodes: &[Node], segments: &[[usize; 2]]) -> Vec<Branch> {
+    let mut adj: Vec<Vec<(usize, usize)>> = vec![Vec::new(); nodes.len()];
+    for (i, s) in segments.iter().enumerate() {
+        if s[0] != s[1] {
+            adj[s[0]].push((s[1], i));
+            adj[s[1]].push((s[0], i));
+        }
+    }
+    let mut used = vec![false; segments.len()];
+    let mut out = Vec::new();
+    for start in 0..nodes.len() {
+        if adj[start].len() == 2 {
+            continue;
+        }
+        for &(first, seg) in &adj[start] {
+            if used[seg] {
+                continue;
+            }
+            used[seg] = true;
+            let mut chain = vec![start, first];
+            let (mut prev, mut cur) = (start, first);
+            while adj[cur].len() == 2 {
+                let &(next, s) = adj[cur].iter().find(|(m, _)| *m != prev).unwrap_or(&adj[cur][0]);
+                if used[s] {
+                    break;
+                }
+                used[s] = true;
+                chain.push(next);
+                prev = cur;
+                cur = next;
+            }
+            let (a, b) = (adj[chain[0]].len(), adj[*chain.last().unwrap_or(&start)].len());
+            let kind = if a == 1 || b == 1 { BranchKind::Terminal } else { BranchKind::Body };
+            if a == 1 && b != 1 {
+                chain.reverse(); // free end last
+            }
+            out.push(Branch { nodes: chain, kind });
+        }
+    }
+    if out.is_empty() && !nodes.is_empty() {
+        out.push(Branch { nodes: vec![0], kind: BranchKind::Terminal });
+    }
+    out
+}

@@ -1,0 +1,336 @@
+//! Spheres along the skeleton (Wither et al. §3.1), the minimal feature radius r_f and the
+//! inflation slider, and the automatic 3D extension (§3.2).
+//!
+//! Coordinates: the outline's plane is z = 0, z points toward the viewer.
+
+use glam::{DQuat, DVec2, DVec3};
+
+use super::outline::{Outline, boundary_distance, contains};
+use super::skeleton::{BranchKind, Skeleton};
+
+/// Most spheres one stroke makes (copies from the 3D extension included).
+pub const MAX_SPHERES: usize = 3000;
+/// Spacing of spheres along the skeleton as a fraction of the smaller neighbouring radius:
+/// well below 1, so neighbours overlap deeply and the body never splits.
+const SPACING: f64 = 0.4;
+
+/// A sphere primitive.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sphere {
+    /// Centre.
+    pub center: DVec3,
+    /// Radius.
+    pub radius: f64,
+    /// Maximal-ball radius before inflation (equal to `radius` at t = 0).
+    pub max_radius: f64,
+    /// Index of the skeleton branch it belongs to.
+    pub branch: usize,
+    /// Whether this branch is terminal (a feature).
+    pub terminal: bool,
+    /// Fraction along its branch from its root (0) to its free end (1).
+    pub along: f64,
+}
+
+/// Spheres sampled densely along every branch, radius = distance to the outline.
+pub fn sample(outline: &Outline, skeleton: &Skeleton) -> Vec<Sphere> {
+    let p = &outline.points;
+    let total_len: f64 = skeleton
+        .segments
+        .iter()
+        .map(|s| skeleton.nodes[s[0]].pos.distance(skeleton.nodes[s[1]].pos))
+        .sum();
+    let min_radius = skeleton.nodes.iter().map(|n| n.radius).fold(0.0, f64::max) * 1e-4;
+    // Keep within the cap: the step never falls below total length / budget.
+    let floor = total_len / (MAX_SPHERES as f64 * 0.3);
+    let mut out = Vec::new();
+    // A skeleton that is one path has both ends free: its features are its two outer halves.
+    let lone = skeleton.branches.len() == 1;
+    for (b, branch) in skeleton.branches.iter().enumerate() {
+        let terminal = branch.kind == BranchKind::Terminal;
+        let pts: Vec<DVec2> = branch.nodes.iter().map(|&i| skeleton.nodes[i].pos).collect();
+        let length: f64 = pts.windows(2).map(|w| w[0].distance(w[1])).sum();
+        let mut along = 0.0;
+        let push = |q: DVec2, along: f64, out: &mut Vec<Sphere>| {
+            let r = boundary_distance(q, p);
+            if r > min_radius && contains(p, q) {
+                let f = if length > 0.0 { along / length } else { 0.0 };
+                let f = if lone { 1.0 - 2.0 * f.min(1.0 - f) } else { f };
+                out.push(Sphere { center: q.extend(0.0), radius: r, max_radius: r, branch: b, terminal, along: f });
+            }
+        };
+        push(pts[0], 0.0, &mut out);
+        for w in pts.windows(2) {
+            let (a, c) = (w[0], w[1]);
+            let len = a.distance(c);
+            let mut t = 0.0;
+            while t < len {
+                let q = a.lerp(c, t / len);
+                let r = boundary_distance(q, p).max(min_radius);
+                t += (SPACING * r).max(floor).max(len * 1e-3);
+                let q2 = a.lerp(c, (t / len).min(1.0));
+                push(q2, along + t.min(len), &mut out);
+            }
+            along += len;
+        }
+    }
+    bridge(p, &mut out);
+    out
+}
+
+/// Joins spheres that do not overlap the main body to it with spheres along the shortest
+/// link inside the outline, so the cloud's body never splits.
+fn bridge(p: &[DVec2], spheres: &mut Vec<Sphere>) {
+    for _ in 0..64 {
+        let n = spheres.len();
+        if n < 2 {
+            return;
+        }
+        let mut seen = vec![false; n];
+        let mut stack = vec![0];
+        seen[0] = true;
+        while let Some(i) = stack.pop() {
+            for j in 0..n {
+                if !seen[j] && spheres[i].center.distance(spheres[j].center) < spheres[i].radius + spheres[j].radius {
+                    seen[j] = true;
+                    stack.push(j);
+                }
+            }
+        }
+        if seen.iter().all(|&s| s) {
+            return;
+        }
+        // Closest pair between the body and the rest.
+        let mut best = (f64::INFINITY, 0, 0);
+        for i in (0..n).filter(|&i| seen[i]) {
+            for j in (0..n).filter(|&j| !seen[j]) {
+                let d = spheres[i].center.distance(spheres[j].center) - spheres[i].radius - spheres[j].radius;
+                if d < best.0 {
+                    best = (d, i, j);
+                }
+            }
+        }
+        let (a, b) = (spheres[best.1], spheres[best.2]);
+        let (qa, qb) = (a.center.truncate(), b.center.truncate());
+        let len = qa.distance(qb);
+        let mut t = 0.0;
+        let mut added = false;
+        while t < len {
+            let q = qa.lerp(qb, t / len);
+            let r = boundary_distance(q, p);
+            if r <= 0.0 || !contains(p, q) {
+                break;
+            }
+            spheres.push(Sphere { center: q.extend(0.0), radius: r, max_radius: r, ..b });
+            added = true;
+            t += (SPACING * r).max(len * 1e-3);
+        }
+        if !added {
+            // Cannot link it inside the outline: drop the stray piece.
+            let mut k = 0;
+            spheres.retain(|_| {
+                k += 1;
+                seen[k - 1]
+            });
+        }
+    }
+}
+
+/// The minimal feature radius r_f: the largest radius over the last 50% (toward the free end)
+/// of the terminal branches' spheres. Falls back to the largest radius when there are none.
+pub fn feature_radius(spheres: &[Sphere]) -> f64 {
+    let tips = spheres.iter().filter(|s| s.terminal && s.along >= 0.5).map(|s| s.max_radius).fold(0.0, f64::max);
+    if tips > 0.0 { tips } else { spheres.iter().map(|s| s.max_radius).fold(0.0, f64::max) }
+}
+
+/// Inflation slider: t = 0 keeps the maximal balls, t = 1 shrinks every sphere above r_f to
+/// r_f; spheres at or below r_f never change.
+pub fn inflate(spheres: &mut [Sphere], r_f: f64, t: f64) {
+    let t = t.clamp(0.0, 1.0);
+    for s in spheres {
+        if s.max_radius > r_f {
+            s.radius = s.max_radius + (r_f - s.max_radius) * t;
+        }
+    }
+}
+
+/// Tiny deterministic generator for the extension's random choices.
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// The trunk: the longest chain of body branches, or the longest path of the skeleton when it
+/// has too few junctions for a body. Returned as a polyline of points.
+pub fn trunk(skeleton: &Skeleton) -> Vec<DVec2> {
+    let n = skeleton.nodes.len();
+    let mut adj: Vec<Vec<(usize, f64)>> = vec![Vec::new(); n];
+    let body: Vec<bool> = {
+        let mut v = vec![false; skeleton.segments.len()];
+        for b in skeleton.branches.iter().filter(|b| b.kind == BranchKind::Body) {
+            for w in b.nodes.windows(2) {
+                if let Some(i) = skeleton.segments.iter().position(|s| (s[0] == w[0] && s[1] == w[1]) || (s[0] == w[1] && s[1] == w[0])) {
+                    v[i] = true;
+                }
+            }
+        }
+        v
+    };
+    let any_body = body.iter().any(|&b| b);
+    for (i, s) in skeleton.segments.iter().enumerate() {
+        if s[0] != s[1] && (!any_body || body[i]) {
+            let d = skeleton.nodes[s[0]].pos.distance(skeleton.nodes[s[1]].pos);
+            adj[s[0]].push((s[1], d));
+            adj[s[1]].push((s[0], d));
+        }
+    }
+    // Longest path in a forest: farthest node from any node, then farthest from that.
+    let farthest = |from: usize| {
+        let mut dist = vec![f64::NAN; n];
+        let mut parent = vec![usize::MAX; n];
+        dist[from] = 0.0;
+        let mut stack = vec![from];
+        while let Some(u) = stack.pop() {
+            for &(v, d) in &adj[u] {
+                if dist[v].is_nan() {
+                    dist[v] = dist[u] + d;
+                    parent[v] = u;
+                    stack.push(v);
+                }
+            }
+        }
+        let end = (0..n).filter(|&i| !dist[i].is_nan()).max_by(|&a, &b| dist[a].total_cmp(&dist[b])).unwrap_or(from);
+        (end, parent)
+    };
+    let Some(seed) = (0..n).find(|&i| !adj[i].is_empty()) else {
+        return skeleton.nodes.first().map(|n| vec![n.pos]).unwrap_or_default();
+    };
+    let (a, _) = farthest(seed);
+    let (b, parent) = farthest(a);
+    let mut path = vec![skeleton.nodes[b].pos];
+    let mut cur = b;
+    while cur != a && parent[cur] != usize::MAX {
+        cur = parent[cur];
+        path.push(skeleton.nodes[cur].pos);
+    }
+    path
+}
+
+/// Nearest point on a polyline and the polyline's unit direction there.
+fn nearest_on(polyline: &[DVec2], q: DVec2) -> (DVec2, DVec2) {
+    if polyline.len() < 2 {
+        return (polyline.first().copied().unwrap_or(q), DVec2::X);
+    }
+    let mut best = (f64::INFINITY, polyline[0], DVec2::X);
+    for w in polyline.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        let ab = b - a;
+        let len2 = ab.length_squared();
+        if len2 <= 0.0 {
+            continue;
+        }
+        let t = ((q - a).dot(ab) / len2).clamp(0.0, 1.0);
+        let x = a + ab * t;
+        let d = x.distance_squared(q);
+        if d < best.0 {
+            best = (d, x, ab / len2.sqrt());
+        }
+    }
+    (best.1, best.2)
+}
+
+/// Automatic 3D extension: each terminal branch is copied `copies` times and rotated about
+/// the trunk (axis: the trunk's direction at the point nearest the branch's root), evenly
+/// spread around it; originals get a small jitter out of their plane. Every moved sphere is
+/// fitted so its projection to the drawing plane stays inside the outline, which keeps the
+/// silhouette from the drawing view.
+pub fn extend(outline: &Outline, skeleton: &Skeleton, spheres: &[Sphere], seed: u64, copies: usize) -> Vec<Sphere> {
+    let axis_line = trunk(skeleton);
+    let mut rng = Rng(seed ^ 0xC10D_5CE7);
+    let mut out: Vec<Sphere> = Vec::with_capacity(spheres.len() * (copies + 1));
+    let budget_copies = if spheres.len() * (copies + 1) > MAX_SPHERES { (MAX_SPHERES / spheres.len().max(1)).saturating_sub(1) } else { copies };
+
+    for (b, branch) in skeleton.branches.iter().enumerate() {
+        let mut members: Vec<Sphere> = spheres.iter().filter(|s| s.branch == b).copied().collect();
+        if members.is_empty() {
+            continue;
+        }
+        if branch.kind == BranchKind::Body || axis_line.len() < 2 || skeleton.branches.len() == 1 {
+            out.extend(members);
+            continue;
+        }
+        members.sort_by(|a, b| a.along.total_cmp(&b.along));
+        let root = skeleton.nodes[branch.nodes[0]].pos;
+        let (pivot, dir) = nearest_on(&axis_line, root);
+        let axis = dir.extend(0.0);
+        let pivot = pivot.extend(0.0);
+        let rotated = |angle: f64| -> Vec<Sphere> {
+            let q = DQuat::from_axis_angle(axis, angle);
+            members.iter().map(|s| Sphere { center: pivot + q * (s.center - pivot), ..*s }).collect()
+        };
+        // Original: a small jitter rotation out of the plane.
+        let jitter = (rng.next() - 0.5) * 0.5;
+        out.extend(fit_branch(outline, rotated(jitter)));
+        // Copies evenly around the trunk, with a little variation.
+        for k in 1..=budget_copies {
+            let angle = std::f64::consts::TAU * k as f64 / (budget_copies + 1) as f64 + (rng.next() - 0.5) * 0.6;
+            out.extend(fit_branch(outline, rotated(angle)));
+        }
+    }
+    thicken(outline, &mut out);
+    out
+}
+
+/// Where the branches gave too little depth (a shape with few features), spheres still in the
+/// drawing plane get two copies pushed toward and away from the viewer: the projection, hence
+/// the silhouette, is unchanged, and each copy overlaps its original.
+fn thicken(outline: &Outline, spheres: &mut Vec<Sphere>) {
+    let (lo, hi) = outline.points.iter().fold((f64::MAX, f64::MIN), |(a, b), q| (a.min(q.y), b.max(q.y)));
+    let target = 0.5 * (hi - lo);
+    let depth = |s: &[Sphere]| {
+        let (a, b) = s.iter().fold((f64::MAX, f64::MIN), |(a, b), q| (a.min(q.center.z - q.radius), b.max(q.center.z + q.radius)));
+        b - a
+    };
+    if spheres.is_empty() || depth(spheres) >= target || spheres.len() * 3 > MAX_SPHERES {
+        return;
+    }
+    let flat: Vec<Sphere> = spheres.iter().filter(|s| s.center.z.abs() < 1e-9).copied().collect();
+    for s in flat {
+        let dz = (0.9 * s.radius).min((target * 0.5 - s.radius).max(0.0));
+        if dz > 0.0 {
+            for sign in [-1.0, 1.0] {
+                let mut c = s;
+                c.center.z += sign * dz;
+                spheres.push(c);
+            }
+        }
+    }
+}
+
+/// Fits a branch's spheres (root first) so each one's disc, projected to the drawing plane,
+/// lies inside the outline; the branch ends at the first sphere that cannot fit or no longer
+/// overlaps the previous one, so it stays attached to the body.
+fn fit_branch(outline: &Outline, branch: Vec<Sphere>) -> Vec<Sphere> {
+    let p = &outline.points;
+    let mut kept: Vec<Sphere> = Vec::with_capacity(branch.len());
+    for mut s in branch {
+        let q = s.center.truncate();
+        if !contains(p, q) {
+            break;
+        }
+        let room = boundary_distance(q, p);
+        s.radius = s.radius.min(room);
+        s.max_radius = s.max_radius.min(room);
+        if s.radius <= 1e-9 || kept.last().is_some_and(|prev| prev.center.distance(s.center) >= prev.radius + s.radius) {
+            break;
+        }
+        kept.push(s);
+    }
+    kept
+}

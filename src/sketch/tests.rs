@@ -1,0 +1,267 @@
+use std::f64::consts::{PI, TAU};
+
+use glam::DVec2;
+use proptest::prelude::*;
+
+use super::outline::{boundary_distance, contains};
+use super::*;
+
+fn rect(w: f64, h: f64, per_side: usize) -> Vec<[f64; 2]> {
+    let corners = [[0.0, 0.0], [w, 0.0], [w, h], [0.0, h]];
+    let mut v = Vec::new();
+    for k in 0..4 {
+        let (a, b) = (corners[k], corners[(k + 1) % 4]);
+        for i in 0..per_side {
+            let t = i as f64 / per_side as f64;
+            v.push([a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t]);
+        }
+    }
+    v
+}
+
+fn disc(r: f64, n: usize) -> Vec<[f64; 2]> {
+    (0..n).map(|i| i as f64 / n as f64 * TAU).map(|a| [r * a.cos(), r * a.sin()]).collect()
+}
+
+fn star(points: usize, outer: f64, inner: f64) -> Vec<[f64; 2]> {
+    let mut v = Vec::new();
+    for i in 0..points * 2 {
+        let a = PI / 2.0 + i as f64 * PI / points as f64;
+        let r = if i % 2 == 0 { outer } else { inner };
+        let next_a = PI / 2.0 + (i + 1) as f64 * PI / points as f64;
+        let next_r = if i % 2 == 0 { inner } else { outer };
+        for k in 0..20 {
+            let t = k as f64 / 20.0;
+            let (p, q) = (DVec2::from_angle(a) * r, DVec2::from_angle(next_a) * next_r);
+            let m = p.lerp(q, t);
+            v.push([m.x, m.y]);
+        }
+    }
+    v
+}
+
+fn l_shape() -> Vec<[f64; 2]> {
+    let c = [[0.0, 0.0], [6.0, 0.0], [6.0, 2.0], [2.0, 2.0], [2.0, 6.0], [0.0, 6.0]];
+    let mut v = Vec::new();
+    for k in 0..c.len() {
+        let (a, b) = (DVec2::from(c[k]), DVec2::from(c[(k + 1) % c.len()]));
+        let n = (a.distance(b) * 8.0) as usize;
+        for i in 0..n {
+            let m = a.lerp(b, i as f64 / n as f64);
+            v.push([m.x, m.y]);
+        }
+    }
+    v
+}
+
+/// A cumulus-like outline: flat base, bumpy top.
+fn cumulus() -> Vec<[f64; 2]> {
+    let mut v = Vec::new();
+    for i in 0..=80 {
+        v.push([i as f64 / 80.0 * 10.0, 0.0]);
+    }
+    for i in 1..200 {
+        let t = i as f64 / 200.0;
+        let a = t * PI;
+        let bumps = 1.0 + 0.35 * (a * 5.0).sin().abs();
+        v.push([5.0 + 5.0 * a.cos() * bumps.min(1.05), 3.5 * a.sin() * bumps]);
+    }
+    v
+}
+
+fn no_extend() -> SketchParams {
+    SketchParams { extend: false, ..Default::default() }
+}
+
+/// Intersection over union of the outline and the union of the spheres' projected discs.
+fn iou(sketch: &Sketch) -> f64 {
+    let p = &sketch.outline.points;
+    let (lo, hi) = p.iter().fold((DVec2::splat(f64::MAX), DVec2::splat(f64::MIN)), |(a, b), &q| (a.min(q), b.max(q)));
+    let (lo, hi) = (lo - (hi - lo) * 0.1, hi + (hi - lo) * 0.1);
+    let n = 160;
+    let (mut inter, mut union) = (0, 0);
+    for j in 0..n {
+        for i in 0..n {
+            let q = lo + (hi - lo) * DVec2::new((i as f64 + 0.5) / n as f64, (j as f64 + 0.5) / n as f64);
+            let a = contains(p, q);
+            let b = sketch.spheres.iter().any(|s| s.center.truncate().distance_squared(q) <= s.radius * s.radius);
+            inter += (a && b) as usize;
+            union += (a || b) as usize;
+        }
+    }
+    inter as f64 / union as f64
+}
+
+fn height(sketch: &Sketch) -> f64 {
+    let ys = sketch.outline.points.iter().map(|p| p.y);
+    ys.clone().fold(f64::MIN, f64::max) - ys.fold(f64::MAX, f64::min)
+}
+
+/// Whether the spheres form one connected body (overlapping neighbours).
+fn connected(spheres: &[Sphere]) -> bool {
+    let n = spheres.len();
+    let mut seen = vec![false; n];
+    let mut stack = vec![0];
+    seen[0] = true;
+    while let Some(i) = stack.pop() {
+        for j in 0..n {
+            if !seen[j] && spheres[i].center.distance(spheres[j].center) < spheres[i].radius + spheres[j].radius {
+                seen[j] = true;
+                stack.push(j);
+            }
+        }
+    }
+    seen.into_iter().all(|s| s)
+}
+
+#[test]
+fn rectangle_has_two_ends_and_no_junction() {
+    let s = interpret(&rect(12.0, 3.0, 40), true, &no_extend(), 1).unwrap();
+    assert_eq!(s.skeleton.terminal_count(), 2, "{:?}", s.skeleton.branches);
+    assert_eq!(s.skeleton.junction_count(), 0);
+}
+
+#[test]
+fn star_has_five_terminals() {
+    let s = interpret(&star(5, 5.0, 2.0), true, &no_extend(), 1).unwrap();
+    assert_eq!(s.skeleton.terminal_count(), 5);
+    assert!(s.skeleton.junction_count() >= 1);
+}
+
+#[test]
+fn skeleton_lies_inside_with_maximal_ball_radii() {
+    for shape in [rect(9.0, 3.0, 40), disc(4.0, 120), star(5, 5.0, 2.0), l_shape(), cumulus()] {
+        let s = interpret(&shape, true, &no_extend(), 1).unwrap();
+        let p = &s.outline.points;
+        for n in &s.skeleton.nodes {
+            assert!(contains(p, n.pos), "node {} outside", n.pos);
+            assert!((n.radius - boundary_distance(n.pos, p)).abs() < 1e-9);
+            assert!(n.radius > 0.0);
+        }
+        assert_eq!(s.skeleton.edge_to_segment.len(), p.len());
+        assert!(s.skeleton.edge_to_segment.iter().all(|&i| i < s.skeleton.segments.len()));
+    }
+}
+
+#[test]
+fn sphere_discs_match_simple_outlines() {
+    for (name, shape) in [("rect", rect(9.0, 3.0, 40)), ("disc", disc(4.0, 120)), ("L", l_shape()), ("cumulus", cumulus())] {
+        let s = interpret(&shape, true, &no_extend(), 1).unwrap();
+        let v = iou(&s);
+        assert!(v >= 0.9, "{name}: IoU {v:.3}");
+        assert!(connected(&s.spheres), "{name}: body split");
+    }
+}
+
+#[test]
+fn extension_gives_depth_and_keeps_the_silhouette() {
+    for (name, shape) in [("cumulus", cumulus()), ("star", star(5, 5.0, 2.0)), ("L", l_shape())] {
+        let flat = interpret(&shape, true, &no_extend(), 7).unwrap();
+        let s = interpret(&shape, true, &SketchParams::default(), 7).unwrap();
+        let (zmin, zmax) = s.spheres.iter().fold((f64::MAX, f64::MIN), |(a, b), q| (a.min(q.center.z - q.radius), b.max(q.center.z + q.radius)));
+        assert!(zmax - zmin >= 0.4 * height(&s), "{name}: depth {:.2} vs height {:.2}", zmax - zmin, height(&s));
+        assert!(s.spheres.len() > flat.spheres.len(), "{name}: no copies");
+        // Every projected disc stays inside the outline, and the silhouette is still the outline.
+        for q in &s.spheres {
+            assert!(boundary_distance(q.center.truncate(), &s.outline.points) >= q.radius - 1e-9);
+        }
+        assert!(iou(&s) >= 0.85, "{name}: silhouette IoU {:.3}", iou(&s));
+        assert!(connected(&s.spheres), "{name}: body split");
+    }
+}
+
+#[test]
+fn same_seed_same_spheres() {
+    let a = interpret(&cumulus(), true, &SketchParams::default(), 42).unwrap();
+    let b = interpret(&cumulus(), true, &SketchParams::default(), 42).unwrap();
+    let c = interpret(&cumulus(), true, &SketchParams::default(), 43).unwrap();
+    assert_eq!(a.spheres, b.spheres);
+    assert_ne!(a.spheres, c.spheres);
+}
+
+#[test]
+fn inflation_shrinks_only_spheres_above_the_feature_radius() {
+    let shape = star(5, 5.0, 2.0);
+    let base = interpret(&shape, true, &no_extend(), 1).unwrap();
+    let full = interpret(&shape, true, &SketchParams { inflate: 1.0, ..no_extend() }, 1).unwrap();
+    let half = interpret(&shape, true, &SketchParams { inflate: 0.5, ..no_extend() }, 1).unwrap();
+    let r_f = base.feature_radius;
+    assert!(r_f > 0.0);
+    assert!(base.spheres.iter().any(|s| s.radius > r_f * 1.05), "nothing to deflate");
+    for ((a, b), c) in base.spheres.iter().zip(&full.spheres).zip(&half.spheres) {
+        assert_eq!(a.radius, a.max_radius, "t = 0 keeps the maximal balls");
+        if a.max_radius <= r_f {
+            assert_eq!(b.radius, a.radius);
+            assert_eq!(c.radius, a.radius);
+        } else {
+            assert!((b.radius - r_f).abs() < 1e-12);
+            assert!(c.radius <= a.radius && c.radius >= r_f);
+        }
+    }
+}
+
+#[test]
+fn far_off_and_huge_coordinates_work() {
+    let shifted: Vec<[f64; 2]> = cumulus().iter().map(|p| [p[0] * 1000.0 + 1e6, p[1] * 1000.0 - 5e5]).collect();
+    let s = interpret(&shifted, true, &no_extend(), 1).unwrap();
+    assert!(iou(&s) > 0.9);
+}
+
+#[test]
+fn messy_strokes_are_repaired_with_warnings() {
+    // Ends overlapping: the pen went past the start.
+    let mut over = cumulus();
+    over.extend(cumulus().into_iter().take(30).map(|p| [p[0], p[1] - 0.05]));
+    let s = interpret(&over, false, &SketchParams::default(), 1).unwrap();
+    assert!(s.spheres.len() > 10);
+    // An open stroke is closed by joining its ends.
+    let arc: Vec<[f64; 2]> = disc(3.0, 100).into_iter().take(70).collect();
+    let s = interpret(&arc, false, &SketchParams::default(), 1).unwrap();
+    assert!(s.warnings.iter().any(|w| w.contains("open")), "{:?}", s.warnings);
+    // Very many points are thinned, not refused.
+    let many: Vec<[f64; 2]> = disc(3.0, 50_000);
+    let s = interpret(&many, true, &SketchParams::default(), 1).unwrap();
+    assert!(s.warnings.iter().any(|w| w.contains("thinned")));
+}
+
+#[test]
+fn cut_line_is_monotone() {
+    let l = cut_line(&[[3.0, 1.0], [0.0, 0.0], [1.0, 2.0], [1.0, 4.0]]).unwrap();
+    assert_eq!(l.len(), 3);
+    assert!(l.windows(2).all(|w| w[0].x < w[1].x));
+    assert_eq!(l[1], DVec2::new(1.0, 3.0));
+    assert!(cut_line(&[[1.0, 1.0]]).is_err());
+    assert!(cut_line(&[[1.0, 1.0], [1.0, 5.0]]).is_err());
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 96, .. ProptestConfig::default() })]
+
+    /// Random polygons, self-intersecting ones included: never a panic, never a hang; either
+    /// spheres inside the outline or a clear refusal.
+    #[test]
+    fn random_strokes_never_panic(points in prop::collection::vec((-100.0f64..100.0, -100.0f64..100.0), 0..120), closed: bool, extend: bool, seed: u64) {
+        let pts: Vec<[f64; 2]> = points.into_iter().map(|(x, y)| [x, y]).collect();
+        let params = SketchParams { extend, ..Default::default() };
+        if let Ok(s) = interpret(&pts, closed, &params, seed) {
+            prop_assert!(!s.spheres.is_empty());
+            prop_assert!(s.spheres.len() <= spheres::MAX_SPHERES);
+            for q in &s.spheres {
+                prop_assert!(q.center.is_finite() && q.radius.is_finite() && q.radius > 0.0);
+                prop_assert!(contains(&s.outline.points, q.center.truncate()));
+            }
+        }
+    }
+
+    /// Star-shaped random outlines (simple by construction) always give a connected body.
+    #[test]
+    fn random_simple_outlines_give_one_body(radii in prop::collection::vec(2.0f64..6.0, 5..40)) {
+        let n = radii.len();
+        let pts: Vec<[f64; 2]> = radii.iter().enumerate().map(|(i, r)| {
+            let a = i as f64 / n as f64 * TAU;
+            [r * a.cos(), r * a.sin()]
+        }).collect();
+        let s = interpret(&pts, true, &no_extend(), 1).unwrap();
+        prop_assert!(connected(&s.spheres));
+    }
+}

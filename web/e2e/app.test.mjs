@@ -1,0 +1,92 @@
+// The app in the browser: the default cloud is drawn (WebGPU, then the WebGL2 fallback), a
+// drag orbits the camera and changes the image, nothing logs an error, and ?preset=empty
+// opens an empty scene. Screenshots: web/test-results/screenshots/.
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import {
+  serve, launch, openApp, waitForBody, waitForFullQuality, state, screenshot, countDiffering, countChanged, recordTiming,
+} from './harness.mjs';
+
+let server;
+before(async () => { server = await serve(); });
+after(async () => { await server?.close(); });
+
+const toBytes = (rgb) => rgb.map((v) => Math.round(v * 255));
+
+/** Drags with the primary button from the viewport's centre by (dx, dy) in a few steps. */
+async function drag(page, rect, dx, dy) {
+  const x = rect.x + rect.w / 2;
+  const y = rect.y + rect.h / 2;
+  await page.mouse.move(x, y);
+  await page.mouse.down();
+  for (let i = 1; i <= 6; i++) {
+    await page.mouse.move(x + (dx * i) / 6, y + (dy * i) / 6);
+    await page.waitForTimeout(30);
+  }
+  await page.mouse.up();
+}
+
+for (const backend of ['webgpu', 'webgl2']) {
+  test(`default cloud drawn and orbited (${backend})`, { timeout: 300_000 }, async () => {
+    const { browser, close } = await launch({ webgpu: backend === 'webgpu' });
+    try {
+      const { page, errors, log, started } = await openApp(browser, server.url);
+      try {
+        await waitForBody(page, 'data-ready', (v) => v === 'true');
+        const readySeconds = (Date.now() - started) / 1000;
+        assert.equal(await page.getAttribute('body', 'data-backend'), backend, 'active backend');
+        const adapter = await page.getAttribute('body', 'data-adapter');
+        const before = await state(page);
+        const [vw, vh] = before.view.viewport;
+        const rect = { x: 0, y: 0, w: vw, h: vh };
+        const bg = toBytes(before.scene.light.background);
+
+        const first = await screenshot(page, `${backend}-1-default`);
+        const cloud = countDiffering(first, rect, bg);
+        assert.ok(cloud > 0.03 * vw * vh, `cloud covers ${cloud} of ${vw * vh} viewport pixels (${first.file})`);
+        // Away from the cloud the background is untouched: the viewport's top corners.
+        for (const [x, y] of [[3, 3], [vw - 4, 3]]) {
+          assert.equal(countDiffering(first, { x, y, w: 1, h: 1 }, bg), 0, `background at (${x},${y})`);
+        }
+
+        const t0 = Date.now();
+        await drag(page, rect, 160, 0);
+        const dragSeconds = (Date.now() - t0) / 1000;
+        const { seconds: refineSeconds } = await waitForFullQuality(page);
+        const afterDrag = await state(page);
+        const yaw = afterDrag.scene.camera.yaw_deg - before.scene.camera.yaw_deg;
+        assert.ok(Math.abs(yaw) > 10, `drag turned the camera by ${yaw.toFixed(1)}°`);
+        const second = await screenshot(page, `${backend}-2-orbited`);
+        const changed = countChanged(first, second, rect);
+        assert.ok(changed > 0.01 * vw * vh, `orbit changed ${changed} viewport pixels (${second.file})`);
+        assert.ok(countDiffering(second, rect, bg) > 0.03 * vw * vh, 'cloud still drawn after orbiting');
+
+        assert.deepEqual(errors, [], `errors logged:\n${errors.join('\n')}`);
+        recordTiming({ test: 'orbit', backend, adapter, readySeconds, dragSeconds, refineSeconds, quality: afterDrag.view.quality });
+      } catch (e) {
+        console.error(log.slice(-40).join('\n'));
+        await screenshot(page, `${backend}-failure`).catch(() => {});
+        throw e;
+      }
+    } finally {
+      await close();
+    }
+  });
+}
+
+test('?preset=empty opens an empty scene', { timeout: 180_000 }, async () => {
+  const { browser, close } = await launch({ webgpu: true });
+  try {
+    const { page, errors } = await openApp(browser, server.url, '?preset=empty');
+    await waitForBody(page, 'data-ready', (v) => v === 'true');
+    const s = await state(page);
+    assert.equal(s.scene.ellipsoids.length, 0);
+    const [vw, vh] = s.view.viewport;
+    const img = await screenshot(page, 'webgpu-3-empty');
+    // Only the hint text may differ from the background in an empty viewport.
+    assert.ok(countDiffering(img, { x: 0, y: 0, w: vw, h: vh }, toBytes(s.scene.light.background)) < 0.01 * vw * vh);
+    assert.deepEqual(errors, []);
+  } finally {
+    await close();
+  }
+});

@@ -1,0 +1,133 @@
+// Shared browser-test harness: serves the Trunk build (dist/) under a sub-path from a tiny
+// static server, launches Debian's Chromium headless through playwright-core with WebGPU on
+// (SwiftShader) or off (WebGL2 fallback), and reads the page's test contract
+// (<body data-ready data-backend data-quality>, window.cloudsketch.state()).
+import http from 'node:http';
+import fs from 'node:fs';
+import os from 'node:os';
+import path from 'node:path';
+import { fileURLToPath } from 'node:url';
+import { chromium } from 'playwright-core';
+import { PNG } from 'pngjs';
+
+const here = path.dirname(fileURLToPath(import.meta.url));
+export const DIST = process.env.CLOUDSKETCH_DIST ?? path.resolve(here, '../../dist');
+/** Screenshots of every run land here, for a person to look at. */
+export const SCREENSHOTS = path.resolve(here, '../test-results/screenshots');
+/** Served under a sub-path to prove the build's asset URLs are relative. */
+export const SUB_PATH = '/some/sub/path/';
+
+const TYPES = { '.html': 'text/html', '.js': 'text/javascript', '.wasm': 'application/wasm', '.css': 'text/css', '.png': 'image/png', '.json': 'application/json' };
+
+/** Starts a static server for DIST under SUB_PATH; resolves to { url, close }. */
+export function serve() {
+  if (!fs.existsSync(path.join(DIST, 'index.html'))) {
+    throw new Error(`no web build at ${DIST}: run 'trunk build --release' first (scripts/test.sh does)`);
+  }
+  const server = http.createServer((req, res) => {
+    const url = new URL(req.url, 'http://x');
+    if (!url.pathname.startsWith(SUB_PATH)) { res.writeHead(404); res.end('outside the app'); return; }
+    let rel = decodeURIComponent(url.pathname.slice(SUB_PATH.length)) || 'index.html';
+    const file = path.resolve(DIST, rel);
+    if (!file.startsWith(DIST) || !fs.existsSync(file) || fs.statSync(file).isDirectory()) { res.writeHead(404); res.end(); return; }
+    res.writeHead(200, { 'content-type': TYPES[path.extname(file)] ?? 'application/octet-stream' });
+    fs.createReadStream(file).pipe(res);
+  });
+  return new Promise((resolve) => server.listen(0, '127.0.0.1', () => {
+    const { port } = server.address();
+    resolve({ url: `http://127.0.0.1:${port}${SUB_PATH}`, close: () => new Promise((r) => server.close(r)) });
+  }));
+}
+
+const QUIET = ['--no-first-run', '--disable-background-networking', '--disable-component-update', '--disable-sync',
+  '--disable-quic', '--disable-default-apps', '--disable-extensions', '--no-default-browser-check', '--mute-audio'];
+const SWIFTSHADER = ['--use-angle=swiftshader', '--enable-features=Vulkan', '--use-vulkan=swiftshader',
+  '--enable-unsafe-swiftshader', '--ignore-gpu-blocklist'];
+
+/** Launches Chromium; `webgpu: false` leaves WebGPU off so the app must fall back to WebGL2. */
+export async function launch({ webgpu }) {
+  const userDataDir = fs.mkdtempSync(path.join(os.tmpdir(), 'cloudsketch-chromium-'));
+  const args = ['--remote-debugging-pipe', `--user-data-dir=${userDataDir}`, '--headless=new', '--no-sandbox',
+    ...QUIET, ...SWIFTSHADER, ...(webgpu ? ['--enable-unsafe-webgpu'] : []), 'about:blank'];
+  const browser = await chromium.launch({
+    executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium', ignoreDefaultArgs: true, args, timeout: 60_000,
+  });
+  const close = async () => { await browser.close(); fs.rmSync(userDataDir, { recursive: true, force: true }); };
+  return { browser, close };
+}
+
+/** Opens the app in a new page and records console errors and page errors. */
+export async function openApp(browser, base, query = '', viewport = { width: 900, height: 560 }) {
+  const page = await browser.newPage({ viewport });
+  const errors = [];
+  const log = [];
+  page.on('console', (m) => { log.push(`[${m.type()}] ${m.text()}`); if (m.type() === 'error') errors.push(m.text()); });
+  page.on('pageerror', (e) => errors.push(`pageerror: ${e.message}`));
+  const started = Date.now();
+  await page.goto(base + query);
+  return { page, errors, log, started };
+}
+
+/** Waits for the body attribute `name` to satisfy `pred` (string → bool); returns its value. */
+export async function waitForBody(page, name, pred = (v) => v != null, timeout = 120_000) {
+  const handle = await page.waitForFunction(
+    ([n, src]) => { const v = document.body.getAttribute(n); return new Function('v', `return (${src})(v)`)(v) ? v : null; },
+    [name, pred.toString()], { timeout, polling: 100 });
+  return handle.jsonValue();
+}
+
+/** The page's state (scene document and view). */
+export const state = (page) => page.evaluate(() => window.cloudsketch.state());
+
+/** Waits until the page shows a full-quality image of the current view. */
+export async function waitForFullQuality(page, timeout = 120_000) {
+  const t0 = Date.now();
+  // Give the app a frame to notice a change before trusting "full".
+  await page.waitForTimeout(50);
+  const quality = await waitForBody(page, 'data-quality', (v) => typeof v === 'string' && v.startsWith('full'), timeout);
+  return { quality, seconds: (Date.now() - t0) / 1000 };
+}
+
+/** Screenshot saved under SCREENSHOTS/name.png, decoded to { width, height, data (RGBA) }. */
+export async function screenshot(page, name) {
+  fs.mkdirSync(SCREENSHOTS, { recursive: true });
+  const file = path.join(SCREENSHOTS, `${name}.png`);
+  const buffer = await page.screenshot({ path: file });
+  const png = PNG.sync.read(buffer);
+  return { width: png.width, height: png.height, data: png.data, file };
+}
+
+/** Pixels of `img` inside `rect` ({x, y, w, h}) whose colour differs from `rgb` by more than `tol`. */
+export function countDiffering(img, rect, rgb, tol = 12) {
+  let n = 0;
+  for (let y = rect.y; y < rect.y + rect.h; y++) {
+    for (let x = rect.x; x < rect.x + rect.w; x++) {
+      const i = 4 * (y * img.width + x);
+      const d = Math.abs(img.data[i] - rgb[0]) + Math.abs(img.data[i + 1] - rgb[1]) + Math.abs(img.data[i + 2] - rgb[2]);
+      if (d > tol) n++;
+    }
+  }
+  return n;
+}
+
+/** Pixels inside `rect` that differ by more than `tol` between two same-size images. */
+export function countChanged(a, b, rect, tol = 24) {
+  let n = 0;
+  for (let y = rect.y; y < rect.y + rect.h; y++) {
+    for (let x = rect.x; x < rect.x + rect.w; x++) {
+      const i = 4 * (y * a.width + x);
+      const d = Math.abs(a.data[i] - b.data[i]) + Math.abs(a.data[i + 1] - b.data[i + 1]) + Math.abs(a.data[i + 2] - b.data[i + 2]);
+      if (d > tol) n++;
+    }
+  }
+  return n;
+}
+
+/** Appends a timing record to test-results/timings.json (figures for the README and notes). */
+export function recordTiming(entry) {
+  const file = path.resolve(here, '../test-results/timings.json');
+  fs.mkdirSync(path.dirname(file), { recursive: true });
+  const all = fs.existsSync(file) ? JSON.parse(fs.readFileSync(file, 'utf8')) : [];
+  all.push({ ...entry, at: new Date().toISOString() });
+  fs.writeFileSync(file, JSON.stringify(all, null, 2));
+}

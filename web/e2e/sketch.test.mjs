@@ -1,0 +1,111 @@
+// Sketching in the browser (WebGPU): drawing an outline with pointer events makes a cloud
+// where it was drawn and a drawing plane in the list; a cut stroke flattens its base; undo
+// removes it. Screenshots: web/test-results/screenshots/sketch-*.png.
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import { serve, launch, openApp, waitForBody, waitForFullQuality, state, screenshot, countDiffering } from './harness.mjs';
+
+let server;
+before(async () => { server = await serve(); });
+after(async () => { await server?.close(); });
+
+const toBytes = (rgb) => rgb.map((v) => Math.round(v * 255));
+
+async function stroke(page, points) {
+  await page.mouse.move(points[0][0], points[0][1]);
+  await page.mouse.down();
+  for (const [x, y] of points.slice(1)) await page.mouse.move(x, y);
+  await page.mouse.up();
+}
+
+async function until(page, pred, what, timeout = 60_000) {
+  const t0 = Date.now();
+  for (;;) {
+    const s = await state(page);
+    if (pred(s)) return s;
+    if (Date.now() - t0 > timeout) throw new Error(`timed out waiting for ${what}: ${JSON.stringify(s.view)}`);
+    await page.waitForTimeout(100);
+  }
+}
+
+test('draw an outline, then cut its base', { timeout: 300_000 }, async () => {
+  const { browser, close } = await launch({ webgpu: true });
+  try {
+    const { page, errors, log } = await openApp(browser, server.url, '?preset=empty');
+    try {
+      await waitForBody(page, 'data-ready', (v) => v === 'true');
+      let s = await state(page);
+      const [vw, vh] = s.view.viewport;
+      const bg = toBytes(s.scene.light.background);
+      // Focus the canvas, pick the Sketch tool with its shortcut.
+      await page.mouse.click(vw * 0.1, vh * 0.9);
+      await page.keyboard.press('d');
+      await until(page, (s) => s.view.tool === 'sketch', 'sketch tool');
+
+      // A cumulus outline: flat base, bumpy top, centred in the viewport.
+      const cx = vw * 0.5, base = vh * 0.62, w = vw * 0.42, h = vh * 0.36;
+      const pts = [];
+      for (let i = 0; i <= 30; i++) pts.push([cx - w / 2 + (w * i) / 30, base]);
+      for (let i = 1; i < 60; i++) {
+        const a = (i / 60) * Math.PI;
+        const bump = 1 + 0.12 * Math.abs(Math.sin(a * 5));
+        pts.push([cx + (w / 2) * Math.cos(a), base - h * Math.sin(a) * bump]);
+      }
+      pts.push(pts[0]);
+      await stroke(page, pts);
+      s = await until(page, (s) => s.scene.planes.length === 1, 'a drawing plane');
+      assert.equal(s.scene.planes[0].name, 'Outline 1');
+      assert.equal(s.view.selected_plane, 0, 'the new plane is selected in the list');
+      await page.keyboard.press('h'); // hide guides: look at the cloud alone
+      await until(page, (s) => s.view.guides_hidden, 'guides hidden');
+      await waitForFullQuality(page);
+      const drawn = await screenshot(page, 'sketch-1-outline');
+
+      const box = { x: Math.round(cx - w / 2), y: Math.round(base - h), w: Math.round(w), h: Math.round(h) };
+      const inside = countDiffering(drawn, box, bg);
+      assert.ok(inside > 0.35 * box.w * box.h, `cloud fills ${inside} of ${box.w * box.h} px of the drawn box`);
+      // Nothing far from the stroke: the strips left and right of it.
+      const left = { x: 2, y: box.y, w: Math.round(box.x * 0.5), h: box.h };
+      const right = { x: Math.round(box.x + box.w + (vw - box.x - box.w) * 0.5), y: box.y, w: Math.round((vw - box.x - box.w) * 0.45), h: box.h };
+      assert.equal(countDiffering(drawn, left, bg), 0, 'cloud left of the stroke');
+      assert.equal(countDiffering(drawn, right, bg), 0, 'cloud right of the stroke');
+
+      // Cut: a horizontal line through the lower part of the cloud, wider than it.
+      const cutY = base - h * 0.35;
+      const lower = { x: box.x, y: Math.round(cutY + 6), w: box.w, h: Math.round(base - cutY - 6) };
+      const upper = { x: box.x, y: box.y, w: box.w, h: Math.round(cutY - 6 - box.y) };
+      const lowerBefore = countDiffering(drawn, lower, bg);
+      const upperBefore = countDiffering(drawn, upper, bg);
+      assert.ok(lowerBefore > 0.3 * lower.w * lower.h, `cloud below the cut line before cutting: ${lowerBefore}`);
+      await page.keyboard.press('c');
+      await until(page, (s) => s.view.tool === 'cut', 'cut tool');
+      const cut = [];
+      for (let i = 0; i <= 20; i++) cut.push([cx - w * 0.7 + (w * 1.4 * i) / 20, cutY]);
+      await stroke(page, cut);
+      s = await until(page, (s) => s.scene.planes.length === 2, 'a cut plane');
+      assert.equal(s.scene.planes[1].kind, 'cut');
+      await waitForFullQuality(page);
+      const flattened = await screenshot(page, 'sketch-2-cut');
+      const lowerAfter = countDiffering(flattened, lower, bg);
+      const upperAfter = countDiffering(flattened, upper, bg);
+      assert.ok(lowerAfter < 0.1 * lowerBefore, `below the cut: ${lowerBefore} → ${lowerAfter} px`);
+      assert.ok(upperAfter > 0.7 * upperBefore, `above the cut: ${upperBefore} → ${upperAfter} px`);
+
+      // Undo removes the cut.
+      await page.keyboard.press('Control+z');
+      s = await until(page, (s) => s.scene.planes.length === 1, 'undo of the cut');
+      // A degenerate stroke (a straight line, no inside) is refused with a message, changes nothing.
+      await page.keyboard.press('d');
+      await stroke(page, Array.from({ length: 10 }, (_, i) => [vw * 0.15 + i * 12, vh * 0.15 + i * 4]));
+      s = await until(page, (s) => s.view.notice && s.view.notice.error, 'a refusal message', 20_000);
+      assert.equal(s.scene.planes.length, 1);
+      assert.deepEqual(errors, [], `errors logged:\n${errors.join('\n')}`);
+    } catch (e) {
+      console.error(log.slice(-40).join('\n'));
+      await screenshot(page, 'sketch-failure').catch(() => {});
+      throw e;
+    }
+  } finally {
+    await close();
+  }
+});
