@@ -34,7 +34,11 @@ pub struct BenchReport {
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(|a, b| a.total_cmp(b));
-    if v.is_empty() { f64::NAN } else { v[v.len() / 2] }
+    if v.is_empty() {
+        f64::NAN
+    } else {
+        v[v.len() / 2]
+    }
 }
 
 fn result(name: &str, value: f64, unit: &str, baseline: &str, baseline_value: f64) -> BenchResult {
@@ -56,10 +60,18 @@ fn render_frame(offscreen: &mut Offscreen) -> Result<BenchResult, String> {
     scene.render.slices = 128;
     let (w, h) = (1280, 720);
     // Warm up (pipeline compilation, uploads), then measure both alternately.
-    offscreen.time_frames(&scene, w, h, 1, false).map_err(|e| e.to_string())?;
-    offscreen.time_frames(&scene, w, h, 1, true).map_err(|e| e.to_string())?;
-    let ours = offscreen.time_frames(&scene, w, h, FRAMES, false).map_err(|e| e.to_string())?;
-    let plain = offscreen.time_frames(&scene, w, h, FRAMES, true).map_err(|e| e.to_string())?;
+    offscreen
+        .time_frames(&scene, w, h, 1, false)
+        .map_err(|e| e.to_string())?;
+    offscreen
+        .time_frames(&scene, w, h, 1, true)
+        .map_err(|e| e.to_string())?;
+    let ours = offscreen
+        .time_frames(&scene, w, h, FRAMES, false)
+        .map_err(|e| e.to_string())?;
+    let plain = offscreen
+        .time_frames(&scene, w, h, FRAMES, true)
+        .map_err(|e| e.to_string())?;
     Ok(result(
         "render_frame_1280x720_128_slices",
         median(ours) * 1e3,
@@ -113,10 +125,20 @@ fn sketch_pipeline() -> Result<BenchResult, String> {
     let cdt = time(&mut || {
         let vertices: Vec<Point2<f64>> = stroke.iter().map(|&[x, y]| Point2::new(x, y)).collect();
         let edges: Vec<[usize; 2]> = (0..n).map(|i| [i, (i + 1) % n]).collect();
-        let t = ConstrainedDelaunayTriangulation::<Point2<f64>>::try_bulk_load_cdt(vertices, edges, |_| {});
+        let t = ConstrainedDelaunayTriangulation::<Point2<f64>>::try_bulk_load_cdt(
+            vertices,
+            edges,
+            |_| {},
+        );
         std::hint::black_box(t.map(|t| t.num_inner_faces()).unwrap_or(0));
     });
-    Ok(result("sketch_500_point_stroke_to_spheres", ours * 1e3, "ms", "spade_cdt_500_point_polygon", cdt * 1e3))
+    Ok(result(
+        "sketch_500_point_stroke_to_spheres",
+        ours * 1e3,
+        "ms",
+        "spade_cdt_500_point_polygon",
+        cdt * 1e3,
+    ))
 }
 
 /// Runs the suite and prints it.
@@ -124,7 +146,9 @@ pub fn run(json: bool) -> Result<(), String> {
     let mut offscreen = Offscreen::new().map_err(|e| e.to_string())?;
     let machine = format!(
         "{} cores, {} {}; adapter {}",
-        std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1),
+        std::thread::available_parallelism()
+            .map(|n| n.get())
+            .unwrap_or(1),
         std::env::consts::OS,
         std::env::consts::ARCH,
         offscreen.adapter_name()
@@ -132,10 +156,16 @@ pub fn run(json: bool) -> Result<(), String> {
     let results = vec![sketch_pipeline()?, render_frame(&mut offscreen)?];
     let report = BenchReport { machine, results };
     if json {
-        println!("{}", serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?);
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?
+        );
     } else {
         println!("machine: {}", report.machine);
-        println!("{:<40} {:>12} {:<5} {:<44} {:>12} {:>8}", "name", "value", "unit", "baseline", "baseline", "ratio");
+        println!(
+            "{:<40} {:>12} {:<5} {:<44} {:>12} {:>8}",
+            "name", "value", "unit", "baseline", "baseline", "ratio"
+        );
         for r in &report.results {
             println!(
                 "{:<40} {:>12.3} {:<5} {:<44} {:>12.3} {:>7.2}×",

@@ -14,7 +14,11 @@ use crate::ui::{CloudApp, StartOptions};
 pub const MAX_INPUT_BYTES: u64 = 64 << 20;
 
 #[derive(Parser)]
-#[command(name = "cloudsketch", version, about = "Sketch a cloud's outline, get a volumetric 3D cloud.")]
+#[command(
+    name = "cloudsketch",
+    version,
+    about = "Sketch a cloud's outline, get a volumetric 3D cloud."
+)]
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
@@ -81,10 +85,27 @@ pub fn main() -> ExitCode {
     let result = match cli.command {
         None => run_desktop(),
         Some(Command::New { preset, output }) => new_scene(&preset, &output),
-        Some(Command::Render { scene, output, size, set }) => render(scene.as_deref(), &output, &size, &set),
-        Some(Command::Sketch { strokes, output, spheres_out, inflate, no_extend, seed }) => {
-            sketch(&strokes, &output, spheres_out.as_deref(), inflate, !no_extend, seed)
-        }
+        Some(Command::Render {
+            scene,
+            output,
+            size,
+            set,
+        }) => render(scene.as_deref(), &output, &size, &set),
+        Some(Command::Sketch {
+            strokes,
+            output,
+            spheres_out,
+            inflate,
+            no_extend,
+            seed,
+        }) => sketch(
+            &strokes,
+            &output,
+            spheres_out.as_deref(),
+            inflate,
+            !no_extend,
+            seed,
+        ),
         Some(Command::Bench { json }) => crate::bench::run(json),
     };
     match result {
@@ -98,13 +119,23 @@ pub fn main() -> ExitCode {
 
 fn run_desktop() -> Result<(), String> {
     let options = eframe::NativeOptions {
-        viewport: egui::ViewportBuilder::default().with_title("cloudsketch").with_inner_size([1280.0, 800.0]),
+        viewport: egui::ViewportBuilder::default()
+            .with_title("cloudsketch")
+            .with_inner_size([1280.0, 800.0]),
         ..Default::default()
     };
     eframe::run_native(
         "cloudsketch",
         options,
-        Box::new(|cc| Ok(Box::new(CloudApp::new(cc, StartOptions { initial_cost: 1e-8, ..Default::default() })))),
+        Box::new(|cc| {
+            Ok(Box::new(CloudApp::new(
+                cc,
+                StartOptions {
+                    initial_cost: 1e-8,
+                    ..Default::default()
+                },
+            )))
+        }),
     )
     .map_err(|e| format!("could not open the desktop window: {e}"))
 }
@@ -113,7 +144,12 @@ fn run_desktop() -> Result<(), String> {
 pub fn read_capped(path: &Path) -> Result<String, String> {
     let meta = std::fs::metadata(path).map_err(|e| format!("{}: {e}", path.display()))?;
     if meta.len() > MAX_INPUT_BYTES {
-        return Err(format!("{}: {} bytes is more than the {} MiB limit", path.display(), meta.len(), MAX_INPUT_BYTES >> 20));
+        return Err(format!(
+            "{}: {} bytes is more than the {} MiB limit",
+            path.display(),
+            meta.len(),
+            MAX_INPUT_BYTES >> 20
+        ));
     }
     std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))
 }
@@ -130,16 +166,23 @@ fn write(path: &Path, bytes: &[u8]) -> Result<(), String> {
 fn new_scene(preset: &str, output: &Path) -> Result<(), String> {
     let preset = Preset::from_name(preset).ok_or_else(|| {
         let names: Vec<_> = Preset::ALL.iter().map(|(_, n)| *n).collect();
-        format!("unknown preset {preset:?} (choose one of: {})", names.join(", "))
+        format!(
+            "unknown preset {preset:?} (choose one of: {})",
+            names.join(", ")
+        )
     })?;
     write(output, Scene::preset(preset).to_json().as_bytes())
 }
 
 /// Parses `WIDTHxHEIGHT`.
 pub fn parse_size(text: &str) -> Result<(u32, u32), String> {
-    let bad = || format!("size {text:?} is not WIDTHxHEIGHT with sides 1..={MAX_SIDE} (e.g. 1280x720)");
+    let bad =
+        || format!("size {text:?} is not WIDTHxHEIGHT with sides 1..={MAX_SIDE} (e.g. 1280x720)");
     let (w, h) = text.split_once(['x', 'X']).ok_or_else(bad)?;
-    let (w, h): (u32, u32) = (w.trim().parse().map_err(|_| bad())?, h.trim().parse().map_err(|_| bad())?);
+    let (w, h): (u32, u32) = (
+        w.trim().parse().map_err(|_| bad())?,
+        h.trim().parse().map_err(|_| bad())?,
+    );
     if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
         return Err(bad());
     }
@@ -157,8 +200,12 @@ fn render(scene: Option<&Path>, output: &Path, size: &str, sets: &[String]) -> R
     }
     let mut offscreen = Offscreen::new().map_err(|e| e.to_string())?;
     let start = std::time::Instant::now();
-    let image = offscreen.render(&scene, width, height).map_err(|e| e.to_string())?;
-    let png = image.to_png().map_err(|e| format!("PNG encoding failed: {e}"))?;
+    let image = offscreen
+        .render(&scene, width, height)
+        .map_err(|e| e.to_string())?;
+    let png = image
+        .to_png()
+        .map_err(|e| format!("PNG encoding failed: {e}"))?;
     write(output, &png)?;
     eprintln!(
         "rendered {width}x{height}, {} slices on {} in {:.2} s → {}",
@@ -199,7 +246,14 @@ fn yes() -> bool {
 /// World height the strokes are scaled to, so the default camera frames them.
 const SKETCH_WORLD_HEIGHT: f64 = 6.0;
 
-fn sketch(paths: &[PathBuf], output: &Path, spheres_out: Option<&Path>, inflate: f64, extend: bool, seed: u64) -> Result<(), String> {
+fn sketch(
+    paths: &[PathBuf],
+    output: &Path,
+    spheres_out: Option<&Path>,
+    inflate: f64,
+    extend: bool,
+    seed: u64,
+) -> Result<(), String> {
     use crate::scene::{DrawingPlane, MAX_PLANES, StrokeKind};
     use crate::sketch::{SketchParams, interpret};
     if !(0.0..=1.0).contains(&inflate) {
@@ -208,35 +262,63 @@ fn sketch(paths: &[PathBuf], output: &Path, spheres_out: Option<&Path>, inflate:
     if paths.len() > MAX_PLANES {
         return Err(format!("{} strokes (at most {MAX_PLANES})", paths.len()));
     }
-    let params = SketchParams { inflate, extend, ..Default::default() };
+    let params = SketchParams {
+        inflate,
+        extend,
+        ..Default::default()
+    };
     let mut strokes = Vec::new();
     for path in paths {
-        let file: StrokeFile = serde_json::from_str(&read_capped(path)?)
-            .map_err(|e| format!("{}: not a stroke file ({{\"points\": [[x, y], ...]}}): {e}", path.display()))?;
+        let file: StrokeFile = serde_json::from_str(&read_capped(path)?).map_err(|e| {
+            format!(
+                "{}: not a stroke file ({{\"points\": [[x, y], ...]}}): {e}",
+                path.display()
+            )
+        })?;
         // y down → y up, so the plane's points read like the world.
         let points: Vec<[f64; 2]> = file.points.iter().map(|&[x, y]| [x, -y]).collect();
-        let sketch = interpret(&points, file.closed, &params, seed.wrapping_add(strokes.len() as u64))
-            .map_err(|e| format!("{}: {e}", path.display()))?;
+        let sketch = interpret(
+            &points,
+            file.closed,
+            &params,
+            seed.wrapping_add(strokes.len() as u64),
+        )
+        .map_err(|e| format!("{}: {e}", path.display()))?;
         for w in &sketch.warnings {
             eprintln!("warning: {}: {w}", path.display());
         }
         strokes.push((points, file.closed, sketch));
     }
     // One frame for all strokes (they were drawn on one canvas): fit their box to the view.
-    let all: Vec<glam::DVec2> = strokes.iter().flat_map(|(_, _, s)| s.outline.points.iter().copied()).collect();
-    let (lo, hi) = all.iter().fold((glam::DVec2::MAX, glam::DVec2::MIN), |(a, b), &q| (a.min(q), b.max(q)));
+    let all: Vec<glam::DVec2> = strokes
+        .iter()
+        .flat_map(|(_, _, s)| s.outline.points.iter().copied())
+        .collect();
+    let (lo, hi) = all
+        .iter()
+        .fold((glam::DVec2::MAX, glam::DVec2::MIN), |(a, b), &q| {
+            (a.min(q), b.max(q))
+        });
     let scale = SKETCH_WORLD_HEIGHT / (hi.y - lo.y).max((hi.x - lo.x) * 0.5).max(1e-9);
     let mut scene = Scene::preset(crate::scene::Preset::Empty);
     let target = scene.camera.target.as_dvec3();
     let centre = (lo + hi) * 0.5;
     for (i, (points, closed, _)) in strokes.iter().enumerate() {
-        let c = crate::scene::centre_of(&points.iter().map(|&[x, y]| glam::DVec2::new(x, y)).collect::<Vec<_>>());
+        let c = crate::scene::centre_of(
+            &points
+                .iter()
+                .map(|&[x, y]| glam::DVec2::new(x, y))
+                .collect::<Vec<_>>(),
+        );
         let origin = target + ((c - centre) * scale).extend(0.0);
         scene.planes.push(DrawingPlane {
             name: format!("Outline {}", i + 1),
             kind: StrokeKind::Outline,
             origin: origin.as_vec3(),
-            points: points.iter().map(|&[x, y]| ((glam::DVec2::new(x, y) - c) * scale).as_vec2()).collect(),
+            points: points
+                .iter()
+                .map(|&[x, y]| ((glam::DVec2::new(x, y) - c) * scale).as_vec2())
+                .collect(),
             closed: *closed,
             sketch: params.clone(),
             seed: seed.wrapping_add(i as u64),
@@ -252,10 +334,15 @@ fn sketch(paths: &[PathBuf], output: &Path, spheres_out: Option<&Path>, inflate:
             .iter()
             .map(|s| serde_json::json!({"center": [s.center.x, -s.center.y, s.center.z], "radius": s.radius}))
             .collect();
-        let text = serde_json::to_string_pretty(&serde_json::json!({ "spheres": spheres })).map_err(|e| e.to_string())?;
+        let text = serde_json::to_string_pretty(&serde_json::json!({ "spheres": spheres }))
+            .map_err(|e| e.to_string())?;
         write(path, text.as_bytes())?;
     }
     let total: usize = strokes.iter().map(|s| s.2.spheres.len()).sum();
-    eprintln!("{} stroke(s) → {total} spheres → {}", strokes.len(), output.display());
+    eprintln!(
+        "{} stroke(s) → {total} spheres → {}",
+        strokes.len(),
+        output.display()
+    );
     Ok(())
 }

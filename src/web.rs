@@ -22,11 +22,17 @@ pub fn start() {
     let _ = eframe::WebLogger::init(log::LevelFilter::Info);
     let previous = std::panic::take_hook();
     std::panic::set_hook(Box::new(move |info| {
-        show_error(&format!("cloudsketch stopped after an internal error: {info}"));
+        show_error(&format!(
+            "cloudsketch stopped after an internal error: {info}"
+        ));
         previous(info);
     }));
     install_state_accessor();
-    let options = StartOptions { scene: scene_from_url(), host: Some(Box::new(WebHost)), initial_cost: 4e-8 };
+    let options = StartOptions {
+        scene: scene_from_url(),
+        host: Some(Box::new(WebHost)),
+        initial_cost: 4e-8,
+    };
     wasm_bindgen_futures::spawn_local(async move {
         if let Err(message) = run(options).await {
             log::error!("{message}");
@@ -36,7 +42,9 @@ pub fn start() {
 }
 
 async fn run(options: StartOptions) -> Result<(), String> {
-    let document = web_sys::window().and_then(|w| w.document()).ok_or("no document")?;
+    let document = web_sys::window()
+        .and_then(|w| w.document())
+        .ok_or("no document")?;
     let canvas = document
         .get_element_by_id("cloudsketch_canvas")
         .and_then(|e| e.dyn_into::<web_sys::HtmlCanvasElement>().ok())
@@ -60,20 +68,26 @@ async fn run(options: StartOptions) -> Result<(), String> {
 
 /// `?preset=NAME` picks the starting document.
 fn scene_from_url() -> Scene {
-    let search = web_sys::window().and_then(|w| w.location().search().ok()).unwrap_or_default();
+    let search = web_sys::window()
+        .and_then(|w| w.location().search().ok())
+        .unwrap_or_default();
     let params = web_sys::UrlSearchParams::new_with_str(&search).ok();
     match params.and_then(|p| p.get("preset")) {
-        Some(name) => Preset::from_name(&name).map(Scene::preset).unwrap_or_else(|| {
-            log::warn!("unknown preset {name:?}; opening the default scene");
-            Scene::default()
-        }),
+        Some(name) => Preset::from_name(&name)
+            .map(Scene::preset)
+            .unwrap_or_else(|| {
+                log::warn!("unknown preset {name:?}; opening the default scene");
+                Scene::default()
+            }),
         None => Scene::default(),
     }
 }
 
 /// Shows a message in the page's error box (and keeps the page usable as a page).
 fn show_error(message: &str) {
-    let Some(document) = web_sys::window().and_then(|w| w.document()) else { return };
+    let Some(document) = web_sys::window().and_then(|w| w.document()) else {
+        return;
+    };
     if let Some(loading) = document.get_element_by_id("loading") {
         loading.remove();
     }
@@ -85,7 +99,9 @@ fn show_error(message: &str) {
 
 /// `window.cloudsketch.state()`.
 fn install_state_accessor() {
-    let Some(window) = web_sys::window() else { return };
+    let Some(window) = web_sys::window() else {
+        return;
+    };
     let state = Closure::<dyn Fn() -> JsValue>::new(|| {
         STATE.with(|s| js_sys::JSON::parse(&s.borrow()).unwrap_or(JsValue::NULL))
     });
@@ -100,7 +116,12 @@ struct WebHost;
 impl Host for WebHost {
     fn publish(&mut self, status: &PageStatus) {
         STATE.with(|s| s.replace(status.state.clone()));
-        let Some(body) = web_sys::window().and_then(|w| w.document()).and_then(|d| d.body()) else { return };
+        let Some(body) = web_sys::window()
+            .and_then(|w| w.document())
+            .and_then(|d| d.body())
+        else {
+            return;
+        };
         let set = |name: &str, value: &str| {
             if body.get_attribute(name).as_deref() != Some(value) {
                 let _ = body.set_attribute(name, value);

@@ -4,7 +4,10 @@ use std::path::PathBuf;
 use std::process::{Command, Output};
 
 fn cloudsketch(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_cloudsketch")).args(args).output().expect("run cloudsketch")
+    Command::new(env!("CARGO_BIN_EXE_cloudsketch"))
+        .args(args)
+        .output()
+        .expect("run cloudsketch")
 }
 
 fn temp(name: &str) -> PathBuf {
@@ -22,16 +25,24 @@ fn new_writes_the_default_scene() {
     let path = temp("new.json");
     let out = cloudsketch(&["new", "-o", path.to_str().unwrap()]);
     assert!(out.status.success(), "{}", stderr(&out));
-    let scene = cloudsketch::scene::Scene::from_json(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    let scene =
+        cloudsketch::scene::Scene::from_json(&std::fs::read_to_string(&path).unwrap()).unwrap();
     assert_eq!(scene, cloudsketch::scene::Scene::default());
 
     let empty = temp("empty.json");
     let out = cloudsketch(&["new", "--preset", "empty", "-o", empty.to_str().unwrap()]);
     assert!(out.status.success(), "{}", stderr(&out));
-    let scene = cloudsketch::scene::Scene::from_json(&std::fs::read_to_string(&empty).unwrap()).unwrap();
+    let scene =
+        cloudsketch::scene::Scene::from_json(&std::fs::read_to_string(&empty).unwrap()).unwrap();
     assert!(scene.ellipsoids.is_empty());
 
-    let out = cloudsketch(&["new", "--preset", "nimbus9", "-o", temp("x.json").to_str().unwrap()]);
+    let out = cloudsketch(&[
+        "new",
+        "--preset",
+        "nimbus9",
+        "-o",
+        temp("x.json").to_str().unwrap(),
+    ]);
     assert!(!out.status.success());
     assert!(stderr(&out).contains("unknown preset"), "{}", stderr(&out));
 }
@@ -39,9 +50,22 @@ fn new_writes_the_default_scene() {
 #[test]
 fn render_writes_a_png_of_the_scene() {
     let scene = temp("scene.json");
-    assert!(cloudsketch(&["new", "-o", scene.to_str().unwrap()]).status.success());
+    assert!(
+        cloudsketch(&["new", "-o", scene.to_str().unwrap()])
+            .status
+            .success()
+    );
     let png = temp("out.png");
-    let out = cloudsketch(&["render", scene.to_str().unwrap(), "-o", png.to_str().unwrap(), "--size", "96x64", "--set", "/render/slices=32"]);
+    let out = cloudsketch(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        png.to_str().unwrap(),
+        "--size",
+        "96x64",
+        "--set",
+        "/render/slices=32",
+    ]);
     assert!(out.status.success(), "{}", stderr(&out));
     let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&png).unwrap()));
     let reader = decoder.read_info().unwrap();
@@ -54,12 +78,21 @@ fn bad_input_is_a_clear_error() {
     let png = temp("never.png");
     let p = png.to_str().unwrap();
     let cases: &[(&[&str], &str)] = &[
-        (&["render", "-o", p, "--set", "/render/nope=3"], "/render/nope"),
-        (&["render", "-o", p, "--set", "/render/slices=\"many\""], "/render/slices"),
+        (
+            &["render", "-o", p, "--set", "/render/nope=3"],
+            "/render/nope",
+        ),
+        (
+            &["render", "-o", p, "--set", "/render/slices=\"many\""],
+            "/render/slices",
+        ),
         (&["render", "-o", p, "--set", "render.slices"], "PATH=VALUE"),
         (&["render", "-o", p, "--size", "0x5"], "WIDTHxHEIGHT"),
         (&["render", "-o", p, "--size", "100000x5"], "WIDTHxHEIGHT"),
-        (&["render", "/definitely/not/here.json", "-o", p], "here.json"),
+        (
+            &["render", "/definitely/not/here.json", "-o", p],
+            "here.json",
+        ),
     ];
     for (args, needle) in cases {
         let out = cloudsketch(args);
@@ -71,7 +104,11 @@ fn bad_input_is_a_clear_error() {
     assert!(!png.exists());
 
     let garbage = temp("garbage.json");
-    std::fs::write(&garbage, "{\"version\": 1, \"ellipsoids\": [{\"center\": 5}]}").unwrap();
+    std::fs::write(
+        &garbage,
+        "{\"version\": 1, \"ellipsoids\": [{\"center\": 5}]}",
+    )
+    .unwrap();
     let out = cloudsketch(&["render", garbage.to_str().unwrap(), "-o", p]);
     assert!(!out.status.success());
     assert!(stderr(&out).contains("garbage.json"), "{}", stderr(&out));
@@ -79,7 +116,11 @@ fn bad_input_is_a_clear_error() {
 
 fn write_stroke(name: &str, points: &[[f64; 2]], closed: bool) -> PathBuf {
     let path = temp(name);
-    std::fs::write(&path, serde_json::json!({ "points": points, "closed": closed, "pen": "ignored" }).to_string()).unwrap();
+    std::fs::write(
+        &path,
+        serde_json::json!({ "points": points, "closed": closed, "pen": "ignored" }).to_string(),
+    )
+    .unwrap();
     path
 }
 
@@ -110,18 +151,29 @@ fn sketch_makes_a_scene_and_spheres_that_fit_the_outline() {
         "5",
     ]);
     assert!(out.status.success(), "{}", stderr(&out));
-    let scene = cloudsketch::scene::Scene::from_json(&std::fs::read_to_string(&scene_path).unwrap()).unwrap();
+    let scene =
+        cloudsketch::scene::Scene::from_json(&std::fs::read_to_string(&scene_path).unwrap())
+            .unwrap();
     assert_eq!(scene.planes.len(), 1);
-    let spheres: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&spheres_path).unwrap()).unwrap();
+    let spheres: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&spheres_path).unwrap()).unwrap();
     let spheres = spheres["spheres"].as_array().unwrap();
     assert!(spheres.len() > 20);
     // In the stroke's own units and axes: inside the drawn box, with depth toward the viewer.
     let (mut zmin, mut zmax) = (f64::MAX, f64::MIN);
     for s in spheres {
-        let c: Vec<f64> = s["center"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+        let c: Vec<f64> = s["center"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
         let r = s["radius"].as_f64().unwrap();
         assert!(c[0] - r >= 99.0 && c[0] + r <= 401.0, "{c:?} r {r}");
-        assert!(c[1] + r <= 301.0 && c[1] - r >= 300.0 - 110.0 * 1.16, "{c:?} r {r}");
+        assert!(
+            c[1] + r <= 301.0 && c[1] - r >= 300.0 - 110.0 * 1.16,
+            "{c:?} r {r}"
+        );
         zmin = zmin.min(c[2] - r);
         zmax = zmax.max(c[2] + r);
     }
@@ -129,31 +181,74 @@ fn sketch_makes_a_scene_and_spheres_that_fit_the_outline() {
 
     // The scene renders: the cloud is where the default camera looks.
     let png = temp("sketched.png");
-    let out = cloudsketch(&["render", scene_path.to_str().unwrap(), "-o", png.to_str().unwrap(), "--size", "80x60", "--set", "/render/slices=24"]);
+    let out = cloudsketch(&[
+        "render",
+        scene_path.to_str().unwrap(),
+        "-o",
+        png.to_str().unwrap(),
+        "--size",
+        "80x60",
+        "--set",
+        "/render/slices=24",
+    ]);
     assert!(out.status.success(), "{}", stderr(&out));
 
     // --no-extend keeps the spheres in the drawing plane.
     let flat = temp("flat.json");
-    let out = cloudsketch(&["sketch", stroke.to_str().unwrap(), "-o", temp("flat-scene.json").to_str().unwrap(), "--spheres-out", flat.to_str().unwrap(), "--no-extend"]);
+    let out = cloudsketch(&[
+        "sketch",
+        stroke.to_str().unwrap(),
+        "-o",
+        temp("flat-scene.json").to_str().unwrap(),
+        "--spheres-out",
+        flat.to_str().unwrap(),
+        "--no-extend",
+    ]);
     assert!(out.status.success(), "{}", stderr(&out));
-    let flat: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&flat).unwrap()).unwrap();
-    assert!(flat["spheres"].as_array().unwrap().iter().all(|s| s["center"][2].as_f64().unwrap() == 0.0));
+    let flat: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&flat).unwrap()).unwrap();
+    assert!(
+        flat["spheres"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .all(|s| s["center"][2].as_f64().unwrap() == 0.0)
+    );
 }
 
 #[test]
 fn sketch_repairs_or_refuses_bad_strokes() {
     // Overlapping ends: repaired, exit 0, warning on stderr.
     let mut over = canvas_cloud();
-    over.extend(canvas_cloud().into_iter().take(40).map(|[x, y]| [x, y + 3.0]));
+    over.extend(
+        canvas_cloud()
+            .into_iter()
+            .take(40)
+            .map(|[x, y]| [x, y + 3.0]),
+    );
     over.push([90.0, 320.0]);
     let path = write_stroke("over.json", &over, false);
-    let out = cloudsketch(&["sketch", path.to_str().unwrap(), "-o", temp("over-scene.json").to_str().unwrap()]);
+    let out = cloudsketch(&[
+        "sketch",
+        path.to_str().unwrap(),
+        "-o",
+        temp("over-scene.json").to_str().unwrap(),
+    ]);
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(stderr(&out).contains("warning"), "{}", stderr(&out));
 
-    for (name, points) in [("line.json", vec![[0.0, 0.0], [10.0, 10.0], [20.0, 20.0]]), ("dot.json", vec![[5.0, 5.0]]), ("two.json", vec![[0.0, 0.0], [1.0, 0.0]])] {
+    for (name, points) in [
+        ("line.json", vec![[0.0, 0.0], [10.0, 10.0], [20.0, 20.0]]),
+        ("dot.json", vec![[5.0, 5.0]]),
+        ("two.json", vec![[0.0, 0.0], [1.0, 0.0]]),
+    ] {
         let path = write_stroke(name, &points, true);
-        let out = cloudsketch(&["sketch", path.to_str().unwrap(), "-o", temp("never.json").to_str().unwrap()]);
+        let out = cloudsketch(&[
+            "sketch",
+            path.to_str().unwrap(),
+            "-o",
+            temp("never.json").to_str().unwrap(),
+        ]);
         assert!(!out.status.success(), "{name} accepted");
         let err = stderr(&out);
         assert_eq!(err.trim().lines().count(), 1, "{name}: {err}");
@@ -161,7 +256,12 @@ fn sketch_repairs_or_refuses_bad_strokes() {
     }
     let junk = temp("junk.json");
     std::fs::write(&junk, "{\"points\": 3}").unwrap();
-    let out = cloudsketch(&["sketch", junk.to_str().unwrap(), "-o", temp("never.json").to_str().unwrap()]);
+    let out = cloudsketch(&[
+        "sketch",
+        junk.to_str().unwrap(),
+        "-o",
+        temp("never.json").to_str().unwrap(),
+    ]);
     assert!(!out.status.success());
     assert!(stderr(&out).contains("not a stroke file"));
     assert!(!temp("never.json").exists());
@@ -174,9 +274,19 @@ fn bench_reports_ratios_as_json() {
     let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert!(report["machine"].as_str().unwrap().contains("adapter"));
     let results = report["results"].as_array().unwrap();
-    for name in ["render_frame_1280x720_128_slices", "sketch_500_point_stroke_to_spheres"] {
-        let r = results.iter().find(|r| r["name"] == name).unwrap_or_else(|| panic!("{name} missing"));
-        let (v, b, ratio) = (r["value"].as_f64().unwrap(), r["baseline_value"].as_f64().unwrap(), r["ratio"].as_f64().unwrap());
+    for name in [
+        "render_frame_1280x720_128_slices",
+        "sketch_500_point_stroke_to_spheres",
+    ] {
+        let r = results
+            .iter()
+            .find(|r| r["name"] == name)
+            .unwrap_or_else(|| panic!("{name} missing"));
+        let (v, b, ratio) = (
+            r["value"].as_f64().unwrap(),
+            r["baseline_value"].as_f64().unwrap(),
+            r["ratio"].as_f64().unwrap(),
+        );
         assert!(v > 0.0 && b > 0.0 && ((b / v) - ratio).abs() < 1e-9 * ratio.max(1.0));
     }
 }

@@ -12,12 +12,19 @@ const H: u32 = 150;
 
 fn render(scene: &Scene) -> Image {
     static DEVICE: OnceLock<Mutex<Offscreen>> = OnceLock::new();
-    let device = DEVICE.get_or_init(|| Mutex::new(Offscreen::new().expect("an offscreen wgpu adapter (lavapipe)")));
-    device.lock().unwrap_or_else(|e| e.into_inner()).render(scene, W, H).expect("render")
+    let device = DEVICE.get_or_init(|| {
+        Mutex::new(Offscreen::new().expect("an offscreen wgpu adapter (lavapipe)"))
+    });
+    device
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .render(scene, W, H)
+        .expect("render")
 }
 
 fn with(scene: &Scene, sets: &[&str]) -> Scene {
-    sets.iter().fold(scene.clone(), |s, a| set_by_pointer(&s, a).unwrap())
+    sets.iter()
+        .fold(scene.clone(), |s, a| set_by_pointer(&s, a).unwrap())
 }
 
 fn background(scene: &Scene) -> [u8; 3] {
@@ -34,12 +41,20 @@ fn luminance(p: [u8; 4]) -> f64 {
 
 /// Mean luminance of cloud pixels in the left and right halves of the cloud's screen extent.
 fn half_brightness(image: &Image, bg: [u8; 3]) -> (f64, f64) {
-    let cloud: Vec<(u32, u32)> =
-        (0..image.height).flat_map(|y| (0..image.width).map(move |x| (x, y))).filter(|&(x, y)| differs(image.pixel(x, y), bg)).collect();
-    let (min_x, max_x) = cloud.iter().fold((u32::MAX, 0), |(a, b), &(x, _)| (a.min(x), b.max(x)));
+    let cloud: Vec<(u32, u32)> = (0..image.height)
+        .flat_map(|y| (0..image.width).map(move |x| (x, y)))
+        .filter(|&(x, y)| differs(image.pixel(x, y), bg))
+        .collect();
+    let (min_x, max_x) = cloud
+        .iter()
+        .fold((u32::MAX, 0), |(a, b), &(x, _)| (a.min(x), b.max(x)));
     let mid = (min_x + max_x) / 2;
     let mean = |f: &dyn Fn(u32) -> bool| {
-        let v: Vec<f64> = cloud.iter().filter(|(x, _)| f(*x)).map(|&(x, y)| luminance(image.pixel(x, y))).collect();
+        let v: Vec<f64> = cloud
+            .iter()
+            .filter(|(x, _)| f(*x))
+            .map(|&(x, y)| luminance(image.pixel(x, y)))
+            .collect();
         v.iter().sum::<f64>() / v.len().max(1) as f64
     };
     (mean(&|x| x < mid), mean(&|x| x > mid))
@@ -50,16 +65,33 @@ fn default_cloud_covers_the_middle_of_the_frame() {
     let scene = Scene::default();
     let image = render(&scene);
     let bg = background(&scene);
-    let covered = image.rgba.chunks(4).filter(|p| differs([p[0], p[1], p[2], p[3]], bg)).count();
+    let covered = image
+        .rgba
+        .chunks(4)
+        .filter(|p| differs([p[0], p[1], p[2], p[3]], bg))
+        .count();
     let fraction = covered as f64 / (W * H) as f64;
-    assert!((0.05..0.8).contains(&fraction), "cloud covers {:.1}% of the frame", fraction * 100.0);
-    assert!(differs(image.pixel(W / 2, H / 2), bg), "no cloud at the centre");
+    assert!(
+        (0.05..0.8).contains(&fraction),
+        "cloud covers {:.1}% of the frame",
+        fraction * 100.0
+    );
+    assert!(
+        differs(image.pixel(W / 2, H / 2), bg),
+        "no cloud at the centre"
+    );
     for (x, y) in [(0, 0), (W - 1, 0), (0, H - 1), (W - 1, H - 1)] {
         let p = image.pixel(x, y);
         assert_eq!([p[0], p[1], p[2]], bg, "corner ({x},{y}) is not background");
     }
     // The cloud is brighter than the sky behind it somewhere (it is lit, not a dark hole).
-    assert!(image.rgba.chunks(4).any(|p| luminance([p[0], p[1], p[2], 255]) > luminance([bg[0], bg[1], bg[2], 255]) + 40.0));
+    assert!(
+        image
+            .rgba
+            .chunks(4)
+            .any(|p| luminance([p[0], p[1], p[2], 255])
+                > luminance([bg[0], bg[1], bg[2], 255]) + 40.0)
+    );
 }
 
 #[test]
@@ -67,12 +99,24 @@ fn the_sun_side_is_brighter() {
     let scene = Scene::default();
     let bg = background(&scene);
     // Sun low on the right (+x), then low on the left.
-    let right = render(&with(&scene, &["/light/sun_azimuth_deg=0", "/light/sun_elevation_deg=5"]));
-    let left = render(&with(&scene, &["/light/sun_azimuth_deg=180", "/light/sun_elevation_deg=5"]));
+    let right = render(&with(
+        &scene,
+        &["/light/sun_azimuth_deg=0", "/light/sun_elevation_deg=5"],
+    ));
+    let left = render(&with(
+        &scene,
+        &["/light/sun_azimuth_deg=180", "/light/sun_elevation_deg=5"],
+    ));
     let (rl, rr) = half_brightness(&right, bg);
     let (ll, lr) = half_brightness(&left, bg);
-    assert!(rr > rl + 8.0, "sun on the right: left {rl:.1}, right {rr:.1}");
-    assert!(ll > lr + 8.0, "sun on the left: left {ll:.1}, right {lr:.1}");
+    assert!(
+        rr > rl + 8.0,
+        "sun on the right: left {rl:.1}, right {rr:.1}"
+    );
+    assert!(
+        ll > lr + 8.0,
+        "sun on the left: left {ll:.1}, right {lr:.1}"
+    );
 }
 
 #[test]
@@ -93,8 +137,17 @@ fn empty_scene_is_all_background() {
 fn more_opacity_more_cover() {
     let scene = Scene::default();
     let bg = background(&scene);
-    let cover = |s: &Scene| render(s).rgba.chunks(4).filter(|p| differs([p[0], p[1], p[2], p[3]], bg)).count();
+    let cover = |s: &Scene| {
+        render(s)
+            .rgba
+            .chunks(4)
+            .filter(|p| differs([p[0], p[1], p[2], p[3]], bg))
+            .count()
+    };
     let thin = cover(&with(&scene, &["/render/opacity=0.2"]));
     let thick = cover(&with(&scene, &["/render/opacity=6"]));
-    assert!(thick > thin, "opacity 6 covers {thick} px, 0.2 covers {thin} px");
+    assert!(
+        thick > thin,
+        "opacity 6 covers {thick} px, 0.2 covers {thin} px"
+    );
 }

@@ -4,10 +4,14 @@
 use std::path::Path;
 
 fn validate(name: &str, source: &str) {
-    let module = naga::front::wgsl::parse_str(source).unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(source)));
-    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::default())
-        .validate(&module)
+    let module = naga::front::wgsl::parse_str(source)
         .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(source)));
+    naga::valid::Validator::new(
+        naga::valid::ValidationFlags::all(),
+        naga::valid::Capabilities::default(),
+    )
+    .validate(&module)
+    .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(source)));
 }
 
 #[test]
@@ -37,7 +41,9 @@ fn renderer_embeds_every_shader_file() {
     for name in &on_disk {
         let text = std::fs::read_to_string(dir.join(name)).unwrap();
         assert!(
-            cloudsketch::render::shaders::ALL.iter().any(|(_, src)| *src == text),
+            cloudsketch::render::shaders::ALL
+                .iter()
+                .any(|(_, src)| *src == text),
             "{name} is not in render::shaders::ALL"
         );
     }

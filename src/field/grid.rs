@@ -54,7 +54,10 @@ impl FieldGrid {
     /// Decoded (field, transmittance) at a texel.
     pub fn texel(&self, x: u32, y: u32, z: u32) -> (f32, f32) {
         let i = 2 * (x + self.dims.x * (y + self.dims.y * z)) as usize;
-        (self.texels[i] as f32 / 255.0, self.texels[i + 1] as f32 / 255.0)
+        (
+            self.texels[i] as f32 / 255.0,
+            self.texels[i + 1] as f32 / 255.0,
+        )
     }
 }
 
@@ -68,22 +71,37 @@ pub fn density(field: f32, softness: f32) -> f32 {
 /// Bakes `field` into a grid over its bounds.
 pub fn bake(field: &Field, params: &GridParams) -> FieldGrid {
     let Some((lo, hi)) = field.bounds() else {
-        return FieldGrid { dims: UVec3::ZERO, min: Vec3::ZERO, size: Vec3::ZERO, texels: Vec::new() };
+        return FieldGrid {
+            dims: UVec3::ZERO,
+            min: Vec3::ZERO,
+            size: Vec3::ZERO,
+            texels: Vec::new(),
+        };
     };
     let size = (hi - lo).max(Vec3::splat(1e-3));
     let res = params.resolution.clamp(MIN_SIDE, MAX_RESOLUTION) as f32;
     let longest = size.max_element();
-    let dims = (size / longest * res).ceil().as_uvec3().max(UVec3::splat(MIN_SIDE));
+    let dims = (size / longest * res)
+        .ceil()
+        .as_uvec3()
+        .max(UVec3::splat(MIN_SIDE));
     let h = size / dims.as_vec3();
     let (nx, ny, nz) = (dims.x as usize, dims.y as usize, dims.z as usize);
     let mut values = vec![0f32; nx * ny * nz];
-    let center_of = |i: usize, j: usize, k: usize| lo + (Vec3::new(i as f32, j as f32, k as f32) + 0.5) * h;
+    let center_of =
+        |i: usize, j: usize, k: usize| lo + (Vec3::new(i as f32, j as f32, k as f32) + 0.5) * h;
 
     // Accumulate each primitive over the texels of its influence box only.
     let splat = |blob: &super::Blob, out: &mut [f32], combine: fn(f32, f32) -> f32| {
         let reach = blob.extent * super::SUPPORT;
-        let a = ((blob.center - reach - lo) / h - 0.5).floor().max(Vec3::ZERO).as_uvec3();
-        let b = ((blob.center + reach - lo) / h - 0.5).ceil().as_ivec3().min(dims.as_ivec3() - 1);
+        let a = ((blob.center - reach - lo) / h - 0.5)
+            .floor()
+            .max(Vec3::ZERO)
+            .as_uvec3();
+        let b = ((blob.center + reach - lo) / h - 0.5)
+            .ceil()
+            .as_ivec3()
+            .min(dims.as_ivec3() - 1);
         if b.min_element() < 0 {
             return;
         }
@@ -93,7 +111,10 @@ pub fn bake(field: &Field, params: &GridParams) -> FieldGrid {
                 let row = (k as usize * ny + j as usize) * nx;
                 for i in a.x..=b.x {
                     let v = &mut out[row + i as usize];
-                    *v = combine(*v, blob.value(center_of(i as usize, j as usize, k as usize)));
+                    *v = combine(
+                        *v,
+                        blob.value(center_of(i as usize, j as usize, k as usize)),
+                    );
                 }
             }
         }
@@ -108,7 +129,10 @@ pub fn bake(field: &Field, params: &GridParams) -> FieldGrid {
             for blob in group {
                 splat(blob, &mut group_values, f32::max);
             }
-            values.iter_mut().zip(&group_values).for_each(|(v, g)| *v += g);
+            values
+                .iter_mut()
+                .zip(&group_values)
+                .for_each(|(v, g)| *v += g);
         }
     }
     if !field.clips.is_empty() {
@@ -123,14 +147,22 @@ pub fn bake(field: &Field, params: &GridParams) -> FieldGrid {
         }
     }
 
-    let dens: Vec<f32> = values.iter().map(|&v| density(v, params.softness)).collect();
+    let dens: Vec<f32> = values
+        .iter()
+        .map(|&v| density(v, params.softness))
+        .collect();
     let trans = sweep_transmittance(&dens, dims, h, params.sun_dir, params.extinction);
     let mut texels = Vec::with_capacity(values.len() * 2);
     for (v, t) in values.iter().zip(&trans) {
         texels.push((v.clamp(0.0, 1.0) * 255.0).round() as u8);
         texels.push((t.clamp(0.0, 1.0) * 255.0).round() as u8);
     }
-    FieldGrid { dims, min: lo, size, texels }
+    FieldGrid {
+        dims,
+        min: lo,
+        size,
+        texels,
+    }
 }
 
 /// Transmittance toward the sun for every texel, sweeping layers away from the sun along the
@@ -152,8 +184,11 @@ fn sweep_transmittance(dens: &[f32], dims: UVec3, h: Vec3, sun: Vec3, extinction
         (idx[2] * n[1] + idx[1]) * n[0] + idx[0]
     };
     let mut trans = vec![1f32; dens.len()];
-    let layers: Box<dyn Iterator<Item = usize>> =
-        if toward_sun > 0 { Box::new((0..n[a]).rev()) } else { Box::new(0..n[a]) };
+    let layers: Box<dyn Iterator<Item = usize>> = if toward_sun > 0 {
+        Box::new((0..n[a]).rev())
+    } else {
+        Box::new(0..n[a])
+    };
     let mut first = true;
     for ia in layers {
         let prev_a = ia as isize + toward_sun;
@@ -197,7 +232,12 @@ mod tests {
     use super::*;
 
     fn params(sun: Vec3) -> GridParams {
-        GridParams { resolution: 32, sun_dir: sun, extinction: 2.0, softness: 0.1 }
+        GridParams {
+            resolution: 32,
+            sun_dir: sun,
+            extinction: 2.0,
+            softness: 0.1,
+        }
     }
 
     #[test]
@@ -207,11 +247,23 @@ mod tests {
 
     #[test]
     fn grid_is_capped_and_matches_the_field() {
-        let f = Field { blobs: vec![Blob::sphere(Vec3::ZERO, 2.0)], ..Default::default() };
-        let g = bake(&f, &GridParams { resolution: 100_000, ..params(Vec3::Y) });
+        let f = Field {
+            blobs: vec![Blob::sphere(Vec3::ZERO, 2.0)],
+            ..Default::default()
+        };
+        let g = bake(
+            &f,
+            &GridParams {
+                resolution: 100_000,
+                ..params(Vec3::Y)
+            },
+        );
         assert!(g.dims.max_element() <= MAX_RESOLUTION);
         let g = bake(&f, &params(Vec3::Y));
-        assert_eq!(g.texels.len(), (g.dims.x * g.dims.y * g.dims.z * 2) as usize);
+        assert_eq!(
+            g.texels.len(),
+            (g.dims.x * g.dims.y * g.dims.z * 2) as usize
+        );
         let c = g.dims / 2;
         assert!(g.texel(c.x, c.y, c.z).0 > 0.9);
         assert!(g.texel(0, 0, 0).0 < 0.05);
@@ -219,17 +271,30 @@ mod tests {
 
     #[test]
     fn sun_side_is_brighter_than_the_far_side() {
-        let f = Field { blobs: vec![Blob::sphere(Vec3::ZERO, 2.0)], ..Default::default() };
-        for sun in [Vec3::X, Vec3::NEG_X, Vec3::Y, Vec3::new(0.3, 0.8, -0.5).normalize()] {
+        let f = Field {
+            blobs: vec![Blob::sphere(Vec3::ZERO, 2.0)],
+            ..Default::default()
+        };
+        for sun in [
+            Vec3::X,
+            Vec3::NEG_X,
+            Vec3::Y,
+            Vec3::new(0.3, 0.8, -0.5).normalize(),
+        ] {
             let g = bake(&f, &params(sun));
             let texel_at = |p: Vec3| {
-                let idx = ((p - g.min) / g.size * g.dims.as_vec3()).as_uvec3().min(g.dims - 1);
+                let idx = ((p - g.min) / g.size * g.dims.as_vec3())
+                    .as_uvec3()
+                    .min(g.dims - 1);
                 g.texel(idx.x, idx.y, idx.z).1
             };
             // 0.5 units of cloud toward the sun at extinction 2: about e^-1 of the light left.
             let lit = texel_at(sun * 1.5);
             let dark = texel_at(-sun * 1.5);
-            assert!(lit > 0.3 && dark < 0.1 && lit > dark + 0.25, "sun {sun}: lit {lit}, dark {dark}");
+            assert!(
+                lit > 0.3 && dark < 0.1 && lit > dark + 0.25,
+                "sun {sun}: lit {lit}, dark {dark}"
+            );
         }
     }
 

@@ -53,7 +53,12 @@ impl Blob {
     /// A sphere of visible radius `radius`.
     pub fn sphere(center: Vec3, radius: f32) -> Self {
         let r = radius.max(1e-4);
-        Self { center, to_unit: Mat3::from_diagonal(Vec3::splat(1.0 / (SUPPORT * r))), strength: 1.0, extent: Vec3::splat(r) }
+        Self {
+            center,
+            to_unit: Mat3::from_diagonal(Vec3::splat(1.0 / (SUPPORT * r))),
+            strength: 1.0,
+            extent: Vec3::splat(r),
+        }
     }
 
     /// An ellipsoid primitive of the document.
@@ -63,7 +68,12 @@ impl Blob {
         let to_unit = Mat3::from_diagonal(1.0 / (SUPPORT * radii)) * rot.transpose();
         // Axis-aligned half extents of the rotated ellipsoid.
         let abs = Mat3::from_cols(rot.x_axis.abs(), rot.y_axis.abs(), rot.z_axis.abs());
-        Self { center: e.center, to_unit, strength: e.strength, extent: abs * radii }
+        Self {
+            center: e.center,
+            to_unit,
+            strength: e.strength,
+            extent: abs * radii,
+        }
     }
 
     /// This primitive's field contribution at `p`.
@@ -109,7 +119,11 @@ fn line_height(line: &[Vec2], x: f32) -> Option<f32> {
         return Some(first.y);
     }
     let (a, b) = (line[i - 1], line[i.min(line.len() - 1)]);
-    let t = if b.x > a.x { (x - a.x) / (b.x - a.x) } else { 0.0 };
+    let t = if b.x > a.x {
+        (x - a.x) / (b.x - a.x)
+    } else {
+        0.0
+    };
     Some(a.y + (b.y - a.y) * t)
 }
 
@@ -162,14 +176,23 @@ pub struct Field {
 impl Field {
     /// The field a document describes: its ellipsoids plus the spheres and cuts of its planes.
     pub fn from_scene(scene: &Scene) -> Self {
-        let mut field = Field { blobs: scene.ellipsoids.iter().map(Blob::ellipsoid).collect(), groups: Vec::new(), clips: Vec::new() };
+        let mut field = Field {
+            blobs: scene.ellipsoids.iter().map(Blob::ellipsoid).collect(),
+            groups: Vec::new(),
+            clips: Vec::new(),
+        };
         field.blobs.truncate(MAX_PRIMITIVES);
         let mut budget = MAX_PRIMITIVES.saturating_sub(field.blobs.len());
         for plane in &scene.planes {
             match plane.kind {
                 StrokeKind::Outline => {
                     // Planes are validated when made; a stroke that no longer interprets adds nothing.
-                    let Ok(sketch) = crate::sketch::interpret(&plane.stroke(), plane.closed, &plane.sketch, plane.seed) else {
+                    let Ok(sketch) = crate::sketch::interpret(
+                        &plane.stroke(),
+                        plane.closed,
+                        &plane.sketch,
+                        plane.seed,
+                    ) else {
                         continue;
                     };
                     let group: Vec<Blob> = sketch
@@ -184,7 +207,12 @@ impl Field {
                 StrokeKind::Cut => {
                     if let Ok(line) = crate::sketch::cut_line(&plane.stroke()) {
                         let line = line.into_iter().map(|p| p.as_vec2()).collect();
-                        field.clips.push(Clip { origin: plane.origin, right: plane.right(), up: plane.up(), line });
+                        field.clips.push(Clip {
+                            origin: plane.origin,
+                            right: plane.right(),
+                            up: plane.up(),
+                            line,
+                        });
                     }
                 }
             }
@@ -203,7 +231,11 @@ impl Field {
             return 0.0;
         }
         let summed: f32 = self.blobs.iter().map(|b| b.value(p)).sum();
-        let grouped: f32 = self.groups.iter().map(|g| g.iter().map(|b| b.value(p)).fold(0.0, f32::max)).sum();
+        let grouped: f32 = self
+            .groups
+            .iter()
+            .map(|g| g.iter().map(|b| b.value(p)).fold(0.0, f32::max))
+            .sum();
         summed + grouped
     }
 
@@ -214,14 +246,20 @@ impl Field {
 
     /// Axis-aligned box holding everything visible, or `None` for an empty field.
     pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
-        let mut it = self.all_blobs().map(|b| (b.center - b.extent * BOUNDS_MARGIN, b.center + b.extent * BOUNDS_MARGIN));
+        let mut it = self.all_blobs().map(|b| {
+            (
+                b.center - b.extent * BOUNDS_MARGIN,
+                b.center + b.extent * BOUNDS_MARGIN,
+            )
+        });
         let first = it.next()?;
         Some(it.fold(first, |(lo, hi), (a, b)| (lo.min(a), hi.max(b))))
     }
 
     /// Bounding sphere (centre, radius) of [`Field::bounds`].
     pub fn bounding_sphere(&self) -> Option<(Vec3, f32)> {
-        self.bounds().map(|(lo, hi)| ((lo + hi) * 0.5, (hi - lo).length() * 0.5))
+        self.bounds()
+            .map(|(lo, hi)| ((lo + hi) * 0.5, (hi - lo).length() * 0.5))
     }
 
     /// First point where a ray enters the visible surface, marching in steps of `step`.
@@ -294,7 +332,10 @@ mod tests {
             let p = e.center + e.rotation * axis * r;
             assert!((b.value(p) - ISO).abs() < 1e-4, "{axis}");
         }
-        let f = Field { blobs: vec![b], ..Default::default() };
+        let f = Field {
+            blobs: vec![b],
+            ..Default::default()
+        };
         let (lo, hi) = f.bounds().unwrap();
         for axis in [Vec3::X, Vec3::Y, Vec3::Z] {
             let p = e.center + e.rotation * axis * [3.0, 1.0, 2.0][axis.abs().max_position()];
@@ -306,29 +347,53 @@ mod tests {
     fn blending_grows_the_union() {
         let a = Blob::sphere(Vec3::ZERO, 1.0);
         let b = Blob::sphere(Vec3::new(2.2, 0.0, 0.0), 1.0);
-        let f = Field { blobs: vec![a, b], ..Default::default() };
+        let f = Field {
+            blobs: vec![a, b],
+            ..Default::default()
+        };
         // The midpoint is outside both spheres alone but the blend bridges them.
         assert!(f.inside(Vec3::new(1.1, 0.0, 0.0)));
     }
 
     #[test]
     fn clip_removes_below_its_line_within_its_footprint() {
-        let clip = Clip { origin: Vec3::ZERO, right: Vec3::X, up: Vec3::Y, line: vec![Vec2::new(-1.0, 0.0), Vec2::new(1.0, 0.5)] };
+        let clip = Clip {
+            origin: Vec3::ZERO,
+            right: Vec3::X,
+            up: Vec3::Y,
+            line: vec![Vec2::new(-1.0, 0.0), Vec2::new(1.0, 0.5)],
+        };
         assert!(clip.removes(Vec3::new(0.0, 0.2, 5.0)));
         assert!(!clip.removes(Vec3::new(0.0, 0.3, 0.0)));
-        assert!(!clip.removes(Vec3::new(2.0, -10.0, 0.0)), "outside the footprint");
-        let f = Field { blobs: vec![Blob::sphere(Vec3::ZERO, 1.0)], groups: vec![], clips: vec![clip] };
+        assert!(
+            !clip.removes(Vec3::new(2.0, -10.0, 0.0)),
+            "outside the footprint"
+        );
+        let f = Field {
+            blobs: vec![Blob::sphere(Vec3::ZERO, 1.0)],
+            groups: vec![],
+            clips: vec![clip],
+        };
         assert!(!f.inside(Vec3::new(0.0, -0.5, 0.0)));
         assert!(f.inside(Vec3::new(0.0, 0.5, 0.0)));
     }
 
     #[test]
     fn raycast_finds_the_surface() {
-        let f = Field { blobs: vec![Blob::sphere(Vec3::ZERO, 2.0)], ..Default::default() };
-        let ray = Ray { origin: Vec3::new(0.0, 0.0, 10.0), dir: Vec3::NEG_Z };
+        let f = Field {
+            blobs: vec![Blob::sphere(Vec3::ZERO, 2.0)],
+            ..Default::default()
+        };
+        let ray = Ray {
+            origin: Vec3::new(0.0, 0.0, 10.0),
+            dir: Vec3::NEG_Z,
+        };
         let hit = f.raycast(&ray, 0.05).unwrap();
         assert!((hit.z - 2.0).abs() < 1e-3, "{hit}");
-        let miss = Ray { origin: Vec3::new(5.0, 0.0, 10.0), dir: Vec3::NEG_Z };
+        let miss = Ray {
+            origin: Vec3::new(5.0, 0.0, 10.0),
+            dir: Vec3::NEG_Z,
+        };
         assert!(f.raycast(&miss, 0.05).is_none());
         assert!(Field::default().raycast(&ray, 0.05).is_none());
     }

@@ -56,7 +56,13 @@ pub struct Slicing {
 
 impl VolumeUniforms {
     /// Uniforms for drawing `scene`'s field grid from `camera` at image aspect `aspect`.
-    pub fn new(scene: &Scene, camera: &OrbitCamera, grid: &FieldGrid, aspect: f32, slicing: Slicing) -> Self {
+    pub fn new(
+        scene: &Scene,
+        camera: &OrbitCamera,
+        grid: &FieldGrid,
+        aspect: f32,
+        slicing: Slicing,
+    ) -> Self {
         let (center, radius) = grid.bounding_sphere();
         let total = slicing.total.max(1);
         let light = &scene.light;
@@ -78,8 +84,22 @@ impl VolumeUniforms {
             sun_dir: sun.extend(0.0).to_array(),
             sun_color: sun_color.extend(1.0).to_array(),
             sky_color: sky_color.extend(1.0).to_array(),
-            media: [r.opacity, ISO, r.softness, if r.noise_octaves == 0 { 0.0 } else { r.noise_amount }],
-            noise: [1.0 / r.noise_scale.max(1e-3), r.detail, 0.5, r.noise_octaves.min(MAX_OCTAVES as u32) as f32],
+            media: [
+                r.opacity,
+                ISO,
+                r.softness,
+                if r.noise_octaves == 0 {
+                    0.0
+                } else {
+                    r.noise_amount
+                },
+            ],
+            noise: [
+                1.0 / r.noise_scale.max(1e-3),
+                r.detail,
+                0.5,
+                r.noise_octaves.min(MAX_OCTAVES as u32) as f32,
+            ],
             octave_offset: [[0.0; 4]; MAX_OCTAVES],
         }
     }
@@ -101,7 +121,13 @@ pub struct CompositeUniforms {
 
 /// sRGB-encoded colour → linear.
 pub fn srgb_to_linear(c: [f32; 3]) -> Vec3 {
-    let f = |v: f32| if v <= 0.04045 { v / 12.92 } else { ((v + 0.055) / 1.055).powf(2.4) };
+    let f = |v: f32| {
+        if v <= 0.04045 {
+            v / 12.92
+        } else {
+            ((v + 0.055) / 1.055).powf(2.4)
+        }
+    };
     Vec3::new(f(c[0]), f(c[1]), f(c[2]))
 }
 
@@ -120,13 +146,21 @@ mod tests {
         let scene = Scene::default();
         let grid = crate::field::bake(
             &crate::field::Field::from_scene(&scene),
-            &crate::field::GridParams { resolution: 16, sun_dir: Vec3::Y, extinction: 1.0, softness: 0.1 },
+            &crate::field::GridParams {
+                resolution: 16,
+                sun_dir: Vec3::Y,
+                extinction: 1.0,
+                softness: 0.1,
+            },
         );
         let u = VolumeUniforms::new(&scene, &scene.camera, &grid, 1.5, Slicing { total: 64 });
         let center = Vec3::from_slice(&u.sphere[..3]);
         assert!(center.abs_diff_eq(grid.min + grid.size * 0.5, 1e-4));
         assert!((u.slicing[2] * 64.0 - 2.0 * u.sphere[3]).abs() < 1e-4);
-        assert_eq!(glam::Mat4::from_cols_array_2d(&u.view_proj), scene.camera.view_projection(1.5));
+        assert_eq!(
+            glam::Mat4::from_cols_array_2d(&u.view_proj),
+            scene.camera.view_projection(1.5)
+        );
         assert_eq!(u.starting_at(10).slicing[1], 10.0);
     }
 

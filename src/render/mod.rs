@@ -40,7 +40,11 @@ impl VolumeCache {
             _ => {
                 self.generation += 1;
                 let grid = bake(&Field::from_scene(scene), &inputs.grid);
-                let data = Arc::new(VolumeData { generation: self.generation, grid, noise_seed: scene.seed });
+                let data = Arc::new(VolumeData {
+                    generation: self.generation,
+                    grid,
+                    noise_seed: scene.seed,
+                });
                 self.inputs = Some(inputs);
                 self.data = Some(data.clone());
                 data

@@ -42,7 +42,15 @@ fn perlin(seed: u64, p: [f32; 3]) -> f32 {
         let l = |i: usize| (c[i] + o[i] as i64).rem_euclid(LATTICE as i64) as u32;
         let g = gradient(seed, l(0), l(1), l(2));
         let d = [f[0] - o[0] as f32, f[1] - o[1] as f32, f[2] - o[2] as f32];
-        let w = (0..3).map(|i| if o[i] == 1 { fade(f[i]) } else { 1.0 - fade(f[i]) }).product::<f32>();
+        let w = (0..3)
+            .map(|i| {
+                if o[i] == 1 {
+                    fade(f[i])
+                } else {
+                    1.0 - fade(f[i])
+                }
+            })
+            .product::<f32>();
         sum += w * (g[0] * d[0] + g[1] * d[1] + g[2] * d[2]);
     }
     sum
@@ -56,13 +64,21 @@ pub fn noise_volume(seed: u64) -> Vec<u8> {
     for z in 0..n {
         for y in 0..n {
             for x in 0..n {
-                values.push(perlin(seed, [x as f32 * scale, y as f32 * scale, z as f32 * scale]));
+                values.push(perlin(
+                    seed,
+                    [x as f32 * scale, y as f32 * scale, z as f32 * scale],
+                ));
             }
         }
     }
-    let (lo, hi) = values.iter().fold((f32::MAX, f32::MIN), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+    let (lo, hi) = values
+        .iter()
+        .fold((f32::MAX, f32::MIN), |(lo, hi), &v| (lo.min(v), hi.max(v)));
     let span = (hi - lo).max(1e-6);
-    values.iter().map(|v| ((v - lo) / span * 255.0).round() as u8).collect()
+    values
+        .iter()
+        .map(|v| ((v - lo) / span * 255.0).round() as u8)
+        .collect()
 }
 
 #[cfg(test)]

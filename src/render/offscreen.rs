@@ -2,8 +2,8 @@
 //! and the image tests use it, with the same renderer and shaders as the app.
 
 use super::VolumeCache;
-use super::volume::{SliceJob, VolumeRenderer, accumulation_format};
 use super::gpu_types::{Slicing, VolumeUniforms};
+use super::volume::{SliceJob, VolumeRenderer, accumulation_format};
 use crate::scene::Scene;
 
 /// Largest offscreen image side.
@@ -15,7 +15,9 @@ const OUTPUT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 #[derive(Debug, thiserror::Error)]
 pub enum OffscreenError {
     /// No adapter at all.
-    #[error("no GPU adapter found (on Linux without a GPU install Mesa's lavapipe: mesa-vulkan-drivers)")]
+    #[error(
+        "no GPU adapter found (on Linux without a GPU install Mesa's lavapipe: mesa-vulkan-drivers)"
+    )]
     NoAdapter,
     /// Device creation failed.
     #[error("could not open the GPU device: {0}")]
@@ -43,7 +45,12 @@ impl Image {
     /// The pixel at (x, y).
     pub fn pixel(&self, x: u32, y: u32) -> [u8; 4] {
         let i = 4 * (y * self.width + x) as usize;
-        [self.rgba[i], self.rgba[i + 1], self.rgba[i + 2], self.rgba[i + 3]]
+        [
+            self.rgba[i],
+            self.rgba[i + 1],
+            self.rgba[i + 2],
+            self.rgba[i + 3],
+        ]
     }
 
     /// Encodes as PNG.
@@ -75,7 +82,8 @@ impl Offscreen {
     }
 
     async fn new_async() -> Result<Self, OffscreenError> {
-        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        let instance =
+            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
         let mut adapter = None;
         for force_fallback_adapter in [false, true] {
             let options = wgpu::RequestAdapterOptions {
@@ -91,16 +99,31 @@ impl Offscreen {
         }
         let adapter = match adapter {
             Some(a) => a,
-            None => instance.enumerate_adapters(wgpu::Backends::all()).await.into_iter().next().ok_or(OffscreenError::NoAdapter)?,
+            None => instance
+                .enumerate_adapters(wgpu::Backends::all())
+                .await
+                .into_iter()
+                .next()
+                .ok_or(OffscreenError::NoAdapter)?,
         };
         let info = adapter.get_info();
         let limits = wgpu::Limits::downlevel_defaults().using_resolution(adapter.limits());
         let (device, queue) = adapter
-            .request_device(&wgpu::DeviceDescriptor { label: Some("cloudsketch offscreen"), required_limits: limits, ..Default::default() })
+            .request_device(&wgpu::DeviceDescriptor {
+                label: Some("cloudsketch offscreen"),
+                required_limits: limits,
+                ..Default::default()
+            })
             .await
             .map_err(|e| OffscreenError::Device(e.to_string()))?;
         let renderer = VolumeRenderer::new(&device, OUTPUT_FORMAT, accumulation_format(&adapter));
-        Ok(Self { device, queue, info, renderer, cache: VolumeCache::default() })
+        Ok(Self {
+            device,
+            queue,
+            info,
+            renderer,
+            cache: VolumeCache::default(),
+        })
     }
 
     /// Name and backend of the adapter, e.g. "llvmpipe (LLVM 15.0.6, 256 bits) (Vulkan)".
@@ -109,7 +132,12 @@ impl Offscreen {
     }
 
     /// Renders `scene` from its camera at full quality.
-    pub fn render(&mut self, scene: &Scene, width: u32, height: u32) -> Result<Image, OffscreenError> {
+    pub fn render(
+        &mut self,
+        scene: &Scene,
+        width: u32,
+        height: u32,
+    ) -> Result<Image, OffscreenError> {
         if width == 0 || height == 0 || width > MAX_SIDE || height > MAX_SIDE {
             return Err(OffscreenError::Size(width, height));
         }
@@ -119,7 +147,14 @@ impl Offscreen {
 
     /// Times `frames` full-quality frames of `scene` (slices and composite, no readback), each
     /// waited for on the device. With `baseline`, the slices use the plain benchmark shader.
-    pub fn time_frames(&mut self, scene: &Scene, width: u32, height: u32, frames: usize, baseline: bool) -> Result<Vec<f64>, OffscreenError> {
+    pub fn time_frames(
+        &mut self,
+        scene: &Scene,
+        width: u32,
+        height: u32,
+        frames: usize,
+        baseline: bool,
+    ) -> Result<Vec<f64>, OffscreenError> {
         if width == 0 || height == 0 || width > MAX_SIDE || height > MAX_SIDE {
             return Err(OffscreenError::Size(width, height));
         }
@@ -130,7 +165,9 @@ impl Offscreen {
             let start = std::time::Instant::now();
             let (encoder, _output) = self.encode(&job, scene.light.background, pipeline.as_ref());
             self.queue.submit([encoder.finish()]);
-            self.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| OffscreenError::Readback(e.to_string()))?;
+            self.device
+                .poll(wgpu::PollType::wait_indefinitely())
+                .map_err(|e| OffscreenError::Readback(e.to_string()))?;
             times.push(start.elapsed().as_secs_f64());
         }
         Ok(times)
@@ -139,9 +176,22 @@ impl Offscreen {
     fn full_job(&mut self, scene: &Scene, width: u32, height: u32) -> SliceJob {
         let data = self.cache.update(scene);
         self.renderer.upload(&self.device, &self.queue, &data);
-        let uniforms =
-            VolumeUniforms::new(scene, &scene.camera, &data.grid, width as f32 / height as f32, Slicing { total: scene.render.slices });
-        SliceJob { target: 0, size: [width, height], range: 0..scene.render.slices, clear: true, uniforms }
+        let uniforms = VolumeUniforms::new(
+            scene,
+            &scene.camera,
+            &data.grid,
+            width as f32 / height as f32,
+            Slicing {
+                total: scene.render.slices,
+            },
+        );
+        SliceJob {
+            target: 0,
+            size: [width, height],
+            range: 0..scene.render.slices,
+            clear: true,
+            uniforms,
+        }
     }
 
     /// Records slices and composite into a new output texture.
@@ -154,7 +204,11 @@ impl Offscreen {
         let [width, height] = job.size;
         let output = self.device.create_texture(&wgpu::TextureDescriptor {
             label: Some("offscreen output"),
-            size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+            size: wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
             mip_level_count: 1,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
@@ -163,8 +217,13 @@ impl Offscreen {
             view_formats: &[],
         });
         let view = output.create_view(&wgpu::TextureViewDescriptor::default());
-        let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("offscreen") });
-        self.renderer.draw_slices_with(&self.device, &self.queue, &mut encoder, job, pipeline);
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("offscreen"),
+            });
+        self.renderer
+            .draw_slices_with(&self.device, &self.queue, &mut encoder, job, pipeline);
         {
             let [r, g, b] = background.map(|v| v as f64);
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -173,7 +232,10 @@ impl Offscreen {
                     view: &view,
                     depth_slice: None,
                     resolve_target: None,
-                    ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color { r, g, b, a: 1.0 }), store: wgpu::StoreOp::Store },
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color { r, g, b, a: 1.0 }),
+                        store: wgpu::StoreOp::Store,
+                    },
                 })],
                 depth_stencil_attachment: None,
                 timestamp_writes: None,
@@ -187,7 +249,8 @@ impl Offscreen {
 
     fn draw(&mut self, job: &SliceJob, background: [f32; 3]) -> Result<Image, OffscreenError> {
         let [width, height] = job.size;
-        let row = (width * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let row = (width * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
+            * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
         let readback = self.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("offscreen readback"),
             size: (row * height) as u64,
@@ -196,12 +259,25 @@ impl Offscreen {
         });
         let (mut encoder, output) = self.encode(job, background, None);
         encoder.copy_texture_to_buffer(
-            wgpu::TexelCopyTextureInfo { texture: &output, mip_level: 0, origin: wgpu::Origin3d::ZERO, aspect: wgpu::TextureAspect::All },
+            wgpu::TexelCopyTextureInfo {
+                texture: &output,
+                mip_level: 0,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
             wgpu::TexelCopyBufferInfo {
                 buffer: &readback,
-                layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row), rows_per_image: Some(height) },
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(row),
+                    rows_per_image: Some(height),
+                },
             },
-            wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+            wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
         );
         self.queue.submit([encoder.finish()]);
         let slice = readback.slice(..);
@@ -209,11 +285,15 @@ impl Offscreen {
         slice.map_async(wgpu::MapMode::Read, move |r| {
             let _ = tx.send(r);
         });
-        self.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| OffscreenError::Readback(e.to_string()))?;
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| OffscreenError::Readback(e.to_string()))?;
         rx.recv()
             .map_err(|e| OffscreenError::Readback(e.to_string()))?
             .map_err(|e| OffscreenError::Readback(e.to_string()))?;
-        let mapped = slice.get_mapped_range().map_err(|e| OffscreenError::Readback(e.to_string()))?;
+        let mapped = slice
+            .get_mapped_range()
+            .map_err(|e| OffscreenError::Readback(e.to_string()))?;
         let mut rgba = Vec::with_capacity((width * height * 4) as usize);
         for y in 0..height as usize {
             let start = y * row as usize;
@@ -221,7 +301,10 @@ impl Offscreen {
         }
         drop(mapped);
         readback.unmap();
-        Ok(Image { width, height, rgba })
+        Ok(Image {
+            width,
+            height,
+            rgba,
+        })
     }
 }
-

@@ -36,7 +36,12 @@ impl egui_wgpu::CallbackTrait for ViewportPaint {
         Vec::new()
     }
 
-    fn paint(&self, _info: egui::PaintCallbackInfo, pass: &mut wgpu::RenderPass<'static>, resources: &egui_wgpu::CallbackResources) {
+    fn paint(
+        &self,
+        _info: egui::PaintCallbackInfo,
+        pass: &mut wgpu::RenderPass<'static>,
+        resources: &egui_wgpu::CallbackResources,
+    ) {
         if let (Some(renderer), Some(target)) = (resources.get::<VolumeRenderer>(), self.display) {
             renderer.composite(pass, target);
         }
@@ -56,7 +61,11 @@ pub struct BackendInfo {
 pub fn install(render_state: &egui_wgpu::RenderState) -> BackendInfo {
     let format = accumulation_format(&render_state.adapter);
     let renderer = VolumeRenderer::new(&render_state.device, render_state.target_format, format);
-    render_state.renderer.write().callback_resources.insert(renderer);
+    render_state
+        .renderer
+        .write()
+        .callback_resources
+        .insert(renderer);
     let info = render_state.adapter.get_info();
     let backend = match info.backend {
         wgpu::Backend::BrowserWebGpu => "webgpu",
@@ -67,7 +76,11 @@ pub fn install(render_state: &egui_wgpu::RenderState) -> BackendInfo {
         wgpu::Backend::Dx12 => "dx12",
         _ => "other",
     };
-    let adapter = if info.name.is_empty() { format!("{:?}", info.backend) } else { info.name.clone() };
+    let adapter = if info.name.is_empty() {
+        format!("{:?}", info.backend)
+    } else {
+        info.name.clone()
+    };
     log::info!("graphics: {backend} on {adapter} (volume accumulates in {format:?})");
     BackendInfo { backend, adapter }
 }

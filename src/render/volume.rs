@@ -18,8 +18,11 @@ pub mod shaders {
     /// `shaders/plain_slices.wgsl` (the benchmark baseline).
     pub const PLAIN_SLICES: &str = include_str!("../../shaders/plain_slices.wgsl");
     /// Every shader file with its name (for validation).
-    pub const ALL: [(&str, &str); 3] =
-        [("volume.wgsl", VOLUME), ("composite.wgsl", COMPOSITE), ("plain_slices.wgsl", PLAIN_SLICES)];
+    pub const ALL: [(&str, &str); 3] = [
+        ("volume.wgsl", VOLUME),
+        ("composite.wgsl", COMPOSITE),
+        ("plain_slices.wgsl", PLAIN_SLICES),
+    ];
 }
 
 /// The field grid and noise seed a frame draws, with a generation that changes when they do.
@@ -84,9 +87,18 @@ pub struct VolumeRenderer {
 /// (smooth gradients over many faint slices), 8-bit otherwise (plain WebGL2).
 pub fn accumulation_format(adapter: &wgpu::Adapter) -> wgpu::TextureFormat {
     let f = adapter.get_texture_format_features(wgpu::TextureFormat::Rgba16Float);
-    let ok = f.allowed_usages.contains(wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING)
-        && f.flags.contains(wgpu::TextureFormatFeatureFlags::BLENDABLE | wgpu::TextureFormatFeatureFlags::FILTERABLE);
-    if ok { wgpu::TextureFormat::Rgba16Float } else { wgpu::TextureFormat::Rgba8Unorm }
+    let ok = f
+        .allowed_usages
+        .contains(wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING)
+        && f.flags.contains(
+            wgpu::TextureFormatFeatureFlags::BLENDABLE
+                | wgpu::TextureFormatFeatureFlags::FILTERABLE,
+        );
+    if ok {
+        wgpu::TextureFormat::Rgba16Float
+    } else {
+        wgpu::TextureFormat::Rgba8Unorm
+    }
 }
 
 fn texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
@@ -115,7 +127,11 @@ fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGrou
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility,
-        ty: wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Uniform, has_dynamic_offset: false, min_binding_size: None },
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
         count: None,
     }
 }
@@ -178,7 +194,11 @@ fn pipeline(
 
 impl VolumeRenderer {
     /// Creates pipelines for compositing into `output_format`, accumulating in `accum_format`.
-    pub fn new(device: &wgpu::Device, output_format: wgpu::TextureFormat, accum_format: wgpu::TextureFormat) -> Self {
+    pub fn new(
+        device: &wgpu::Device,
+        output_format: wgpu::TextureFormat,
+        accum_format: wgpu::TextureFormat,
+    ) -> Self {
         let volume_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("volume"),
             entries: &[
@@ -206,8 +226,20 @@ impl VolumeRenderer {
                 sampler_entry(2),
             ],
         });
-        let slice_pipeline = pipeline(device, "volume slices", shaders::VOLUME, &volume_layout, accum_format);
-        let composite_pipeline = pipeline(device, "volume composite", shaders::COMPOSITE, &composite_layout, output_format);
+        let slice_pipeline = pipeline(
+            device,
+            "volume slices",
+            shaders::VOLUME,
+            &volume_layout,
+            accum_format,
+        );
+        let composite_pipeline = pipeline(
+            device,
+            "volume composite",
+            shaders::COMPOSITE,
+            &composite_layout,
+            output_format,
+        );
         let volume_uniforms = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("volume uniforms"),
             size: std::mem::size_of::<VolumeUniforms>() as u64,
@@ -216,7 +248,9 @@ impl VolumeRenderer {
         });
         let composite_uniforms = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("composite uniforms"),
-            contents: bytemuck::bytes_of(&CompositeUniforms { params: [1.0, 0.0, 0.0, 0.0] }),
+            contents: bytemuck::bytes_of(&CompositeUniforms {
+                params: [1.0, 0.0, 0.0, 0.0],
+            }),
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         });
         let sampler = |mode: wgpu::AddressMode| {
@@ -253,34 +287,85 @@ impl VolumeRenderer {
 
     /// Uploads the field grid and noise volume if they changed since the last call.
     pub fn upload(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, data: &VolumeData) {
-        if self.field.as_ref().is_some_and(|f| f.generation == data.generation && f.noise_seed == data.noise_seed) {
+        if self
+            .field
+            .as_ref()
+            .is_some_and(|f| f.generation == data.generation && f.noise_seed == data.noise_seed)
+        {
             return;
         }
-        if self.noise.as_ref().is_none_or(|(seed, _)| *seed != data.noise_seed) {
+        if self
+            .noise
+            .as_ref()
+            .is_none_or(|(seed, _)| *seed != data.noise_seed)
+        {
             let n = NOISE_SIZE;
-            let view = upload_3d(device, queue, "noise", [n, n, n], wgpu::TextureFormat::R8Unorm, &noise_volume(data.noise_seed));
+            let view = upload_3d(
+                device,
+                queue,
+                "noise",
+                [n, n, n],
+                wgpu::TextureFormat::R8Unorm,
+                &noise_volume(data.noise_seed),
+            );
             self.noise = Some((data.noise_seed, view));
         }
         let grid = &data.grid;
         let empty = grid.is_empty();
         let field_view = if empty {
-            upload_3d(device, queue, "field", [1, 1, 1], wgpu::TextureFormat::Rg8Unorm, &[0, 255])
+            upload_3d(
+                device,
+                queue,
+                "field",
+                [1, 1, 1],
+                wgpu::TextureFormat::Rg8Unorm,
+                &[0, 255],
+            )
         } else {
-            upload_3d(device, queue, "field", grid.dims.to_array(), wgpu::TextureFormat::Rg8Unorm, &grid.texels)
+            upload_3d(
+                device,
+                queue,
+                "field",
+                grid.dims.to_array(),
+                wgpu::TextureFormat::Rg8Unorm,
+                &grid.texels,
+            )
         };
-        let Some((_, noise_view)) = &self.noise else { return };
+        let Some((_, noise_view)) = &self.noise else {
+            return;
+        };
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("volume"),
             layout: &self.volume_layout,
             entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: self.volume_uniforms.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&field_view) },
-                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&self.clamp_sampler) },
-                wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(noise_view) },
-                wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::Sampler(&self.repeat_sampler) },
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: self.volume_uniforms.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(&field_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: wgpu::BindingResource::Sampler(&self.clamp_sampler),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: wgpu::BindingResource::TextureView(noise_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: wgpu::BindingResource::Sampler(&self.repeat_sampler),
+                },
             ],
         });
-        self.field = Some(UploadedField { generation: data.generation, noise_seed: data.noise_seed, bind_group, empty });
+        self.field = Some(UploadedField {
+            generation: data.generation,
+            noise_seed: data.noise_seed,
+            bind_group,
+            empty,
+        });
     }
 
     fn ensure_target(&mut self, device: &wgpu::Device, index: usize, size: [u32; 2]) {
@@ -290,7 +375,11 @@ impl VolumeRenderer {
         }
         let texture = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("volume accumulation"),
-            size: wgpu::Extent3d { width: size[0], height: size[1], depth_or_array_layers: 1 },
+            size: wgpu::Extent3d {
+                width: size[0],
+                height: size[1],
+                depth_or_array_layers: 1,
+            },
             mip_level_count: 1,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
@@ -303,22 +392,47 @@ impl VolumeRenderer {
             label: Some("composite"),
             layout: &self.composite_layout,
             entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: self.composite_uniforms.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&view) },
-                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&self.clamp_sampler) },
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: self.composite_uniforms.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(&view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: wgpu::BindingResource::Sampler(&self.clamp_sampler),
+                },
             ],
         });
-        self.targets[index] = Some(Target { size, view, composite_bind_group });
+        self.targets[index] = Some(Target {
+            size,
+            view,
+            composite_bind_group,
+        });
     }
 
     /// A pipeline for the benchmark baseline (`shaders/plain_slices.wgsl`), for
     /// [`VolumeRenderer::draw_slices_with`].
     pub fn baseline_pipeline(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
-        pipeline(device, "plain slices (baseline)", shaders::PLAIN_SLICES, &self.volume_layout, self.accum_format)
+        pipeline(
+            device,
+            "plain slices (baseline)",
+            shaders::PLAIN_SLICES,
+            &self.volume_layout,
+            self.accum_format,
+        )
     }
 
     /// Records one volume draw (see [`SliceJob`]). Call [`VolumeRenderer::upload`] first.
-    pub fn draw_slices(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, encoder: &mut wgpu::CommandEncoder, job: &SliceJob) {
+    pub fn draw_slices(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        job: &SliceJob,
+    ) {
         self.draw_slices_with(device, queue, encoder, job, None);
     }
 
@@ -333,8 +447,14 @@ impl VolumeRenderer {
     ) {
         let index = job.target.min(TARGETS - 1);
         self.ensure_target(device, index, job.size);
-        queue.write_buffer(&self.volume_uniforms, 0, bytemuck::bytes_of(&job.uniforms.starting_at(job.range.start)));
-        let (Some(target), Some(field)) = (&self.targets[index], &self.field) else { return };
+        queue.write_buffer(
+            &self.volume_uniforms,
+            0,
+            bytemuck::bytes_of(&job.uniforms.starting_at(job.range.start)),
+        );
+        let (Some(target), Some(field)) = (&self.targets[index], &self.field) else {
+            return;
+        };
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("volume slices"),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -342,7 +462,11 @@ impl VolumeRenderer {
                 depth_slice: None,
                 resolve_target: None,
                 ops: wgpu::Operations {
-                    load: if job.clear { wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT) } else { wgpu::LoadOp::Load },
+                    load: if job.clear {
+                        wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT)
+                    } else {
+                        wgpu::LoadOp::Load
+                    },
                     store: wgpu::StoreOp::Store,
                 },
             })],
@@ -363,7 +487,9 @@ impl VolumeRenderer {
 
     /// Draws accumulation target `index` over the current render pass's viewport.
     pub fn composite(&self, pass: &mut wgpu::RenderPass<'_>, index: usize) {
-        let Some(target) = self.targets.get(index).and_then(|t| t.as_ref()) else { return };
+        let Some(target) = self.targets.get(index).and_then(|t| t.as_ref()) else {
+            return;
+        };
         pass.set_pipeline(&self.composite_pipeline);
         pass.set_bind_group(0, &target.composite_bind_group, &[]);
         pass.draw(0..3, 0..1);
@@ -380,7 +506,11 @@ fn upload_3d(
 ) -> wgpu::TextureView {
     let texture = device.create_texture(&wgpu::TextureDescriptor {
         label: Some(label),
-        size: wgpu::Extent3d { width: dims[0], height: dims[1], depth_or_array_layers: dims[2] },
+        size: wgpu::Extent3d {
+            width: dims[0],
+            height: dims[1],
+            depth_or_array_layers: dims[2],
+        },
         mip_level_count: 1,
         sample_count: 1,
         dimension: wgpu::TextureDimension::D3,
@@ -390,10 +520,23 @@ fn upload_3d(
     });
     let bytes_per_texel = format.block_copy_size(None).unwrap_or(1);
     queue.write_texture(
-        wgpu::TexelCopyTextureInfo { texture: &texture, mip_level: 0, origin: wgpu::Origin3d::ZERO, aspect: wgpu::TextureAspect::All },
+        wgpu::TexelCopyTextureInfo {
+            texture: &texture,
+            mip_level: 0,
+            origin: wgpu::Origin3d::ZERO,
+            aspect: wgpu::TextureAspect::All,
+        },
         data,
-        wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(dims[0] * bytes_per_texel), rows_per_image: Some(dims[1]) },
-        wgpu::Extent3d { width: dims[0], height: dims[1], depth_or_array_layers: dims[2] },
+        wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(dims[0] * bytes_per_texel),
+            rows_per_image: Some(dims[1]),
+        },
+        wgpu::Extent3d {
+            width: dims[0],
+            height: dims[1],
+            depth_or_array_layers: dims[2],
+        },
     );
     texture.create_view(&wgpu::TextureViewDescriptor::default())
 }

@@ -23,7 +23,13 @@ pub struct OrbitCamera {
 
 impl Default for OrbitCamera {
     fn default() -> Self {
-        Self { target: Vec3::new(0.0, 3.0, 0.0), yaw_deg: 0.0, pitch_deg: 8.0, distance: 19.0, fov_y_deg: 45.0 }
+        Self {
+            target: Vec3::new(0.0, 3.0, 0.0),
+            yaw_deg: 0.0,
+            pitch_deg: 8.0,
+            distance: 19.0,
+            fov_y_deg: 45.0,
+        }
     }
 }
 
@@ -67,7 +73,11 @@ impl OrbitCamera {
     /// Unit vector from the target toward the eye.
     fn back(&self) -> Vec3 {
         let (yaw, pitch) = (self.yaw_deg.to_radians(), self.pitch_deg.to_radians());
-        Vec3::new(pitch.cos() * yaw.sin(), pitch.sin(), pitch.cos() * yaw.cos())
+        Vec3::new(
+            pitch.cos() * yaw.sin(),
+            pitch.sin(),
+            pitch.cos() * yaw.cos(),
+        )
     }
 
     /// Unit view direction.
@@ -110,8 +120,13 @@ impl OrbitCamera {
     /// (x right, y up, both in −1..1).
     pub fn ray(&self, ndc: Vec2, aspect: f32) -> Ray {
         let tan = (self.fov_y_deg.to_radians() * 0.5).tan();
-        let dir = self.forward() + self.right() * (ndc.x * tan * aspect.max(1e-3)) + self.up() * (ndc.y * tan);
-        Ray { origin: self.eye(), dir: dir.normalize() }
+        let dir = self.forward()
+            + self.right() * (ndc.x * tan * aspect.max(1e-3))
+            + self.up() * (ndc.y * tan);
+        Ray {
+            origin: self.eye(),
+            dir: dir.normalize(),
+        }
     }
 
     /// Projects a world point to normalised device coordinates; `None` behind the camera.
@@ -124,12 +139,14 @@ impl OrbitCamera {
     pub fn orbit(&mut self, delta_px: Vec2) {
         const DEG_PER_PX: f32 = 0.35;
         self.yaw_deg = (self.yaw_deg - delta_px.x * DEG_PER_PX).rem_euclid(360.0);
-        self.pitch_deg = (self.pitch_deg + delta_px.y * DEG_PER_PX).clamp(-PITCH_LIMIT, PITCH_LIMIT);
+        self.pitch_deg =
+            (self.pitch_deg + delta_px.y * DEG_PER_PX).clamp(-PITCH_LIMIT, PITCH_LIMIT);
     }
 
     /// Pans so the point under the pointer follows it; `viewport_height_px` scales pixels to world.
     pub fn pan(&mut self, delta_px: Vec2, viewport_height_px: f32) {
-        let world_per_px = 2.0 * self.distance * (self.fov_y_deg.to_radians() * 0.5).tan() / viewport_height_px.max(1.0);
+        let world_per_px = 2.0 * self.distance * (self.fov_y_deg.to_radians() * 0.5).tan()
+            / viewport_height_px.max(1.0);
         self.target += (-self.right() * delta_px.x + self.up() * delta_px.y) * world_per_px;
     }
 
@@ -146,7 +163,8 @@ impl OrbitCamera {
         let half_fov_x = (half_fov_y.tan() * aspect.clamp(0.1, 10.0)).atan();
         let half = half_fov_y.min(half_fov_x).max(0.05);
         self.target = center;
-        self.distance = (radius.max(1e-3) / half.sin() * 1.05).clamp(DISTANCE_RANGE.0, DISTANCE_RANGE.1);
+        self.distance =
+            (radius.max(1e-3) / half.sin() * 1.05).clamp(DISTANCE_RANGE.0, DISTANCE_RANGE.1);
     }
 
     pub(super) fn sanitize(&mut self) {
@@ -156,7 +174,8 @@ impl OrbitCamera {
         }
         self.yaw_deg = finite_or(self.yaw_deg, d.yaw_deg).rem_euclid(360.0);
         self.pitch_deg = finite_or(self.pitch_deg, d.pitch_deg).clamp(-PITCH_LIMIT, PITCH_LIMIT);
-        self.distance = finite_or(self.distance, d.distance).clamp(DISTANCE_RANGE.0, DISTANCE_RANGE.1);
+        self.distance =
+            finite_or(self.distance, d.distance).clamp(DISTANCE_RANGE.0, DISTANCE_RANGE.1);
         self.fov_y_deg = finite_or(self.fov_y_deg, d.fov_y_deg).clamp(5.0, 120.0);
     }
 }
@@ -167,7 +186,11 @@ mod tests {
 
     #[test]
     fn basis_is_orthonormal_and_looks_at_target() {
-        let cam = OrbitCamera { yaw_deg: 37.0, pitch_deg: -20.0, ..Default::default() };
+        let cam = OrbitCamera {
+            yaw_deg: 37.0,
+            pitch_deg: -20.0,
+            ..Default::default()
+        };
         let (f, r, u) = (cam.forward(), cam.right(), cam.up());
         for v in [f, r, u] {
             assert!((v.length() - 1.0).abs() < 1e-5);
@@ -178,7 +201,11 @@ mod tests {
 
     #[test]
     fn target_projects_to_centre_and_ray_round_trips() {
-        let cam = OrbitCamera { yaw_deg: 123.0, pitch_deg: 30.0, ..Default::default() };
+        let cam = OrbitCamera {
+            yaw_deg: 123.0,
+            pitch_deg: 30.0,
+            ..Default::default()
+        };
         let aspect = 1.6;
         let c = cam.project(cam.target, aspect).unwrap();
         assert!(c.length() < 1e-5, "{c}");
@@ -205,7 +232,10 @@ mod tests {
         cam.pan(Vec2::new(50.0, 0.0), 500.0);
         let moved = cam.target - before;
         assert!(moved.dot(cam.forward()).abs() < 1e-4);
-        assert!(moved.dot(cam.right()) < 0.0, "drag right moves the scene right, so the target goes left");
+        assert!(
+            moved.dot(cam.right()) < 0.0,
+            "drag right moves the scene right, so the target goes left"
+        );
     }
 
     #[test]
@@ -223,7 +253,10 @@ mod tests {
 
     #[test]
     fn plane_hit() {
-        let ray = Ray { origin: Vec3::ZERO, dir: Vec3::NEG_Z };
+        let ray = Ray {
+            origin: Vec3::ZERO,
+            dir: Vec3::NEG_Z,
+        };
         assert_eq!(ray.hit_plane(Vec3::new(0.0, 0.0, -5.0), Vec3::Z), Some(5.0));
         assert_eq!(ray.hit_plane(Vec3::new(0.0, 0.0, 5.0), Vec3::Z), None);
         assert_eq!(ray.hit_plane(Vec3::new(0.0, 0.0, -5.0), Vec3::X), None);

@@ -59,7 +59,12 @@ impl History {
     /// Applies `edit` to `scene` and records an undo step. Edits that share a `merge_key` with
     /// the previous one (the same slider being dragged) fold into one step. Returns whether the
     /// document changed.
-    pub fn apply(&mut self, scene: &mut Scene, edit: Edit, merge_key: Option<&'static str>) -> bool {
+    pub fn apply(
+        &mut self,
+        scene: &mut Scene,
+        edit: Edit,
+        merge_key: Option<&'static str>,
+    ) -> bool {
         let before = scene.clone();
         if !edit.apply_to(scene) || *scene == before {
             return false;
@@ -92,8 +97,14 @@ impl History {
     }
 
     fn step(&mut self, scene: &mut Scene, back: bool) -> bool {
-        let (from, to) = if back { (&mut self.undo, &mut self.redo) } else { (&mut self.redo, &mut self.undo) };
-        let Some(mut prev) = from.pop() else { return false };
+        let (from, to) = if back {
+            (&mut self.undo, &mut self.redo)
+        } else {
+            (&mut self.redo, &mut self.undo)
+        };
+        let Some(mut prev) = from.pop() else {
+            return false;
+        };
         prev.camera = scene.camera.clone();
         to.push(std::mem::replace(scene, prev));
         self.last_key = None;

@@ -76,16 +76,24 @@ pub enum Preset {
 
 impl Preset {
     /// All presets with their names.
-    pub const ALL: [(Preset, &'static str); 2] = [(Preset::Cumulus, "cumulus"), (Preset::Empty, "empty")];
+    pub const ALL: [(Preset, &'static str); 2] =
+        [(Preset::Cumulus, "cumulus"), (Preset::Empty, "empty")];
 
     /// Looks a preset up by name.
     pub fn from_name(name: &str) -> Option<Preset> {
-        Self::ALL.iter().find(|(_, n)| n.eq_ignore_ascii_case(name)).map(|(p, _)| *p)
+        Self::ALL
+            .iter()
+            .find(|(_, n)| n.eq_ignore_ascii_case(name))
+            .map(|(p, _)| *p)
     }
 
     /// The preset's name.
     pub fn name(self) -> &'static str {
-        Self::ALL.iter().find(|(p, _)| *p == self).map(|(_, n)| *n).unwrap_or("cumulus")
+        Self::ALL
+            .iter()
+            .find(|(p, _)| *p == self)
+            .map(|(_, n)| *n)
+            .unwrap_or("cumulus")
     }
 }
 
@@ -123,11 +131,18 @@ impl Scene {
     /// Like [`Scene::from_json`] for an already parsed value.
     pub fn from_value(value: serde_json::Value) -> Result<Self, SceneError> {
         if !value.is_object() {
-            return Err(SceneError::Invalid("a scene document is a JSON object".into()));
+            return Err(SceneError::Invalid(
+                "a scene document is a JSON object".into(),
+            ));
         }
-        let found = value.get("version").and_then(|v| v.as_u64()).unwrap_or(SCENE_VERSION as u64);
+        let found = value
+            .get("version")
+            .and_then(|v| v.as_u64())
+            .unwrap_or(SCENE_VERSION as u64);
         if found > SCENE_VERSION as u64 {
-            return Err(SceneError::TooNew { found: found.min(u32::MAX as u64) as u32 });
+            return Err(SceneError::TooNew {
+                found: found.min(u32::MAX as u64) as u32,
+            });
         }
         let mut scene: Scene = serde_json::from_value(value)?;
         scene.version = SCENE_VERSION;
@@ -150,15 +165,26 @@ impl Scene {
             )));
         }
         for (i, e) in self.ellipsoids.iter().enumerate() {
-            if !(e.center.is_finite() && e.radii.is_finite() && e.rotation.is_finite() && e.strength.is_finite()) {
-                return Err(SceneError::Invalid(format!("ellipsoid {i} has a non-finite value")));
+            if !(e.center.is_finite()
+                && e.radii.is_finite()
+                && e.rotation.is_finite()
+                && e.strength.is_finite())
+            {
+                return Err(SceneError::Invalid(format!(
+                    "ellipsoid {i} has a non-finite value"
+                )));
             }
             if e.radii.min_element() <= 0.0 {
-                return Err(SceneError::Invalid(format!("ellipsoid {i} has a radius ≤ 0")));
+                return Err(SceneError::Invalid(format!(
+                    "ellipsoid {i} has a radius ≤ 0"
+                )));
             }
         }
         if self.planes.len() > MAX_PLANES {
-            return Err(SceneError::Invalid(format!("{} drawing planes (at most {MAX_PLANES})", self.planes.len())));
+            return Err(SceneError::Invalid(format!(
+                "{} drawing planes (at most {MAX_PLANES})",
+                self.planes.len()
+            )));
         }
         for (i, plane) in self.planes.iter_mut().enumerate() {
             plane.validate(i).map_err(SceneError::Invalid)?;
@@ -193,7 +219,12 @@ impl Default for Ellipsoid {
 impl Ellipsoid {
     /// An axis-aligned ellipsoid of unit strength.
     pub fn new(center: Vec3, radii: Vec3) -> Self {
-        Self { center, radii, rotation: Quat::IDENTITY, strength: 1.0 }
+        Self {
+            center,
+            radii,
+            rotation: Quat::IDENTITY,
+            strength: 1.0,
+        }
     }
 }
 
@@ -234,7 +265,10 @@ impl Default for Lighting {
 impl Lighting {
     /// Unit vector pointing from the scene toward the sun.
     pub fn sun_direction(&self) -> Vec3 {
-        let (az, el) = (self.sun_azimuth_deg.to_radians(), self.sun_elevation_deg.to_radians());
+        let (az, el) = (
+            self.sun_azimuth_deg.to_radians(),
+            self.sun_elevation_deg.to_radians(),
+        );
         Vec3::new(el.cos() * az.cos(), el.sin(), el.cos() * az.sin()).normalize_or(Vec3::Y)
     }
 
@@ -243,7 +277,11 @@ impl Lighting {
         self.sun_azimuth_deg = finite_or(self.sun_azimuth_deg, 20.0).rem_euclid(360.0);
         self.sun_intensity = finite_or(self.sun_intensity, 1.6).clamp(0.0, 20.0);
         self.ambient = finite_or(self.ambient, 0.45).clamp(0.0, 5.0);
-        for c in [&mut self.sun_color, &mut self.sky_color, &mut self.background] {
+        for c in [
+            &mut self.sun_color,
+            &mut self.sky_color,
+            &mut self.background,
+        ] {
             for v in c.iter_mut() {
                 *v = finite_or(*v, 0.5).clamp(0.0, 1.0);
             }
@@ -301,8 +339,12 @@ impl Default for RenderSettings {
 impl RenderSettings {
     fn sanitize(&mut self) {
         self.slices = self.slices.clamp(limits::SLICES.0, limits::SLICES.1);
-        self.field_resolution = self.field_resolution.clamp(limits::FIELD_RESOLUTION.0, limits::FIELD_RESOLUTION.1);
-        self.noise_octaves = self.noise_octaves.clamp(limits::OCTAVES.0, limits::OCTAVES.1);
+        self.field_resolution = self
+            .field_resolution
+            .clamp(limits::FIELD_RESOLUTION.0, limits::FIELD_RESOLUTION.1);
+        self.noise_octaves = self
+            .noise_octaves
+            .clamp(limits::OCTAVES.0, limits::OCTAVES.1);
         self.opacity = finite_or(self.opacity, 2.5).clamp(0.0, 100.0);
         self.noise_amount = finite_or(self.noise_amount, 0.35).clamp(0.0, 1.0);
         self.noise_scale = finite_or(self.noise_scale, 3.0).clamp(0.05, 1000.0);
@@ -341,7 +383,13 @@ mod tests {
 
     #[test]
     fn malformed_documents_give_errors_not_panics() {
-        for text in ["", "[]", "{", r#"{"ellipsoids": 3}"#, r#"{"ellipsoids":[{"radii":[0,1,1]}]}"#] {
+        for text in [
+            "",
+            "[]",
+            "{",
+            r#"{"ellipsoids": 3}"#,
+            r#"{"ellipsoids":[{"radii":[0,1,1]}]}"#,
+        ] {
             assert!(Scene::from_json(text).is_err(), "{text:?} accepted");
         }
     }
@@ -355,7 +403,11 @@ mod tests {
 
     #[test]
     fn sun_direction_follows_angles() {
-        let mut l = Lighting { sun_azimuth_deg: 0.0, sun_elevation_deg: 0.0, ..Default::default() };
+        let mut l = Lighting {
+            sun_azimuth_deg: 0.0,
+            sun_elevation_deg: 0.0,
+            ..Default::default()
+        };
         assert!(l.sun_direction().abs_diff_eq(Vec3::X, 1e-6));
         l.sun_elevation_deg = 90.0;
         assert!(l.sun_direction().abs_diff_eq(Vec3::Y, 1e-6));

@@ -83,7 +83,10 @@ impl DrawingPlane {
 
     /// The stroke as f64 pairs for the sketch pipeline.
     pub fn stroke(&self) -> Vec<[f64; 2]> {
-        self.points.iter().map(|p| [p.x as f64, p.y as f64]).collect()
+        self.points
+            .iter()
+            .map(|p| [p.x as f64, p.y as f64])
+            .collect()
     }
 
     /// Plane coordinates of a world point projected onto the plane.
@@ -94,12 +97,37 @@ impl DrawingPlane {
 
     /// A plane through `origin` facing the viewer of a camera with the given right/up axes,
     /// holding `world_points` (which should lie on it), re-centred on their centroid.
-    pub fn facing(name: String, kind: StrokeKind, origin: Vec3, right: Vec3, up: Vec3, world_points: &[Vec3], seed: u64) -> Self {
+    pub fn facing(
+        name: String,
+        kind: StrokeKind,
+        origin: Vec3,
+        right: Vec3,
+        up: Vec3,
+        world_points: &[Vec3],
+        seed: u64,
+    ) -> Self {
         let normal = right.cross(up).normalize_or(Vec3::Z);
-        let rotation = Quat::from_mat3(&glam::Mat3::from_cols(right.normalize_or(Vec3::X), normal.cross(right).normalize_or(Vec3::Y), normal));
-        let mut plane = Self { name, kind, origin, rotation, points: Vec::new(), closed: kind == StrokeKind::Outline, sketch: SketchParams::default(), seed };
+        let rotation = Quat::from_mat3(&glam::Mat3::from_cols(
+            right.normalize_or(Vec3::X),
+            normal.cross(right).normalize_or(Vec3::Y),
+            normal,
+        ));
+        let mut plane = Self {
+            name,
+            kind,
+            origin,
+            rotation,
+            points: Vec::new(),
+            closed: kind == StrokeKind::Outline,
+            sketch: SketchParams::default(),
+            seed,
+        };
         let local: Vec<Vec2> = world_points.iter().map(|&p| plane.to_plane(p)).collect();
-        let centre = if local.is_empty() { Vec2::ZERO } else { local.iter().copied().sum::<Vec2>() / local.len() as f32 };
+        let centre = if local.is_empty() {
+            Vec2::ZERO
+        } else {
+            local.iter().copied().sum::<Vec2>() / local.len() as f32
+        };
         plane.origin = plane.to_world(centre.extend(0.0));
         plane.points = local.into_iter().map(|p| p - centre).collect();
         plane
@@ -107,9 +135,15 @@ impl DrawingPlane {
 
     pub(super) fn validate(&mut self, index: usize) -> Result<(), String> {
         if self.points.len() > MAX_PLANE_POINTS {
-            return Err(format!("plane {index} has {} points (at most {MAX_PLANE_POINTS})", self.points.len()));
+            return Err(format!(
+                "plane {index} has {} points (at most {MAX_PLANE_POINTS})",
+                self.points.len()
+            ));
         }
-        if !(self.origin.is_finite() && self.rotation.is_finite() && self.points.iter().all(|p| p.is_finite())) {
+        if !(self.origin.is_finite()
+            && self.rotation.is_finite()
+            && self.points.iter().all(|p| p.is_finite()))
+        {
             return Err(format!("plane {index} has a non-finite value"));
         }
         if self.rotation.length_squared() < 1e-6 {
@@ -123,6 +157,9 @@ impl DrawingPlane {
 
 /// Bounding box centre of plane points (used to re-centre imported strokes).
 pub fn centre_of(points: &[DVec2]) -> DVec2 {
-    let (lo, hi) = points.iter().fold((DVec2::splat(f64::MAX), DVec2::splat(f64::MIN)), |(a, b), &q| (a.min(q), b.max(q)));
+    let (lo, hi) = points.iter().fold(
+        (DVec2::splat(f64::MAX), DVec2::splat(f64::MIN)),
+        |(a, b), &q| (a.min(q), b.max(q)),
+    );
     (lo + hi) * 0.5
 }

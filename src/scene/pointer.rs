@@ -9,7 +9,9 @@ pub enum SetError {
     #[error("expected PATH=VALUE (e.g. /render/slices=256), got {0:?}")]
     Syntax(String),
     /// The pointer names nothing in the document.
-    #[error("no value at {0} in the scene (paths look like /render/slices or /ellipsoids/0/center/1)")]
+    #[error(
+        "no value at {0} in the scene (paths look like /render/slices or /ellipsoids/0/center/1)"
+    )]
     UnknownPath(String),
     /// The new value has the wrong type or is out of range.
     #[error("cannot set {path} to {value}: {reason}")]
@@ -26,7 +28,9 @@ pub enum SetError {
 /// Applies `PATH=VALUE`. VALUE is read as JSON (`256`, `true`, `[1,2,3]`); anything that is not
 /// JSON is taken as a string.
 pub fn set_by_pointer(scene: &Scene, assignment: &str) -> Result<Scene, SetError> {
-    let (path, raw) = assignment.split_once('=').ok_or_else(|| SetError::Syntax(assignment.to_string()))?;
+    let (path, raw) = assignment
+        .split_once('=')
+        .ok_or_else(|| SetError::Syntax(assignment.to_string()))?;
     if !path.starts_with('/') {
         return Err(SetError::Syntax(assignment.to_string()));
     }
@@ -37,7 +41,9 @@ pub fn set_by_pointer(scene: &Scene, assignment: &str) -> Result<Scene, SetError
         value: raw.to_string(),
         reason: e.to_string(),
     })?;
-    let slot = doc.pointer_mut(path).ok_or_else(|| SetError::UnknownPath(path.to_string()))?;
+    let slot = doc
+        .pointer_mut(path)
+        .ok_or_else(|| SetError::UnknownPath(path.to_string()))?;
     let same_kind = std::mem::discriminant(slot) == std::mem::discriminant(&new_value);
     if !same_kind && !(slot.is_number() && new_value.is_number()) {
         return Err(SetError::BadValue {
@@ -86,13 +92,25 @@ mod tests {
     #[test]
     fn unknown_paths_and_wrong_types_are_clear_errors() {
         let s = Scene::default();
-        assert!(matches!(set_by_pointer(&s, "/render/nope=1"), Err(SetError::UnknownPath(_))));
-        assert!(matches!(set_by_pointer(&s, "/ellipsoids/99/center=1"), Err(SetError::UnknownPath(_))));
+        assert!(matches!(
+            set_by_pointer(&s, "/render/nope=1"),
+            Err(SetError::UnknownPath(_))
+        ));
+        assert!(matches!(
+            set_by_pointer(&s, "/ellipsoids/99/center=1"),
+            Err(SetError::UnknownPath(_))
+        ));
         let e = set_by_pointer(&s, "/render/slices=many").unwrap_err();
         assert!(e.to_string().contains("expected a number"), "{e}");
         let e = set_by_pointer(&s, "/render/slices=-3").unwrap_err();
         assert!(matches!(e, SetError::BadValue { .. }), "{e}");
-        assert!(matches!(set_by_pointer(&s, "render/slices"), Err(SetError::Syntax(_))));
-        assert!(matches!(set_by_pointer(&s, "nopath"), Err(SetError::Syntax(_))));
+        assert!(matches!(
+            set_by_pointer(&s, "render/slices"),
+            Err(SetError::Syntax(_))
+        ));
+        assert!(matches!(
+            set_by_pointer(&s, "nopath"),
+            Err(SetError::Syntax(_))
+        ));
     }
 }

@@ -49,14 +49,21 @@ pub struct SketchParams {
 
 impl Default for SketchParams {
     fn default() -> Self {
-        Self { simplify: 0.01, prune: 0.02, inflate: 0.0, extend: true, copies: 2 }
+        Self {
+            simplify: 0.01,
+            prune: 0.02,
+            inflate: 0.0,
+            extend: true,
+            copies: 2,
+        }
     }
 }
 
 impl SketchParams {
     /// Clamps every value into its range (documents and links may carry anything).
     pub fn sanitize(&mut self) {
-        let fix = |v: f64, d: f64, lo: f64, hi: f64| if v.is_finite() { v.clamp(lo, hi) } else { d };
+        let fix =
+            |v: f64, d: f64, lo: f64, hi: f64| if v.is_finite() { v.clamp(lo, hi) } else { d };
         self.simplify = fix(self.simplify, 0.01, 0.0, 0.2);
         self.prune = fix(self.prune, 0.02, 0.0, 0.5);
         self.inflate = fix(self.inflate, 0.0, 0.0, 1.0);
@@ -80,7 +87,12 @@ pub struct Sketch {
 }
 
 /// Interprets a stroke (points in any 2D units) as a cloud outline.
-pub fn interpret(points: &[[f64; 2]], closed: bool, params: &SketchParams, seed: u64) -> Result<Sketch, SketchError> {
+pub fn interpret(
+    points: &[[f64; 2]],
+    closed: bool,
+    params: &SketchParams,
+    seed: u64,
+) -> Result<Sketch, SketchError> {
     let mut params = params.clone();
     params.sanitize();
     // Work around the stroke's centre so far-off coordinates keep their precision.
@@ -89,8 +101,15 @@ pub fn interpret(points: &[[f64; 2]], closed: bool, params: &SketchParams, seed:
         .map(|&[x, y]| DVec2::new(x, y))
         .filter(|p| p.is_finite())
         .fold((DVec2::ZERO, 0usize), |(s, n), p| (s + p, n + 1));
-    let centre = if centre.1 > 0 { centre.0 / centre.1 as f64 } else { DVec2::ZERO };
-    let local: Vec<[f64; 2]> = points.iter().map(|&[x, y]| [x - centre.x, y - centre.y]).collect();
+    let centre = if centre.1 > 0 {
+        centre.0 / centre.1 as f64
+    } else {
+        DVec2::ZERO
+    };
+    let local: Vec<[f64; 2]> = points
+        .iter()
+        .map(|&[x, y]| [x - centre.x, y - centre.y])
+        .collect();
 
     let mut outline = outline::clean(&local, closed, params.simplify)?;
     let skeleton = skeleton::chordal_axis(&outline, params.prune)?;
@@ -116,13 +135,23 @@ pub fn interpret(points: &[[f64; 2]], closed: bool, params: &SketchParams, seed:
     for s in &mut spheres {
         s.center += shift;
     }
-    Ok(Sketch { outline, skeleton, feature_radius, spheres, warnings })
+    Ok(Sketch {
+        outline,
+        skeleton,
+        feature_radius,
+        spheres,
+        warnings,
+    })
 }
 
 /// A cut stroke's line: the drawn points made x-monotone (sorted by x, one height per x), so
 /// "below the line" is well defined. Needs two points spanning some width.
 pub fn cut_line(points: &[[f64; 2]]) -> Result<Vec<DVec2>, SketchError> {
-    let mut pts: Vec<DVec2> = points.iter().map(|&[x, y]| DVec2::new(x, y)).filter(|p| p.is_finite()).collect();
+    let mut pts: Vec<DVec2> = points
+        .iter()
+        .map(|&[x, y]| DVec2::new(x, y))
+        .filter(|p| p.is_finite())
+        .collect();
     if pts.len() > outline::MAX_STROKE_POINTS {
         let step = pts.len() / outline::MAX_STROKE_POINTS + 1;
         pts = pts.into_iter().step_by(step).collect();

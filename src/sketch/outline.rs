@@ -38,7 +38,10 @@ pub fn perimeter(p: &[DVec2]) -> f64 {
 
 /// Diagonal of the bounding box.
 pub fn diagonal(p: &[DVec2]) -> f64 {
-    let (lo, hi) = p.iter().fold((DVec2::splat(f64::MAX), DVec2::splat(f64::MIN)), |(a, b), &q| (a.min(q), b.max(q)));
+    let (lo, hi) = p.iter().fold(
+        (DVec2::splat(f64::MAX), DVec2::splat(f64::MIN)),
+        |(a, b), &q| (a.min(q), b.max(q)),
+    );
     (hi - lo).length()
 }
 
@@ -46,14 +49,20 @@ pub fn diagonal(p: &[DVec2]) -> f64 {
 pub fn segment_distance(q: DVec2, a: DVec2, b: DVec2) -> f64 {
     let ab = b - a;
     let len2 = ab.length_squared();
-    let t = if len2 > 0.0 { ((q - a).dot(ab) / len2).clamp(0.0, 1.0) } else { 0.0 };
+    let t = if len2 > 0.0 {
+        ((q - a).dot(ab) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
     q.distance(a + ab * t)
 }
 
 /// Distance from `q` to a closed polygon's boundary.
 pub fn boundary_distance(q: DVec2, p: &[DVec2]) -> f64 {
     let n = p.len();
-    (0..n).map(|i| segment_distance(q, p[i], p[(i + 1) % n])).fold(f64::INFINITY, f64::min)
+    (0..n)
+        .map(|i| segment_distance(q, p[i], p[(i + 1) % n]))
+        .fold(f64::INFINITY, f64::min)
 }
 
 /// Even–odd point-in-polygon test.
@@ -75,14 +84,26 @@ pub fn contains(p: &[DVec2], q: DVec2) -> bool {
 /// of the outline's bounding-box diagonal.
 pub fn clean(raw: &[[f64; 2]], closed: bool, simplify: f64) -> Result<Outline, SketchError> {
     let mut warnings = Vec::new();
-    let finite: Vec<DVec2> = raw.iter().map(|&[x, y]| DVec2::new(x, y)).filter(|p| p.is_finite()).collect();
+    let finite: Vec<DVec2> = raw
+        .iter()
+        .map(|&[x, y]| DVec2::new(x, y))
+        .filter(|p| p.is_finite())
+        .collect();
     if finite.len() < raw.len() {
-        warnings.push(format!("ignored {} points that were not numbers", raw.len() - finite.len()));
+        warnings.push(format!(
+            "ignored {} points that were not numbers",
+            raw.len() - finite.len()
+        ));
     }
     let mut points = if finite.len() > MAX_STROKE_POINTS {
-        warnings.push(format!("the stroke had {} points; thinned to {MAX_STROKE_POINTS}", finite.len()));
+        warnings.push(format!(
+            "the stroke had {} points; thinned to {MAX_STROKE_POINTS}",
+            finite.len()
+        ));
         let step = finite.len() as f64 / MAX_STROKE_POINTS as f64;
-        (0..MAX_STROKE_POINTS).map(|i| finite[(i as f64 * step) as usize]).collect()
+        (0..MAX_STROKE_POINTS)
+            .map(|i| finite[(i as f64 * step) as usize])
+            .collect()
     } else {
         finite
     };
@@ -146,7 +167,11 @@ pub fn clean(raw: &[[f64; 2]], closed: bool, simplify: f64) -> Result<Outline, S
     if points.len() < 3 || area <= 0.0 {
         return Err(SketchError::NoArea);
     }
-    Ok(Outline { points, area, warnings })
+    Ok(Outline {
+        points,
+        area,
+        warnings,
+    })
 }
 
 /// Removes consecutive points closer than `eps` (the polygon is closed: last vs first too).
@@ -163,7 +188,12 @@ fn douglas_peucker_closed(p: &[DVec2], tolerance: f64) -> Vec<DVec2> {
     if n <= 4 {
         return p.to_vec();
     }
-    let far = (1..n).max_by(|&a, &b| p[0].distance_squared(p[a]).total_cmp(&p[0].distance_squared(p[b]))).unwrap_or(n / 2);
+    let far = (1..n)
+        .max_by(|&a, &b| {
+            p[0].distance_squared(p[a])
+                .total_cmp(&p[0].distance_squared(p[b]))
+        })
+        .unwrap_or(n / 2);
     let mut keep = vec![false; n];
     keep[0] = true;
     keep[far] = true;
@@ -197,8 +227,11 @@ fn douglas_peucker_closed(p: &[DVec2], tolerance: f64) -> Vec<DVec2> {
 /// Resamples a closed polygon evenly, keeping every vertex (the corners of the simplified outline).
 fn resample(p: &[DVec2], tolerance: f64) -> Vec<DVec2> {
     let total = perimeter(p);
-    let target = (total / (tolerance * 2.0).max(total / MAX_OUTLINE_POINTS as f64)).round() as usize;
-    let count = target.clamp(MIN_OUTLINE_POINTS, MAX_OUTLINE_POINTS).max(p.len());
+    let target =
+        (total / (tolerance * 2.0).max(total / MAX_OUTLINE_POINTS as f64)).round() as usize;
+    let count = target
+        .clamp(MIN_OUTLINE_POINTS, MAX_OUTLINE_POINTS)
+        .max(p.len());
     let spacing = total / count as f64;
     let n = p.len();
     let mut out = Vec::with_capacity(count + n);
@@ -221,8 +254,15 @@ fn orient(a: DVec2, b: DVec2, c: DVec2) -> f64 {
 
 /// Where segments `a`–`b` and `c`–`d` meet, touching and overlapping included.
 fn intersection(a: DVec2, b: DVec2, c: DVec2, d: DVec2) -> Option<DVec2> {
-    let (d1, d2, d3, d4) = (orient(c, d, a), orient(c, d, b), orient(a, b, c), orient(a, b, d));
-    if ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0)) && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0)) {
+    let (d1, d2, d3, d4) = (
+        orient(c, d, a),
+        orient(c, d, b),
+        orient(a, b, c),
+        orient(a, b, d),
+    );
+    if ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0))
+        && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0))
+    {
         let t = d1 / (d1 - d2);
         return Some(a + (b - a) * t);
     }
@@ -345,11 +385,27 @@ mod tests {
 
     #[test]
     fn degenerate_strokes_are_refused() {
-        assert!(matches!(clean(&[], true, 0.01), Err(SketchError::TooFewPoints(0))));
-        assert!(matches!(clean(&[[1.0, 1.0], [2.0, 2.0]], true, 0.01), Err(SketchError::TooFewPoints(2))));
+        assert!(matches!(
+            clean(&[], true, 0.01),
+            Err(SketchError::TooFewPoints(0))
+        ));
+        assert!(matches!(
+            clean(&[[1.0, 1.0], [2.0, 2.0]], true, 0.01),
+            Err(SketchError::TooFewPoints(2))
+        ));
         assert!(clean(&[[1.0, 1.0]; 50], true, 0.01).is_err());
         let line: Vec<[f64; 2]> = (0..50).map(|i| [i as f64, 2.0 * i as f64]).collect();
-        assert!(matches!(clean(&line, false, 0.01), Err(SketchError::NoArea)));
-        assert!(clean(&[[f64::NAN, 0.0], [0.0, f64::INFINITY], [1.0, 1.0]], true, 0.01).is_err());
+        assert!(matches!(
+            clean(&line, false, 0.01),
+            Err(SketchError::NoArea)
+        ));
+        assert!(
+            clean(
+                &[[f64::NAN, 0.0], [0.0, f64::INFINITY], [1.0, 1.0]],
+                true,
+                0.01
+            )
+            .is_err()
+        );
     }
 }

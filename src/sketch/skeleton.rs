@@ -122,13 +122,26 @@ fn key(a: usize, b: usize) -> (usize, usize) {
 pub fn chordal_axis(outline: &Outline, prune: f64) -> Result<Skeleton, SketchError> {
     let p = &outline.points;
     let n = p.len();
-    let vertices: Vec<Vertex> = p.iter().enumerate().map(|(index, q)| Vertex { pos: Point2::new(q.x, q.y), index }).collect();
+    let vertices: Vec<Vertex> = p
+        .iter()
+        .enumerate()
+        .map(|(index, q)| Vertex {
+            pos: Point2::new(q.x, q.y),
+            index,
+        })
+        .collect();
     let edges: Vec<[usize; 2]> = (0..n).map(|i| [i, (i + 1) % n]).collect();
     let mut conflicts = 0usize;
-    let cdt = ConstrainedDelaunayTriangulation::<Vertex>::try_bulk_load_cdt(vertices, edges, |_| conflicts += 1)
+    let cdt =
+        ConstrainedDelaunayTriangulation::<Vertex>::try_bulk_load_cdt(vertices, edges, |_| {
+            conflicts += 1
+        })
         .map_err(|e| SketchError::Triangulation(e.to_string()))?;
     if conflicts > 0 || cdt.num_vertices() != n {
-        return Err(SketchError::Triangulation(format!("{conflicts} crossing edges, {} of {n} vertices", cdt.num_vertices())));
+        return Err(SketchError::Triangulation(format!(
+            "{conflicts} crossing edges, {} of {n} vertices",
+            cdt.num_vertices()
+        )));
     }
 
     let mut triangles = Vec::new();
@@ -141,7 +154,10 @@ pub fn chordal_axis(outline: &Outline, prune: f64) -> Result<Skeleton, SketchErr
             continue;
         }
         let v = if area > 0.0 { v } else { [v[0], v[2], v[1]] };
-        triangles.push(Triangle { v, area: area.abs() });
+        triangles.push(Triangle {
+            v,
+            area: area.abs(),
+        });
     }
     if triangles.is_empty() {
         return Err(SketchError::NoArea);
@@ -193,7 +209,10 @@ pub fn chordal_axis(outline: &Outline, prune: f64) -> Result<Skeleton, SketchErr
             }
             let (mut chain, mut prev, mut cur) = (vec![start], usize::MAX, start);
             let end = loop {
-                let next = adj[cur].iter().map(|(s, _)| *s).find(|&s| alive[s] && s != prev);
+                let next = adj[cur]
+                    .iter()
+                    .map(|(s, _)| *s)
+                    .find(|&s| alive[s] && s != prev);
                 let Some(next) = next else { break None };
                 if degree(next, &alive) >= 3 {
                     break Some(next);
@@ -220,9 +239,18 @@ pub fn chordal_axis(outline: &Outline, prune: f64) -> Result<Skeleton, SketchErr
                     }
                     frontier = next;
                 }
-                let discs: Vec<(DVec2, f64)> =
-                    near.iter().map(|&t| *disc_cache.entry(t).or_insert_with(|| largest_disc(&triangles[t], p))).collect();
-                chain.iter().map(|&t| triangles[t].area * outside_fraction(&triangles[t], p, &discs)).sum::<f64>()
+                let discs: Vec<(DVec2, f64)> = near
+                    .iter()
+                    .map(|&t| {
+                        *disc_cache
+                            .entry(t)
+                            .or_insert_with(|| largest_disc(&triangles[t], p))
+                    })
+                    .collect();
+                chain
+                    .iter()
+                    .map(|&t| triangles[t].area * outside_fraction(&triangles[t], p, &discs))
+                    .sum::<f64>()
             });
             if let (Some(junction), Some(area)) = (end, significance)
                 && area < threshold
@@ -231,7 +259,9 @@ pub fn chordal_axis(outline: &Outline, prune: f64) -> Result<Skeleton, SketchErr
                 best = Some((area, chain, junction));
             }
         }
-        let Some((_, chain, junction)) = best else { break };
+        let Some((_, chain, junction)) = best else {
+            break;
+        };
         for t in chain {
             alive[t] = false;
             owner[t] = junction;
@@ -249,7 +279,10 @@ pub fn chordal_axis(outline: &Outline, prune: f64) -> Result<Skeleton, SketchErr
     let mut nodes: Vec<Node> = Vec::new();
     let mut node_of_edge: std::collections::BTreeMap<(usize, usize), usize> = Default::default();
     let node = |nodes: &mut Vec<Node>, pos: DVec2| {
-        nodes.push(Node { pos, radius: boundary_distance(pos, p) });
+        nodes.push(Node {
+            pos,
+            radius: boundary_distance(pos, p),
+        });
         nodes.len() - 1
     };
     for (&e, ts) in &by_edge {
@@ -262,8 +295,11 @@ pub fn chordal_axis(outline: &Outline, prune: f64) -> Result<Skeleton, SketchErr
     let mut segments_of_triangle: Vec<Vec<usize>> = vec![Vec::new(); triangles.len()];
     // Visit triangles in a fixed order so the result does not depend on hash order.
     let live_edges_of = |t: usize| -> Vec<usize> {
-        let mut v: Vec<((usize, usize), usize)> =
-            adj[t].iter().filter(|(s, _)| alive[*s]).map(|(_, e)| (*e, node_of_edge[e])).collect();
+        let mut v: Vec<((usize, usize), usize)> = adj[t]
+            .iter()
+            .filter(|(s, _)| alive[*s])
+            .map(|(_, e)| (*e, node_of_edge[e]))
+            .collect();
         v.sort();
         v.into_iter().map(|(_, id)| id).collect()
     };
@@ -289,7 +325,12 @@ pub fn chordal_axis(outline: &Outline, prune: f64) -> Result<Skeleton, SketchErr
             1 => {
                 // Terminal: from the chord's midpoint halfway toward the opposite vertex.
                 let m = nodes[mids[0]].pos;
-                let apex = tri.v.iter().map(|&i| p[i]).max_by(|x, y| x.distance_squared(m).total_cmp(&y.distance_squared(m))).unwrap_or(a);
+                let apex = tri
+                    .v
+                    .iter()
+                    .map(|&i| p[i])
+                    .max_by(|x, y| x.distance_squared(m).total_cmp(&y.distance_squared(m)))
+                    .unwrap_or(a);
                 let tip = node(&mut nodes, m.lerp(apex, 0.5));
                 add(&mut segments, [mids[0], tip]);
             }
@@ -297,7 +338,11 @@ pub fn chordal_axis(outline: &Outline, prune: f64) -> Result<Skeleton, SketchErr
             _ => {
                 // Junctions (and former junctions whose small branches were pruned) pass through
                 // their largest inscribed disc, which covers what the pruned branches held.
-                let refined = disc_cache.get(&t).copied().unwrap_or_else(|| largest_disc(tri, p)).0;
+                let refined = disc_cache
+                    .get(&t)
+                    .copied()
+                    .unwrap_or_else(|| largest_disc(tri, p))
+                    .0;
                 // Only where the way from each chord to it stays well inside the outline.
                 let r_refined = boundary_distance(refined, p);
                 let inside = |q: DVec2| {
@@ -307,7 +352,11 @@ pub fn chordal_axis(outline: &Outline, prune: f64) -> Result<Skeleton, SketchErr
                         contains(p, x) && boundary_distance(x, p) >= floor
                     })
                 };
-                let centre = if mids.iter().all(|&m| inside(nodes[m].pos)) { refined } else { sampled_disc(tri, p).0 };
+                let centre = if mids.iter().all(|&m| inside(nodes[m].pos)) {
+                    refined
+                } else {
+                    sampled_disc(tri, p).0
+                };
                 let centre = node(&mut nodes, centre);
                 for &m in &mids {
                     add(&mut segments, [centre, m]);
@@ -335,20 +384,34 @@ pub fn chordal_axis(outline: &Outline, prune: f64) -> Result<Skeleton, SketchErr
         .map(|i| {
             let mid = (p[i] + p[(i + 1) % n]) * 0.5;
             let t = triangle_of_edge[i];
-            let candidates: Vec<usize> = if t != usize::MAX && !segments_of_triangle[resolve(t)].is_empty() {
-                segments_of_triangle[resolve(t)].clone()
-            } else {
-                (0..segments.len()).collect()
-            };
+            let candidates: Vec<usize> =
+                if t != usize::MAX && !segments_of_triangle[resolve(t)].is_empty() {
+                    segments_of_triangle[resolve(t)].clone()
+                } else {
+                    (0..segments.len()).collect()
+                };
             candidates
                 .into_iter()
-                .min_by(|&x, &y| seg_dist(mid, &nodes, segments[x]).total_cmp(&seg_dist(mid, &nodes, segments[y])))
+                .min_by(|&x, &y| {
+                    seg_dist(mid, &nodes, segments[x]).total_cmp(&seg_dist(
+                        mid,
+                        &nodes,
+                        segments[y],
+                    ))
+                })
                 .unwrap_or(0)
         })
         .collect();
 
     let branches = branches(&nodes, &segments);
-    Ok(Skeleton { triangles, kinds, nodes, segments, branches, edge_to_segment })
+    Ok(Skeleton {
+        triangles,
+        kinds,
+        nodes,
+        segments,
+        branches,
+        edge_to_segment,
+    })
 }
 
 /// The largest disc centred in triangle `t`, from a fixed set of samples in it.
@@ -408,7 +471,10 @@ fn outside_fraction(t: &Triangle, p: &[DVec2], discs: &[(DVec2, f64)]) -> f64 {
     let (mut outside, mut total) = (0usize, 0usize);
     for i in 0..N {
         for j in 0..N - i {
-            let (u, v) = ((i as f64 + 1.0 / 3.0) / N as f64, (j as f64 + 1.0 / 3.0) / N as f64);
+            let (u, v) = (
+                (i as f64 + 1.0 / 3.0) / N as f64,
+                (j as f64 + 1.0 / 3.0) / N as f64,
+            );
             let q = a + (b - a) * u + (c - a) * v;
             total += 1;
             outside += discs.iter().all(|(c, r)| q.distance_squared(*c) > r * r) as usize;
@@ -444,7 +510,10 @@ fn branches(nodes: &[Node], segments: &[[usize; 2]]) -> Vec<Branch> {
             let mut chain = vec![start, first];
             let (mut prev, mut cur) = (start, first);
             while adj[cur].len() == 2 {
-                let &(next, s) = adj[cur].iter().find(|(m, _)| *m != prev).unwrap_or(&adj[cur][0]);
+                let &(next, s) = adj[cur]
+                    .iter()
+                    .find(|(m, _)| *m != prev)
+                    .unwrap_or(&adj[cur][0]);
                 if used[s] {
                     break;
                 }
@@ -453,8 +522,15 @@ fn branches(nodes: &[Node], segments: &[[usize; 2]]) -> Vec<Branch> {
                 prev = cur;
                 cur = next;
             }
-            let (a, b) = (adj[chain[0]].len(), adj[*chain.last().unwrap_or(&start)].len());
-            let kind = if a == 1 || b == 1 { BranchKind::Terminal } else { BranchKind::Body };
+            let (a, b) = (
+                adj[chain[0]].len(),
+                adj[*chain.last().unwrap_or(&start)].len(),
+            );
+            let kind = if a == 1 || b == 1 {
+                BranchKind::Terminal
+            } else {
+                BranchKind::Body
+            };
             if a == 1 && b != 1 {
                 chain.reverse(); // free end last
             }
@@ -462,7 +538,10 @@ fn branches(nodes: &[Node], segments: &[[usize; 2]]) -> Vec<Branch> {
         }
     }
     if out.is_empty() && !nodes.is_empty() {
-        out.push(Branch { nodes: vec![0], kind: BranchKind::Terminal });
+        out.push(Branch {
+            nodes: vec![0],
+            kind: BranchKind::Terminal,
+        });
     }
     out
 }

@@ -47,7 +47,11 @@ pub fn sample(outline: &Outline, skeleton: &Skeleton) -> Vec<Sphere> {
     let lone = skeleton.branches.len() == 1;
     for (b, branch) in skeleton.branches.iter().enumerate() {
         let terminal = branch.kind == BranchKind::Terminal;
-        let pts: Vec<DVec2> = branch.nodes.iter().map(|&i| skeleton.nodes[i].pos).collect();
+        let pts: Vec<DVec2> = branch
+            .nodes
+            .iter()
+            .map(|&i| skeleton.nodes[i].pos)
+            .collect();
         let length: f64 = pts.windows(2).map(|w| w[0].distance(w[1])).sum();
         let mut along = 0.0;
         let push = |q: DVec2, along: f64, out: &mut Vec<Sphere>| {
@@ -55,7 +59,14 @@ pub fn sample(outline: &Outline, skeleton: &Skeleton) -> Vec<Sphere> {
             if r > min_radius && contains(p, q) {
                 let f = if length > 0.0 { along / length } else { 0.0 };
                 let f = if lone { 1.0 - 2.0 * f.min(1.0 - f) } else { f };
-                out.push(Sphere { center: q.extend(0.0), radius: r, max_radius: r, branch: b, terminal, along: f });
+                out.push(Sphere {
+                    center: q.extend(0.0),
+                    radius: r,
+                    max_radius: r,
+                    branch: b,
+                    terminal,
+                    along: f,
+                });
             }
         };
         push(pts[0], 0.0, &mut out);
@@ -90,7 +101,10 @@ fn bridge(p: &[DVec2], spheres: &mut Vec<Sphere>) {
         seen[0] = true;
         while let Some(i) = stack.pop() {
             for j in 0..n {
-                if !seen[j] && spheres[i].center.distance(spheres[j].center) < spheres[i].radius + spheres[j].radius {
+                if !seen[j]
+                    && spheres[i].center.distance(spheres[j].center)
+                        < spheres[i].radius + spheres[j].radius
+                {
                     seen[j] = true;
                     stack.push(j);
                 }
@@ -103,7 +117,9 @@ fn bridge(p: &[DVec2], spheres: &mut Vec<Sphere>) {
         let mut best = (f64::INFINITY, 0, 0);
         for i in (0..n).filter(|&i| seen[i]) {
             for j in (0..n).filter(|&j| !seen[j]) {
-                let d = spheres[i].center.distance(spheres[j].center) - spheres[i].radius - spheres[j].radius;
+                let d = spheres[i].center.distance(spheres[j].center)
+                    - spheres[i].radius
+                    - spheres[j].radius;
                 if d < best.0 {
                     best = (d, i, j);
                 }
@@ -120,7 +136,12 @@ fn bridge(p: &[DVec2], spheres: &mut Vec<Sphere>) {
             if r <= 0.0 || !contains(p, q) {
                 break;
             }
-            spheres.push(Sphere { center: q.extend(0.0), radius: r, max_radius: r, ..b });
+            spheres.push(Sphere {
+                center: q.extend(0.0),
+                radius: r,
+                max_radius: r,
+                ..b
+            });
             added = true;
             t += (SPACING * r).max(len * 1e-3);
         }
@@ -138,8 +159,16 @@ fn bridge(p: &[DVec2], spheres: &mut Vec<Sphere>) {
 /// The minimal feature radius r_f: the largest radius over the last 50% (toward the free end)
 /// of the terminal branches' spheres. Falls back to the largest radius when there are none.
 pub fn feature_radius(spheres: &[Sphere]) -> f64 {
-    let tips = spheres.iter().filter(|s| s.terminal && s.along >= 0.5).map(|s| s.max_radius).fold(0.0, f64::max);
-    if tips > 0.0 { tips } else { spheres.iter().map(|s| s.max_radius).fold(0.0, f64::max) }
+    let tips = spheres
+        .iter()
+        .filter(|s| s.terminal && s.along >= 0.5)
+        .map(|s| s.max_radius)
+        .fold(0.0, f64::max);
+    if tips > 0.0 {
+        tips
+    } else {
+        spheres.iter().map(|s| s.max_radius).fold(0.0, f64::max)
+    }
 }
 
 /// Inflation slider: t = 0 keeps the maximal balls, t = 1 shrinks every sphere above r_f to
@@ -171,17 +200,24 @@ impl Rng {
 pub fn trunk(skeleton: &Skeleton) -> Vec<DVec2> {
     let n = skeleton.nodes.len();
     let mut adj: Vec<Vec<(usize, f64)>> = vec![Vec::new(); n];
-    let body: Vec<bool> = {
-        let mut v = vec![false; skeleton.segments.len()];
-        for b in skeleton.branches.iter().filter(|b| b.kind == BranchKind::Body) {
-            for w in b.nodes.windows(2) {
-                if let Some(i) = skeleton.segments.iter().position(|s| (s[0] == w[0] && s[1] == w[1]) || (s[0] == w[1] && s[1] == w[0])) {
-                    v[i] = true;
+    let body: Vec<bool> =
+        {
+            let mut v = vec![false; skeleton.segments.len()];
+            for b in skeleton
+                .branches
+                .iter()
+                .filter(|b| b.kind == BranchKind::Body)
+            {
+                for w in b.nodes.windows(2) {
+                    if let Some(i) = skeleton.segments.iter().position(|s| {
+                        (s[0] == w[0] && s[1] == w[1]) || (s[0] == w[1] && s[1] == w[0])
+                    }) {
+                        v[i] = true;
+                    }
                 }
             }
-        }
-        v
-    };
+            v
+        };
     let any_body = body.iter().any(|&b| b);
     for (i, s) in skeleton.segments.iter().enumerate() {
         if s[0] != s[1] && (!any_body || body[i]) {
@@ -205,11 +241,18 @@ pub fn trunk(skeleton: &Skeleton) -> Vec<DVec2> {
                 }
             }
         }
-        let end = (0..n).filter(|&i| !dist[i].is_nan()).max_by(|&a, &b| dist[a].total_cmp(&dist[b])).unwrap_or(from);
+        let end = (0..n)
+            .filter(|&i| !dist[i].is_nan())
+            .max_by(|&a, &b| dist[a].total_cmp(&dist[b]))
+            .unwrap_or(from);
         (end, parent)
     };
     let Some(seed) = (0..n).find(|&i| !adj[i].is_empty()) else {
-        return skeleton.nodes.first().map(|n| vec![n.pos]).unwrap_or_default();
+        return skeleton
+            .nodes
+            .first()
+            .map(|n| vec![n.pos])
+            .unwrap_or_default();
     };
     let (a, _) = farthest(seed);
     let (b, parent) = farthest(a);
@@ -250,11 +293,21 @@ fn nearest_on(polyline: &[DVec2], q: DVec2) -> (DVec2, DVec2) {
 /// spread around it; originals get a small jitter out of their plane. Every moved sphere is
 /// fitted so its projection to the drawing plane stays inside the outline, which keeps the
 /// silhouette from the drawing view.
-pub fn extend(outline: &Outline, skeleton: &Skeleton, spheres: &[Sphere], seed: u64, copies: usize) -> Vec<Sphere> {
+pub fn extend(
+    outline: &Outline,
+    skeleton: &Skeleton,
+    spheres: &[Sphere],
+    seed: u64,
+    copies: usize,
+) -> Vec<Sphere> {
     let axis_line = trunk(skeleton);
     let mut rng = Rng(seed ^ 0xC10D_5CE7);
     let mut out: Vec<Sphere> = Vec::with_capacity(spheres.len() * (copies + 1));
-    let budget_copies = if spheres.len() * (copies + 1) > MAX_SPHERES { (MAX_SPHERES / spheres.len().max(1)).saturating_sub(1) } else { copies };
+    let budget_copies = if spheres.len() * (copies + 1) > MAX_SPHERES {
+        (MAX_SPHERES / spheres.len().max(1)).saturating_sub(1)
+    } else {
+        copies
+    };
 
     for (b, branch) in skeleton.branches.iter().enumerate() {
         let mut members: Vec<Sphere> = spheres.iter().filter(|s| s.branch == b).copied().collect();
@@ -272,14 +325,21 @@ pub fn extend(outline: &Outline, skeleton: &Skeleton, spheres: &[Sphere], seed: 
         let pivot = pivot.extend(0.0);
         let rotated = |angle: f64| -> Vec<Sphere> {
             let q = DQuat::from_axis_angle(axis, angle);
-            members.iter().map(|s| Sphere { center: pivot + q * (s.center - pivot), ..*s }).collect()
+            members
+                .iter()
+                .map(|s| Sphere {
+                    center: pivot + q * (s.center - pivot),
+                    ..*s
+                })
+                .collect()
         };
         // Original: a small jitter rotation out of the plane.
         let jitter = (rng.next() - 0.5) * 0.5;
         out.extend(fit_branch(outline, rotated(jitter)));
         // Copies evenly around the trunk, with a little variation.
         for k in 1..=budget_copies {
-            let angle = std::f64::consts::TAU * k as f64 / (budget_copies + 1) as f64 + (rng.next() - 0.5) * 0.6;
+            let angle = std::f64::consts::TAU * k as f64 / (budget_copies + 1) as f64
+                + (rng.next() - 0.5) * 0.6;
             out.extend(fit_branch(outline, rotated(angle)));
         }
     }
@@ -291,16 +351,25 @@ pub fn extend(outline: &Outline, skeleton: &Skeleton, spheres: &[Sphere], seed: 
 /// drawing plane get two copies pushed toward and away from the viewer: the projection, hence
 /// the silhouette, is unchanged, and each copy overlaps its original.
 fn thicken(outline: &Outline, spheres: &mut Vec<Sphere>) {
-    let (lo, hi) = outline.points.iter().fold((f64::MAX, f64::MIN), |(a, b), q| (a.min(q.y), b.max(q.y)));
+    let (lo, hi) = outline
+        .points
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(a, b), q| (a.min(q.y), b.max(q.y)));
     let target = 0.5 * (hi - lo);
     let depth = |s: &[Sphere]| {
-        let (a, b) = s.iter().fold((f64::MAX, f64::MIN), |(a, b), q| (a.min(q.center.z - q.radius), b.max(q.center.z + q.radius)));
+        let (a, b) = s.iter().fold((f64::MAX, f64::MIN), |(a, b), q| {
+            (a.min(q.center.z - q.radius), b.max(q.center.z + q.radius))
+        });
         b - a
     };
     if spheres.is_empty() || depth(spheres) >= target || spheres.len() * 3 > MAX_SPHERES {
         return;
     }
-    let flat: Vec<Sphere> = spheres.iter().filter(|s| s.center.z.abs() < 1e-9).copied().collect();
+    let flat: Vec<Sphere> = spheres
+        .iter()
+        .filter(|s| s.center.z.abs() < 1e-9)
+        .copied()
+        .collect();
     for s in flat {
         let dz = (0.9 * s.radius).min((target * 0.5 - s.radius).max(0.0));
         if dz > 0.0 {
@@ -327,7 +396,11 @@ fn fit_branch(outline: &Outline, branch: Vec<Sphere>) -> Vec<Sphere> {
         let room = boundary_distance(q, p);
         s.radius = s.radius.min(room);
         s.max_radius = s.max_radius.min(room);
-        if s.radius <= 1e-9 || kept.last().is_some_and(|prev| prev.center.distance(s.center) >= prev.radius + s.radius) {
+        if s.radius <= 1e-9
+            || kept
+                .last()
+                .is_some_and(|prev| prev.center.distance(s.center) >= prev.radius + s.radius)
+        {
             break;
         }
         kept.push(s);

@@ -20,7 +20,10 @@ fn rect(w: f64, h: f64, per_side: usize) -> Vec<[f64; 2]> {
 }
 
 fn disc(r: f64, n: usize) -> Vec<[f64; 2]> {
-    (0..n).map(|i| i as f64 / n as f64 * TAU).map(|a| [r * a.cos(), r * a.sin()]).collect()
+    (0..n)
+        .map(|i| i as f64 / n as f64 * TAU)
+        .map(|a| [r * a.cos(), r * a.sin()])
+        .collect()
 }
 
 fn star(points: usize, outer: f64, inner: f64) -> Vec<[f64; 2]> {
@@ -41,7 +44,14 @@ fn star(points: usize, outer: f64, inner: f64) -> Vec<[f64; 2]> {
 }
 
 fn l_shape() -> Vec<[f64; 2]> {
-    let c = [[0.0, 0.0], [6.0, 0.0], [6.0, 2.0], [2.0, 2.0], [2.0, 6.0], [0.0, 6.0]];
+    let c = [
+        [0.0, 0.0],
+        [6.0, 0.0],
+        [6.0, 2.0],
+        [2.0, 2.0],
+        [2.0, 6.0],
+        [0.0, 6.0],
+    ];
     let mut v = Vec::new();
     for k in 0..c.len() {
         let (a, b) = (DVec2::from(c[k]), DVec2::from(c[(k + 1) % c.len()]));
@@ -70,21 +80,31 @@ fn cumulus() -> Vec<[f64; 2]> {
 }
 
 fn no_extend() -> SketchParams {
-    SketchParams { extend: false, ..Default::default() }
+    SketchParams {
+        extend: false,
+        ..Default::default()
+    }
 }
 
 /// Intersection over union of the outline and the union of the spheres' projected discs.
 fn iou(sketch: &Sketch) -> f64 {
     let p = &sketch.outline.points;
-    let (lo, hi) = p.iter().fold((DVec2::splat(f64::MAX), DVec2::splat(f64::MIN)), |(a, b), &q| (a.min(q), b.max(q)));
+    let (lo, hi) = p.iter().fold(
+        (DVec2::splat(f64::MAX), DVec2::splat(f64::MIN)),
+        |(a, b), &q| (a.min(q), b.max(q)),
+    );
     let (lo, hi) = (lo - (hi - lo) * 0.1, hi + (hi - lo) * 0.1);
     let n = 160;
     let (mut inter, mut union) = (0, 0);
     for j in 0..n {
         for i in 0..n {
-            let q = lo + (hi - lo) * DVec2::new((i as f64 + 0.5) / n as f64, (j as f64 + 0.5) / n as f64);
+            let q = lo
+                + (hi - lo) * DVec2::new((i as f64 + 0.5) / n as f64, (j as f64 + 0.5) / n as f64);
             let a = contains(p, q);
-            let b = sketch.spheres.iter().any(|s| s.center.truncate().distance_squared(q) <= s.radius * s.radius);
+            let b = sketch
+                .spheres
+                .iter()
+                .any(|s| s.center.truncate().distance_squared(q) <= s.radius * s.radius);
             inter += (a && b) as usize;
             union += (a || b) as usize;
         }
@@ -105,7 +125,10 @@ fn connected(spheres: &[Sphere]) -> bool {
     seen[0] = true;
     while let Some(i) = stack.pop() {
         for j in 0..n {
-            if !seen[j] && spheres[i].center.distance(spheres[j].center) < spheres[i].radius + spheres[j].radius {
+            if !seen[j]
+                && spheres[i].center.distance(spheres[j].center)
+                    < spheres[i].radius + spheres[j].radius
+            {
                 seen[j] = true;
                 stack.push(j);
             }
@@ -130,7 +153,13 @@ fn star_has_five_terminals() {
 
 #[test]
 fn skeleton_lies_inside_with_maximal_ball_radii() {
-    for shape in [rect(9.0, 3.0, 40), disc(4.0, 120), star(5, 5.0, 2.0), l_shape(), cumulus()] {
+    for shape in [
+        rect(9.0, 3.0, 40),
+        disc(4.0, 120),
+        star(5, 5.0, 2.0),
+        l_shape(),
+        cumulus(),
+    ] {
         let s = interpret(&shape, true, &no_extend(), 1).unwrap();
         let p = &s.outline.points;
         for n in &s.skeleton.nodes {
@@ -139,13 +168,23 @@ fn skeleton_lies_inside_with_maximal_ball_radii() {
             assert!(n.radius > 0.0);
         }
         assert_eq!(s.skeleton.edge_to_segment.len(), p.len());
-        assert!(s.skeleton.edge_to_segment.iter().all(|&i| i < s.skeleton.segments.len()));
+        assert!(
+            s.skeleton
+                .edge_to_segment
+                .iter()
+                .all(|&i| i < s.skeleton.segments.len())
+        );
     }
 }
 
 #[test]
 fn sphere_discs_match_simple_outlines() {
-    for (name, shape) in [("rect", rect(9.0, 3.0, 40)), ("disc", disc(4.0, 120)), ("L", l_shape()), ("cumulus", cumulus())] {
+    for (name, shape) in [
+        ("rect", rect(9.0, 3.0, 40)),
+        ("disc", disc(4.0, 120)),
+        ("L", l_shape()),
+        ("cumulus", cumulus()),
+    ] {
         let s = interpret(&shape, true, &no_extend(), 1).unwrap();
         let v = iou(&s);
         assert!(v >= 0.9, "{name}: IoU {v:.3}");
@@ -155,11 +194,22 @@ fn sphere_discs_match_simple_outlines() {
 
 #[test]
 fn extension_gives_depth_and_keeps_the_silhouette() {
-    for (name, shape) in [("cumulus", cumulus()), ("star", star(5, 5.0, 2.0)), ("L", l_shape())] {
+    for (name, shape) in [
+        ("cumulus", cumulus()),
+        ("star", star(5, 5.0, 2.0)),
+        ("L", l_shape()),
+    ] {
         let flat = interpret(&shape, true, &no_extend(), 7).unwrap();
         let s = interpret(&shape, true, &SketchParams::default(), 7).unwrap();
-        let (zmin, zmax) = s.spheres.iter().fold((f64::MAX, f64::MIN), |(a, b), q| (a.min(q.center.z - q.radius), b.max(q.center.z + q.radius)));
-        assert!(zmax - zmin >= 0.4 * height(&s), "{name}: depth {:.2} vs height {:.2}", zmax - zmin, height(&s));
+        let (zmin, zmax) = s.spheres.iter().fold((f64::MAX, f64::MIN), |(a, b), q| {
+            (a.min(q.center.z - q.radius), b.max(q.center.z + q.radius))
+        });
+        assert!(
+            zmax - zmin >= 0.4 * height(&s),
+            "{name}: depth {:.2} vs height {:.2}",
+            zmax - zmin,
+            height(&s)
+        );
         assert!(s.spheres.len() > flat.spheres.len(), "{name}: no copies");
         // Every projected disc stays inside the outline, and the silhouette is still the outline.
         for q in &s.spheres {
@@ -183,11 +233,32 @@ fn same_seed_same_spheres() {
 fn inflation_shrinks_only_spheres_above_the_feature_radius() {
     let shape = star(5, 5.0, 2.0);
     let base = interpret(&shape, true, &no_extend(), 1).unwrap();
-    let full = interpret(&shape, true, &SketchParams { inflate: 1.0, ..no_extend() }, 1).unwrap();
-    let half = interpret(&shape, true, &SketchParams { inflate: 0.5, ..no_extend() }, 1).unwrap();
+    let full = interpret(
+        &shape,
+        true,
+        &SketchParams {
+            inflate: 1.0,
+            ..no_extend()
+        },
+        1,
+    )
+    .unwrap();
+    let half = interpret(
+        &shape,
+        true,
+        &SketchParams {
+            inflate: 0.5,
+            ..no_extend()
+        },
+        1,
+    )
+    .unwrap();
     let r_f = base.feature_radius;
     assert!(r_f > 0.0);
-    assert!(base.spheres.iter().any(|s| s.radius > r_f * 1.05), "nothing to deflate");
+    assert!(
+        base.spheres.iter().any(|s| s.radius > r_f * 1.05),
+        "nothing to deflate"
+    );
     for ((a, b), c) in base.spheres.iter().zip(&full.spheres).zip(&half.spheres) {
         assert_eq!(a.radius, a.max_radius, "t = 0 keeps the maximal balls");
         if a.max_radius <= r_f {
@@ -202,7 +273,10 @@ fn inflation_shrinks_only_spheres_above_the_feature_radius() {
 
 #[test]
 fn far_off_and_huge_coordinates_work() {
-    let shifted: Vec<[f64; 2]> = cumulus().iter().map(|p| [p[0] * 1000.0 + 1e6, p[1] * 1000.0 - 5e5]).collect();
+    let shifted: Vec<[f64; 2]> = cumulus()
+        .iter()
+        .map(|p| [p[0] * 1000.0 + 1e6, p[1] * 1000.0 - 5e5])
+        .collect();
     let s = interpret(&shifted, true, &no_extend(), 1).unwrap();
     assert!(iou(&s) > 0.9);
 }
@@ -217,7 +291,11 @@ fn messy_strokes_are_repaired_with_warnings() {
     // An open stroke is closed by joining its ends.
     let arc: Vec<[f64; 2]> = disc(3.0, 100).into_iter().take(70).collect();
     let s = interpret(&arc, false, &SketchParams::default(), 1).unwrap();
-    assert!(s.warnings.iter().any(|w| w.contains("open")), "{:?}", s.warnings);
+    assert!(
+        s.warnings.iter().any(|w| w.contains("open")),
+        "{:?}",
+        s.warnings
+    );
     // Very many points are thinned, not refused.
     let many: Vec<[f64; 2]> = disc(3.0, 50_000);
     let s = interpret(&many, true, &SketchParams::default(), 1).unwrap();

@@ -43,7 +43,11 @@ pub struct StartOptions {
 
 impl Default for StartOptions {
     fn default() -> Self {
-        Self { scene: Scene::default(), host: None, initial_cost: 2e-8 }
+        Self {
+            scene: Scene::default(),
+            host: None,
+            initial_cost: 2e-8,
+        }
     }
 }
 
@@ -65,6 +69,8 @@ pub struct CloudApp {
     pub(super) frame_request: bool,
     /// Sketch tools, plane selection and messages.
     pub(super) sketch: super::sketch_tool::SketchUi,
+    /// The guide image underlay.
+    pub(super) guide: super::guide::Guide,
 }
 
 impl CloudApp {
@@ -75,6 +81,7 @@ impl CloudApp {
             log::error!("no wgpu render state: the volume cannot be drawn");
         }
         cc.egui_ctx.set_visuals(egui::Visuals::dark());
+        super::files::install(&cc.egui_ctx);
         Self {
             scene: options.scene,
             history: History::default(),
@@ -90,6 +97,7 @@ impl CloudApp {
             frame_seconds: None,
             frame_request: false,
             sketch: Default::default(),
+            guide: Default::default(),
         }
     }
 
@@ -103,8 +111,10 @@ impl CloudApp {
             return;
         }
         let (undo, redo, frame) = ctx.input_mut(|i| {
-            let redo = i.consume_key(egui::Modifiers::COMMAND | egui::Modifiers::SHIFT, egui::Key::Z)
-                || i.consume_key(egui::Modifiers::COMMAND, egui::Key::Y);
+            let redo = i.consume_key(
+                egui::Modifiers::COMMAND | egui::Modifiers::SHIFT,
+                egui::Key::Z,
+            ) || i.consume_key(egui::Modifiers::COMMAND, egui::Key::Y);
             let undo = i.consume_key(egui::Modifiers::COMMAND, egui::Key::Z);
             let frame = i.consume_key(egui::Modifiers::NONE, egui::Key::F);
             (undo, redo, frame)
@@ -142,16 +152,30 @@ impl CloudApp {
         super::camera_input::handle(ui, &response, &mut self.scene.camera, !drawing);
 
         let painter = ui.painter_at(rect);
-        let [r, g, b] = self.scene.light.background.map(|v| (v * 255.0).round() as u8);
+        let [r, g, b] = self
+            .scene
+            .light
+            .background
+            .map(|v| (v * 255.0).round() as u8);
         painter.rect_filled(rect, 0.0, Color32::from_rgb(r, g, b));
+        self.paint_guide(&painter, rect);
 
         let ppp = ui.ctx().pixels_per_point();
-        let px = [(rect.width() * ppp).round().max(1.0) as u32, (rect.height() * ppp).round().max(1.0) as u32];
+        let px = [
+            (rect.width() * ppp).round().max(1.0) as u32,
+            (rect.height() * ppp).round().max(1.0) as u32,
+        ];
         self.viewport_px = px;
         let volume = self.cache.update(&self.scene);
         let key = view_key(&self.scene, px, volume.generation);
         let now = ui.input(|i| i.time);
-        let plan = self.progressive.plan(now, key, px, self.scene.render.slices, response.is_pointer_button_down_on());
+        let plan = self.progressive.plan(
+            now,
+            key,
+            px,
+            self.scene.render.slices,
+            response.is_pointer_button_down_on(),
+        );
         self.shown = plan.shown;
         self.refining = plan.refining;
         self.frame_seconds = self.progressive.last_frame_seconds();
@@ -164,10 +188,23 @@ impl CloudApp {
             size: j.size,
             range: j.range,
             clear: j.clear,
-            uniforms: VolumeUniforms::new(&self.scene, &self.scene.camera, &volume.grid, aspect, Slicing { total: j.total }),
+            uniforms: VolumeUniforms::new(
+                &self.scene,
+                &self.scene.camera,
+                &volume.grid,
+                aspect,
+                Slicing { total: j.total },
+            ),
         });
         if self.backend.is_some() {
-            painter.add(egui_wgpu::Callback::new_paint_callback(rect, ViewportPaint { volume, job, display: plan.display }));
+            painter.add(egui_wgpu::Callback::new_paint_callback(
+                rect,
+                ViewportPaint {
+                    volume,
+                    job,
+                    display: plan.display,
+                },
+            ));
         }
         if plan.repaint {
             ui.ctx().request_repaint();
@@ -199,8 +236,13 @@ impl CloudApp {
     }
 
     fn publish(&mut self) {
-        let Some(host) = self.host.as_mut() else { return };
-        let backend = self.backend.clone().unwrap_or(BackendInfo { backend: "none", adapter: String::new() });
+        let Some(host) = self.host.as_mut() else {
+            return;
+        };
+        let backend = self.backend.clone().unwrap_or(BackendInfo {
+            backend: "none",
+            adapter: String::new(),
+        });
         let quality = self.shown.map(|q| q.to_string()).unwrap_or_default();
         let state = serde_json::json!({
             "scene": self.scene,
@@ -214,11 +256,21 @@ impl CloudApp {
                 "tool": self.sketch.tool.name(),
                 "selected_plane": self.sketch.selected,
                 "guides_hidden": self.sketch.hide_guides,
+                "guide_image": self.guide.image.as_ref().map(|g| serde_json::json!({
+                    "name": g.name, "size": g.size, "opacity": self.guide.opacity, "visible": self.guide.visible,
+                })),
+                "guide_error": self.guide.error,
                 "notice": self.sketch.notice.as_ref().map(|n| serde_json::json!({"text": n.text, "error": n.error})),
             }
         })
         .to_string();
-        let status = PageStatus { ready: self.ready, backend: backend.backend.to_string(), adapter: backend.adapter, quality, state };
+        let status = PageStatus {
+            ready: self.ready,
+            backend: backend.backend.to_string(),
+            adapter: backend.adapter,
+            quality,
+            state,
+        };
         if self.last_status.as_ref() != Some(&status) {
             host.publish(&status);
             self.last_status = Some(status);
@@ -232,7 +284,9 @@ fn view_key(scene: &Scene, px: [u32; 2], generation: u64) -> u64 {
     px.hash(&mut h);
     generation.hash(&mut h);
     // Camera, light and render settings: hash their exact JSON form (f32s written losslessly).
-    serde_json::to_string(&(&scene.camera, &scene.light, &scene.render)).unwrap_or_default().hash(&mut h);
+    serde_json::to_string(&(&scene.camera, &scene.light, &scene.render))
+        .unwrap_or_default()
+        .hash(&mut h);
     h.finish()
 }
 
@@ -241,9 +295,13 @@ impl eframe::App for CloudApp {
         let ctx = ui.ctx().clone();
         self.shortcuts(&ctx);
         self.sketch_shortcuts(&ctx);
-        egui::Panel::right("controls").resizable(true).default_size(270.0).show(ui, |ui| {
-            egui::ScrollArea::vertical().show(ui, |ui| self.side_panel(ui));
-        });
+        self.guide_input(&ctx);
+        egui::Panel::right("controls")
+            .resizable(true)
+            .default_size(270.0)
+            .show(ui, |ui| {
+                egui::ScrollArea::vertical().show(ui, |ui| self.side_panel(ui));
+            });
         egui::CentralPanel::no_frame().show(ui, |ui| self.viewport(ui));
         if !ctx.input(|i| i.pointer.any_down()) {
             self.history.end_merge();

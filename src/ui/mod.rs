@@ -4,6 +4,13 @@
 
 mod app;
 mod camera_input;
+#[cfg(not(target_arch = "wasm32"))]
+#[path = "files_native.rs"]
+mod files;
+#[cfg(target_arch = "wasm32")]
+#[path = "files_web.rs"]
+mod files;
+mod guide;
 mod panels;
 mod sketch_tool;
 

@@ -61,20 +61,32 @@ pub struct SketchUi {
 }
 
 fn ndc(rect: Rect, p: Pos2) -> Vec2 {
-    Vec2::new((p.x - rect.left()) / rect.width() * 2.0 - 1.0, 1.0 - (p.y - rect.top()) / rect.height() * 2.0)
+    Vec2::new(
+        (p.x - rect.left()) / rect.width() * 2.0 - 1.0,
+        1.0 - (p.y - rect.top()) / rect.height() * 2.0,
+    )
 }
 
 fn screen(rect: Rect, ndc: Vec2) -> Pos2 {
-    Pos2::new(rect.left() + (ndc.x + 1.0) * 0.5 * rect.width(), rect.top() + (1.0 - ndc.y) * 0.5 * rect.height())
+    Pos2::new(
+        rect.left() + (ndc.x + 1.0) * 0.5 * rect.width(),
+        rect.top() + (1.0 - ndc.y) * 0.5 * rect.height(),
+    )
 }
 
 fn project(camera: &OrbitCamera, rect: Rect, p: Vec3) -> Option<Pos2> {
-    camera.project(p, rect.aspect_ratio()).map(|n| screen(rect, n))
+    camera
+        .project(p, rect.aspect_ratio())
+        .map(|n| screen(rect, n))
 }
 
 impl CloudApp {
     fn notify(&mut self, ui: &Ui, text: String, error: bool) {
-        self.sketch.notice = Some(Notice { text, error, at: ui.input(|i| i.time) });
+        self.sketch.notice = Some(Notice {
+            text,
+            error,
+            at: ui.input(|i| i.time),
+        });
     }
 
     /// Tool shortcuts: V navigate, D draw, C cut, H hides guides, Esc cancels a stroke (or
@@ -133,13 +145,20 @@ impl CloudApp {
         if response.drag_started_by(egui::PointerButton::Primary) {
             self.sketch.stroke.clear();
             // Start where the button went down, not where the drag was recognised.
-            if let Some(p) = ui.input(|i| i.pointer.press_origin()).or(response.interact_pointer_pos()) {
+            if let Some(p) = ui
+                .input(|i| i.pointer.press_origin())
+                .or(response.interact_pointer_pos())
+            {
                 self.sketch.stroke.push(p);
             }
         }
         if response.dragged_by(egui::PointerButton::Primary)
             && let Some(p) = response.interact_pointer_pos()
-            && self.sketch.stroke.last().is_none_or(|q| q.distance(p) >= 1.0)
+            && self
+                .sketch
+                .stroke
+                .last()
+                .is_none_or(|q| q.distance(p) >= 1.0)
             && self.sketch.stroke.len() < MAX_PLANE_POINTS
         {
             self.sketch.stroke.push(p);
@@ -155,16 +174,27 @@ impl CloudApp {
     /// point where the first point's ray meets the cloud, or through the focus point.
     fn finish_stroke(&mut self, ui: &Ui, rect: Rect, stroke: &[Pos2]) {
         if self.scene.planes.len() >= MAX_PLANES {
-            self.notify(ui, format!("at most {MAX_PLANES} drawing planes: delete one first"), true);
+            self.notify(
+                ui,
+                format!("at most {MAX_PLANES} drawing planes: delete one first"),
+                true,
+            );
             return;
         }
-        let kind = if self.sketch.tool == Tool::Cut { StrokeKind::Cut } else { StrokeKind::Outline };
+        let kind = if self.sketch.tool == Tool::Cut {
+            StrokeKind::Cut
+        } else {
+            StrokeKind::Outline
+        };
         let camera = self.scene.camera.clone();
         let aspect = rect.aspect_ratio();
         let Some(&first) = stroke.first() else { return };
         let first_ray = camera.ray(ndc(rect, first), aspect);
         let field = Field::from_scene(&self.scene);
-        let step = field.bounding_sphere().map(|(_, r)| r / 200.0).unwrap_or(0.05);
+        let step = field
+            .bounding_sphere()
+            .map(|(_, r)| r / 200.0)
+            .unwrap_or(0.05);
         let anchor = field.raycast(&first_ray, step).unwrap_or(camera.target);
         let normal = -camera.forward();
         let world: Vec<Vec3> = stroke
@@ -179,10 +209,23 @@ impl CloudApp {
             StrokeKind::Outline => format!("Outline {count}"),
             StrokeKind::Cut => format!("Cut {count}"),
         };
-        let seed = crate::render::noise::hash64(self.scene.seed ^ ((self.scene.planes.len() as u64) << 32) ^ world.len() as u64);
-        let plane = DrawingPlane::facing(name, kind, anchor, camera.right(), camera.up(), &world, seed);
+        let seed = crate::render::noise::hash64(
+            self.scene.seed ^ ((self.scene.planes.len() as u64) << 32) ^ world.len() as u64,
+        );
+        let plane = DrawingPlane::facing(
+            name,
+            kind,
+            anchor,
+            camera.right(),
+            camera.up(),
+            &world,
+            seed,
+        );
         let result = match kind {
-            StrokeKind::Outline => crate::sketch::interpret(&plane.stroke(), true, &plane.sketch, plane.seed).map(|s| s.warnings),
+            StrokeKind::Outline => {
+                crate::sketch::interpret(&plane.stroke(), true, &plane.sketch, plane.seed)
+                    .map(|s| s.warnings)
+            }
             StrokeKind::Cut => crate::sketch::cut_line(&plane.stroke()).map(|_| Vec::new()),
         };
         match result {
@@ -196,7 +239,11 @@ impl CloudApp {
                 let text = if warnings.is_empty() {
                     format!("Added {} (Ctrl+Z undoes)", self.scene.planes[index].name)
                 } else {
-                    format!("Added {}: {}", self.scene.planes[index].name, warnings.join("; "))
+                    format!(
+                        "Added {}: {}",
+                        self.scene.planes[index].name,
+                        warnings.join("; ")
+                    )
                 };
                 self.notify(ui, text, false);
             }
@@ -204,7 +251,11 @@ impl CloudApp {
     }
 
     fn delete_selected(&mut self) {
-        if let Some(i) = self.sketch.selected.filter(|&i| i < self.scene.planes.len()) {
+        if let Some(i) = self
+            .sketch
+            .selected
+            .filter(|&i| i < self.scene.planes.len())
+        {
             let mut planes = self.scene.planes.clone();
             planes.remove(i);
             self.apply(Edit::SetPlanes(planes), None);
@@ -213,12 +264,21 @@ impl CloudApp {
     }
 
     fn duplicate_selected(&mut self) {
-        let Some(i) = self.sketch.selected.filter(|&i| i < self.scene.planes.len()) else { return };
+        let Some(i) = self
+            .sketch
+            .selected
+            .filter(|&i| i < self.scene.planes.len())
+        else {
+            return;
+        };
         if self.scene.planes.len() >= MAX_PLANES {
             return;
         }
         let mut copy = self.scene.planes[i].clone();
-        let width = copy.points.iter().fold((f32::MAX, f32::MIN), |(a, b), p| (a.min(p.x), b.max(p.x)));
+        let width = copy
+            .points
+            .iter()
+            .fold((f32::MAX, f32::MIN), |(a, b), p| (a.min(p.x), b.max(p.x)));
         // Behind the original by a third of its width, so the copy thickens the cloud.
         copy.origin -= copy.normal() * ((width.1 - width.0).max(0.1) / 3.0);
         copy.name = format!("{} copy", copy.name);
@@ -233,7 +293,11 @@ impl CloudApp {
     pub(super) fn sketch_overlay(&mut self, ui: &Ui, rect: Rect) {
         let painter = ui.painter_at(rect);
         let camera = &self.scene.camera;
-        let planes = if self.sketch.hide_guides { &[][..] } else { &self.scene.planes[..] };
+        let planes = if self.sketch.hide_guides {
+            &[][..]
+        } else {
+            &self.scene.planes[..]
+        };
         for (i, plane) in planes.iter().enumerate() {
             let selected = self.sketch.selected == Some(i);
             if selected || self.sketch.show_all_planes {
@@ -244,65 +308,115 @@ impl CloudApp {
                 (_, true) => Color32::from_rgb(255, 90, 90),
                 _ => Color32::from_white_alpha(70),
             };
-            let pts: Vec<Pos2> = plane.points.iter().filter_map(|p| project(camera, rect, plane.to_world(p.extend(0.0)))).collect();
+            let pts: Vec<Pos2> = plane
+                .points
+                .iter()
+                .filter_map(|p| project(camera, rect, plane.to_world(p.extend(0.0))))
+                .collect();
             if pts.len() >= 2 {
                 let mut pts = pts;
                 if plane.kind == StrokeKind::Outline {
                     pts.push(pts[0]);
                 }
-                painter.add(egui::Shape::line(pts, Stroke::new(if selected { 2.0 } else { 1.0 }, color)));
+                painter.add(egui::Shape::line(
+                    pts,
+                    Stroke::new(if selected { 2.0 } else { 1.0 }, color),
+                ));
             }
         }
         if self.sketch.stroke.len() >= 2 {
-            let color = if self.sketch.tool == Tool::Cut { Color32::from_rgb(255, 150, 60) } else { Color32::WHITE };
-            painter.add(egui::Shape::line(self.sketch.stroke.clone(), Stroke::new(2.0, color)));
+            let color = if self.sketch.tool == Tool::Cut {
+                Color32::from_rgb(255, 150, 60)
+            } else {
+                Color32::WHITE
+            };
+            painter.add(egui::Shape::line(
+                self.sketch.stroke.clone(),
+                Stroke::new(2.0, color),
+            ));
         }
         let now = ui.input(|i| i.time);
         if let Some(n) = &self.sketch.notice {
             let age = now - n.at;
             if n.error || age < 6.0 {
-                let color = if n.error { Color32::from_rgb(255, 140, 140) } else { Color32::from_white_alpha(220) };
-                painter.text(rect.left_top() + egui::vec2(10.0, 10.0), egui::Align2::LEFT_TOP, &n.text, egui::FontId::proportional(14.0), color);
+                let color = if n.error {
+                    Color32::from_rgb(255, 140, 140)
+                } else {
+                    Color32::from_white_alpha(220)
+                };
+                painter.text(
+                    rect.left_top() + egui::vec2(10.0, 10.0),
+                    egui::Align2::LEFT_TOP,
+                    &n.text,
+                    egui::FontId::proportional(14.0),
+                    color,
+                );
                 if !n.error {
-                    ui.ctx().request_repaint_after(std::time::Duration::from_millis(500));
+                    ui.ctx()
+                        .request_repaint_after(std::time::Duration::from_millis(500));
                 }
             }
         }
-        if self.sketch.tool != Tool::Navigate && self.scene.planes.is_empty() && self.sketch.stroke.is_empty() {
-            let hint = if self.sketch.tool == Tool::Cut { "Drag to draw a cut line: the cloud is removed below it" } else { "Drag to draw a cloud's outline" };
-            painter.text(rect.center_top() + egui::vec2(0.0, 36.0), egui::Align2::CENTER_TOP, hint, egui::FontId::proportional(15.0), Color32::from_white_alpha(200));
+        if self.sketch.tool != Tool::Navigate
+            && self.scene.planes.is_empty()
+            && self.sketch.stroke.is_empty()
+        {
+            let hint = if self.sketch.tool == Tool::Cut {
+                "Drag to draw a cut line: the cloud is removed below it"
+            } else {
+                "Drag to draw a cloud's outline"
+            };
+            painter.text(
+                rect.center_top() + egui::vec2(0.0, 36.0),
+                egui::Align2::CENTER_TOP,
+                hint,
+                egui::FontId::proportional(15.0),
+                Color32::from_white_alpha(200),
+            );
         }
     }
 
     /// The Sketch group of the side panel: tools, the plane list and the selected plane.
     pub(super) fn sketch_group(&mut self, ui: &mut Ui) {
-        egui::CollapsingHeader::new("Sketch").default_open(true).show(ui, |ui| {
-            ui.horizontal(|ui| {
-                for (tool, label, key) in [(Tool::Navigate, "Navigate", "V"), (Tool::Sketch, "✏ Sketch", "D"), (Tool::Cut, "✂ Cut", "C")] {
-                    ui.selectable_value(&mut self.sketch.tool, tool, label).on_hover_text(format!("{key}"));
+        egui::CollapsingHeader::new("Sketch")
+            .default_open(true)
+            .show(ui, |ui| {
+                ui.horizontal(|ui| {
+                    for (tool, label, key) in [
+                        (Tool::Navigate, "Navigate", "V"),
+                        (Tool::Sketch, "✏ Sketch", "D"),
+                        (Tool::Cut, "✂ Cut", "C"),
+                    ] {
+                        ui.selectable_value(&mut self.sketch.tool, tool, label)
+                            .on_hover_text(format!("{key}"));
+                    }
+                });
+                ui.horizontal(|ui| {
+                    ui.checkbox(&mut self.sketch.show_all_planes, "all grids");
+                    ui.checkbox(&mut self.sketch.hide_guides, "hide guides")
+                        .on_hover_text("H");
+                });
+                if self.scene.planes.is_empty() {
+                    ui.label("No drawing planes yet. Pick Sketch and drag an outline in the view.");
+                    return;
+                }
+                ui.label("Drawing planes:");
+                for i in 0..self.scene.planes.len() {
+                    let selected = self.sketch.selected == Some(i);
+                    let name = self.scene.planes[i].name.clone();
+                    if ui.selectable_label(selected, name).clicked() {
+                        self.sketch.selected = if selected { None } else { Some(i) };
+                    }
+                }
+                if let Some(i) = self
+                    .sketch
+                    .selected
+                    .filter(|&i| i < self.scene.planes.len())
+                {
+                    ui.separator();
+                    self.plane_controls(ui, i);
                 }
             });
-            ui.horizontal(|ui| {
-                ui.checkbox(&mut self.sketch.show_all_planes, "all grids");
-                ui.checkbox(&mut self.sketch.hide_guides, "hide guides").on_hover_text("H");
-            });
-            if self.scene.planes.is_empty() {
-                ui.label("No drawing planes yet. Pick Sketch and drag an outline in the view.");
-                return;
-            }
-            ui.label("Drawing planes:");
-            for i in 0..self.scene.planes.len() {
-                let selected = self.sketch.selected == Some(i);
-                let name = self.scene.planes[i].name.clone();
-                if ui.selectable_label(selected, name).clicked() {
-                    self.sketch.selected = if selected { None } else { Some(i) };
-                }
-            }
-            if let Some(i) = self.sketch.selected.filter(|&i| i < self.scene.planes.len()) {
-                ui.separator();
-                self.plane_controls(ui, i);
-            }
-        });
     }
 
     fn plane_controls(&mut self, ui: &mut Ui, i: usize) {
@@ -314,21 +428,40 @@ impl CloudApp {
             ui.add(egui::Slider::new(&mut plane.sketch.simplify, 0.0..=0.08).text("simplify"));
             ui.add(egui::Slider::new(&mut plane.sketch.prune, 0.0..=0.2).text("prune branches"));
             ui.checkbox(&mut plane.sketch.extend, "3D extension");
-            ui.add_enabled(plane.sketch.extend, egui::Slider::new(&mut plane.sketch.copies, 0..=6).text("branch copies"));
+            ui.add_enabled(
+                plane.sketch.extend,
+                egui::Slider::new(&mut plane.sketch.copies, 0..=6).text("branch copies"),
+            );
         }
         ui.horizontal(|ui| {
             ui.label("move");
             for (axis, v) in ["x", "y", "z"].iter().zip(plane.origin.as_mut()) {
-                ui.add(egui::DragValue::new(v).speed(0.05).prefix(format!("{axis} ")));
+                ui.add(
+                    egui::DragValue::new(v)
+                        .speed(0.05)
+                        .prefix(format!("{axis} ")),
+                );
             }
         });
         let (mut yaw, mut pitch, mut roll) = plane.rotation.to_euler(EulerRot::YXZ);
         let before = (yaw, pitch, roll);
         ui.horizontal(|ui| {
             ui.label("rotate");
-            for (label, v) in [("yaw ", &mut yaw), ("pitch ", &mut pitch), ("roll ", &mut roll)] {
+            for (label, v) in [
+                ("yaw ", &mut yaw),
+                ("pitch ", &mut pitch),
+                ("roll ", &mut roll),
+            ] {
                 let mut deg = v.to_degrees();
-                if ui.add(egui::DragValue::new(&mut deg).speed(0.5).prefix(label).suffix("°")).changed() {
+                if ui
+                    .add(
+                        egui::DragValue::new(&mut deg)
+                            .speed(0.5)
+                            .prefix(label)
+                            .suffix("°"),
+                    )
+                    .changed()
+                {
                     *v = deg.to_radians();
                 }
             }
@@ -353,23 +486,40 @@ impl CloudApp {
 }
 
 /// The selected plane's grid: its stroke's box, padded, with a few lines each way.
-fn draw_grid(painter: &egui::Painter, camera: &OrbitCamera, rect: Rect, plane: &DrawingPlane, selected: bool) {
+fn draw_grid(
+    painter: &egui::Painter,
+    camera: &OrbitCamera,
+    rect: Rect,
+    plane: &DrawingPlane,
+    selected: bool,
+) {
     if plane.points.is_empty() {
         return;
     }
-    let (lo, hi) = plane.points.iter().fold((Vec2::MAX, Vec2::MIN), |(a, b), &p| (a.min(p), b.max(p)));
+    let (lo, hi) = plane
+        .points
+        .iter()
+        .fold((Vec2::MAX, Vec2::MIN), |(a, b), &p| (a.min(p), b.max(p)));
     let pad = (hi - lo) * 0.15 + Vec2::splat(0.1);
     let (lo, hi) = (lo - pad, hi + pad);
-    let color = if selected { Color32::from_rgba_unmultiplied(255, 80, 80, 110) } else { Color32::from_rgba_unmultiplied(255, 255, 255, 40) };
+    let color = if selected {
+        Color32::from_rgba_unmultiplied(255, 80, 80, 110)
+    } else {
+        Color32::from_rgba_unmultiplied(255, 255, 255, 40)
+    };
     let lines = 8;
     for k in 0..=lines {
         let t = k as f32 / lines as f32;
         let x = lo.x + (hi.x - lo.x) * t;
         let y = lo.y + (hi.y - lo.y) * t;
-        for (a, b) in [(Vec2::new(x, lo.y), Vec2::new(x, hi.y)), (Vec2::new(lo.x, y), Vec2::new(hi.x, y))] {
-            if let (Some(a), Some(b)) =
-                (project(camera, rect, plane.to_world(a.extend(0.0))), project(camera, rect, plane.to_world(b.extend(0.0))))
-            {
+        for (a, b) in [
+            (Vec2::new(x, lo.y), Vec2::new(x, hi.y)),
+            (Vec2::new(lo.x, y), Vec2::new(hi.x, y)),
+        ] {
+            if let (Some(a), Some(b)) = (
+                project(camera, rect, plane.to_world(a.extend(0.0))),
+                project(camera, rect, plane.to_world(b.extend(0.0))),
+            ) {
                 painter.line_segment([a, b], Stroke::new(1.0, color));
             }
         }
