@@ -47,7 +47,7 @@ fi
 
 # Node packages for the browser tests (playwright-core drives Debian's Chromium).
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-if [ -f "$ROOT/web/package.json" ] && [ ! -d "$ROOT/web/node_modules/playwright-core" ]; then
+if [ -f "$ROOT/web/package.json" ] && { [ ! -f "$ROOT/web/node_modules/.package-lock.json" ] || [ "$ROOT/web/package-lock.json" -nt "$ROOT/web/node_modules/.package-lock.json" ]; }; then
   log "npm ci in web/"
   (cd "$ROOT/web" && npm ci --no-audit --no-fund --silent)
 fi

@@ -16,6 +16,7 @@ cargo test --locked
 log "trunk build --release (wasm)"
 trunk build --release
 
-log "browser end-to-end tests"
+log "browser end-to-end tests (screenshots: web/test-results/screenshots/)"
+rm -rf web/test-results
 (cd web && npm test)
 log "all tests passed"

@@ -1,5 +1,6 @@
 //! Everything wasm-only: start-up in the page, URL options, the page's test contract and the
-//! on-page error box. The one place `cfg(target_arch = "wasm32")` code lives.
+//! on-page error box. Gated as a whole module (with `ui/files_web.rs`, the browser's file
+//! reading), so wasm-only code stays out of the rest of the crate.
 //!
 //! Test contract: `<body>` carries `data-ready` (first full-quality image shown),
 //! `data-backend` (`webgpu` | `webgl2`), `data-adapter` and `data-quality`
