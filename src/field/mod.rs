@@ -398,6 +398,92 @@ mod tests {
         assert!(Field::default().raycast(&ray, 0.05).is_none());
     }
 
+    fn cloud_outline() -> Vec<Vec2> {
+        let mut v: Vec<Vec2> = (0..=40)
+            .map(|i| Vec2::new(-5.0 + i as f32 * 0.25, -2.0))
+            .collect();
+        for i in 1..120 {
+            let a = i as f32 / 120.0 * std::f32::consts::PI;
+            let bump = 1.0 + 0.3 * (a * 5.0).sin().abs();
+            v.push(Vec2::new(5.0 * a.cos(), -2.0 + 3.5 * a.sin() * bump));
+        }
+        v
+    }
+
+    fn plane(kind: StrokeKind, points: Vec<Vec2>) -> DrawingPlane {
+        DrawingPlane {
+            kind,
+            points,
+            closed: kind == StrokeKind::Outline,
+            ..Default::default()
+        }
+    }
+
+    fn inside_polygon(poly: &[Vec2], q: Vec2) -> bool {
+        let mut c = false;
+        let mut j = poly.len() - 1;
+        for i in 0..poly.len() {
+            let (a, b) = (poly[i], poly[j]);
+            if (a.y > q.y) != (b.y > q.y) && q.x < (b.x - a.x) * (q.y - a.y) / (b.y - a.y) + a.x {
+                c = !c;
+            }
+            j = i;
+        }
+        c
+    }
+
+    #[test]
+    fn sketched_field_outline_in_its_plane_matches_the_stroke() {
+        let outline = cloud_outline();
+        let mut scene = Scene::preset(crate::scene::Preset::Empty);
+        scene
+            .planes
+            .push(plane(StrokeKind::Outline, outline.clone()));
+        let field = Field::from_scene(&scene);
+        assert_eq!(field.groups.len(), 1);
+        let (mut inter, mut union) = (0, 0);
+        for j in 0..100 {
+            for i in 0..140 {
+                let q = Vec2::new(
+                    -6.0 + i as f32 * 12.0 / 140.0,
+                    -3.0 + j as f32 * 8.0 / 100.0,
+                );
+                let a = inside_polygon(&outline, q);
+                let b = field.inside(q.extend(0.0));
+                inter += (a && b) as usize;
+                union += (a || b) as usize;
+            }
+        }
+        let iou = inter as f64 / union as f64;
+        assert!(iou >= 0.85, "field outline vs stroke IoU {iou:.3}");
+        // The 3D extension gives the cloud depth in front of and behind the plane.
+        assert!(field.inside(Vec3::new(0.0, 0.0, 1.0)) || field.inside(Vec3::new(0.0, 0.0, -1.0)));
+    }
+
+    #[test]
+    fn cut_stroke_flattens_the_base() {
+        let mut scene = Scene::preset(crate::scene::Preset::Empty);
+        scene
+            .planes
+            .push(plane(StrokeKind::Outline, cloud_outline()));
+        let before = Field::from_scene(&scene);
+        assert!(before.inside(Vec3::new(0.0, -1.0, 0.0)));
+        scene.planes.push(plane(
+            StrokeKind::Cut,
+            vec![Vec2::new(-8.0, -0.5), Vec2::new(8.0, -0.5)],
+        ));
+        let after = Field::from_scene(&scene);
+        for x in [-3.0, 0.0, 3.0] {
+            for z in [-2.0, 0.0, 2.0] {
+                assert!(
+                    !after.inside(Vec3::new(x, -1.0, z)),
+                    "cloud below the cut at x {x} z {z}"
+                );
+            }
+        }
+        assert!(after.inside(Vec3::new(0.0, 0.5, 0.0)));
+    }
+
     #[test]
     fn default_scene_field_is_bounded() {
         let f = Field::from_scene(&Scene::default());

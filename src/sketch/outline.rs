@@ -60,9 +60,134 @@ pub fn segment_distance(q: DVec2, a: DVec2, b: DVec2) -> f64 {
 /// Distance from `q` to a closed polygon's boundary.
 pub fn boundary_distance(q: DVec2, p: &[DVec2]) -> f64 {
     let n = p.len();
-    (0..n)
-        .map(|i| segment_distance(q, p[i], p[(i + 1) % n]))
-        .fold(f64::INFINITY, f64::min)
+    let mut best = f64::INFINITY;
+    let mut a = p[n - 1];
+    for &b in p {
+        // Squared distance to segment a–b, one square root at the end.
+        let ab = b - a;
+        let aq = q - a;
+        let len2 = ab.length_squared();
+        let t = if len2 > 0.0 {
+            (aq.dot(ab) / len2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let d = (aq - ab * t).length_squared();
+        if d < best {
+            best = d;
+        }
+        a = b;
+    }
+    best.sqrt()
+}
+
+/// A closed polygon with a uniform grid of its edges, for fast distance queries (the sketch
+/// asks for the distance to the outline thousands of times).
+#[derive(Clone, Debug)]
+pub struct Boundary {
+    points: Vec<DVec2>,
+    lo: DVec2,
+    cell: f64,
+    dims: [usize; 2],
+    /// Edge indices (edge i runs from point i to point i + 1) overlapping each cell.
+    cells: Vec<Vec<u32>>,
+}
+
+impl std::ops::Deref for Boundary {
+    type Target = [DVec2];
+    fn deref(&self) -> &[DVec2] {
+        &self.points
+    }
+}
+
+impl Boundary {
+    /// Indexes the edges of a closed polygon.
+    pub fn new(points: &[DVec2]) -> Self {
+        let n = points.len();
+        let (lo, hi) = points.iter().fold(
+            (DVec2::splat(f64::MAX), DVec2::splat(f64::MIN)),
+            |(a, b), &q| (a.min(q), b.max(q)),
+        );
+        let size = (hi - lo).max(DVec2::splat(1e-12));
+        let side = ((n as f64).sqrt().ceil() as usize).clamp(1, 64);
+        let cell = size.max_element() / side as f64;
+        let dims = [
+            ((size.x / cell).ceil() as usize).clamp(1, 64),
+            ((size.y / cell).ceil() as usize).clamp(1, 64),
+        ];
+        let mut cells = vec![Vec::new(); dims[0] * dims[1]];
+        let cell_of = |q: DVec2| {
+            let c = ((q - lo) / cell).floor();
+            [
+                (c.x.max(0.0) as usize).min(dims[0] - 1),
+                (c.y.max(0.0) as usize).min(dims[1] - 1),
+            ]
+        };
+        for i in 0..n {
+            let (a, b) = (points[i], points[(i + 1) % n]);
+            let (ca, cb) = (cell_of(a.min(b)), cell_of(a.max(b)));
+            for y in ca[1]..=cb[1] {
+                for x in ca[0]..=cb[0] {
+                    cells[y * dims[0] + x].push(i as u32);
+                }
+            }
+        }
+        Self {
+            points: points.to_vec(),
+            lo,
+            cell,
+            dims,
+            cells,
+        }
+    }
+
+    /// Distance from `q` to the polygon's boundary (equal to [`boundary_distance`]).
+    pub fn distance(&self, q: DVec2) -> f64 {
+        let n = self.points.len();
+        if n == 0 {
+            return f64::INFINITY;
+        }
+        let c = ((q - self.lo) / self.cell).floor();
+        let (cx, cy) = (c.x as i64, c.y as i64);
+        let (w, h) = (self.dims[0] as i64, self.dims[1] as i64);
+        let mut best = f64::INFINITY;
+        let mut seen_all = false;
+        let mut k = 0i64;
+        while !seen_all {
+            // Cells on ring k around (cx, cy), clamped to the grid.
+            let (x0, x1, y0, y1) = (cx - k, cx + k, cy - k, cy + k);
+            for y in y0.max(0)..=y1.min(h - 1) {
+                for x in x0.max(0)..=x1.min(w - 1) {
+                    if y != y0 && y != y1 && x != x0 && x != x1 {
+                        continue; // inside the ring: searched already
+                    }
+                    for &e in &self.cells[(y * w + x) as usize] {
+                        let e = e as usize;
+                        let (a, b) = (self.points[e], self.points[(e + 1) % n]);
+                        let ab = b - a;
+                        let aq = q - a;
+                        let len2 = ab.length_squared();
+                        let t = if len2 > 0.0 {
+                            (aq.dot(ab) / len2).clamp(0.0, 1.0)
+                        } else {
+                            0.0
+                        };
+                        best = best.min((aq - ab * t).length_squared());
+                    }
+                }
+            }
+            seen_all = x0 <= 0 && y0 <= 0 && x1 >= w - 1 && y1 >= h - 1;
+            // Every edge not yet seen lies outside the searched block of cells.
+            let block_lo = self.lo + DVec2::new(x0 as f64, y0 as f64) * self.cell;
+            let block_hi = self.lo + DVec2::new((x1 + 1) as f64, (y1 + 1) as f64) * self.cell;
+            let margin = (q - block_lo).min(block_hi - q).min_element();
+            if margin > 0.0 && best <= margin * margin {
+                break;
+            }
+            k += 1;
+        }
+        best.sqrt()
+    }
 }
 
 /// Even–odd point-in-polygon test.
@@ -356,6 +481,26 @@ mod tests {
             }
         }
         v
+    }
+
+    #[test]
+    fn indexed_distance_equals_brute_force() {
+        let mut pts: Vec<DVec2> = Vec::new();
+        for i in 0..300 {
+            let a = i as f64 / 300.0 * std::f64::consts::TAU;
+            let r = 3.0 + (a * 7.0).sin();
+            pts.push(DVec2::new(r * a.cos() + 100.0, r * a.sin() - 50.0));
+        }
+        let b = Boundary::new(&pts);
+        for i in 0..40 {
+            for j in 0..40 {
+                let q = DVec2::new(92.0 + i as f64 * 0.4, -58.0 + j as f64 * 0.4);
+                assert!(
+                    (b.distance(q) - boundary_distance(q, &pts)).abs() < 1e-12,
+                    "{q}"
+                );
+            }
+        }
     }
 
     #[test]

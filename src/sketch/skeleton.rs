@@ -8,7 +8,7 @@ use glam::DVec2;
 use spade::{ConstrainedDelaunayTriangulation, HasPosition, Point2, Triangulation};
 
 use super::SketchError;
-use super::outline::{Outline, boundary_distance, contains};
+use super::outline::{Boundary, Outline, contains};
 
 #[derive(Clone, Copy, Debug)]
 struct Vertex {
@@ -120,7 +120,7 @@ fn key(a: usize, b: usize) -> (usize, usize) {
 /// maximal discs of the body around the junction it hangs from (so a rectangle's corners go,
 /// a star's arms stay).
 pub fn chordal_axis(outline: &Outline, prune: f64) -> Result<Skeleton, SketchError> {
-    let p = &outline.points;
+    let p = &Boundary::new(&outline.points);
     let n = p.len();
     let vertices: Vec<Vertex> = p
         .iter()
@@ -197,12 +197,17 @@ pub fn chordal_axis(outline: &Outline, prune: f64) -> Result<Skeleton, SketchErr
     let mut owner: Vec<usize> = (0..triangles.len()).collect(); // pruned triangle → absorbing triangle
     let mut disc_cache: std::collections::BTreeMap<usize, (DVec2, f64)> = Default::default();
     let mut absorbed = vec![false; triangles.len()];
+    // A branch's significance changes only when its chain or junction does.
+    let mut significance_cache: std::collections::BTreeMap<(usize, usize, usize), f64> =
+        Default::default();
     loop {
         let degree = |t: usize, alive: &[bool]| adj[t].iter().filter(|(s, _)| alive[*s]).count();
         if !(0..triangles.len()).any(|t| alive[t] && degree(t, &alive) >= 3) {
             break;
         }
-        let mut best: Option<(f64, Vec<usize>, usize)> = None;
+        // Candidates below the threshold; per pass, each junction loses at most its smallest
+        // branch (pruning one turns the junction into a sleeve and lengthens its other chains).
+        let mut candidates: Vec<(f64, Vec<usize>, usize)> = Vec::new();
         for start in 0..triangles.len() {
             if !alive[start] || degree(start, &alive) != 1 {
                 continue;
@@ -224,49 +229,36 @@ pub fn chordal_axis(outline: &Outline, prune: f64) -> Result<Skeleton, SketchErr
             // Significance: the branch's area outside the junction's maximal disc, i.e. what
             // the feature adds to the shape beyond the body it hangs from.
             let significance = end.map(|j| {
-                // The body near the junction: live triangles within a few steps, off the chain.
-                let mut near = vec![j];
-                let mut frontier = vec![j];
-                for _ in 0..3 {
-                    let mut next = Vec::new();
-                    for &u in &frontier {
-                        for &(v, _) in &adj[u] {
-                            if alive[v] && !chain.contains(&v) && !near.contains(&v) {
-                                near.push(v);
-                                next.push(v);
-                            }
-                        }
-                    }
-                    frontier = next;
+                let key = (start, j, chain.len());
+                if let Some(&v) = significance_cache.get(&key) {
+                    return v;
                 }
-                let discs: Vec<(DVec2, f64)> = near
-                    .iter()
-                    .map(|&t| {
-                        *disc_cache
-                            .entry(t)
-                            .or_insert_with(|| largest_disc(&triangles[t], p))
-                    })
-                    .collect();
-                chain
-                    .iter()
-                    .map(|&t| triangles[t].area * outside_fraction(&triangles[t], p, &discs))
-                    .sum::<f64>()
+                let v = significance_of(j, &chain, &adj, &alive, &triangles, p, &mut disc_cache);
+                significance_cache.insert(key, v);
+                v
             });
             if let (Some(junction), Some(area)) = (end, significance)
                 && area < threshold
-                && best.as_ref().is_none_or(|(a, _, _)| area < *a)
             {
-                best = Some((area, chain, junction));
+                candidates.push((area, chain, junction));
             }
         }
-        let Some((_, chain, junction)) = best else {
+        if candidates.is_empty() {
             break;
-        };
-        for t in chain {
-            alive[t] = false;
-            owner[t] = junction;
         }
-        absorbed[junction] = true;
+        candidates.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.2.cmp(&b.2)));
+        let mut touched = std::collections::BTreeSet::new();
+        for (_, chain, junction) in candidates {
+            // A junction of degree 3 that already lost a branch this pass is now a sleeve.
+            if !touched.insert(junction) {
+                continue;
+            }
+            for t in chain {
+                alive[t] = false;
+                owner[t] = junction;
+            }
+            absorbed[junction] = true;
+        }
     }
     let resolve = |mut t: usize| {
         while owner[t] != t {
@@ -281,7 +273,7 @@ pub fn chordal_axis(outline: &Outline, prune: f64) -> Result<Skeleton, SketchErr
     let node = |nodes: &mut Vec<Node>, pos: DVec2| {
         nodes.push(Node {
             pos,
-            radius: boundary_distance(pos, p),
+            radius: p.distance(pos),
         });
         nodes.len() - 1
     };
@@ -344,18 +336,18 @@ pub fn chordal_axis(outline: &Outline, prune: f64) -> Result<Skeleton, SketchErr
                     .unwrap_or_else(|| largest_disc(tri, p))
                     .0;
                 // Only where the way from each chord to it stays well inside the outline.
-                let r_refined = boundary_distance(refined, p);
+                let r_refined = p.distance(refined);
                 let inside = |q: DVec2| {
-                    let floor = 0.5 * boundary_distance(q, p).min(r_refined);
+                    let floor = 0.5 * p.distance(q).min(r_refined);
                     (0..=16).all(|k| {
                         let x = q.lerp(refined, k as f64 / 16.0);
-                        contains(p, x) && boundary_distance(x, p) >= floor
+                        contains(p, x) && p.distance(x) >= floor
                     })
                 };
                 let centre = if mids.iter().all(|&m| inside(nodes[m].pos)) {
                     refined
                 } else {
-                    sampled_disc(tri, p).0
+                    sampled_disc(tri, p, true, 5).0
                 };
                 let centre = node(&mut nodes, centre);
                 for &m in &mids {
@@ -414,16 +406,59 @@ pub fn chordal_axis(outline: &Outline, prune: f64) -> Result<Skeleton, SketchErr
     })
 }
 
-/// The largest disc centred in triangle `t`, from a fixed set of samples in it.
-fn sampled_disc(t: &Triangle, p: &[DVec2]) -> (DVec2, f64) {
-    const N: usize = 5;
+/// What a terminal branch (`chain`, hanging from junction triangle `junction`) adds to the
+/// shape: its triangles' area outside the maximal discs of the live body within two steps of
+/// the junction.
+fn significance_of(
+    junction: usize,
+    chain: &[usize],
+    adj: &[Vec<(usize, (usize, usize))>],
+    alive: &[bool],
+    triangles: &[Triangle],
+    p: &Boundary,
+    disc_cache: &mut std::collections::BTreeMap<usize, (DVec2, f64)>,
+) -> f64 {
+    let mut near = vec![junction];
+    let mut frontier = vec![junction];
+    for _ in 0..2 {
+        let mut next = Vec::new();
+        for &u in &frontier {
+            for &(v, _) in &adj[u] {
+                if alive[v] && !chain.contains(&v) && !near.contains(&v) {
+                    near.push(v);
+                    next.push(v);
+                }
+            }
+        }
+        frontier = next;
+    }
+    let discs: Vec<(DVec2, f64)> = near
+        .iter()
+        .map(|&t| {
+            *disc_cache
+                .entry(t)
+                .or_insert_with(|| largest_disc(&triangles[t], p))
+        })
+        .collect();
+    chain
+        .iter()
+        .map(|&t| triangles[t].area * outside_fraction(&triangles[t], p, &discs))
+        .sum()
+}
+
+/// The largest disc centred at one of a fixed set of samples of triangle `t` (strictly inside
+/// it when `interior`, so segments from it to the triangle's edges stay in the triangle).
+fn sampled_disc(t: &Triangle, p: &Boundary, interior: bool, steps: usize) -> (DVec2, f64) {
     let [a, b, c] = t.v.map(|i| p[i]);
-    let mut best = ((a + b + c) / 3.0, boundary_distance((a + b + c) / 3.0, p));
-    for i in 0..=N {
-        for j in 0..=N - i {
-            let q = a + (b - a) * (i as f64 / N as f64) + (c - a) * (j as f64 / N as f64);
-            let r = boundary_distance(q, p);
-            if r > best.1 && i + j < N && i > 0 && j > 0 {
+    let mut best = ((a + b + c) / 3.0, p.distance((a + b + c) / 3.0));
+    for i in 0..=steps {
+        for j in 0..=steps - i {
+            if interior && (i == 0 || j == 0 || i + j == steps) {
+                continue;
+            }
+            let q = a + (b - a) * (i as f64 / steps as f64) + (c - a) * (j as f64 / steps as f64);
+            let r = p.distance(q);
+            if r > best.1 {
                 best = (q, r);
             }
         }
@@ -432,26 +467,17 @@ fn sampled_disc(t: &Triangle, p: &[DVec2]) -> (DVec2, f64) {
 }
 
 /// The largest disc inside the outline centred near triangle `t` (samples, then refined).
-fn largest_disc(t: &Triangle, p: &[DVec2]) -> (DVec2, f64) {
-    const N: usize = 5;
+fn largest_disc(t: &Triangle, p: &Boundary) -> (DVec2, f64) {
     let [a, b, c] = t.v.map(|i| p[i]);
-    let mut best = ((a + b + c) / 3.0, boundary_distance((a + b + c) / 3.0, p));
-    for i in 0..=N {
-        for j in 0..=N - i {
-            let q = a + (b - a) * (i as f64 / N as f64) + (c - a) * (j as f64 / N as f64);
-            let r = boundary_distance(q, p);
-            if r > best.1 {
-                best = (q, r);
-            }
-        }
-    }
+    let mut best = sampled_disc(t, p, false, 3);
     // Refine by compass search (the maximal disc's centre may lie just outside the triangle).
-    let mut step = a.distance(b).max(b.distance(c)).max(c.distance(a)) * 0.25;
-    for _ in 0..16 {
+    let size = a.distance(b).max(b.distance(c)).max(c.distance(a));
+    let mut step = size * 0.25;
+    while step > size * 1e-2 {
         let mut moved = false;
         for d in [DVec2::X, DVec2::NEG_X, DVec2::Y, DVec2::NEG_Y] {
             let q = best.0 + d * step;
-            let r = boundary_distance(q, p);
+            let r = p.distance(q);
             if r > best.1 && contains(p, q) {
                 best = (q, r);
                 moved = true;
@@ -465,7 +491,7 @@ fn largest_disc(t: &Triangle, p: &[DVec2]) -> (DVec2, f64) {
 }
 
 /// Fraction of a triangle lying outside every disc, from a fixed set of samples.
-fn outside_fraction(t: &Triangle, p: &[DVec2], discs: &[(DVec2, f64)]) -> f64 {
+fn outside_fraction(t: &Triangle, p: &Boundary, discs: &[(DVec2, f64)]) -> f64 {
     const N: usize = 6;
     let [a, b, c] = t.v.map(|i| p[i]);
     let (mut outside, mut total) = (0usize, 0usize);

@@ -5,7 +5,7 @@
 
 use glam::{DQuat, DVec2, DVec3};
 
-use super::outline::{Outline, boundary_distance, contains};
+use super::outline::{Boundary, Outline, contains};
 use super::skeleton::{BranchKind, Skeleton};
 
 /// Most spheres one stroke makes (copies from the 3D extension included).
@@ -33,7 +33,7 @@ pub struct Sphere {
 
 /// Spheres sampled densely along every branch, radius = distance to the outline.
 pub fn sample(outline: &Outline, skeleton: &Skeleton) -> Vec<Sphere> {
-    let p = &outline.points;
+    let p = &Boundary::new(&outline.points);
     let total_len: f64 = skeleton
         .segments
         .iter()
@@ -55,7 +55,7 @@ pub fn sample(outline: &Outline, skeleton: &Skeleton) -> Vec<Sphere> {
         let length: f64 = pts.windows(2).map(|w| w[0].distance(w[1])).sum();
         let mut along = 0.0;
         let push = |q: DVec2, along: f64, out: &mut Vec<Sphere>| {
-            let r = boundary_distance(q, p);
+            let r = p.distance(q);
             if r > min_radius && contains(p, q) {
                 let f = if length > 0.0 { along / length } else { 0.0 };
                 let f = if lone { 1.0 - 2.0 * f.min(1.0 - f) } else { f };
@@ -76,7 +76,7 @@ pub fn sample(outline: &Outline, skeleton: &Skeleton) -> Vec<Sphere> {
             let mut t = 0.0;
             while t < len {
                 let q = a.lerp(c, t / len);
-                let r = boundary_distance(q, p).max(min_radius);
+                let r = p.distance(q).max(min_radius);
                 t += (SPACING * r).max(floor).max(len * 1e-3);
                 let q2 = a.lerp(c, (t / len).min(1.0));
                 push(q2, along + t.min(len), &mut out);
@@ -90,7 +90,7 @@ pub fn sample(outline: &Outline, skeleton: &Skeleton) -> Vec<Sphere> {
 
 /// Joins spheres that do not overlap the main body to it with spheres along the shortest
 /// link inside the outline, so the cloud's body never splits.
-fn bridge(p: &[DVec2], spheres: &mut Vec<Sphere>) {
+fn bridge(p: &Boundary, spheres: &mut Vec<Sphere>) {
     for _ in 0..64 {
         let n = spheres.len();
         if n < 2 {
@@ -132,7 +132,7 @@ fn bridge(p: &[DVec2], spheres: &mut Vec<Sphere>) {
         let mut added = false;
         while t < len {
             let q = qa.lerp(qb, t / len);
-            let r = boundary_distance(q, p);
+            let r = p.distance(q);
             if r <= 0.0 || !contains(p, q) {
                 break;
             }
@@ -386,14 +386,14 @@ fn thicken(outline: &Outline, spheres: &mut Vec<Sphere>) {
 /// lies inside the outline; the branch ends at the first sphere that cannot fit or no longer
 /// overlaps the previous one, so it stays attached to the body.
 fn fit_branch(outline: &Outline, branch: Vec<Sphere>) -> Vec<Sphere> {
-    let p = &outline.points;
+    let p = &Boundary::new(&outline.points);
     let mut kept: Vec<Sphere> = Vec::with_capacity(branch.len());
     for mut s in branch {
         let q = s.center.truncate();
         if !contains(p, q) {
             break;
         }
-        let room = boundary_distance(q, p);
+        let room = p.distance(q);
         s.radius = s.radius.min(room);
         s.max_radius = s.max_radius.min(room);
         if s.radius <= 1e-9

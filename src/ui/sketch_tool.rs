@@ -132,9 +132,14 @@ impl CloudApp {
     }
 
     /// Stroke capture in the viewport. Returns whether the primary button draws (so the camera
-    /// must not orbit with it).
+    /// must not orbit with it). In Navigate, a click selects the drawing plane under the pointer.
     pub(super) fn sketch_input(&mut self, ui: &Ui, response: &Response, rect: Rect) -> bool {
         if self.sketch.tool == Tool::Navigate {
+            if response.clicked()
+                && let Some(p) = response.interact_pointer_pos()
+            {
+                self.sketch.selected = self.plane_at(rect, p);
+            }
             return false;
         }
         let (alt, multi) = ui.input(|i| (i.modifiers.alt, i.multi_touch().is_some()));
@@ -248,6 +253,35 @@ impl CloudApp {
                 self.notify(ui, text, false);
             }
         }
+    }
+
+    /// The drawing plane whose stroke encloses screen point `p` (outlines by their inside, cuts
+    /// within a few pixels of their line), the nearest to the camera when several do.
+    fn plane_at(&self, rect: Rect, p: Pos2) -> Option<usize> {
+        let camera = &self.scene.camera;
+        let eye = camera.eye();
+        let mut best: Option<(f32, usize)> = None;
+        for (i, plane) in self.scene.planes.iter().enumerate() {
+            let pts: Vec<Pos2> = plane
+                .points
+                .iter()
+                .filter_map(|q| project(camera, rect, plane.to_world(q.extend(0.0))))
+                .collect();
+            if pts.len() < 2 {
+                continue;
+            }
+            let hit = match plane.kind {
+                StrokeKind::Outline => inside(&pts, p),
+                StrokeKind::Cut => pts
+                    .windows(2)
+                    .any(|w| distance_to_segment(p, w[0], w[1]) < 6.0),
+            };
+            let depth = plane.origin.distance(eye);
+            if hit && best.is_none_or(|(d, _)| depth < d) {
+                best = Some((depth, i));
+            }
+        }
+        best.map(|(_, i)| i)
     }
 
     fn delete_selected(&mut self) {
@@ -483,6 +517,30 @@ impl CloudApp {
             }
         });
     }
+}
+
+/// Even–odd test of a point in a screen polygon.
+fn inside(poly: &[Pos2], p: Pos2) -> bool {
+    let mut c = false;
+    let mut j = poly.len() - 1;
+    for i in 0..poly.len() {
+        let (a, b) = (poly[i], poly[j]);
+        if (a.y > p.y) != (b.y > p.y) && p.x < (b.x - a.x) * (p.y - a.y) / (b.y - a.y) + a.x {
+            c = !c;
+        }
+        j = i;
+    }
+    c
+}
+
+fn distance_to_segment(p: Pos2, a: Pos2, b: Pos2) -> f32 {
+    let ab = b - a;
+    let t = if ab.length_sq() > 0.0 {
+        ((p - a).dot(ab) / ab.length_sq()).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    p.distance(a + ab * t)
 }
 
 /// The selected plane's grid: its stroke's box, padded, with a few lines each way.

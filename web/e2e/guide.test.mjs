@@ -7,7 +7,7 @@ import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
 import { PNG } from 'pngjs';
-import { serve, launch, openApp, waitForBody, state, screenshot } from './harness.mjs';
+import { serve, launch, openApp, waitForBody, state, screenshot, until } from './harness.mjs';
 
 let server;
 before(async () => { server = await serve(); });
@@ -17,16 +17,6 @@ function solidPng(w, h, [r, g, b]) {
   const png = new PNG({ width: w, height: h });
   for (let i = 0; i < w * h; i++) png.data.set([r, g, b, 255], i * 4);
   return PNG.sync.write(png);
-}
-
-async function until(page, pred, what, timeout = 30_000) {
-  const t0 = Date.now();
-  for (;;) {
-    const s = await state(page);
-    if (pred(s)) return s;
-    if (Date.now() - t0 > timeout) throw new Error(`timed out waiting for ${what}: ${JSON.stringify(s.view)}`);
-    await page.waitForTimeout(100);
-  }
 }
 
 async function drop(page, name, bytes) {

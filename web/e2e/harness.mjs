@@ -131,3 +131,14 @@ export function recordTiming(entry) {
   all.push({ ...entry, at: new Date().toISOString() });
   fs.writeFileSync(file, JSON.stringify(all, null, 2));
 }
+
+/** Polls the page state until `pred(state)` holds; throws with the view state on timeout. */
+export async function until(page, pred, what, timeout = 60_000) {
+  const t0 = Date.now();
+  for (;;) {
+    const s = await state(page);
+    if (pred(s)) return s;
+    if (Date.now() - t0 > timeout) throw new Error(`timed out waiting for ${what}: ${JSON.stringify(s.view)}`);
+    await page.waitForTimeout(100);
+  }
+}

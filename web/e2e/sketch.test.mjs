@@ -3,7 +3,7 @@
 // removes it. Screenshots: web/test-results/screenshots/sketch-*.png.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { serve, launch, openApp, waitForBody, waitForFullQuality, state, screenshot, countDiffering } from './harness.mjs';
+import { serve, launch, openApp, waitForBody, waitForFullQuality, state, screenshot, countDiffering, until } from './harness.mjs';
 
 let server;
 before(async () => { server = await serve(); });
@@ -16,16 +16,6 @@ async function stroke(page, points) {
   await page.mouse.down();
   for (const [x, y] of points.slice(1)) await page.mouse.move(x, y);
   await page.mouse.up();
-}
-
-async function until(page, pred, what, timeout = 60_000) {
-  const t0 = Date.now();
-  for (;;) {
-    const s = await state(page);
-    if (pred(s)) return s;
-    if (Date.now() - t0 > timeout) throw new Error(`timed out waiting for ${what}: ${JSON.stringify(s.view)}`);
-    await page.waitForTimeout(100);
-  }
 }
 
 test('draw an outline, then cut its base', { timeout: 300_000 }, async () => {
