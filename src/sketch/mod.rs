@@ -125,9 +125,7 @@ pub fn interpret(
     let warnings = std::mem::take(&mut outline.warnings);
     // Back to the caller's coordinates.
     let shift = centre.extend(0.0);
-    for p in &mut outline.points {
-        *p += centre;
-    }
+    outline.translate(centre);
     let mut skeleton = skeleton;
     for n in &mut skeleton.nodes {
         n.pos += centre;

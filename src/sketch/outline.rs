@@ -22,6 +22,18 @@ pub struct Outline {
     pub area: f64,
     /// Repairs made, in words.
     pub warnings: Vec<String>,
+    /// `points` indexed for distance queries; rebuild with [`Outline::translate`] when moving.
+    pub boundary: Boundary,
+}
+
+impl Outline {
+    /// Moves the outline (and its index) by `offset`.
+    pub fn translate(&mut self, offset: DVec2) {
+        for p in &mut self.points {
+            *p += offset;
+        }
+        self.boundary = Boundary::new(&self.points);
+    }
 }
 
 /// Signed area (shoelace), positive for counter-clockwise in a y-up frame.
@@ -292,10 +304,12 @@ pub fn clean(raw: &[[f64; 2]], closed: bool, simplify: f64) -> Result<Outline, S
     if points.len() < 3 || area <= 0.0 {
         return Err(SketchError::NoArea);
     }
+    let boundary = Boundary::new(&points);
     Ok(Outline {
         points,
         area,
         warnings,
+        boundary,
     })
 }
 

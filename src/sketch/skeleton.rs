@@ -120,7 +120,7 @@ fn key(a: usize, b: usize) -> (usize, usize) {
 /// maximal discs of the body around the junction it hangs from (so a rectangle's corners go,
 /// a star's arms stay).
 pub fn chordal_axis(outline: &Outline, prune: f64) -> Result<Skeleton, SketchError> {
-    let p = &Boundary::new(&outline.points);
+    let p = &outline.boundary;
     let n = p.len();
     let vertices: Vec<Vertex> = p
         .iter()
@@ -344,7 +344,12 @@ pub fn chordal_axis(outline: &Outline, prune: f64) -> Result<Skeleton, SketchErr
                         contains(p, x) && p.distance(x) >= floor
                     })
                 };
-                let centre = if mids.iter().all(|&m| inside(nodes[m].pos)) {
+                // Inside the (convex) triangle the way to each chord is inside it: no check needed.
+                let in_triangle = {
+                    let o = |u: DVec2, v: DVec2| (v - u).perp_dot(refined - u) >= 0.0;
+                    o(a, b) && o(b, c) && o(c, a)
+                };
+                let centre = if in_triangle || mids.iter().all(|&m| inside(nodes[m].pos)) {
                     refined
                 } else {
                     sampled_disc(tri, p, true, 5).0
@@ -466,28 +471,32 @@ fn sampled_disc(t: &Triangle, p: &Boundary, interior: bool, steps: usize) -> (DV
     best
 }
 
-/// The largest disc inside the outline centred near triangle `t` (samples, then refined).
+/// The largest disc inside the outline centred near triangle `t`: the best of its circumcentre
+/// (a Voronoi vertex of the outline's samples, so close to the medial axis), its centroid and
+/// its edge midpoints.
 fn largest_disc(t: &Triangle, p: &Boundary) -> (DVec2, f64) {
     let [a, b, c] = t.v.map(|i| p[i]);
-    let mut best = sampled_disc(t, p, false, 3);
-    // Refine by compass search (the maximal disc's centre may lie just outside the triangle).
-    let size = a.distance(b).max(b.distance(c)).max(c.distance(a));
-    let mut step = size * 0.25;
-    while step > size * 1e-2 {
-        let mut moved = false;
-        for d in [DVec2::X, DVec2::NEG_X, DVec2::Y, DVec2::NEG_Y] {
-            let q = best.0 + d * step;
-            let r = p.distance(q);
-            if r > best.1 && contains(p, q) {
-                best = (q, r);
-                moved = true;
-            }
-        }
-        if !moved {
-            step *= 0.5;
+    let mut candidates = vec![
+        (a + b + c) / 3.0,
+        (a + b) * 0.5,
+        (b + c) * 0.5,
+        (c + a) * 0.5,
+    ];
+    let d = 2.0 * (a.x * (b.y - c.y) + b.x * (c.y - a.y) + c.x * (a.y - b.y));
+    if d.abs() > 1e-300 {
+        let (a2, b2, c2) = (a.length_squared(), b.length_squared(), c.length_squared());
+        let centre = DVec2::new(
+            (a2 * (b.y - c.y) + b2 * (c.y - a.y) + c2 * (a.y - b.y)) / d,
+            (a2 * (c.x - b.x) + b2 * (a.x - c.x) + c2 * (b.x - a.x)) / d,
+        );
+        if centre.is_finite() && contains(p, centre) {
+            candidates.push(centre);
         }
     }
-    best
+    candidates
+        .into_iter()
+        .map(|q| (q, p.distance(q)))
+        .fold((a, 0.0), |best, x| if x.1 > best.1 { x } else { best })
 }
 
 /// Fraction of a triangle lying outside every disc, from a fixed set of samples.

@@ -33,7 +33,7 @@ pub struct Sphere {
 
 /// Spheres sampled densely along every branch, radius = distance to the outline.
 pub fn sample(outline: &Outline, skeleton: &Skeleton) -> Vec<Sphere> {
-    let p = &Boundary::new(&outline.points);
+    let p = &outline.boundary;
     let total_len: f64 = skeleton
         .segments
         .iter()
@@ -386,7 +386,7 @@ fn thicken(outline: &Outline, spheres: &mut Vec<Sphere>) {
 /// lies inside the outline; the branch ends at the first sphere that cannot fit or no longer
 /// overlaps the previous one, so it stays attached to the body.
 fn fit_branch(outline: &Outline, branch: Vec<Sphere>) -> Vec<Sphere> {
-    let p = &Boundary::new(&outline.points);
+    let p = &outline.boundary;
     let mut kept: Vec<Sphere> = Vec::with_capacity(branch.len());
     for mut s in branch {
         let q = s.center.truncate();
