@@ -224,6 +224,28 @@ impl CloudApp {
         if self.scene.ellipsoids.is_empty() && self.scene.planes.is_empty() {
             text.push_str("Empty scene: open Scene ▸ New cumulus, or sketch a cloud.");
         }
+        // Status line: backend, adapter and the volume's current quality.
+        if let Some(b) = &self.backend {
+            let adapter: String = if b.adapter.chars().count() > 40 {
+                b.adapter.chars().take(39).chain(std::iter::once('…')).collect()
+            } else {
+                b.adapter.clone()
+            };
+            let mut status = format!("{} · {adapter}", b.backend);
+            if let Some(q) = self.shown {
+                status.push_str(&format!(" · {}×{}×{}{}", q.size[0], q.size[1], q.slices, if q.full { "" } else { " preview" }));
+            }
+            if let Some(s) = self.frame_seconds {
+                status.push_str(&format!(" · {:.0} ms", s * 1000.0));
+            }
+            painter.text(
+                rect.right_bottom() + egui::vec2(-8.0, -6.0),
+                egui::Align2::RIGHT_BOTTOM,
+                status,
+                egui::FontId::proportional(11.0),
+                Color32::from_white_alpha(150),
+            );
+        }
         if !text.is_empty() {
             painter.text(
                 rect.left_bottom() + egui::vec2(8.0, -8.0),
