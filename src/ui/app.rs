@@ -227,13 +227,23 @@ impl CloudApp {
         // Status line: backend, adapter and the volume's current quality.
         if let Some(b) = &self.backend {
             let adapter: String = if b.adapter.chars().count() > 40 {
-                b.adapter.chars().take(39).chain(std::iter::once('…')).collect()
+                b.adapter
+                    .chars()
+                    .take(39)
+                    .chain(std::iter::once('…'))
+                    .collect()
             } else {
                 b.adapter.clone()
             };
             let mut status = format!("{} · {adapter}", b.backend);
             if let Some(q) = self.shown {
-                status.push_str(&format!(" · {}×{}×{}{}", q.size[0], q.size[1], q.slices, if q.full { "" } else { " preview" }));
+                status.push_str(&format!(
+                    " · {}×{}×{}{}",
+                    q.size[0],
+                    q.size[1],
+                    q.slices,
+                    if q.full { "" } else { " preview" }
+                ));
             }
             if let Some(s) = self.frame_seconds {
                 status.push_str(&format!(" · {:.0} ms", s * 1000.0));

@@ -19,6 +19,10 @@ pub enum Tool {
     Sketch,
     /// Drag draws a cut line (flat base).
     Cut,
+    /// Drag moves the selected drawing plane parallel to the view (Shift: toward or away).
+    Move,
+    /// Drag turns the selected drawing plane (sideways: about the vertical; up/down: tilt).
+    Rotate,
 }
 
 impl Tool {
@@ -28,6 +32,8 @@ impl Tool {
             Tool::Navigate => "navigate",
             Tool::Sketch => "sketch",
             Tool::Cut => "cut",
+            Tool::Move => "move",
+            Tool::Rotate => "rotate",
         }
     }
 }
@@ -89,11 +95,23 @@ impl CloudApp {
         });
     }
 
-    /// Tool shortcuts: V navigate, D draw, C cut, H hides guides, Esc cancels a stroke (or
-    /// clears the selection), Delete removes the selected plane, Ctrl+D duplicates it.
+    /// Tool shortcuts: V navigate, D draw, C cut, G move, R rotate, H hides guides, Esc cancels
+    /// a stroke (or clears the selection), Delete removes the selected plane, Ctrl+D duplicates it.
     pub(super) fn sketch_shortcuts(&mut self, ctx: &egui::Context) {
         if ctx.egui_wants_keyboard_input() {
             return;
+        }
+        let (g, r) = ctx.input_mut(|i| {
+            (
+                i.consume_key(egui::Modifiers::NONE, egui::Key::G),
+                i.consume_key(egui::Modifiers::NONE, egui::Key::R),
+            )
+        });
+        if g {
+            self.sketch.tool = Tool::Move;
+        }
+        if r {
+            self.sketch.tool = Tool::Rotate;
         }
         let (v, d, c, esc, del, dup, h) = ctx.input_mut(|i| {
             (
@@ -134,13 +152,16 @@ impl CloudApp {
     /// Stroke capture in the viewport. Returns whether the primary button draws (so the camera
     /// must not orbit with it). In Navigate, a click selects the drawing plane under the pointer.
     pub(super) fn sketch_input(&mut self, ui: &Ui, response: &Response, rect: Rect) -> bool {
-        if self.sketch.tool == Tool::Navigate {
-            if response.clicked()
-                && let Some(p) = response.interact_pointer_pos()
-            {
-                self.sketch.selected = self.plane_at(rect, p);
-            }
-            return false;
+        if matches!(self.sketch.tool, Tool::Navigate | Tool::Move | Tool::Rotate)
+            && response.clicked()
+            && let Some(p) = response.interact_pointer_pos()
+        {
+            self.sketch.selected = self.plane_at(rect, p);
+        }
+        match self.sketch.tool {
+            Tool::Navigate => return false,
+            Tool::Move | Tool::Rotate => return self.manipulate(ui, response, rect),
+            Tool::Sketch | Tool::Cut => {}
         }
         let (alt, multi) = ui.input(|i| (i.modifiers.alt, i.multi_touch().is_some()));
         if alt || multi {
@@ -253,6 +274,54 @@ impl CloudApp {
                 self.notify(ui, text, false);
             }
         }
+    }
+
+    /// Move and Rotate: a primary drag transforms the selected plane (one undo step per drag).
+    /// Without a selection the drag orbits as in Navigate.
+    fn manipulate(&mut self, ui: &Ui, response: &Response, rect: Rect) -> bool {
+        let Some(i) = self
+            .sketch
+            .selected
+            .filter(|&i| i < self.scene.planes.len())
+        else {
+            return false;
+        };
+        if ui.input(|i| i.modifiers.alt || i.multi_touch().is_some()) {
+            return true;
+        }
+        if !response.dragged_by(egui::PointerButton::Primary) {
+            return true;
+        }
+        let delta = response.drag_delta();
+        if delta == egui::Vec2::ZERO {
+            return true;
+        }
+        let camera = &self.scene.camera;
+        let mut plane = self.scene.planes[i].clone();
+        match self.sketch.tool {
+            Tool::Move => {
+                // World units per pixel at the plane's depth.
+                let depth = (plane.origin - camera.eye()).dot(camera.forward()).max(0.1);
+                let per_px = 2.0 * depth * (camera.fov_y_deg.to_radians() * 0.5).tan()
+                    / rect.height().max(1.0);
+                let shift = ui.input(|i| i.modifiers.shift);
+                plane.origin += if shift {
+                    camera.forward() * (delta.y * per_px)
+                } else {
+                    camera.right() * (delta.x * per_px) - camera.up() * (delta.y * per_px)
+                };
+            }
+            _ => {
+                const RAD_PER_PX: f32 = 0.01;
+                let turn = Quat::from_axis_angle(Vec3::Y, delta.x * RAD_PER_PX)
+                    * Quat::from_axis_angle(camera.right(), delta.y * RAD_PER_PX);
+                plane.rotation = (turn * plane.rotation).normalize();
+            }
+        }
+        let mut planes = self.scene.planes.clone();
+        planes[i] = plane;
+        self.apply(Edit::SetPlanes(planes), Some("plane-drag"));
+        true
     }
 
     /// The drawing plane whose stroke encloses screen point `p` (outlines by their inside, cuts
@@ -391,7 +460,16 @@ impl CloudApp {
                 }
             }
         }
-        if self.sketch.tool != Tool::Navigate
+        if matches!(self.sketch.tool, Tool::Move | Tool::Rotate) && self.sketch.selected.is_none() {
+            painter.text(
+                rect.center_top() + egui::vec2(0.0, 36.0),
+                egui::Align2::CENTER_TOP,
+                "Click a drawing plane (or pick one in the list) to move or rotate it",
+                egui::FontId::proportional(15.0),
+                Color32::from_white_alpha(200),
+            );
+        }
+        if matches!(self.sketch.tool, Tool::Sketch | Tool::Cut)
             && self.scene.planes.is_empty()
             && self.sketch.stroke.is_empty()
         {
@@ -415,11 +493,13 @@ impl CloudApp {
         egui::CollapsingHeader::new("Sketch")
             .default_open(true)
             .show(ui, |ui| {
-                ui.horizontal(|ui| {
+                ui.horizontal_wrapped(|ui| {
                     for (tool, label, key) in [
                         (Tool::Navigate, "Navigate", "V"),
                         (Tool::Sketch, "✏ Sketch", "D"),
                         (Tool::Cut, "✂ Cut", "C"),
+                        (Tool::Move, "✥ Move", "G"),
+                        (Tool::Rotate, "⟳ Rotate", "R"),
                     ] {
                         ui.selectable_value(&mut self.sketch.tool, tool, label)
                             .on_hover_text(format!("{key}"));

@@ -1,6 +1,6 @@
 // Sketching in the browser (WebGPU): drawing an outline with pointer events makes a cloud
 // where it was drawn and a drawing plane in the list; a cut stroke flattens its base; undo
-// removes it. Screenshots: web/test-results/screenshots/sketch-*.png.
+// removes it; the Move tool drags a plane. Screenshots: web/test-results/screenshots/sketch-*.png.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { serve, launch, openApp, waitForBody, waitForFullQuality, state, screenshot, countDiffering, until } from './harness.mjs';
@@ -84,6 +84,18 @@ test('draw an outline, then cut its base', { timeout: 300_000 }, async () => {
       // Undo removes the cut.
       await page.keyboard.press('Control+z');
       s = await until(page, (s) => s.scene.planes.length === 1, 'undo of the cut');
+      // Move tool: click the cloud to select its plane, drag it right; one undo step.
+      await page.keyboard.press('g');
+      await until(page, (s) => s.view.tool === 'move', 'move tool');
+      await page.mouse.click(cx, base - h * 0.4);
+      s = await until(page, (s) => s.view.selected_plane === 0, 'the plane selected by a click');
+      const before = { x: s.scene.planes[0].origin[0], undo: s.view.undo };
+      await stroke(page, Array.from({ length: 8 }, (_, i) => [cx + i * 10, base - h * 0.4]));
+      s = await until(page, (s) => s.scene.planes[0].origin[0] > before.x + 0.5, 'the plane moved right');
+      assert.equal(s.view.undo, before.undo + 1, 'one drag, one undo step');
+      await page.keyboard.press('Control+z');
+      await until(page, (s) => Math.abs(s.scene.planes[0].origin[0] - before.x) < 1e-6, 'move undone');
+
       // A degenerate stroke (a straight line, no inside) is refused with a message, changes nothing.
       await page.keyboard.press('d');
       await stroke(page, Array.from({ length: 10 }, (_, i) => [vw * 0.15 + i * 12, vh * 0.15 + i * 4]));
