@@ -1,6 +1,7 @@
 // The app in the browser: the default cloud is drawn (WebGPU, then the WebGL2 fallback), a
-// drag orbits the camera and changes the image, nothing logs an error, and ?preset=empty
-// opens an empty scene. Screenshots: web/test-results/screenshots/.
+// drag orbits the camera and changes the image, nothing logs an error, ?preset=empty opens an
+// empty scene, and a browser with neither WebGPU nor WebGL2 gets a plain message.
+// Screenshots: web/test-results/screenshots/.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import {
@@ -86,6 +87,21 @@ test('?preset=empty opens an empty scene', { timeout: 180_000 }, async () => {
     // Only the hint text may differ from the background in an empty viewport.
     assert.ok(countDiffering(img, { x: 0, y: 0, w: vw, h: vh }, toBytes(s.scene.light.background)) < 0.01 * vw * vh);
     assert.deepEqual(errors, []);
+  } finally {
+    await close();
+  }
+});
+
+test('without WebGPU and WebGL2 the page says so plainly', { timeout: 120_000 }, async () => {
+  const { browser, close } = await launch({ webgpu: false, webgl: false });
+  try {
+    const { page } = await openApp(browser, server.url);
+    await page.waitForSelector('#error[style*="display:block"]', { timeout: 60_000 });
+    const text = await page.textContent('#error');
+    assert.match(text, /neither WebGPU nor WebGL2/);
+    assert.equal(await page.$('#loading'), null, 'the loading note is gone');
+    assert.equal(await page.getAttribute('body', 'data-ready'), null);
+    await screenshot(page, 'no-gpu-message');
   } finally {
     await close();
   }

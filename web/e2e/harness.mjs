@@ -44,11 +44,15 @@ const QUIET = ['--no-first-run', '--disable-background-networking', '--disable-c
 const SWIFTSHADER = ['--use-angle=swiftshader', '--enable-features=Vulkan', '--use-vulkan=swiftshader',
   '--enable-unsafe-swiftshader', '--ignore-gpu-blocklist'];
 
-/** Launches Chromium; `webgpu: false` leaves WebGPU off so the app must fall back to WebGL2. */
-export async function launch({ webgpu }) {
+/**
+ * Launches Chromium; `webgpu: false` leaves WebGPU off so the app must fall back to WebGL2;
+ * `webgl: false` also turns WebGL off (no way to draw at all).
+ */
+export async function launch({ webgpu, webgl = true }) {
   const userDataDir = fs.mkdtempSync(path.join(os.tmpdir(), 'cloudsketch-chromium-'));
   const args = ['--remote-debugging-pipe', `--user-data-dir=${userDataDir}`, '--headless=new', '--no-sandbox',
-    ...QUIET, ...SWIFTSHADER, ...(webgpu ? ['--enable-unsafe-webgpu'] : []), 'about:blank'];
+    ...QUIET, ...SWIFTSHADER, ...(webgpu ? ['--enable-unsafe-webgpu'] : []),
+    ...(webgl ? [] : ['--disable-3d-apis', '--disable-webgl']), 'about:blank'];
   const browser = await chromium.launch({
     executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium', ignoreDefaultArgs: true, args, timeout: 60_000,
   });
