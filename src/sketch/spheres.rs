@@ -14,6 +14,10 @@ pub const MAX_SPHERES: usize = 3000;
 /// well below 1, so neighbours overlap deeply and the body never splits.
 const SPACING: f64 = 0.4;
 
+/// Largest turn of a branch copy about the trunk (70°): copies fan out over the dome of the
+/// trunk on the branch's side, so a cloud seen from the side is rounded, not cross-shaped.
+const MAX_COPY_ANGLE: f64 = 70.0 * std::f64::consts::PI / 180.0;
+
 /// A sphere primitive.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Sphere {
@@ -289,10 +293,10 @@ fn nearest_on(polyline: &[DVec2], q: DVec2) -> (DVec2, DVec2) {
 }
 
 /// Automatic 3D extension: each terminal branch is copied `copies` times and rotated about
-/// the trunk (axis: the trunk's direction at the point nearest the branch's root), evenly
-/// spread around it; originals get a small jitter out of their plane. Every moved sphere is
-/// fitted so its projection to the drawing plane stays inside the outline, which keeps the
-/// silhouette from the drawing view.
+/// the trunk (axis: the trunk's direction at the point nearest the branch's root), spread
+/// evenly toward and away from the viewer over the half of the trunk it grows from; originals
+/// get a small jitter out of their plane. Every moved sphere is fitted so its projection to
+/// the drawing plane stays inside the outline, which keeps the silhouette from the drawing view.
 pub fn extend(
     outline: &Outline,
     skeleton: &Skeleton,
@@ -336,10 +340,14 @@ pub fn extend(
         // Original: a small jitter rotation out of the plane.
         let jitter = (rng.next() - 0.5) * 0.5;
         out.extend(fit_branch(outline, rotated(jitter)));
-        // Copies evenly around the trunk, with a little variation.
-        for k in 1..=budget_copies {
-            let angle = std::f64::consts::TAU * k as f64 / (budget_copies + 1) as f64
-                + (rng.next() - 0.5) * 0.6;
+        // Copies spread evenly over the half of the trunk's surface the branch grows from,
+        // toward and away from the viewer (a bump on top stays on top, never under the base),
+        // with a little seeded variation.
+        let pairs = budget_copies.div_ceil(2);
+        for k in 0..budget_copies {
+            let step = (k / 2 + 1) as f64 / pairs as f64;
+            let side = if k % 2 == 0 { 1.0 } else { -1.0 };
+            let angle = side * (step * MAX_COPY_ANGLE + (rng.next() - 0.5) * 0.3);
             out.extend(fit_branch(outline, rotated(angle)));
         }
     }
