@@ -270,7 +270,7 @@ impl Progressive {
             return;
         };
         let dt = now - then;
-        if !(dt > 0.0) || work <= 0.0 {
+        if dt.is_nan() || dt <= 0.0 || work <= 0.0 {
             return;
         }
         self.last_frame = Some(dt);

@@ -45,7 +45,7 @@ pub fn set_by_pointer(scene: &Scene, assignment: &str) -> Result<Scene, SetError
         .pointer_mut(path)
         .ok_or_else(|| SetError::UnknownPath(path.to_string()))?;
     let same_kind = std::mem::discriminant(slot) == std::mem::discriminant(&new_value);
-    if !same_kind && !(slot.is_number() && new_value.is_number()) {
+    if !same_kind && (!slot.is_number() || !new_value.is_number()) {
         return Err(SetError::BadValue {
             path: path.to_string(),
             value: raw.to_string(),

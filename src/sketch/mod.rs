@@ -159,7 +159,7 @@ pub fn cut_line(points: &[[f64; 2]]) -> Result<Vec<DVec2>, SketchError> {
     }
     pts.sort_by(|a, b| a.x.total_cmp(&b.x));
     let width = pts[pts.len() - 1].x - pts[0].x;
-    if !(width > 0.0) {
+    if width.is_nan() || width <= 0.0 {
         return Err(SketchError::NoArea);
     }
     // Average runs of (almost) equal x into one point.

@@ -248,7 +248,7 @@ pub fn clean(raw: &[[f64; 2]], closed: bool, simplify: f64) -> Result<Outline, S
         return Err(SketchError::TooFewPoints(points.len()));
     }
     let size = diagonal(&points);
-    if !(size > 0.0) || !size.is_finite() {
+    if !size.is_finite() || size <= 0.0 {
         return Err(SketchError::NoArea);
     }
     // Coordinates far from the origin lose precision in the triangulation: work around the centre.

@@ -502,7 +502,7 @@ impl CloudApp {
                         (Tool::Rotate, "⟳ Rotate", "R"),
                     ] {
                         ui.selectable_value(&mut self.sketch.tool, tool, label)
-                            .on_hover_text(format!("{key}"));
+                            .on_hover_text(key);
                     }
                 });
                 ui.horizontal(|ui| {
