@@ -57,40 +57,32 @@ pub fn diagonal(p: &[DVec2]) -> f64 {
     (hi - lo).length()
 }
 
-/// Distance from `q` to the segment `a`–`b`.
-pub fn segment_distance(q: DVec2, a: DVec2, b: DVec2) -> f64 {
+/// Squared distance from `q` to the segment `a`–`b`.
+#[inline]
+pub fn segment_distance_squared(q: DVec2, a: DVec2, b: DVec2) -> f64 {
     let ab = b - a;
+    let aq = q - a;
     let len2 = ab.length_squared();
     let t = if len2 > 0.0 {
-        ((q - a).dot(ab) / len2).clamp(0.0, 1.0)
+        (aq.dot(ab) / len2).clamp(0.0, 1.0)
     } else {
         0.0
     };
-    q.distance(a + ab * t)
+    (aq - ab * t).length_squared()
+}
+
+/// Distance from `q` to the segment `a`–`b`.
+pub fn segment_distance(q: DVec2, a: DVec2, b: DVec2) -> f64 {
+    segment_distance_squared(q, a, b).sqrt()
 }
 
 /// Distance from `q` to a closed polygon's boundary.
 pub fn boundary_distance(q: DVec2, p: &[DVec2]) -> f64 {
     let n = p.len();
-    let mut best = f64::INFINITY;
-    let mut a = p[n - 1];
-    for &b in p {
-        // Squared distance to segment a–b, one square root at the end.
-        let ab = b - a;
-        let aq = q - a;
-        let len2 = ab.length_squared();
-        let t = if len2 > 0.0 {
-            (aq.dot(ab) / len2).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        let d = (aq - ab * t).length_squared();
-        if d < best {
-            best = d;
-        }
-        a = b;
-    }
-    best.sqrt()
+    (0..n)
+        .map(|i| segment_distance_squared(q, p[i], p[(i + 1) % n]))
+        .fold(f64::INFINITY, f64::min)
+        .sqrt()
 }
 
 /// A closed polygon with a uniform grid of its edges, for fast distance queries (the sketch
@@ -175,16 +167,11 @@ impl Boundary {
                     }
                     for &e in &self.cells[(y * w + x) as usize] {
                         let e = e as usize;
-                        let (a, b) = (self.points[e], self.points[(e + 1) % n]);
-                        let ab = b - a;
-                        let aq = q - a;
-                        let len2 = ab.length_squared();
-                        let t = if len2 > 0.0 {
-                            (aq.dot(ab) / len2).clamp(0.0, 1.0)
-                        } else {
-                            0.0
-                        };
-                        best = best.min((aq - ab * t).length_squared());
+                        best = best.min(segment_distance_squared(
+                            q,
+                            self.points[e],
+                            self.points[(e + 1) % n],
+                        ));
                     }
                 }
             }
