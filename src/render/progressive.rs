@@ -80,7 +80,7 @@ impl Default for Budget {
         Self {
             interactive: 0.1,
             refine: 0.15,
-            refine_total: 1.5,
+            refine_total: 1.2,
         }
     }
 }
