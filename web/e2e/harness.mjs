@@ -61,8 +61,8 @@ export async function launch({ webgpu, webgl = true }) {
 }
 
 /** Opens the app in a new page and records console errors and page errors. */
-export async function openApp(browser, base, query = '', viewport = { width: 900, height: 560 }) {
-  const page = await browser.newPage({ viewport });
+export async function openApp(browser, base, query = '', viewport = { width: 900, height: 560 }, options = {}) {
+  const page = await browser.newPage({ viewport, ...options });
   const errors = [];
   const log = [];
   page.on('console', (m) => { log.push(`[${m.type()}] ${m.text()}`); if (m.type() === 'error') errors.push(m.text()); });

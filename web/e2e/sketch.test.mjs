@@ -111,3 +111,45 @@ test('draw an outline, then cut its base', { timeout: 300_000 }, async () => {
     await close();
   }
 });
+
+test('touch: one finger sketches, two fingers orbit', { timeout: 240_000 }, async () => {
+  const { browser, close } = await launch({ webgpu: true });
+  try {
+    const { page, errors } = await openApp(browser, server.url, '?preset=empty', { width: 900, height: 560 }, { hasTouch: true });
+    await waitForBody(page, 'data-ready', (v) => v === 'true');
+    let s = await state(page);
+    const [vw, vh] = s.view.viewport;
+    const cdp = await page.context().newCDPSession(page);
+    const touch = (type, points) => cdp.send('Input.dispatchTouchEvent', {
+      type, touchPoints: points.map(([x, y], id) => ({ x, y, id, radiusX: 2, radiusY: 2, force: 1 })),
+    });
+    await page.keyboard.press('d');
+    await until(page, (s) => s.view.tool === 'sketch', 'sketch tool');
+    // One finger: an outline (an ellipse with a flat base).
+    const cx = vw * 0.5, cy = vh * 0.5;
+    const pts = [];
+    for (let i = 0; i <= 48; i++) {
+      const a = (i / 48) * 2 * Math.PI;
+      pts.push([cx + vw * 0.2 * Math.cos(a), cy + Math.min(vh * 0.18 * Math.sin(a), vh * 0.08)]);
+    }
+    await touch('touchStart', [pts[0]]);
+    for (const p of pts.slice(1)) { await touch('touchMove', [p]); }
+    await touch('touchEnd', []);
+    s = await until(page, (s) => s.scene.planes.length === 1, 'a plane drawn with one finger');
+    const yaw = s.scene.camera.yaw_deg;
+    // Two fingers moving together orbit, even in the Sketch tool, and draw nothing.
+    let a = [cx - 40, cy], b = [cx + 40, cy];
+    await touch('touchStart', [a, b]);
+    for (let i = 1; i <= 10; i++) {
+      a = [a[0] + 12, a[1]]; b = [b[0] + 12, b[1]];
+      await touch('touchMove', [a, b]);
+    }
+    await touch('touchEnd', []);
+    s = await until(page, (s) => Math.abs(s.scene.camera.yaw_deg - yaw) > 5, 'a two-finger orbit');
+    assert.equal(s.scene.planes.length, 1, 'two fingers drew no stroke');
+    await screenshot(page, 'sketch-touch');
+    assert.deepEqual(errors, []);
+  } finally {
+    await close();
+  }
+});
