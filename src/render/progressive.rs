@@ -79,7 +79,7 @@ impl Default for Budget {
     fn default() -> Self {
         Self {
             interactive: 0.1,
-            refine: 0.15,
+            refine: 0.2,
             refine_total: 1.2,
         }
     }

@@ -281,6 +281,8 @@ impl CloudApp {
             "view": {
                 "viewport": self.viewport_px,
                 "quality": quality,
+                "frame_ms": self.frame_seconds.map(|s| (s * 1000.0).round()),
+                "refining": self.refining,
                 "backend": backend.backend,
                 "adapter": backend.adapter,
                 "undo": self.history.undo_len(),
