@@ -121,6 +121,36 @@ fn key(a: usize, b: usize) -> (usize, usize) {
 /// a star's arms stay).
 pub fn chordal_axis(outline: &Outline, prune: f64) -> Result<Skeleton, SketchError> {
     let p = &outline.boundary;
+    let triangles = triangulate(outline)?;
+    let dual = Dual::new(&triangles, p.len());
+    let kinds = dual
+        .adj
+        .iter()
+        .map(|a| match a.len() {
+            0 => TriangleKind::Isolated,
+            1 => TriangleKind::Terminal,
+            2 => TriangleKind::Sleeve,
+            _ => TriangleKind::Junction,
+        })
+        .collect();
+    let pruned = Pruned::new(&triangles, &dual, p, prune.max(0.0) * outline.area);
+    let graph = Graph::new(&triangles, &dual, &pruned, p);
+    let edge_to_segment = graph.map_outline_edges(&triangles, &pruned, p);
+    let branches = branches(&graph.nodes, &graph.segments);
+    Ok(Skeleton {
+        triangles,
+        kinds,
+        nodes: graph.nodes,
+        segments: graph.segments,
+        branches,
+        edge_to_segment,
+    })
+}
+
+/// The constrained Delaunay triangles inside the outline (spade; conflicts are refused, never
+/// a panic).
+fn triangulate(outline: &Outline) -> Result<Vec<Triangle>, SketchError> {
+    let p = &outline.boundary;
     let n = p.len();
     let vertices: Vec<Vertex> = p
         .iter()
@@ -162,253 +192,304 @@ pub fn chordal_axis(outline: &Outline, prune: f64) -> Result<Skeleton, SketchErr
     if triangles.is_empty() {
         return Err(SketchError::NoArea);
     }
+    Ok(triangles)
+}
 
-    // Dual tree: triangles adjacent across internal edges.
-    let is_boundary = |a: usize, b: usize| (a + 1) % n == b || (b + 1) % n == a;
-    let mut by_edge: std::collections::BTreeMap<(usize, usize), Vec<usize>> = Default::default();
-    for (t, tri) in triangles.iter().enumerate() {
-        for k in 0..3 {
-            let (a, b) = (tri.v[k], tri.v[(k + 1) % 3]);
-            if !is_boundary(a, b) {
-                by_edge.entry(key(a, b)).or_default().push(t);
-            }
-        }
-    }
-    let mut adj: Vec<Vec<(usize, (usize, usize))>> = vec![Vec::new(); triangles.len()];
-    for (&e, ts) in &by_edge {
-        if let [s, t] = ts[..] {
-            adj[s].push((t, e));
-            adj[t].push((s, e));
-        }
-    }
-    let kinds: Vec<TriangleKind> = adj
-        .iter()
-        .map(|a| match a.len() {
-            0 => TriangleKind::Isolated,
-            1 => TriangleKind::Terminal,
-            2 => TriangleKind::Sleeve,
-            _ => TriangleKind::Junction,
-        })
-        .collect();
+/// The dual tree: triangles adjacent across internal (non-outline) edges.
+struct Dual {
+    /// Internal edge (sorted vertex pair) → the triangles sharing it.
+    by_edge: std::collections::BTreeMap<(usize, usize), Vec<usize>>,
+    /// Per triangle: (neighbour, shared edge).
+    adj: Vec<Vec<(usize, (usize, usize))>>,
+}
 
-    // Pruning: repeatedly remove the smallest terminal branch below the area threshold.
-    let threshold = prune.max(0.0) * outline.area;
-    let mut alive = vec![true; triangles.len()];
-    let mut owner: Vec<usize> = (0..triangles.len()).collect(); // pruned triangle → absorbing triangle
-    let mut disc_cache: std::collections::BTreeMap<usize, (DVec2, f64)> = Default::default();
-    let mut absorbed = vec![false; triangles.len()];
-    // A branch's significance changes only when its chain or junction does.
-    let mut significance_cache: std::collections::BTreeMap<(usize, usize, usize), f64> =
-        Default::default();
-    loop {
-        let degree = |t: usize, alive: &[bool]| adj[t].iter().filter(|(s, _)| alive[*s]).count();
-        if !(0..triangles.len()).any(|t| alive[t] && degree(t, &alive) >= 3) {
-            break;
-        }
-        // Candidates below the threshold; per pass, each junction loses at most its smallest
-        // branch (pruning one turns the junction into a sleeve and lengthens its other chains).
-        let mut candidates: Vec<(f64, Vec<usize>, usize)> = Vec::new();
-        for start in 0..triangles.len() {
-            if !alive[start] || degree(start, &alive) != 1 {
-                continue;
-            }
-            let (mut chain, mut prev, mut cur) = (vec![start], usize::MAX, start);
-            let end = loop {
-                let next = adj[cur]
-                    .iter()
-                    .map(|(s, _)| *s)
-                    .find(|&s| alive[s] && s != prev);
-                let Some(next) = next else { break None };
-                if degree(next, &alive) >= 3 {
-                    break Some(next);
+impl Dual {
+    fn new(triangles: &[Triangle], n: usize) -> Self {
+        let is_boundary = |a: usize, b: usize| (a + 1) % n == b || (b + 1) % n == a;
+        let mut by_edge: std::collections::BTreeMap<(usize, usize), Vec<usize>> =
+            Default::default();
+        for (t, tri) in triangles.iter().enumerate() {
+            for k in 0..3 {
+                let (a, b) = (tri.v[k], tri.v[(k + 1) % 3]);
+                if !is_boundary(a, b) {
+                    by_edge.entry(key(a, b)).or_default().push(t);
                 }
-                chain.push(next);
-                prev = cur;
-                cur = next;
-            };
-            // Significance: the branch's area outside the junction's maximal disc, i.e. what
-            // the feature adds to the shape beyond the body it hangs from.
-            let significance = end.map(|j| {
-                let key = (start, j, chain.len());
-                if let Some(&v) = significance_cache.get(&key) {
-                    return v;
+            }
+        }
+        let mut adj: Vec<Vec<(usize, (usize, usize))>> = vec![Vec::new(); triangles.len()];
+        for (&e, ts) in &by_edge {
+            if let [s, t] = ts[..] {
+                adj[s].push((t, e));
+                adj[t].push((s, e));
+            }
+        }
+        Self { by_edge, adj }
+    }
+}
+
+/// Pruning: repeatedly removes the least significant terminal branches below `threshold`.
+struct Pruned {
+    /// Triangles still in the skeleton.
+    alive: Vec<bool>,
+    /// Pruned triangle → the triangle that absorbed it (itself when alive).
+    owner: Vec<usize>,
+    /// Triangles that absorbed pruned branches.
+    absorbed: Vec<bool>,
+    /// Largest discs found per triangle.
+    discs: std::collections::BTreeMap<usize, (DVec2, f64)>,
+}
+
+impl Pruned {
+    fn new(triangles: &[Triangle], dual: &Dual, p: &Boundary, threshold: f64) -> Self {
+        let mut alive = vec![true; triangles.len()];
+        let mut owner: Vec<usize> = (0..triangles.len()).collect(); // pruned triangle → absorbing triangle
+        let mut disc_cache: std::collections::BTreeMap<usize, (DVec2, f64)> = Default::default();
+        let mut absorbed = vec![false; triangles.len()];
+        // A branch's significance changes only when its chain or junction does.
+        let mut significance_cache: std::collections::BTreeMap<(usize, usize, usize), f64> =
+            Default::default();
+        loop {
+            let degree =
+                |t: usize, alive: &[bool]| dual.adj[t].iter().filter(|(s, _)| alive[*s]).count();
+            if !(0..triangles.len()).any(|t| alive[t] && degree(t, &alive) >= 3) {
+                break;
+            }
+            // Candidates below the threshold; per pass, each junction loses at most its smallest
+            // branch (pruning one turns the junction into a sleeve and lengthens its other chains).
+            let mut candidates: Vec<(f64, Vec<usize>, usize)> = Vec::new();
+            for start in 0..triangles.len() {
+                if !alive[start] || degree(start, &alive) != 1 {
+                    continue;
                 }
-                let v = significance_of(j, &chain, &adj, &alive, &triangles, p, &mut disc_cache);
-                significance_cache.insert(key, v);
-                v
-            });
-            if let (Some(junction), Some(area)) = (end, significance)
-                && area < threshold
-            {
-                candidates.push((area, chain, junction));
+                let (mut chain, mut prev, mut cur) = (vec![start], usize::MAX, start);
+                let end = loop {
+                    let next = dual.adj[cur]
+                        .iter()
+                        .map(|(s, _)| *s)
+                        .find(|&s| alive[s] && s != prev);
+                    let Some(next) = next else { break None };
+                    if degree(next, &alive) >= 3 {
+                        break Some(next);
+                    }
+                    chain.push(next);
+                    prev = cur;
+                    cur = next;
+                };
+                // Significance: the branch's area outside the junction's maximal disc, i.e. what
+                // the feature adds to the shape beyond the body it hangs from.
+                let significance = end.map(|j| {
+                    let key = (start, j, chain.len());
+                    if let Some(&v) = significance_cache.get(&key) {
+                        return v;
+                    }
+                    let v = significance_of(
+                        j,
+                        &chain,
+                        &dual.adj,
+                        &alive,
+                        &triangles,
+                        p,
+                        &mut disc_cache,
+                    );
+                    significance_cache.insert(key, v);
+                    v
+                });
+                if let (Some(junction), Some(area)) = (end, significance)
+                    && area < threshold
+                {
+                    candidates.push((area, chain, junction));
+                }
+            }
+            if candidates.is_empty() {
+                break;
+            }
+            candidates.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.2.cmp(&b.2)));
+            let mut touched = std::collections::BTreeSet::new();
+            for (_, chain, junction) in candidates {
+                // A junction of degree 3 that already lost a branch this pass is now a sleeve.
+                if !touched.insert(junction) {
+                    continue;
+                }
+                for t in chain {
+                    alive[t] = false;
+                    owner[t] = junction;
+                }
+                absorbed[junction] = true;
             }
         }
-        if candidates.is_empty() {
-            break;
-        }
-        candidates.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.2.cmp(&b.2)));
-        let mut touched = std::collections::BTreeSet::new();
-        for (_, chain, junction) in candidates {
-            // A junction of degree 3 that already lost a branch this pass is now a sleeve.
-            if !touched.insert(junction) {
-                continue;
-            }
-            for t in chain {
-                alive[t] = false;
-                owner[t] = junction;
-            }
-            absorbed[junction] = true;
+        Self {
+            alive,
+            owner,
+            absorbed,
+            discs: disc_cache,
         }
     }
-    let resolve = |mut t: usize| {
-        while owner[t] != t {
-            t = owner[t];
+
+    /// The live triangle a (possibly pruned) triangle belongs to.
+    fn resolve(&self, mut t: usize) -> usize {
+        while self.owner[t] != t {
+            t = self.owner[t];
         }
         t
-    };
-
-    // Skeleton graph: midpoints of live internal edges, centroids of live junctions, tips of terminals.
-    let mut nodes: Vec<Node> = Vec::new();
-    let mut node_of_edge: std::collections::BTreeMap<(usize, usize), usize> = Default::default();
-    let node = |nodes: &mut Vec<Node>, pos: DVec2| {
-        nodes.push(Node {
-            pos,
-            radius: p.distance(pos),
-        });
-        nodes.len() - 1
-    };
-    for (&e, ts) in &by_edge {
-        if ts.len() == 2 && alive[ts[0]] && alive[ts[1]] {
-            let id = node(&mut nodes, (p[e.0] + p[e.1]) * 0.5);
-            node_of_edge.insert(e, id);
-        }
     }
-    let mut segments = Vec::new();
-    let mut segments_of_triangle: Vec<Vec<usize>> = vec![Vec::new(); triangles.len()];
-    // Visit triangles in a fixed order so the result does not depend on hash order.
-    let live_edges_of = |t: usize| -> Vec<usize> {
-        let mut v: Vec<((usize, usize), usize)> = adj[t]
-            .iter()
-            .filter(|(s, _)| alive[*s])
-            .map(|(_, e)| (*e, node_of_edge[e]))
-            .collect();
-        v.sort();
-        v.into_iter().map(|(_, id)| id).collect()
-    };
-    for t in 0..triangles.len() {
-        if !alive[t] {
-            continue;
-        }
-        let tri = &triangles[t];
-        let [a, b, c] = tri.v.map(|i| p[i]);
-        let mids = live_edges_of(t);
-        let mut add = |segments: &mut Vec<[usize; 2]>, s: [usize; 2]| {
-            segments.push(s);
-            segments_of_triangle[t].push(segments.len() - 1);
+}
+
+/// The skeleton graph: midpoints of live internal edges, discs of live junctions, tips of
+/// terminals.
+struct Graph {
+    nodes: Vec<Node>,
+    segments: Vec<[usize; 2]>,
+    /// Segments made by each triangle.
+    segments_of_triangle: Vec<Vec<usize>>,
+}
+
+impl Graph {
+    fn new(triangles: &[Triangle], dual: &Dual, pruned: &Pruned, p: &Boundary) -> Self {
+        let mut nodes: Vec<Node> = Vec::new();
+        let mut node_of_edge: std::collections::BTreeMap<(usize, usize), usize> =
+            Default::default();
+        let node = |nodes: &mut Vec<Node>, pos: DVec2| {
+            nodes.push(Node {
+                pos,
+                radius: p.distance(pos),
+            });
+            nodes.len() - 1
         };
-        match mids.len() {
-            0 => {
-                // A lone triangle: its incentre is the skeleton.
-                let (la, lb, lc) = (b.distance(c), c.distance(a), a.distance(b));
-                let centre = (a * la + b * lb + c * lc) / (la + lb + lc);
-                let id = node(&mut nodes, centre);
-                add(&mut segments, [id, id]);
+        for (&e, ts) in &dual.by_edge {
+            if ts.len() == 2 && pruned.alive[ts[0]] && pruned.alive[ts[1]] {
+                let id = node(&mut nodes, (p[e.0] + p[e.1]) * 0.5);
+                node_of_edge.insert(e, id);
             }
-            1 => {
-                // Terminal: from the chord's midpoint halfway toward the opposite vertex.
-                let m = nodes[mids[0]].pos;
-                let apex = tri
-                    .v
-                    .iter()
-                    .map(|&i| p[i])
-                    .max_by(|x, y| x.distance_squared(m).total_cmp(&y.distance_squared(m)))
-                    .unwrap_or(a);
-                let tip = node(&mut nodes, m.lerp(apex, 0.5));
-                add(&mut segments, [mids[0], tip]);
+        }
+        let mut segments = Vec::new();
+        let mut segments_of_triangle: Vec<Vec<usize>> = vec![Vec::new(); triangles.len()];
+        // Visit triangles in a fixed order so the result does not depend on hash order.
+        let live_edges_of = |t: usize| -> Vec<usize> {
+            let mut v: Vec<((usize, usize), usize)> = dual.adj[t]
+                .iter()
+                .filter(|(s, _)| pruned.alive[*s])
+                .map(|(_, e)| (*e, node_of_edge[e]))
+                .collect();
+            v.sort();
+            v.into_iter().map(|(_, id)| id).collect()
+        };
+        for t in 0..triangles.len() {
+            if !pruned.alive[t] {
+                continue;
             }
-            2 if !absorbed[t] => add(&mut segments, [mids[0], mids[1]]),
-            _ => {
-                // Junctions (and former junctions whose small branches were pruned) pass through
-                // their largest inscribed disc, which covers what the pruned branches held.
-                let refined = disc_cache
-                    .get(&t)
-                    .copied()
-                    .unwrap_or_else(|| largest_disc(tri, p))
-                    .0;
-                // Only where the way from each chord to it stays well inside the outline.
-                let r_refined = p.distance(refined);
-                // Samples at least `floor` from the outline and closer together than `floor`
-                // cannot have the outline between them, so the whole way stays inside.
-                let inside = |q: DVec2| {
-                    let floor = 0.5 * p.distance(q).min(r_refined);
-                    floor > q.distance(refined) / 8.0
-                        && (1..8).all(|k| p.distance(q.lerp(refined, k as f64 / 8.0)) >= floor)
-                };
-                // Inside the (convex) triangle the way to each chord is inside it: no check needed.
-                let in_triangle = {
-                    let o = |u: DVec2, v: DVec2| (v - u).perp_dot(refined - u) >= 0.0;
-                    o(a, b) && o(b, c) && o(c, a)
-                };
-                let centre = if in_triangle || mids.iter().all(|&m| inside(nodes[m].pos)) {
-                    refined
-                } else {
-                    sampled_disc(tri, p, true, 5).0
-                };
-                let centre = node(&mut nodes, centre);
-                for &m in &mids {
-                    add(&mut segments, [centre, m]);
+            let tri = &triangles[t];
+            let [a, b, c] = tri.v.map(|i| p[i]);
+            let mids = live_edges_of(t);
+            let mut add = |segments: &mut Vec<[usize; 2]>, s: [usize; 2]| {
+                segments.push(s);
+                segments_of_triangle[t].push(segments.len() - 1);
+            };
+            match mids.len() {
+                0 => {
+                    // A lone triangle: its incentre is the skeleton.
+                    let (la, lb, lc) = (b.distance(c), c.distance(a), a.distance(b));
+                    let centre = (a * la + b * lb + c * lc) / (la + lb + lc);
+                    let id = node(&mut nodes, centre);
+                    add(&mut segments, [id, id]);
+                }
+                1 => {
+                    // Terminal: from the chord's midpoint halfway toward the opposite vertex.
+                    let m = nodes[mids[0]].pos;
+                    let apex = tri
+                        .v
+                        .iter()
+                        .map(|&i| p[i])
+                        .max_by(|x, y| x.distance_squared(m).total_cmp(&y.distance_squared(m)))
+                        .unwrap_or(a);
+                    let tip = node(&mut nodes, m.lerp(apex, 0.5));
+                    add(&mut segments, [mids[0], tip]);
+                }
+                2 if !pruned.absorbed[t] => add(&mut segments, [mids[0], mids[1]]),
+                _ => {
+                    // Junctions (and former junctions whose small branches were pruned) pass through
+                    // their largest inscribed disc, which covers what the pruned branches held.
+                    let refined = pruned
+                        .discs
+                        .get(&t)
+                        .copied()
+                        .unwrap_or_else(|| largest_disc(tri, p))
+                        .0;
+                    // Only where the way from each chord to it stays well inside the outline.
+                    let r_refined = p.distance(refined);
+                    // Samples at least `floor` from the outline and closer together than `floor`
+                    // cannot have the outline between them, so the whole way stays inside.
+                    let inside = |q: DVec2| {
+                        let floor = 0.5 * p.distance(q).min(r_refined);
+                        floor > q.distance(refined) / 8.0
+                            && (1..8).all(|k| p.distance(q.lerp(refined, k as f64 / 8.0)) >= floor)
+                    };
+                    // Inside the (convex) triangle the way to each chord is inside it: no check needed.
+                    let in_triangle = {
+                        let o = |u: DVec2, v: DVec2| (v - u).perp_dot(refined - u) >= 0.0;
+                        o(a, b) && o(b, c) && o(c, a)
+                    };
+                    let centre = if in_triangle || mids.iter().all(|&m| inside(nodes[m].pos)) {
+                        refined
+                    } else {
+                        sampled_disc(tri, p, true, 5).0
+                    };
+                    let centre = node(&mut nodes, centre);
+                    for &m in &mids {
+                        add(&mut segments, [centre, m]);
+                    }
                 }
             }
         }
-    }
-    segments.retain(|s| s[0] != s[1] || nodes.len() == 1);
-
-    // Outline edge → the nearest segment of the (absorbing) triangle it borders.
-    let mut triangle_of_edge = vec![usize::MAX; n];
-    for (t, tri) in triangles.iter().enumerate() {
-        for k in 0..3 {
-            let (a, b) = (tri.v[k], tri.v[(k + 1) % 3]);
-            if (a + 1) % n == b {
-                triangle_of_edge[a] = t;
-            }
+        segments.retain(|s| s[0] != s[1] || nodes.len() == 1);
+        Self {
+            nodes,
+            segments,
+            segments_of_triangle,
         }
     }
-    let segments_of_triangle: Vec<Vec<usize>> = segments_of_triangle
-        .into_iter()
-        .map(|v| v.into_iter().filter(|&s| s < segments.len()).collect())
-        .collect();
-    let edge_to_segment = (0..n)
-        .map(|i| {
-            let mid = (p[i] + p[(i + 1) % n]) * 0.5;
-            let t = triangle_of_edge[i];
-            let candidates: Vec<usize> =
-                if t != usize::MAX && !segments_of_triangle[resolve(t)].is_empty() {
-                    segments_of_triangle[resolve(t)].clone()
-                } else {
-                    (0..segments.len()).collect()
-                };
-            candidates
-                .into_iter()
-                .min_by(|&x, &y| {
-                    seg_dist(mid, &nodes, segments[x]).total_cmp(&seg_dist(
-                        mid,
-                        &nodes,
-                        segments[y],
-                    ))
-                })
-                .unwrap_or(0)
-        })
-        .collect();
 
-    let branches = branches(&nodes, &segments);
-    Ok(Skeleton {
-        triangles,
-        kinds,
-        nodes,
-        segments,
-        branches,
-        edge_to_segment,
-    })
+    /// For each outline edge, the nearest segment of the (absorbing) triangle it borders.
+    fn map_outline_edges(
+        &self,
+        triangles: &[Triangle],
+        pruned: &Pruned,
+        p: &Boundary,
+    ) -> Vec<usize> {
+        let n = p.len();
+        let mut triangle_of_edge = vec![usize::MAX; n];
+        for (t, tri) in triangles.iter().enumerate() {
+            for k in 0..3 {
+                let (a, b) = (tri.v[k], tri.v[(k + 1) % 3]);
+                if (a + 1) % n == b {
+                    triangle_of_edge[a] = t;
+                }
+            }
+        }
+        let (nodes, segments, segments_of_triangle) =
+            (&self.nodes, &self.segments, &self.segments_of_triangle);
+        (0..n)
+            .map(|i| {
+                let mid = (p[i] + p[(i + 1) % n]) * 0.5;
+                let t = triangle_of_edge[i];
+                let candidates: Vec<usize> =
+                    if t != usize::MAX && !segments_of_triangle[pruned.resolve(t)].is_empty() {
+                        segments_of_triangle[pruned.resolve(t)].clone()
+                    } else {
+                        (0..segments.len()).collect()
+                    };
+                candidates
+                    .into_iter()
+                    .min_by(|&x, &y| {
+                        seg_dist(mid, nodes, segments[x]).total_cmp(&seg_dist(
+                            mid,
+                            nodes,
+                            segments[y],
+                        ))
+                    })
+                    .unwrap_or(0)
+            })
+            .collect()
+    }
 }
 
 /// What a terminal branch (`chain`, hanging from junction triangle `junction`) adds to the
