@@ -287,7 +287,7 @@ impl Pruned {
                         &chain,
                         &dual.adj,
                         &alive,
-                        &triangles,
+                        triangles,
                         p,
                         &mut disc_cache,
                     );
