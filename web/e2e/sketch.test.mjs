@@ -1,6 +1,6 @@
 // Sketching in the browser (WebGPU): drawing an outline with pointer events makes a cloud
 // where it was drawn and a drawing plane in the list; a cut stroke flattens its base; undo
-// removes it; the Move tool drags a plane. Screenshots: web/test-results/screenshots/sketch-*.png.
+// removes it; Move and Rotate drag a plane; Ctrl+D duplicates and Delete removes it. Screenshots: web/test-results/screenshots/sketch-*.png.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { serve, launch, openApp, waitForBody, waitForFullQuality, state, screenshot, countDiffering, until } from './harness.mjs';
@@ -95,6 +95,19 @@ test('draw an outline, then cut its base', { timeout: 300_000 }, async () => {
       assert.equal(s.view.undo, before.undo + 1, 'one drag, one undo step');
       await page.keyboard.press('Control+z');
       await until(page, (s) => Math.abs(s.scene.planes[0].origin[0] - before.x) < 1e-6, 'move undone');
+
+      // Rotate tool: a sideways drag turns the selected plane; duplicate and delete by shortcut.
+      await page.keyboard.press('r');
+      await until(page, (s) => s.view.tool === 'rotate', 'rotate tool');
+      const rot0 = JSON.stringify(s.scene.planes[0].rotation);
+      await stroke(page, Array.from({ length: 8 }, (_, i) => [cx + i * 10, base - h * 0.4]));
+      s = await until(page, (s) => JSON.stringify(s.scene.planes[0].rotation) !== rot0, 'the plane rotated');
+      await page.keyboard.press('Control+d');
+      s = await until(page, (s) => s.scene.planes.length === 2, 'a duplicate');
+      assert.equal(s.scene.planes[1].name, 'Outline 1 copy');
+      assert.equal(s.view.selected_plane, 1);
+      await page.keyboard.press('Delete');
+      s = await until(page, (s) => s.scene.planes.length === 1, 'the duplicate deleted');
 
       // A degenerate stroke (a straight line, no inside) is refused with a message, changes nothing.
       await page.keyboard.press('d');
