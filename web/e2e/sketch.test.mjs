@@ -1,6 +1,7 @@
 // Sketching in the browser (WebGPU): drawing an outline with pointer events makes a cloud
 // where it was drawn and a drawing plane in the list; a cut stroke flattens its base; undo
-// removes it; Move and Rotate drag a plane; Ctrl+D duplicates and Delete removes it. Screenshots: web/test-results/screenshots/sketch-*.png.
+// removes it; Move and Rotate drag a plane; Ctrl+D duplicates and Delete removes it.
+// Screenshots: web/test-results/screenshots/sketch-*.png.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { serve, launch, openApp, waitForBody, waitForFullQuality, state, screenshot, countDiffering, until } from './harness.mjs';
