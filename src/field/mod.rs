@@ -146,13 +146,28 @@ impl FieldInputs {
         Self {
             ellipsoids: scene.ellipsoids.clone(),
             planes: scene.planes.clone(),
-            grid: GridParams {
-                resolution: scene.render.field_resolution,
-                sun_dir: scene.light.sun_direction(),
-                extinction: scene.render.opacity,
-                softness: scene.render.softness,
-            },
+            grid: GridParams::of(scene),
             seed: scene.seed,
+        }
+    }
+
+    /// Whether these are `scene`'s inputs, compared in place (no copy: it runs every frame).
+    pub fn matches(&self, scene: &Scene) -> bool {
+        self.seed == scene.seed
+            && self.grid == GridParams::of(scene)
+            && self.ellipsoids == scene.ellipsoids
+            && self.planes == scene.planes
+    }
+}
+
+impl GridParams {
+    /// The grid parameters `scene` asks for.
+    pub fn of(scene: &Scene) -> Self {
+        GridParams {
+            resolution: scene.render.field_resolution,
+            sun_dir: scene.light.sun_direction(),
+            extinction: scene.render.opacity,
+            softness: scene.render.softness,
         }
     }
 }
@@ -419,19 +434,6 @@ mod tests {
         }
     }
 
-    fn inside_polygon(poly: &[Vec2], q: Vec2) -> bool {
-        let mut c = false;
-        let mut j = poly.len() - 1;
-        for i in 0..poly.len() {
-            let (a, b) = (poly[i], poly[j]);
-            if (a.y > q.y) != (b.y > q.y) && q.x < (b.x - a.x) * (q.y - a.y) / (b.y - a.y) + a.x {
-                c = !c;
-            }
-            j = i;
-        }
-        c
-    }
-
     #[test]
     fn sketched_field_outline_in_its_plane_matches_the_stroke() {
         let outline = cloud_outline();
@@ -441,6 +443,7 @@ mod tests {
             .push(plane(StrokeKind::Outline, outline.clone()));
         let field = Field::from_scene(&scene);
         assert_eq!(field.groups.len(), 1);
+        let stroke: Vec<glam::DVec2> = outline.iter().map(|p| p.as_dvec2()).collect();
         let (mut inter, mut union) = (0, 0);
         for j in 0..100 {
             for i in 0..140 {
@@ -448,7 +451,7 @@ mod tests {
                     -6.0 + i as f32 * 12.0 / 140.0,
                     -3.0 + j as f32 * 8.0 / 100.0,
                 );
-                let a = inside_polygon(&outline, q);
+                let a = crate::sketch::outline::contains(&stroke, q.as_dvec2());
                 let b = field.inside(q.extend(0.0));
                 inter += (a && b) as usize;
                 union += (a || b) as usize;

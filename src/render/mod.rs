@@ -34,10 +34,10 @@ pub struct VolumeCache {
 impl VolumeCache {
     /// The volume for `scene`; cheap when nothing it depends on changed.
     pub fn update(&mut self, scene: &Scene) -> Arc<VolumeData> {
-        let inputs = FieldInputs::of(scene);
         match (&self.inputs, &self.data) {
-            (Some(old), Some(data)) if *old == inputs => data.clone(),
+            (Some(old), Some(data)) if old.matches(scene) => data.clone(),
             _ => {
+                let inputs = FieldInputs::of(scene);
                 self.generation += 1;
                 let grid = bake(&Field::from_scene(scene), &inputs.grid);
                 let data = Arc::new(VolumeData {

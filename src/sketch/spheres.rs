@@ -58,7 +58,8 @@ pub fn sample(outline: &Outline, skeleton: &Skeleton) -> Vec<Sphere> {
             .collect();
         let length: f64 = pts.windows(2).map(|w| w[0].distance(w[1])).sum();
         let mut along = 0.0;
-        let push = |q: DVec2, along: f64, out: &mut Vec<Sphere>| {
+        // Places a sphere at `q` (when usable); returns the distance to the outline there.
+        let push = |q: DVec2, along: f64, out: &mut Vec<Sphere>| -> f64 {
             let r = p.distance(q);
             if r > min_radius && contains(p, q) {
                 let f = if length > 0.0 { along / length } else { 0.0 };
@@ -72,24 +73,46 @@ pub fn sample(outline: &Outline, skeleton: &Skeleton) -> Vec<Sphere> {
                     along: f,
                 });
             }
+            r
         };
-        push(pts[0], 0.0, &mut out);
+        // Each segment starts where the previous one ended, at the distance found there.
+        let mut r = push(pts[0], 0.0, &mut out);
         for w in pts.windows(2) {
             let (a, c) = (w[0], w[1]);
             let len = a.distance(c);
             let mut t = 0.0;
             while t < len {
-                let q = a.lerp(c, t / len);
-                let r = p.distance(q).max(min_radius);
-                t += (SPACING * r).max(floor).max(len * 1e-3);
-                let q2 = a.lerp(c, (t / len).min(1.0));
-                push(q2, along + t.min(len), &mut out);
+                t += (SPACING * r.max(min_radius)).max(floor).max(len * 1e-3);
+                r = push(a.lerp(c, (t / len).min(1.0)), along + t.min(len), &mut out);
             }
             along += len;
         }
     }
     bridge(p, &mut out);
     out
+}
+
+/// Which spheres are joined to the first one through a chain of overlapping spheres.
+pub fn body_of_first(spheres: &[Sphere]) -> Vec<bool> {
+    let n = spheres.len();
+    let mut seen = vec![false; n];
+    let mut stack = Vec::new();
+    if n > 0 {
+        seen[0] = true;
+        stack.push(0);
+    }
+    while let Some(i) = stack.pop() {
+        for j in 0..n {
+            if !seen[j]
+                && spheres[i].center.distance(spheres[j].center)
+                    < spheres[i].radius + spheres[j].radius
+            {
+                seen[j] = true;
+                stack.push(j);
+            }
+        }
+    }
+    seen
 }
 
 /// Joins spheres that do not overlap the main body to it with spheres along the shortest
@@ -100,20 +123,7 @@ fn bridge(p: &Boundary, spheres: &mut Vec<Sphere>) {
         if n < 2 {
             return;
         }
-        let mut seen = vec![false; n];
-        let mut stack = vec![0];
-        seen[0] = true;
-        while let Some(i) = stack.pop() {
-            for j in 0..n {
-                if !seen[j]
-                    && spheres[i].center.distance(spheres[j].center)
-                        < spheres[i].radius + spheres[j].radius
-                {
-                    seen[j] = true;
-                    stack.push(j);
-                }
-            }
-        }
+        let seen = body_of_first(spheres);
         if seen.iter().all(|&s| s) {
             return;
         }

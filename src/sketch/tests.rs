@@ -119,22 +119,7 @@ fn height(sketch: &Sketch) -> f64 {
 
 /// Whether the spheres form one connected body (overlapping neighbours).
 fn connected(spheres: &[Sphere]) -> bool {
-    let n = spheres.len();
-    let mut seen = vec![false; n];
-    let mut stack = vec![0];
-    seen[0] = true;
-    while let Some(i) = stack.pop() {
-        for j in 0..n {
-            if !seen[j]
-                && spheres[i].center.distance(spheres[j].center)
-                    < spheres[i].radius + spheres[j].radius
-            {
-                seen[j] = true;
-                stack.push(j);
-            }
-        }
-    }
-    seen.into_iter().all(|s| s)
+    spheres::body_of_first(spheres).into_iter().all(|s| s)
 }
 
 #[test]

@@ -63,6 +63,8 @@ pub struct CloudApp {
     pub(super) refining: Option<f32>,
     ready: bool,
     last_status: Option<PageStatus>,
+    /// The document as last published, with its JSON.
+    published_scene: Option<(Scene, String)>,
     pub(super) viewport_px: [u32; 2],
     pub(super) frame_seconds: Option<f64>,
     /// Set by panels; applied to the camera once the viewport's size is known.
@@ -93,6 +95,7 @@ impl CloudApp {
             refining: None,
             ready: false,
             last_status: None,
+            published_scene: None,
             viewport_px: [0, 0],
             frame_seconds: None,
             frame_request: false,
@@ -237,13 +240,7 @@ impl CloudApp {
             };
             let mut status = format!("{} · {adapter}", b.backend);
             if let Some(q) = self.shown {
-                status.push_str(&format!(
-                    " · {}×{}×{}{}",
-                    q.size[0],
-                    q.size[1],
-                    q.slices,
-                    if q.full { "" } else { " preview" }
-                ));
+                status.push_str(&format!(" · {q}"));
             }
             if let Some(s) = self.frame_seconds {
                 status.push_str(&format!(" · {:.0} ms", s * 1000.0));
@@ -276,28 +273,39 @@ impl CloudApp {
             adapter: String::new(),
         });
         let quality = self.shown.map(|q| q.to_string()).unwrap_or_default();
-        let state = serde_json::json!({
-            "scene": self.scene,
-            "view": {
-                "viewport": self.viewport_px,
-                "quality": quality,
-                "frame_ms": self.frame_seconds.map(|s| (s * 1000.0).round()),
-                "refining": self.refining,
-                "backend": backend.backend,
-                "adapter": backend.adapter,
-                "undo": self.history.undo_len(),
-                "redo": self.history.redo_len(),
-                "tool": self.sketch.tool.name(),
-                "selected_plane": self.sketch.selected,
-                "guides_hidden": self.sketch.hide_guides,
-                "guide_image": self.guide.image.as_ref().map(|g| serde_json::json!({
-                    "name": g.name, "size": g.size, "opacity": self.guide.opacity, "visible": self.guide.visible,
-                })),
-                "guide_error": self.guide.error,
-                "notice": self.sketch.notice.as_ref().map(|n| serde_json::json!({"text": n.text, "error": n.error})),
-            }
-        })
-        .to_string();
+        // The document is serialised again only when it changed (this runs every frame).
+        if self
+            .published_scene
+            .as_ref()
+            .is_none_or(|(scene, _)| *scene != self.scene)
+        {
+            let json = serde_json::to_string(&self.scene).unwrap_or_default();
+            self.published_scene = Some((self.scene.clone(), json));
+        }
+        let scene_json = self
+            .published_scene
+            .as_ref()
+            .map(|(_, json)| json.as_str())
+            .unwrap_or("null");
+        let view = serde_json::json!({
+            "viewport": self.viewport_px,
+            "quality": quality,
+            "frame_ms": self.frame_seconds.map(|s| (s * 1000.0).round()),
+            "refining": self.refining,
+            "backend": backend.backend,
+            "adapter": backend.adapter,
+            "undo": self.history.undo_len(),
+            "redo": self.history.redo_len(),
+            "tool": self.sketch.tool.name(),
+            "selected_plane": self.sketch.selected,
+            "guides_hidden": self.sketch.hide_guides,
+            "guide_image": self.guide.image.as_ref().map(|g| serde_json::json!({
+                "name": g.name, "size": g.size, "opacity": self.guide.opacity, "visible": self.guide.visible,
+            })),
+            "guide_error": self.guide.error,
+            "notice": self.sketch.notice.as_ref().map(|n| serde_json::json!({"text": n.text, "error": n.error})),
+        });
+        let state = format!("{{\"scene\":{scene_json},\"view\":{view}}}");
         let status = PageStatus {
             ready: self.ready,
             backend: backend.backend.to_string(),

@@ -143,13 +143,7 @@ impl CloudApp {
                     None => ui.colored_label(egui::Color32::LIGHT_RED, "no GPU renderer"),
                 };
                 if let Some(q) = self.shown {
-                    ui.label(format!(
-                        "volume: {}×{} px, {} slices{}",
-                        q.size[0],
-                        q.size[1],
-                        q.slices,
-                        if q.full { "" } else { " (preview)" }
-                    ));
+                    ui.label(format!("volume: {q} (width × height × slices)"));
                 }
                 if let Some(p) = self.refining {
                     ui.add(egui::ProgressBar::new(p).text("refining"));

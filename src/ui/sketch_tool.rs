@@ -8,6 +8,7 @@ use glam::{EulerRot, Quat, Vec2, Vec3};
 use super::app::CloudApp;
 use crate::field::Field;
 use crate::scene::{DrawingPlane, Edit, MAX_PLANE_POINTS, MAX_PLANES, OrbitCamera, StrokeKind};
+use crate::sketch::outline;
 
 /// What a primary drag in the viewport does.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -331,19 +332,22 @@ impl CloudApp {
         let eye = camera.eye();
         let mut best: Option<(f32, usize)> = None;
         for (i, plane) in self.scene.planes.iter().enumerate() {
-            let pts: Vec<Pos2> = plane
+            // Screen points in f64, for the sketch core's polygon helpers.
+            let pts: Vec<glam::DVec2> = plane
                 .points
                 .iter()
                 .filter_map(|q| project(camera, rect, plane.to_world(q.extend(0.0))))
+                .map(|q| glam::DVec2::new(q.x as f64, q.y as f64))
                 .collect();
             if pts.len() < 2 {
                 continue;
             }
+            let at = glam::DVec2::new(p.x as f64, p.y as f64);
             let hit = match plane.kind {
-                StrokeKind::Outline => inside(&pts, p),
+                StrokeKind::Outline => outline::contains(&pts, at),
                 StrokeKind::Cut => pts
                     .windows(2)
-                    .any(|w| distance_to_segment(p, w[0], w[1]) < 6.0),
+                    .any(|w| outline::segment_distance(at, w[0], w[1]) < 6.0),
             };
             let depth = plane.origin.distance(eye);
             if hit && best.is_none_or(|(d, _)| depth < d) {
@@ -597,30 +601,6 @@ impl CloudApp {
             }
         });
     }
-}
-
-/// Even–odd test of a point in a screen polygon.
-fn inside(poly: &[Pos2], p: Pos2) -> bool {
-    let mut c = false;
-    let mut j = poly.len() - 1;
-    for i in 0..poly.len() {
-        let (a, b) = (poly[i], poly[j]);
-        if (a.y > p.y) != (b.y > p.y) && p.x < (b.x - a.x) * (p.y - a.y) / (b.y - a.y) + a.x {
-            c = !c;
-        }
-        j = i;
-    }
-    c
-}
-
-fn distance_to_segment(p: Pos2, a: Pos2, b: Pos2) -> f32 {
-    let ab = b - a;
-    let t = if ab.length_sq() > 0.0 {
-        ((p - a).dot(ab) / ab.length_sq()).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    p.distance(a + ab * t)
 }
 
 /// The selected plane's grid: its stroke's box, padded, with a few lines each way.
