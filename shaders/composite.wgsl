@@ -1,14 +1,8 @@
 // Composites the linear, premultiplied volume image into the output (egui's frame or the
 // offscreen image): tone map, encode sRGB, premultiplied "over" blending.
-// Mirrors `CompositeUniforms` in src/render/gpu_types.rs.
 
-struct Composite {
-    params: vec4<f32>,
-};
-
-@group(0) @binding(0) var<uniform> c: Composite;
-@group(0) @binding(1) var src: texture_2d<f32>;
-@group(0) @binding(2) var src_smp: sampler;
+@group(0) @binding(0) var src: texture_2d<f32>;
+@group(0) @binding(1) var src_smp: sampler;
 
 struct VsOut {
     @builtin(position) clip: vec4<f32>,
@@ -38,6 +32,6 @@ fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
     if p.a <= 1e-4 {
         discard;
     }
-    let colour = 1.0 - exp(-c.params.x * p.rgb / p.a);
+    let colour = 1.0 - exp(-p.rgb / p.a);
     return vec4<f32>(linear_to_srgb(colour) * p.a, p.a);
 }

@@ -1,10 +1,14 @@
 //! `cloudsketch bench`: each figure is measured with its baseline in the same run and reported
 //! as a ratio (how many times better than the baseline), never as an absolute pass/fail.
 
+use std::sync::Arc;
+use std::time::Instant;
+
 use serde::Serialize;
 
+use crate::derive::Derived;
 use crate::render::offscreen::Offscreen;
-use crate::scene::Scene;
+use crate::scene::{Document, DrawingPlane, Edit, Preset, Scene};
 
 /// One measurement.
 #[derive(Clone, Debug, Serialize)]
@@ -101,17 +105,7 @@ fn sketch_pipeline() -> Result<BenchResult, String> {
     const RUNS: usize = 31;
     let stroke = bench_outline();
     let params = crate::sketch::SketchParams::default();
-    let time = |f: &mut dyn FnMut()| {
-        f();
-        let v: Vec<f64> = (0..RUNS)
-            .map(|_| {
-                let t = std::time::Instant::now();
-                f();
-                t.elapsed().as_secs_f64()
-            })
-            .collect();
-        median(v)
-    };
+    let time = |f: &mut dyn FnMut()| time_median(RUNS, f);
     let mut failed = None;
     let ours = time(&mut || {
         if let Err(e) = crate::sketch::interpret(&stroke, true, &params, 1) {
@@ -141,6 +135,123 @@ fn sketch_pipeline() -> Result<BenchResult, String> {
     ))
 }
 
+/// Median seconds of `runs` calls of `f`, after one warm-up call.
+fn time_median(runs: usize, f: &mut dyn FnMut()) -> f64 {
+    f();
+    median(
+        (0..runs)
+            .map(|_| {
+                let t = Instant::now();
+                f();
+                t.elapsed().as_secs_f64()
+            })
+            .collect(),
+    )
+}
+
+/// One of `n` cloud outlines side by side (plane units, y up), for the derivation benchmarks.
+fn bench_plane(i: usize) -> DrawingPlane {
+    DrawingPlane {
+        name: format!("Outline {}", i + 1),
+        points: bench_outline()
+            .iter()
+            .map(|&[x, y]| glam::Vec2::new(x as f32 * 0.5, -y as f32 * 0.5))
+            .collect(),
+        origin: glam::Vec3::new(i as f32 * 1.5 - 7.0, 3.0, (i % 3) as f32 - 1.0),
+        seed: i as u64 + 1,
+        ..Default::default()
+    }
+}
+
+/// A scene of `n` sketched outlines.
+pub fn sketched_scene(n: usize) -> Scene {
+    let mut scene = Scene::preset(Preset::Empty);
+    scene.planes = (0..n).map(|i| Arc::new(bench_plane(i))).collect();
+    scene
+}
+
+/// A light-slider tick (the sun's azimuth: the slider that costs most, a new light sweep) on a
+/// 10-stroke scene, until the next frame's volumes are ready, against deriving everything.
+fn light_tick() -> Vec<BenchResult> {
+    let mut doc = Document::new(sketched_scene(10));
+    let mut derived = Derived::default();
+    derived.update(doc.scene(), doc.revisions());
+    let mut azimuth = 0.0;
+    let tick = time_median(9, &mut || {
+        let mut l = doc.scene().light.clone();
+        azimuth += 7.0;
+        l.sun_azimuth_deg = azimuth % 360.0;
+        doc.apply(Edit::SetLight(l), Some("light"));
+        std::hint::black_box(derived.update(doc.scene(), doc.revisions()));
+    });
+    let ambient = time_median(9, &mut || {
+        let mut l = doc.scene().light.clone();
+        l.ambient = if l.ambient > 0.5 { 0.4 } else { 0.6 };
+        doc.apply(Edit::SetLight(l), Some("light"));
+        std::hint::black_box(derived.update(doc.scene(), doc.revisions()));
+    });
+    let full = time_median(5, &mut || {
+        std::hint::black_box(Derived::default().update(doc.scene(), doc.revisions()));
+    });
+    vec![
+        result(
+            "derive_sun_slider_tick_10_strokes",
+            tick * 1e3,
+            "ms",
+            "derive_everything_10_strokes",
+            full * 1e3,
+        ),
+        result(
+            "derive_ambient_slider_tick_10_strokes",
+            ambient * 1e3,
+            "ms",
+            "derive_everything_10_strokes",
+            full * 1e3,
+        ),
+    ]
+}
+
+/// An 11th stroke added to a 10-stroke scene: stroke interpretation (with field assembly)
+/// against interpreting all 11, and the bake of the 11-stroke field apart.
+fn eleventh_stroke() -> Vec<BenchResult> {
+    let ten = sketched_scene(10);
+    let mut eleven = ten.clone();
+    eleven.planes.push(Arc::new(bench_plane(10)));
+    let mut incremental = Vec::new();
+    let mut fresh = Vec::new();
+    let mut bakes = Vec::new();
+    for _ in 0..5 {
+        let mut derived = Derived::default();
+        derived.field(&ten, None);
+        let t = Instant::now();
+        let field = derived.field(&eleven, None);
+        incremental.push(t.elapsed().as_secs_f64());
+        let t = Instant::now();
+        std::hint::black_box(Derived::default().field(&eleven, None));
+        fresh.push(t.elapsed().as_secs_f64());
+        let t = Instant::now();
+        std::hint::black_box(crate::field::bake(&field, eleven.render.field_resolution));
+        bakes.push(t.elapsed().as_secs_f64());
+    }
+    let (inc, all) = (median(incremental), median(fresh));
+    vec![
+        result(
+            "derive_11th_stroke_interpretation",
+            inc * 1e3,
+            "ms",
+            "derive_all_11_strokes_interpretation",
+            all * 1e3,
+        ),
+        result(
+            "bake_11_stroke_field",
+            median(bakes) * 1e3,
+            "ms",
+            "derive_all_11_strokes_interpretation",
+            all * 1e3,
+        ),
+    ]
+}
+
 /// Runs the suite and prints it.
 pub fn run(json: bool) -> Result<(), String> {
     let mut offscreen = Offscreen::new().map_err(|e| e.to_string())?;
@@ -153,7 +264,10 @@ pub fn run(json: bool) -> Result<(), String> {
         std::env::consts::ARCH,
         offscreen.adapter_name()
     );
-    let results = vec![sketch_pipeline()?, render_frame(&mut offscreen)?];
+    let mut results = vec![sketch_pipeline()?];
+    results.extend(light_tick());
+    results.extend(eleventh_stroke());
+    results.push(render_frame(&mut offscreen)?);
     let report = BenchReport { machine, results };
     if json {
         println!(
@@ -163,12 +277,12 @@ pub fn run(json: bool) -> Result<(), String> {
     } else {
         println!("machine: {}", report.machine);
         println!(
-            "{:<40} {:>12} {:<5} {:<44} {:>12} {:>8}",
+            "{:<42} {:>12} {:<5} {:<44} {:>12} {:>8}",
             "name", "value", "unit", "baseline", "baseline", "ratio"
         );
         for r in &report.results {
             println!(
-                "{:<40} {:>12.3} {:<5} {:<44} {:>12.3} {:>7.2}×",
+                "{:<42} {:>12.3} {:<5} {:<44} {:>12.3} {:>7.2}×",
                 r.name, r.value, r.unit, r.baseline, r.baseline_value, r.ratio
             );
         }

@@ -3,16 +3,22 @@
 //! One crate for the browser (wasm32, WebGPU with a WebGL2 fallback) and native (desktop
 //! window and a headless CLI). See ARCHITECTURE.md for the map; in short:
 //!
-//! - [`scene`]: the document, the only state a user makes (pure);
+//! - [`scene`]: the document, the only state a user makes, with undo and revisions (pure);
 //! - [`sketch`]: stroke → skeleton → spheres (pure);
-//! - [`field`]: the blended implicit field and its baked grid (pure);
+//! - [`field`]: the blended implicit field and the density volume it is sampled into (pure);
+//! - [`derive`]: document → per-plane spheres → field → density and light volumes, cached
+//!   per part (pure);
+//! - [`limits`], [`seeded`]: every cap and range, and seeded randomness (pure);
 //! - [`render`]: the only user of wgpu;
 //! - [`ui`]: the eframe app;
 //! - `cli`, `bench` (native) and `web` (wasm32): the entry points of each target.
 
+pub mod derive;
 pub mod field;
+pub mod limits;
 pub mod render;
 pub mod scene;
+pub mod seeded;
 pub mod sketch;
 pub mod ui;
 

@@ -1,9 +1,13 @@
-//! Every WGSL file in `shaders/` parses and validates with naga, and the renderer's list of
-//! shaders covers the whole folder.
+//! Every shader module the renderer compiles parses and validates with naga, every WGSL file in
+//! `shaders/` is part of one, and the WGSL `Volume` struct has exactly the size and member
+//! offsets of the Rust `VolumeUniforms` it mirrors.
 
 use std::path::Path;
 
-fn validate(name: &str, source: &str) {
+use cloudsketch::render::gpu_types::VolumeUniforms;
+use cloudsketch::render::shaders::MODULES;
+
+fn parse(name: &str, source: &str) -> naga::Module {
     let module = naga::front::wgsl::parse_str(source)
         .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(source)));
     naga::valid::Validator::new(
@@ -12,40 +16,68 @@ fn validate(name: &str, source: &str) {
     )
     .validate(&module)
     .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(source)));
+    module
 }
 
 #[test]
-fn every_shader_file_validates() {
+fn every_composed_module_validates() {
+    for (name, _, source) in MODULES {
+        parse(name, source);
+    }
+}
+
+#[test]
+fn every_shader_file_is_composed_into_a_module() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders");
-    let mut count = 0;
+    let mut on_disk = 0;
     for entry in std::fs::read_dir(&dir).unwrap() {
-        let path = entry.unwrap().path();
-        if path.extension().is_some_and(|e| e == "wgsl") {
-            let source = std::fs::read_to_string(&path).unwrap();
-            validate(&path.display().to_string(), &source);
-            count += 1;
+        let name = entry.unwrap().file_name().to_string_lossy().into_owned();
+        if !name.ends_with(".wgsl") {
+            continue;
         }
+        on_disk += 1;
+        let text = std::fs::read_to_string(dir.join(&name)).unwrap();
+        let users: Vec<&str> = MODULES
+            .iter()
+            .filter(|(_, files, source)| files.contains(&name.as_str()) && source.contains(&text))
+            .map(|(m, _, _)| *m)
+            .collect();
+        assert!(!users.is_empty(), "{name} is in no shader module");
     }
-    assert!(count >= 3, "expected the shaders in {}", dir.display());
+    // And every file a module names exists, in the order the module's source holds them.
+    for (module, files, source) in MODULES {
+        let texts: Vec<String> = files
+            .iter()
+            .map(|f| std::fs::read_to_string(dir.join(f)).unwrap())
+            .collect();
+        assert_eq!(texts.concat(), *source, "{module} is not exactly {files:?}");
+    }
+    assert!(on_disk >= 4);
 }
 
 #[test]
-fn renderer_embeds_every_shader_file() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders");
-    let on_disk: Vec<String> = std::fs::read_dir(&dir)
-        .unwrap()
-        .filter_map(|e| e.ok())
-        .map(|e| e.file_name().to_string_lossy().into_owned())
-        .filter(|n| n.ends_with(".wgsl"))
+fn wgsl_volume_struct_matches_the_rust_layout() {
+    let (_, _, source) = MODULES.iter().find(|(n, _, _)| *n == "volume").unwrap();
+    let module = parse("volume", source);
+    let (members, span) = module
+        .types
+        .iter()
+        .find_map(|(_, ty)| match (&ty.name, &ty.inner) {
+            (Some(n), naga::TypeInner::Struct { members, span }) if n == "Volume" => {
+                Some((members.clone(), *span))
+            }
+            _ => None,
+        })
+        .expect("struct Volume in volume_common.wgsl");
+    let wgsl: Vec<(String, usize)> = members
+        .iter()
+        .map(|m| (m.name.clone().unwrap_or_default(), m.offset as usize))
+        .chain(std::iter::once((String::new(), span as usize)))
         .collect();
-    for name in &on_disk {
-        let text = std::fs::read_to_string(dir.join(name)).unwrap();
-        assert!(
-            cloudsketch::render::shaders::ALL
-                .iter()
-                .any(|(_, src)| *src == text),
-            "{name} is not in render::shaders::ALL"
-        );
-    }
-    assert_eq!(on_disk.len(), cloudsketch::render::shaders::ALL.len());
+    let rust: Vec<(String, usize)> = VolumeUniforms::LAYOUT
+        .iter()
+        .map(|(n, o)| (n.to_string(), *o))
+        .collect();
+    assert_eq!(wgsl, rust, "WGSL Volume vs Rust VolumeUniforms (name, offset; last: size)");
+    assert_eq!(span as usize, std::mem::size_of::<VolumeUniforms>());
 }

@@ -7,13 +7,13 @@
 //! surface is the iso-level [`ISO`] = 0.5, and w(1/4) = 0.5 exactly, so an isolated primitive of
 //! visible radius r gets R = 2r: its surface lies exactly at r.
 
-mod grid;
+mod volume;
 
-pub use grid::{FieldGrid, GridParams, bake};
+pub use volume::{DensityVolume, MAX_RESOLUTION, bake, density};
 
 use glam::{Mat3, Vec2, Vec3};
 
-use crate::scene::{DrawingPlane, Ellipsoid, Scene, StrokeKind};
+use crate::scene::Ellipsoid;
 
 /// Iso-level of the visible surface.
 pub const ISO: f32 = 0.5;
@@ -127,51 +127,6 @@ fn line_height(line: &[Vec2], x: f32) -> Option<f32> {
     Some(a.y + (b.y - a.y) * t)
 }
 
-/// Everything in a document that the baked grid depends on; equal inputs give equal grids.
-#[derive(Clone, Debug, PartialEq)]
-pub struct FieldInputs {
-    /// The document's ellipsoids.
-    pub ellipsoids: Vec<Ellipsoid>,
-    /// The document's drawing planes (their spheres and cuts).
-    pub planes: Vec<DrawingPlane>,
-    /// Grid resolution and lighting.
-    pub grid: GridParams,
-    /// Seed of the document's random choices.
-    pub seed: u64,
-}
-
-impl FieldInputs {
-    /// The inputs of `scene`.
-    pub fn of(scene: &Scene) -> Self {
-        Self {
-            ellipsoids: scene.ellipsoids.clone(),
-            planes: scene.planes.clone(),
-            grid: GridParams::of(scene),
-            seed: scene.seed,
-        }
-    }
-
-    /// Whether these are `scene`'s inputs, compared in place (no copy: it runs every frame).
-    pub fn matches(&self, scene: &Scene) -> bool {
-        self.seed == scene.seed
-            && self.grid == GridParams::of(scene)
-            && self.ellipsoids == scene.ellipsoids
-            && self.planes == scene.planes
-    }
-}
-
-impl GridParams {
-    /// The grid parameters `scene` asks for.
-    pub fn of(scene: &Scene) -> Self {
-        GridParams {
-            resolution: scene.render.field_resolution,
-            sun_dir: scene.light.sun_direction(),
-            extinction: scene.render.opacity,
-            softness: scene.render.softness,
-        }
-    }
-}
-
 /// The whole field: blended primitives minus clips.
 ///
 /// Ellipsoids are summed (Wyvill blending). The spheres of one sketched outline are first
@@ -189,52 +144,6 @@ pub struct Field {
 }
 
 impl Field {
-    /// The field a document describes: its ellipsoids plus the spheres and cuts of its planes.
-    pub fn from_scene(scene: &Scene) -> Self {
-        let mut field = Field {
-            blobs: scene.ellipsoids.iter().map(Blob::ellipsoid).collect(),
-            groups: Vec::new(),
-            clips: Vec::new(),
-        };
-        field.blobs.truncate(MAX_PRIMITIVES);
-        let mut budget = MAX_PRIMITIVES.saturating_sub(field.blobs.len());
-        for plane in &scene.planes {
-            match plane.kind {
-                StrokeKind::Outline => {
-                    // Planes are validated when made; a stroke that no longer interprets adds nothing.
-                    let Ok(sketch) = crate::sketch::interpret(
-                        &plane.stroke(),
-                        plane.closed,
-                        &plane.sketch,
-                        plane.seed,
-                    ) else {
-                        continue;
-                    };
-                    let group: Vec<Blob> = sketch
-                        .spheres
-                        .iter()
-                        .take(budget)
-                        .map(|s| Blob::sphere(plane.to_world(s.center.as_vec3()), s.radius as f32))
-                        .collect();
-                    budget -= group.len();
-                    field.groups.push(group);
-                }
-                StrokeKind::Cut => {
-                    if let Ok(line) = crate::sketch::cut_line(&plane.stroke()) {
-                        let line = line.into_iter().map(|p| p.as_vec2()).collect();
-                        field.clips.push(Clip {
-                            origin: plane.origin,
-                            right: plane.right(),
-                            up: plane.up(),
-                            line,
-                        });
-                    }
-                }
-            }
-        }
-        field
-    }
-
     /// Every primitive, summed ones and grouped ones.
     pub fn all_blobs(&self) -> impl Iterator<Item = &Blob> {
         self.blobs.iter().chain(self.groups.iter().flatten())
@@ -411,88 +320,5 @@ mod tests {
         };
         assert!(f.raycast(&miss, 0.05).is_none());
         assert!(Field::default().raycast(&ray, 0.05).is_none());
-    }
-
-    fn cloud_outline() -> Vec<Vec2> {
-        let mut v: Vec<Vec2> = (0..=40)
-            .map(|i| Vec2::new(-5.0 + i as f32 * 0.25, -2.0))
-            .collect();
-        for i in 1..120 {
-            let a = i as f32 / 120.0 * std::f32::consts::PI;
-            let bump = 1.0 + 0.3 * (a * 5.0).sin().abs();
-            v.push(Vec2::new(5.0 * a.cos(), -2.0 + 3.5 * a.sin() * bump));
-        }
-        v
-    }
-
-    fn plane(kind: StrokeKind, points: Vec<Vec2>) -> DrawingPlane {
-        DrawingPlane {
-            kind,
-            points,
-            closed: kind == StrokeKind::Outline,
-            ..Default::default()
-        }
-    }
-
-    #[test]
-    fn sketched_field_outline_in_its_plane_matches_the_stroke() {
-        let outline = cloud_outline();
-        let mut scene = Scene::preset(crate::scene::Preset::Empty);
-        scene
-            .planes
-            .push(plane(StrokeKind::Outline, outline.clone()));
-        let field = Field::from_scene(&scene);
-        assert_eq!(field.groups.len(), 1);
-        let stroke: Vec<glam::DVec2> = outline.iter().map(|p| p.as_dvec2()).collect();
-        let (mut inter, mut union) = (0, 0);
-        for j in 0..100 {
-            for i in 0..140 {
-                let q = Vec2::new(
-                    -6.0 + i as f32 * 12.0 / 140.0,
-                    -3.0 + j as f32 * 8.0 / 100.0,
-                );
-                let a = crate::sketch::outline::contains(&stroke, q.as_dvec2());
-                let b = field.inside(q.extend(0.0));
-                inter += (a && b) as usize;
-                union += (a || b) as usize;
-            }
-        }
-        let iou = inter as f64 / union as f64;
-        assert!(iou >= 0.85, "field outline vs stroke IoU {iou:.3}");
-        // The 3D extension gives the cloud depth in front of and behind the plane.
-        assert!(field.inside(Vec3::new(0.0, 0.0, 1.0)) || field.inside(Vec3::new(0.0, 0.0, -1.0)));
-    }
-
-    #[test]
-    fn cut_stroke_flattens_the_base() {
-        let mut scene = Scene::preset(crate::scene::Preset::Empty);
-        scene
-            .planes
-            .push(plane(StrokeKind::Outline, cloud_outline()));
-        let before = Field::from_scene(&scene);
-        assert!(before.inside(Vec3::new(0.0, -1.0, 0.0)));
-        scene.planes.push(plane(
-            StrokeKind::Cut,
-            vec![Vec2::new(-8.0, -0.5), Vec2::new(8.0, -0.5)],
-        ));
-        let after = Field::from_scene(&scene);
-        for x in [-3.0, 0.0, 3.0] {
-            for z in [-2.0, 0.0, 2.0] {
-                assert!(
-                    !after.inside(Vec3::new(x, -1.0, z)),
-                    "cloud below the cut at x {x} z {z}"
-                );
-            }
-        }
-        assert!(after.inside(Vec3::new(0.0, 0.5, 0.0)));
-    }
-
-    #[test]
-    fn default_scene_field_is_bounded() {
-        let f = Field::from_scene(&Scene::default());
-        let (c, r) = f.bounding_sphere().unwrap();
-        assert!(r > 2.0 && r < 20.0, "{r}");
-        assert!(f.inside(Vec3::new(0.0, 2.5, 0.0)));
-        assert!(c.is_finite());
     }
 }

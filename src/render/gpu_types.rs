@@ -1,16 +1,19 @@
-//! Every struct the GPU reads, `#[repr(C)]` and Pod, in one place. Each is mirrored field by
-//! field in the WGSL named on it; only vec4-sized members, so std140 and Rust agree.
+//! Every struct the GPU reads, `#[repr(C)]` and Pod, in one place. Each is mirrored in the
+//! WGSL named on it; only 16-byte-aligned members, so WGSL's uniform layout and Rust agree,
+//! and `tests/shaders.rs` compares sizes and member offsets with naga's.
+
+use std::mem::offset_of;
 
 use bytemuck::{Pod, Zeroable};
-use glam::Vec3;
+use glam::{Mat4, Quat, Vec3};
 
-use crate::field::{FieldGrid, ISO};
-use crate::scene::{OrbitCamera, Scene};
+use crate::field::{DensityVolume, ISO};
+use crate::scene::{Lighting, OrbitCamera, RenderSettings};
 
-/// Octave transforms passed to the slice shader (the noise octaves the renderer supports).
-pub const MAX_OCTAVES: usize = 4;
+/// Noise octaves the slice shader can composite (`MAX_OCTAVES` in volume_common.wgsl).
+pub const MAX_OCTAVES: usize = 8;
 
-/// Uniforms of `shaders/volume.wgsl` (`struct Volume`).
+/// Uniforms of the slice shaders (`struct Volume` in `shaders/volume_common.wgsl`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct VolumeUniforms {
@@ -24,99 +27,102 @@ pub struct VolumeUniforms {
     pub right: [f32; 4],
     /// Unit image-plane up (xyz).
     pub up: [f32; 4],
-    /// Field grid minimum corner (xyz).
+    /// Density grid minimum corner (xyz).
     pub grid_min: [f32; 4],
-    /// 1 / field grid size (xyz).
+    /// 1 / density grid size (xyz).
     pub grid_inv_size: [f32; 4],
     /// Bounding sphere of the volume: centre (xyz), radius (w).
     pub sphere: [f32; 4],
     /// x: total slices, y: index of the first slice of this draw (0 = farthest),
     /// z: spacing between slices in world units, w: unused.
     pub slicing: [f32; 4],
-    /// Unit vector toward the sun (xyz).
-    pub sun_dir: [f32; 4],
     /// Linear sun colour × intensity (rgb).
     pub sun_color: [f32; 4],
     /// Linear sky colour × ambient intensity (rgb).
     pub sky_color: [f32; 4],
     /// x: extinction per world unit, y: iso-level, z: soft-edge half-width, w: noise amount.
     pub media: [f32; 4],
-    /// x: base noise frequency (per world unit), y: lacunarity, z: gain per octave, w: octaves.
+    /// x: amplitude gain per octave, y: octaves in use, zw: unused.
     pub noise: [f32; 4],
-    /// Per-octave offset of the noise texture coordinates (xyz), for wind animation.
-    pub octave_offset: [[f32; 4]; MAX_OCTAVES],
+    /// Per-octave transform of world positions into noise-texture coordinates.
+    pub octaves: [[[f32; 4]; 4]; MAX_OCTAVES],
 }
 
-/// The volume draw's slice layout: how many slices and where they lie.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Slicing {
-    /// Total slices through the bounding sphere.
-    pub total: u32,
+/// What one image of the volume shows: a plain, `Send + Sync` copy of the document's view,
+/// light and render settings (the renderer turns it into uniforms).
+#[derive(Clone, Debug, PartialEq)]
+pub struct View {
+    /// The camera.
+    pub camera: OrbitCamera,
+    /// Sun and sky.
+    pub light: Lighting,
+    /// Media and quality.
+    pub render: RenderSettings,
+    /// Image width / height.
+    pub aspect: f32,
+}
+
+/// Transform of octave `i`: world → noise-texture coordinates, scale × rotate × translate with
+/// frequency `base × lacunarity^i`. Octaves are turned against each other so their lattices do
+/// not line up.
+pub fn octave_transform(render: &RenderSettings, i: usize) -> Mat4 {
+    let freq = render.detail.powi(i as i32) / render.noise_scale.max(1e-3);
+    let turn = Quat::from_axis_angle(Vec3::new(0.3, 1.0, 0.2).normalize(), i as f32 * 0.9);
+    let shift = Vec3::new(0.37, 0.11, 0.73) * i as f32;
+    Mat4::from_translation(shift) * Mat4::from_quat(turn) * Mat4::from_scale(Vec3::splat(freq))
 }
 
 impl VolumeUniforms {
-    /// Uniforms for drawing `scene`'s field grid from `camera` at image aspect `aspect`.
-    pub fn new(
-        scene: &Scene,
-        camera: &OrbitCamera,
-        grid: &FieldGrid,
-        aspect: f32,
-        slicing: Slicing,
-    ) -> Self {
-        let (center, radius) = grid.bounding_sphere();
-        let total = slicing.total.max(1);
-        let light = &scene.light;
-        let r = &scene.render;
-        let sun = light.sun_direction();
+    /// Names and byte offsets of the members, in order (checked against the WGSL struct).
+    pub const LAYOUT: [(&'static str, usize); 15] = [
+        ("view_proj", offset_of!(Self, view_proj)),
+        ("eye", offset_of!(Self, eye)),
+        ("forward", offset_of!(Self, forward)),
+        ("right", offset_of!(Self, right)),
+        ("up", offset_of!(Self, up)),
+        ("grid_min", offset_of!(Self, grid_min)),
+        ("grid_inv_size", offset_of!(Self, grid_inv_size)),
+        ("sphere", offset_of!(Self, sphere)),
+        ("slicing", offset_of!(Self, slicing)),
+        ("sun_color", offset_of!(Self, sun_color)),
+        ("sky_color", offset_of!(Self, sky_color)),
+        ("media", offset_of!(Self, media)),
+        ("noise", offset_of!(Self, noise)),
+        ("octaves", offset_of!(Self, octaves)),
+        ("", std::mem::size_of::<Self>()),
+    ];
+
+    /// Uniforms for drawing `volume` as `view` shows it, in `total` slices, starting at `first`.
+    pub fn new(view: &View, volume: &DensityVolume, total: u32, first: u32) -> Self {
+        let (center, radius) = volume.bounding_sphere();
+        let total = total.max(1);
+        let (camera, light, r) = (&view.camera, &view.light, &view.render);
         let sun_color = srgb_to_linear(light.sun_color) * light.sun_intensity;
         let sky_color = srgb_to_linear(light.sky_color) * light.ambient;
-        let inv_size = Vec3::ONE / grid.size.max(Vec3::splat(1e-6));
+        let inv_size = Vec3::ONE / volume.size.max(Vec3::splat(1e-6));
+        let octaves = r.noise_octaves.min(MAX_OCTAVES as u32);
         Self {
-            view_proj: camera.view_projection(aspect).to_cols_array_2d(),
+            view_proj: camera.view_projection(view.aspect).to_cols_array_2d(),
             eye: camera.eye().extend(1.0).to_array(),
             forward: camera.forward().extend(0.0).to_array(),
             right: camera.right().extend(0.0).to_array(),
             up: camera.up().extend(0.0).to_array(),
-            grid_min: grid.min.extend(0.0).to_array(),
+            grid_min: volume.min.extend(0.0).to_array(),
             grid_inv_size: inv_size.extend(0.0).to_array(),
             sphere: center.extend(radius).to_array(),
-            slicing: [total as f32, 0.0, 2.0 * radius / total as f32, 0.0],
-            sun_dir: sun.extend(0.0).to_array(),
+            slicing: [total as f32, first as f32, 2.0 * radius / total as f32, 0.0],
             sun_color: sun_color.extend(1.0).to_array(),
             sky_color: sky_color.extend(1.0).to_array(),
             media: [
                 r.opacity,
                 ISO,
                 r.softness,
-                if r.noise_octaves == 0 {
-                    0.0
-                } else {
-                    r.noise_amount
-                },
+                if octaves == 0 { 0.0 } else { r.noise_amount },
             ],
-            noise: [
-                1.0 / r.noise_scale.max(1e-3),
-                r.detail,
-                0.5,
-                r.noise_octaves.min(MAX_OCTAVES as u32) as f32,
-            ],
-            octave_offset: [[0.0; 4]; MAX_OCTAVES],
+            noise: [0.5, octaves as f32, 0.0, 0.0],
+            octaves: std::array::from_fn(|i| octave_transform(r, i).to_cols_array_2d()),
         }
     }
-
-    /// The same uniforms for a draw that starts at slice `first`.
-    pub fn starting_at(mut self, first: u32) -> Self {
-        self.slicing[1] = first as f32;
-        self
-    }
-}
-
-/// Uniforms of `shaders/composite.wgsl` (`struct Composite`).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
-pub struct CompositeUniforms {
-    /// x: exposure, yzw: unused.
-    pub params: [f32; 4],
 }
 
 /// sRGB-encoded colour → linear.
@@ -134,34 +140,41 @@ pub fn srgb_to_linear(c: [f32; 3]) -> Vec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::Scene;
 
     #[test]
-    fn sizes_are_multiples_of_16_bytes() {
-        assert_eq!(std::mem::size_of::<VolumeUniforms>() % 16, 0);
-        assert_eq!(std::mem::size_of::<CompositeUniforms>(), 16);
+    fn uniforms_cover_the_volume() {
+        let scene = Scene::default();
+        let volume = crate::field::bake(&crate::derive::field_of(&scene), 16);
+        let view = View {
+            camera: scene.camera.clone(),
+            light: scene.light.clone(),
+            render: scene.render.clone(),
+            aspect: 1.5,
+        };
+        let u = VolumeUniforms::new(&view, &volume, 64, 10);
+        let center = Vec3::from_slice(&u.sphere[..3]);
+        assert!(center.abs_diff_eq(volume.min + volume.size * 0.5, 1e-4));
+        assert!((u.slicing[2] * 64.0 - 2.0 * u.sphere[3]).abs() < 1e-4);
+        assert_eq!(
+            Mat4::from_cols_array_2d(&u.view_proj),
+            scene.camera.view_projection(1.5)
+        );
+        assert_eq!(u.slicing[1], 10.0);
     }
 
     #[test]
-    fn uniforms_cover_the_grid() {
-        let scene = Scene::default();
-        let grid = crate::field::bake(
-            &crate::field::Field::from_scene(&scene),
-            &crate::field::GridParams {
-                resolution: 16,
-                sun_dir: Vec3::Y,
-                extinction: 1.0,
-                softness: 0.1,
-            },
-        );
-        let u = VolumeUniforms::new(&scene, &scene.camera, &grid, 1.5, Slicing { total: 64 });
-        let center = Vec3::from_slice(&u.sphere[..3]);
-        assert!(center.abs_diff_eq(grid.min + grid.size * 0.5, 1e-4));
-        assert!((u.slicing[2] * 64.0 - 2.0 * u.sphere[3]).abs() < 1e-4);
-        assert_eq!(
-            glam::Mat4::from_cols_array_2d(&u.view_proj),
-            scene.camera.view_projection(1.5)
-        );
-        assert_eq!(u.starting_at(10).slicing[1], 10.0);
+    fn octave_frequency_grows_by_the_lacunarity() {
+        let r = RenderSettings::default();
+        let p = Vec3::new(1.0, 0.0, 0.0);
+        let len = |i| {
+            let m = octave_transform(&r, i);
+            (m.transform_point3(p) - m.transform_point3(Vec3::ZERO)).length()
+        };
+        assert!((len(0) - 1.0 / r.noise_scale).abs() < 1e-5);
+        for i in 1..MAX_OCTAVES {
+            assert!((len(i) / len(i - 1) - r.detail).abs() < 1e-3);
+        }
     }
 
     #[test]

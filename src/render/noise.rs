@@ -8,13 +8,7 @@ pub const NOISE_SIZE: u32 = 32;
 /// Lattice cells along each side (the noise's period inside the texture).
 const LATTICE: u32 = 8;
 
-/// A small, fast, well-mixed integer hash (SplitMix64 finaliser).
-pub fn hash64(mut x: u64) -> u64 {
-    x = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    x = (x ^ (x >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    x = (x ^ (x >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    x ^ (x >> 31)
-}
+use crate::seeded::hash64;
 
 fn gradient(seed: u64, x: u32, y: u32, z: u32) -> [f32; 3] {
     let h = hash64(seed ^ hash64(((x as u64) << 42) | ((y as u64) << 21) | z as u64));

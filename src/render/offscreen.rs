@@ -1,10 +1,11 @@
 //! Headless rendering on any wgpu adapter (lavapipe on CPU-only machines): `render`, `bench`
 //! and the image tests use it, with the same renderer and shaders as the app.
 
-use super::VolumeCache;
-use super::gpu_types::{Slicing, VolumeUniforms};
-use super::volume::{SliceJob, VolumeRenderer, accumulation_format};
-use crate::scene::Scene;
+use super::gpu_types::View;
+use super::renderer::{SliceJob, VolumeRenderer};
+use super::resources::accumulation_format;
+use crate::derive::Derived;
+use crate::scene::{Document, Scene};
 
 /// Largest offscreen image side.
 pub const MAX_SIDE: u32 = 8192;
@@ -72,7 +73,7 @@ pub struct Offscreen {
     queue: wgpu::Queue,
     info: wgpu::AdapterInfo,
     renderer: VolumeRenderer,
-    cache: VolumeCache,
+    derived: Derived,
 }
 
 impl Offscreen {
@@ -122,7 +123,7 @@ impl Offscreen {
             queue,
             info,
             renderer,
-            cache: VolumeCache::default(),
+            derived: Derived::default(),
         })
     }
 
@@ -163,6 +164,7 @@ impl Offscreen {
         let mut times = Vec::with_capacity(frames);
         for _ in 0..frames {
             let start = std::time::Instant::now();
+            self.renderer.begin_frame();
             let (encoder, _output) = self.encode(&job, scene.light.background, pipeline.as_ref());
             self.queue.submit([encoder.finish()]);
             self.device
@@ -173,24 +175,27 @@ impl Offscreen {
         Ok(times)
     }
 
+    /// Derives `scene`'s volumes (through the per-plane cache) and uploads them; returns the
+    /// full-quality job for an image of `width`×`height`.
     fn full_job(&mut self, scene: &Scene, width: u32, height: u32) -> SliceJob {
-        let data = self.cache.update(scene);
-        self.renderer.upload(&self.device, &self.queue, &data);
-        let uniforms = VolumeUniforms::new(
-            scene,
-            &scene.camera,
-            &data.grid,
-            width as f32 / height as f32,
-            Slicing {
-                total: scene.render.slices,
-            },
-        );
+        // A fresh document has fresh revisions: everything is derived again, except strokes
+        // the plane cache has already interpreted.
+        let doc = Document::new(scene.clone());
+        let volumes = self.derived.update(doc.scene(), doc.revisions());
+        self.renderer.begin_frame();
+        self.renderer.upload(&self.device, &self.queue, &volumes);
         SliceJob {
             target: 0,
             size: [width, height],
+            total: scene.render.slices,
             range: 0..scene.render.slices,
             clear: true,
-            uniforms,
+            view: View {
+                camera: scene.camera.clone(),
+                light: scene.light.clone(),
+                render: scene.render.clone(),
+                aspect: width as f32 / height as f32,
+            },
         }
     }
 

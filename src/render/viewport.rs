@@ -1,17 +1,17 @@
 //! The egui paint callback that runs the volume renderer inside the app's viewport.
 //!
 //! The renderer lives in egui-wgpu's callback resources (created once at start-up); each frame
-//! the app hands over a plain `Send + Sync` snapshot: the volume, the job and which target to
-//! show.
+//! the app hands over a plain `Send + Sync` snapshot: the derived volumes, the job (with its
+//! view) and which target to show. Uniforms are built here, from the snapshot.
 
-use std::sync::Arc;
-
-use super::volume::{SliceJob, VolumeData, VolumeRenderer, accumulation_format};
+use super::renderer::{SliceJob, VolumeRenderer};
+use super::resources::accumulation_format;
+use crate::derive::Volumes;
 
 /// What one frame of the viewport draws.
 pub struct ViewportPaint {
-    /// The baked volume (uploaded only when its generation changes).
-    pub volume: Arc<VolumeData>,
+    /// The derived volumes (each uploaded only when its generation changes).
+    pub volumes: Volumes,
     /// Volume work for this frame.
     pub job: Option<SliceJob>,
     /// Accumulation target to composite into the frame.
@@ -28,7 +28,8 @@ impl egui_wgpu::CallbackTrait for ViewportPaint {
         resources: &mut egui_wgpu::CallbackResources,
     ) -> Vec<wgpu::CommandBuffer> {
         if let Some(renderer) = resources.get_mut::<VolumeRenderer>() {
-            renderer.upload(device, queue, &self.volume);
+            renderer.begin_frame();
+            renderer.upload(device, queue, &self.volumes);
             if let Some(job) = &self.job {
                 renderer.draw_slices(device, queue, encoder, job);
             }
@@ -57,8 +58,9 @@ pub struct BackendInfo {
     pub adapter: String,
 }
 
-/// Creates the renderer in egui-wgpu's callback resources; returns what is in use.
-pub fn install(render_state: &egui_wgpu::RenderState) -> BackendInfo {
+/// Creates the renderer in egui-wgpu's callback resources; returns what is in use. `gl_name`
+/// is what the GL backend is called on this platform (`webgl2` in the browser).
+pub fn install(render_state: &egui_wgpu::RenderState, gl_name: &'static str) -> BackendInfo {
     let format = accumulation_format(&render_state.adapter);
     let renderer = VolumeRenderer::new(&render_state.device, render_state.target_format, format);
     render_state
@@ -69,8 +71,7 @@ pub fn install(render_state: &egui_wgpu::RenderState) -> BackendInfo {
     let info = render_state.adapter.get_info();
     let backend = match info.backend {
         wgpu::Backend::BrowserWebGpu => "webgpu",
-        wgpu::Backend::Gl if cfg!(target_arch = "wasm32") => "webgl2",
-        wgpu::Backend::Gl => "gl",
+        wgpu::Backend::Gl => gl_name,
         wgpu::Backend::Vulkan => "vulkan",
         wgpu::Backend::Metal => "metal",
         wgpu::Backend::Dx12 => "dx12",

@@ -143,10 +143,15 @@ impl OrbitCamera {
             (self.pitch_deg + delta_px.y * DEG_PER_PX).clamp(-PITCH_LIMIT, PITCH_LIMIT);
     }
 
+    /// World units per pixel at `depth` along the view direction, in a viewport
+    /// `viewport_height_px` pixels tall.
+    pub fn world_per_px(&self, depth: f32, viewport_height_px: f32) -> f32 {
+        2.0 * depth * (self.fov_y_deg.to_radians() * 0.5).tan() / viewport_height_px.max(1.0)
+    }
+
     /// Pans so the point under the pointer follows it; `viewport_height_px` scales pixels to world.
     pub fn pan(&mut self, delta_px: Vec2, viewport_height_px: f32) {
-        let world_per_px = 2.0 * self.distance * (self.fov_y_deg.to_radians() * 0.5).tan()
-            / viewport_height_px.max(1.0);
+        let world_per_px = self.world_per_px(self.distance, viewport_height_px);
         self.target += (-self.right() * delta_px.x + self.up() * delta_px.y) * world_per_px;
     }
 

@@ -4,23 +4,27 @@
 //! blended field, sphere primitives, GPU buffers) is derived from it deterministically.
 
 mod camera;
+mod document;
 mod edit;
 mod plane;
 mod pointer;
 
 pub use camera::{OrbitCamera, Ray};
-pub use edit::{Edit, History};
-pub use plane::{DrawingPlane, MAX_PLANE_POINTS, MAX_PLANES, StrokeKind, centre_of};
+pub use document::{Document, Revisions};
+pub use edit::Edit;
+pub use crate::limits::{MAX_ELLIPSOIDS, MAX_PLANE_POINTS, MAX_PLANES};
+pub use plane::{DrawingPlane, StrokeKind, centre_of};
 pub use pointer::{SetError, set_by_pointer};
+
+use std::sync::Arc;
+
+use crate::limits;
 
 use glam::{Quat, Vec3};
 use serde::{Deserialize, Serialize};
 
 /// Version written by this build. Older documents are upgraded on load; newer ones are refused.
 pub const SCENE_VERSION: u32 = 1;
-
-/// Most ellipsoids a document may hold (bad files must not exhaust memory).
-pub const MAX_ELLIPSOIDS: usize = 4096;
 
 /// Errors when reading a scene document.
 #[derive(Debug, thiserror::Error)]
@@ -40,6 +44,10 @@ pub enum SceneError {
 }
 
 /// The whole document.
+///
+/// Ellipsoids and drawing planes are each behind an [`Arc`]: cloning a scene (an undo step, a
+/// snapshot for the renderer) shares every primitive it did not change, and derived caches can
+/// tell an unchanged primitive by pointer.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct Scene {
@@ -54,9 +62,9 @@ pub struct Scene {
     /// Render quality and cloud media settings.
     pub render: RenderSettings,
     /// Implicit ellipsoids blended into the cloud field.
-    pub ellipsoids: Vec<Ellipsoid>,
+    pub ellipsoids: Vec<Arc<Ellipsoid>>,
     /// Drawing planes, each holding one sketched stroke (outline or cut).
-    pub planes: Vec<DrawingPlane>,
+    pub planes: Vec<Arc<DrawingPlane>>,
 }
 
 impl Default for Scene {
@@ -108,7 +116,10 @@ impl Scene {
                 Ellipsoid::new(Vec3::new(0.1, 4.7, 0.1), Vec3::new(1.8, 1.7, 1.7)),
                 Ellipsoid::new(Vec3::new(3.4, 2.3, 0.5), Vec3::new(1.5, 1.3, 1.4)),
                 Ellipsoid::new(Vec3::new(-3.6, 2.0, -0.4), Vec3::new(1.3, 1.1, 1.2)),
-            ],
+            ]
+            .into_iter()
+            .map(Arc::new)
+            .collect(),
             Preset::Empty => Vec::new(),
         };
         Scene {
@@ -187,7 +198,10 @@ impl Scene {
             )));
         }
         for (i, plane) in self.planes.iter_mut().enumerate() {
-            plane.validate(i).map_err(SceneError::Invalid)?;
+            // Freshly read planes are not shared, so this copies nothing.
+            Arc::make_mut(plane)
+                .validate(i)
+                .map_err(SceneError::Invalid)?;
         }
         self.camera.sanitize();
         self.light.sanitize();
@@ -251,12 +265,12 @@ pub struct Lighting {
 impl Default for Lighting {
     fn default() -> Self {
         Self {
-            sun_azimuth_deg: 20.0,
-            sun_elevation_deg: 35.0,
+            sun_azimuth_deg: limits::SUN_AZIMUTH.default as f32,
+            sun_elevation_deg: limits::SUN_ELEVATION.default as f32,
             sun_color: [1.0, 0.97, 0.9],
-            sun_intensity: 1.6,
+            sun_intensity: limits::SUN_INTENSITY.default as f32,
             sky_color: [0.55, 0.66, 0.85],
-            ambient: 0.45,
+            ambient: limits::AMBIENT.default as f32,
             background: [0.33, 0.52, 0.78],
         }
     }
@@ -273,10 +287,11 @@ impl Lighting {
     }
 
     fn sanitize(&mut self) {
-        self.sun_elevation_deg = finite_or(self.sun_elevation_deg, 35.0).clamp(-89.0, 89.0);
-        self.sun_azimuth_deg = finite_or(self.sun_azimuth_deg, 20.0).rem_euclid(360.0);
-        self.sun_intensity = finite_or(self.sun_intensity, 1.6).clamp(0.0, 20.0);
-        self.ambient = finite_or(self.ambient, 0.45).clamp(0.0, 5.0);
+        self.sun_elevation_deg = limits::SUN_ELEVATION.fix_f32(self.sun_elevation_deg);
+        self.sun_azimuth_deg =
+            finite_or(self.sun_azimuth_deg, limits::SUN_AZIMUTH.default as f32).rem_euclid(360.0);
+        self.sun_intensity = limits::SUN_INTENSITY.fix_f32(self.sun_intensity);
+        self.ambient = limits::AMBIENT.fix_f32(self.ambient);
         for c in [
             &mut self.sun_color,
             &mut self.sky_color,
@@ -311,45 +326,31 @@ pub struct RenderSettings {
     pub softness: f32,
 }
 
-/// Bounds of the render settings, shared by the UI sliders and validation.
-pub mod limits {
-    /// Slice count range.
-    pub const SLICES: (u32, u32) = (8, 512);
-    /// Field grid resolution range.
-    pub const FIELD_RESOLUTION: (u32, u32) = (16, 128);
-    /// Noise octaves range.
-    pub const OCTAVES: (u32, u32) = (0, 4);
-}
-
 impl Default for RenderSettings {
     fn default() -> Self {
         Self {
-            slices: 128,
-            opacity: 2.5,
-            field_resolution: 64,
-            noise_amount: 0.35,
-            noise_scale: 3.0,
-            noise_octaves: 3,
-            detail: 2.2,
-            softness: 0.12,
+            slices: limits::SLICES.default as u32,
+            opacity: limits::OPACITY.default as f32,
+            field_resolution: limits::FIELD_RESOLUTION.default as u32,
+            noise_amount: limits::NOISE_AMOUNT.default as f32,
+            noise_scale: limits::NOISE_SCALE.default as f32,
+            noise_octaves: limits::OCTAVES.default as u32,
+            detail: limits::DETAIL.default as f32,
+            softness: limits::SOFTNESS.default as f32,
         }
     }
 }
 
 impl RenderSettings {
     fn sanitize(&mut self) {
-        self.slices = self.slices.clamp(limits::SLICES.0, limits::SLICES.1);
-        self.field_resolution = self
-            .field_resolution
-            .clamp(limits::FIELD_RESOLUTION.0, limits::FIELD_RESOLUTION.1);
-        self.noise_octaves = self
-            .noise_octaves
-            .clamp(limits::OCTAVES.0, limits::OCTAVES.1);
-        self.opacity = finite_or(self.opacity, 2.5).clamp(0.0, 100.0);
-        self.noise_amount = finite_or(self.noise_amount, 0.35).clamp(0.0, 1.0);
-        self.noise_scale = finite_or(self.noise_scale, 3.0).clamp(0.05, 1000.0);
-        self.detail = finite_or(self.detail, 2.2).clamp(1.1, 4.0);
-        self.softness = finite_or(self.softness, 0.12).clamp(0.005, 0.5);
+        self.slices = limits::SLICES.fix_u32(self.slices);
+        self.field_resolution = limits::FIELD_RESOLUTION.fix_u32(self.field_resolution);
+        self.noise_octaves = limits::OCTAVES.fix_u32(self.noise_octaves);
+        self.opacity = limits::OPACITY.fix_f32(self.opacity);
+        self.noise_amount = limits::NOISE_AMOUNT.fix_f32(self.noise_amount);
+        self.noise_scale = limits::NOISE_SCALE.fix_f32(self.noise_scale);
+        self.detail = limits::DETAIL.fix_f32(self.detail);
+        self.softness = limits::SOFTNESS.fix_f32(self.softness);
     }
 }
 
@@ -397,8 +398,8 @@ mod tests {
     #[test]
     fn out_of_range_settings_are_clamped() {
         let s = Scene::from_json(r#"{"render":{"slices":100000,"field_resolution":3}}"#).unwrap();
-        assert_eq!(s.render.slices, limits::SLICES.1);
-        assert_eq!(s.render.field_resolution, limits::FIELD_RESOLUTION.0);
+        assert_eq!(s.render.slices, limits::SLICES.max as u32);
+        assert_eq!(s.render.field_resolution, limits::FIELD_RESOLUTION.min as u32);
     }
 
     #[test]

@@ -4,12 +4,8 @@
 use glam::{DVec2, Quat, Vec2, Vec3};
 use serde::{Deserialize, Serialize};
 
+use crate::limits::MAX_PLANE_POINTS;
 use crate::sketch::SketchParams;
-
-/// Most drawing planes in a document.
-pub const MAX_PLANES: usize = 256;
-/// Most points a stored stroke may have.
-pub const MAX_PLANE_POINTS: usize = 20_000;
 
 /// What a stroke means.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]

@@ -13,6 +13,8 @@ pub mod spheres;
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
+use crate::limits;
+
 pub use outline::Outline;
 pub use skeleton::Skeleton;
 pub use spheres::Sphere;
@@ -50,11 +52,11 @@ pub struct SketchParams {
 impl Default for SketchParams {
     fn default() -> Self {
         Self {
-            simplify: 0.01,
-            prune: 0.02,
-            inflate: 0.0,
+            simplify: limits::SIMPLIFY.default,
+            prune: limits::PRUNE.default,
+            inflate: limits::INFLATE.default,
             extend: true,
-            copies: 2,
+            copies: limits::COPIES.default as u32,
         }
     }
 }
@@ -62,12 +64,10 @@ impl Default for SketchParams {
 impl SketchParams {
     /// Clamps every value into its range (documents and links may carry anything).
     pub fn sanitize(&mut self) {
-        let fix =
-            |v: f64, d: f64, lo: f64, hi: f64| if v.is_finite() { v.clamp(lo, hi) } else { d };
-        self.simplify = fix(self.simplify, 0.01, 0.0, 0.2);
-        self.prune = fix(self.prune, 0.02, 0.0, 0.5);
-        self.inflate = fix(self.inflate, 0.0, 0.0, 1.0);
-        self.copies = self.copies.min(6);
+        self.simplify = limits::SIMPLIFY.fix(self.simplify);
+        self.prune = limits::PRUNE.fix(self.prune);
+        self.inflate = limits::INFLATE.fix(self.inflate);
+        self.copies = limits::COPIES.fix_u32(self.copies);
     }
 }
 

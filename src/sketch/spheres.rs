@@ -6,6 +6,7 @@
 use glam::{DQuat, DVec2, DVec3};
 
 use super::outline::{Boundary, Outline, contains};
+use crate::seeded::SplitMix;
 use super::skeleton::{BranchKind, Skeleton};
 
 /// Most spheres one stroke makes (copies from the 3D extension included).
@@ -196,19 +197,6 @@ pub fn inflate(spheres: &mut [Sphere], r_f: f64, t: f64) {
     }
 }
 
-/// Tiny deterministic generator for the extension's random choices.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
-
 /// The trunk: the longest chain of body branches, or the longest path of the skeleton when it
 /// has too few junctions for a body. Returned as a polyline of points.
 pub fn trunk(skeleton: &Skeleton) -> Vec<DVec2> {
@@ -315,7 +303,7 @@ pub fn extend(
     copies: usize,
 ) -> Vec<Sphere> {
     let axis_line = trunk(skeleton);
-    let mut rng = Rng(seed ^ 0xC10D_5CE7);
+    let mut rng = SplitMix::new(seed ^ 0xC10D_5CE7);
     let mut out: Vec<Sphere> = Vec::with_capacity(spheres.len() * (copies + 1));
     let budget_copies = if spheres.len() * (copies + 1) > MAX_SPHERES {
         (MAX_SPHERES / spheres.len().max(1)).saturating_sub(1)
@@ -348,7 +336,7 @@ pub fn extend(
                 .collect()
         };
         // Original: a small jitter rotation out of the plane.
-        let jitter = (rng.next() - 0.5) * 0.5;
+        let jitter = (rng.next_f64() - 0.5) * 0.5;
         out.extend(fit_branch(outline, rotated(jitter)));
         // Copies spread evenly over the half of the trunk's surface the branch grows from,
         // toward and away from the viewer (a bump on top stays on top, never under the base),
@@ -357,7 +345,7 @@ pub fn extend(
         for k in 0..budget_copies {
             let step = (k / 2 + 1) as f64 / pairs as f64;
             let side = if k % 2 == 0 { 1.0 } else { -1.0 };
-            let angle = side * (step * MAX_COPY_ANGLE + (rng.next() - 0.5) * 0.3);
+            let angle = side * (step * MAX_COPY_ANGLE + (rng.next_f64() - 0.5) * 0.3);
             out.extend(fit_branch(outline, rotated(angle)));
         }
     }

@@ -1,14 +1,15 @@
-//! The application state and the frame loop.
+//! The application: owns the document, the derivation cache, the viewport and the side
+//! panel's views, runs the frame loop and the global shortcuts, and publishes the page status.
 
-use std::hash::{Hash, Hasher};
-
-use egui::{Color32, Sense};
-
-use crate::render::gpu_types::{Slicing, VolumeUniforms};
-use crate::render::progressive::{Budget, Progressive, Quality};
-use crate::render::viewport::{BackendInfo, ViewportPaint, install};
-use crate::render::{SliceJob, VolumeCache};
-use crate::scene::{Edit, History, Scene};
+use super::guide::Guide;
+use super::notice::Notices;
+use super::panels::{LightPanel, RenderPanel, ScenePanel, SketchPanel, ViewPanel, ViewStats};
+use super::selection::Selection;
+use super::sketch_tool::{SketchTool, ToolContext};
+use super::viewport::{Viewport, ViewportContext};
+use crate::derive::Derived;
+use crate::render::viewport::{BackendInfo, install};
+use crate::scene::{Document, Scene};
 
 /// What the page (or any embedder) is told after each frame.
 #[derive(Clone, Debug, PartialEq)]
@@ -51,263 +52,199 @@ impl Default for StartOptions {
     }
 }
 
+/// The side panel's views.
+#[derive(Default)]
+struct Panels {
+    sketch: SketchPanel,
+    render: RenderPanel,
+    light: LightPanel,
+    scene: ScenePanel,
+    view: ViewPanel,
+}
+
 /// The cloudsketch app.
 pub struct CloudApp {
-    pub(super) scene: Scene,
-    pub(super) history: History,
-    cache: VolumeCache,
-    progressive: Progressive,
-    pub(super) backend: Option<BackendInfo>,
+    doc: Document,
+    derived: Derived,
+    viewport: Viewport,
+    tool: SketchTool,
+    selection: Selection,
+    notices: Notices,
+    guide: Guide,
+    panels: Panels,
     host: Option<Box<dyn Host>>,
-    pub(super) shown: Option<Quality>,
-    pub(super) refining: Option<f32>,
-    ready: bool,
     last_status: Option<PageStatus>,
-    /// The document as last published, with its JSON.
-    published_scene: Option<(Scene, String)>,
-    pub(super) viewport_px: [u32; 2],
-    pub(super) frame_seconds: Option<f64>,
-    /// Set by panels; applied to the camera once the viewport's size is known.
-    pub(super) frame_request: bool,
-    /// Sketch tools, plane selection and messages.
-    pub(super) sketch: super::sketch_tool::SketchUi,
-    /// The guide image underlay.
-    pub(super) guide: super::guide::Guide,
+    /// The document's JSON as last published, with the revision it was made at.
+    published: Option<(u64, String)>,
 }
 
 impl CloudApp {
     /// Creates the app and its GPU resources.
     pub fn new(cc: &eframe::CreationContext<'_>, options: StartOptions) -> Self {
-        let backend = cc.wgpu_render_state.as_ref().map(install);
+        let backend = cc
+            .wgpu_render_state
+            .as_ref()
+            .map(|rs| install(rs, super::platform::GL_BACKEND_NAME));
         if backend.is_none() {
             log::error!("no wgpu render state: the volume cannot be drawn");
         }
         cc.egui_ctx.set_visuals(egui::Visuals::dark());
-        super::files::install(&cc.egui_ctx);
+        super::platform::install(&cc.egui_ctx);
         Self {
-            scene: options.scene,
-            history: History::default(),
-            cache: VolumeCache::default(),
-            progressive: Progressive::new(options.initial_cost, Budget::default()),
-            backend,
+            doc: Document::new(options.scene),
+            derived: Derived::default(),
+            viewport: Viewport::new(
+                options.initial_cost,
+                ViewStats {
+                    backend,
+                    ..Default::default()
+                },
+            ),
+            tool: SketchTool::default(),
+            selection: Selection::default(),
+            notices: Notices::default(),
+            guide: Guide::default(),
+            panels: Panels::default(),
             host: options.host,
-            shown: None,
-            refining: None,
-            ready: false,
             last_status: None,
-            published_scene: None,
-            viewport_px: [0, 0],
-            frame_seconds: None,
-            frame_request: false,
-            sketch: Default::default(),
-            guide: Default::default(),
+            published: None,
         }
     }
 
-    /// Applies an edit with undo.
-    pub(super) fn apply(&mut self, edit: Edit, merge_key: Option<&'static str>) -> bool {
-        self.history.apply(&mut self.scene, edit, merge_key)
+    fn undo(&mut self, now: f64) {
+        match self.doc.undo() {
+            Some(what) => self.notices.note(now, format!("Undid: {what}")),
+            None => self.notices.note(now, "Nothing to undo"),
+        }
+        self.selection.retain_valid(self.doc.scene());
     }
 
+    fn redo(&mut self, now: f64) {
+        match self.doc.redo() {
+            Some(what) => self.notices.note(now, format!("Redid: {what}")),
+            None => self.notices.note(now, "Nothing to redo"),
+        }
+        self.selection.retain_valid(self.doc.scene());
+    }
+
+    /// Undo (Ctrl+Z), redo (Ctrl+Shift+Z, Ctrl+Y), frame (F), then the tools' shortcuts.
     fn shortcuts(&mut self, ctx: &egui::Context) {
         if ctx.egui_wants_keyboard_input() {
             return;
         }
+        use egui::{Key, Modifiers};
         let (undo, redo, frame) = ctx.input_mut(|i| {
-            let redo = i.consume_key(
-                egui::Modifiers::COMMAND | egui::Modifiers::SHIFT,
-                egui::Key::Z,
-            ) || i.consume_key(egui::Modifiers::COMMAND, egui::Key::Y);
-            let undo = i.consume_key(egui::Modifiers::COMMAND, egui::Key::Z);
-            let frame = i.consume_key(egui::Modifiers::NONE, egui::Key::F);
+            let redo = i.consume_key(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z)
+                || i.consume_key(Modifiers::COMMAND, Key::Y);
+            let undo = i.consume_key(Modifiers::COMMAND, Key::Z);
+            let frame = i.consume_key(Modifiers::NONE, Key::F);
             (undo, redo, frame)
         });
+        let now = ctx.input(|i| i.time);
         if undo {
-            self.history.undo(&mut self.scene);
+            self.undo(now);
         }
         if redo {
-            self.history.redo(&mut self.scene);
+            self.redo(now);
         }
         if frame {
-            self.frame_request = true;
+            self.viewport.frame_request = true;
         }
+        let mut tc = ToolContext {
+            doc: &mut self.doc,
+            derived: &mut self.derived,
+            selection: &mut self.selection,
+            notices: &mut self.notices,
+        };
+        self.tool.shortcuts(ctx, &mut tc);
     }
 
-    /// Frames the cloud (F).
-    fn frame_cloud(&mut self, aspect: f32) {
-        let volume = self.cache.update(&self.scene);
-        if volume.grid.is_empty() {
-            return;
-        }
-        let (center, radius) = volume.grid.bounding_sphere();
-        // The grid box is padded around the visible cloud; frame a little tighter than its sphere.
-        self.scene.camera.frame(center, radius * 0.8, aspect);
-    }
-
-    fn viewport(&mut self, ui: &mut egui::Ui) {
-        let rect = ui.available_rect_before_wrap();
-        let response = ui.allocate_rect(rect, Sense::click_and_drag());
-        if self.frame_request {
-            self.frame_request = false;
-            self.frame_cloud(rect.aspect_ratio());
-        }
-        let drawing = self.sketch_input(ui, &response, rect);
-        super::camera_input::handle(ui, &response, &mut self.scene.camera, !drawing);
-
-        let painter = ui.painter_at(rect);
-        let [r, g, b] = self
-            .scene
-            .light
-            .background
-            .map(|v| (v * 255.0).round() as u8);
-        painter.rect_filled(rect, 0.0, Color32::from_rgb(r, g, b));
-        self.paint_guide(&painter, rect);
-
-        let ppp = ui.ctx().pixels_per_point();
-        let px = [
-            (rect.width() * ppp).round().max(1.0) as u32,
-            (rect.height() * ppp).round().max(1.0) as u32,
-        ];
-        self.viewport_px = px;
-        let volume = self.cache.update(&self.scene);
-        let key = view_key(&self.scene, px, volume.generation);
-        let now = ui.input(|i| i.time);
-        let plan = self.progressive.plan(
-            now,
-            key,
-            px,
-            self.scene.render.slices,
-            response.is_pointer_button_down_on(),
-        );
-        self.shown = plan.shown;
-        self.refining = plan.refining;
-        self.frame_seconds = self.progressive.last_frame_seconds();
-        if plan.shown.is_some_and(|q| q.full) {
-            self.ready = true;
-        }
-        let aspect = rect.width() / rect.height().max(1.0);
-        let job = plan.job.map(|j| SliceJob {
-            target: j.target,
-            size: j.size,
-            range: j.range,
-            clear: j.clear,
-            uniforms: VolumeUniforms::new(
-                &self.scene,
-                &self.scene.camera,
-                &volume.grid,
-                aspect,
-                Slicing { total: j.total },
-            ),
+    /// The side panel: undo/redo/frame buttons, then each group's view.
+    fn side_panel(&mut self, ui: &mut egui::Ui) {
+        ui.heading("cloudsketch");
+        ui.horizontal(|ui| {
+            let now = ui.input(|i| i.time);
+            if ui
+                .add_enabled(self.doc.undo_len() > 0, egui::Button::new("⟲ Undo"))
+                .on_hover_text("Ctrl+Z")
+                .clicked()
+            {
+                self.undo(now);
+            }
+            if ui
+                .add_enabled(self.doc.redo_len() > 0, egui::Button::new("⟳ Redo"))
+                .on_hover_text("Ctrl+Shift+Z")
+                .clicked()
+            {
+                self.redo(now);
+            }
+            if ui
+                .button("Frame")
+                .on_hover_text("F: frame the cloud")
+                .clicked()
+            {
+                self.viewport.frame_request = true;
+            }
         });
-        if self.backend.is_some() {
-            painter.add(egui_wgpu::Callback::new_paint_callback(
-                rect,
-                ViewportPaint {
-                    volume,
-                    job,
-                    display: plan.display,
-                },
-            ));
-        }
-        if plan.repaint {
-            ui.ctx().request_repaint();
-        }
-        self.overlay(ui, rect);
-        self.sketch_overlay(ui, rect);
-    }
-
-    fn overlay(&self, ui: &egui::Ui, rect: egui::Rect) {
-        let painter = ui.painter_at(rect);
-        let mut text = String::new();
-        if self.backend.is_none() {
-            text.push_str("No GPU renderer: the cloud cannot be drawn.");
-        } else if let Some(p) = self.refining {
-            text.push_str(&format!("refining {:.0}%", p * 100.0));
-        }
-        if self.scene.ellipsoids.is_empty() && self.scene.planes.is_empty() {
-            text.push_str("Empty scene: open Scene ▸ New cumulus, or sketch a cloud.");
-        }
-        // Status line: backend, adapter and the volume's current quality.
-        if let Some(b) = &self.backend {
-            let adapter: String = if b.adapter.chars().count() > 40 {
-                b.adapter
-                    .chars()
-                    .take(39)
-                    .chain(std::iter::once('…'))
-                    .collect()
-            } else {
-                b.adapter.clone()
-            };
-            let mut status = format!("{} · {adapter}", b.backend);
-            if let Some(q) = self.shown {
-                status.push_str(&format!(" · {q}"));
-            }
-            if let Some(s) = self.frame_seconds {
-                status.push_str(&format!(" · {:.0} ms", s * 1000.0));
-            }
-            painter.text(
-                rect.right_bottom() + egui::vec2(-8.0, -6.0),
-                egui::Align2::RIGHT_BOTTOM,
-                status,
-                egui::FontId::proportional(11.0),
-                Color32::from_white_alpha(150),
-            );
-        }
-        if !text.is_empty() {
-            painter.text(
-                rect.left_bottom() + egui::vec2(8.0, -8.0),
-                egui::Align2::LEFT_BOTTOM,
-                text,
-                egui::FontId::proportional(13.0),
-                Color32::from_white_alpha(200),
-            );
-        }
+        ui.separator();
+        let p = &mut self.panels;
+        p.sketch.ui(
+            ui,
+            &mut self.doc,
+            &mut self.tool,
+            &mut self.selection,
+            &mut self.notices,
+        );
+        self.guide.ui(ui);
+        p.render.ui(ui, &mut self.doc);
+        p.light.ui(ui, &mut self.doc);
+        p.scene.ui(ui, &mut self.doc);
+        p.view.ui(ui, &self.viewport.stats);
+        self.selection.retain_valid(self.doc.scene());
     }
 
     fn publish(&mut self) {
         let Some(host) = self.host.as_mut() else {
             return;
         };
-        let backend = self.backend.clone().unwrap_or(BackendInfo {
+        let stats = &self.viewport.stats;
+        let backend = stats.backend.clone().unwrap_or(BackendInfo {
             backend: "none",
             adapter: String::new(),
         });
-        let quality = self.shown.map(|q| q.to_string()).unwrap_or_default();
-        // The document is serialised again only when it changed (this runs every frame).
-        if self
-            .published_scene
-            .as_ref()
-            .is_none_or(|(scene, _)| *scene != self.scene)
-        {
-            let json = serde_json::to_string(&self.scene).unwrap_or_default();
-            self.published_scene = Some((self.scene.clone(), json));
+        let quality = stats.shown.map(|q| q.to_string()).unwrap_or_default();
+        // The document is serialised again only when a revision changed.
+        let revision = self.doc.revisions().any();
+        if self.published.as_ref().is_none_or(|(r, _)| *r != revision) {
+            let json = serde_json::to_string(self.doc.scene()).unwrap_or_default();
+            self.published = Some((revision, json));
         }
         let scene_json = self
-            .published_scene
+            .published
             .as_ref()
             .map(|(_, json)| json.as_str())
             .unwrap_or("null");
         let view = serde_json::json!({
-            "viewport": self.viewport_px,
+            "viewport": stats.viewport_px,
             "quality": quality,
-            "frame_ms": self.frame_seconds.map(|s| (s * 1000.0).round()),
-            "refining": self.refining,
+            "frame_ms": stats.frame_seconds.map(|s| (s * 1000.0).round()),
+            "refining": stats.refining,
             "backend": backend.backend,
             "adapter": backend.adapter,
-            "undo": self.history.undo_len(),
-            "redo": self.history.redo_len(),
-            "tool": self.sketch.tool.name(),
-            "selected_plane": self.sketch.selected,
-            "guides_hidden": self.sketch.hide_guides,
+            "undo": self.doc.undo_len(),
+            "redo": self.doc.redo_len(),
+            "tool": self.tool.tool.name(),
+            "selected_plane": self.selection.plane(),
+            "guides_hidden": self.tool.hide_guides,
             "guide_image": self.guide.image.as_ref().map(|g| serde_json::json!({
                 "name": g.name, "size": g.size, "opacity": self.guide.opacity, "visible": self.guide.visible,
             })),
             "guide_error": self.guide.error,
-            "notice": self.sketch.notice.as_ref().map(|n| serde_json::json!({"text": n.text, "error": n.error})),
+            "notice": self.notices.latest.as_ref().map(|n| serde_json::json!({"text": n.text, "error": n.error})),
         });
         let state = format!("{{\"scene\":{scene_json},\"view\":{view}}}");
         let status = PageStatus {
-            ready: self.ready,
+            ready: self.viewport.ready,
             backend: backend.backend.to_string(),
             adapter: backend.adapter,
             quality,
@@ -320,33 +257,32 @@ impl CloudApp {
     }
 }
 
-/// Identifies everything that changes the viewport's image.
-fn view_key(scene: &Scene, px: [u32; 2], generation: u64) -> u64 {
-    let mut h = std::collections::hash_map::DefaultHasher::new();
-    px.hash(&mut h);
-    generation.hash(&mut h);
-    // Camera, light and render settings: hash their exact JSON form (f32s written losslessly).
-    serde_json::to_string(&(&scene.camera, &scene.light, &scene.render))
-        .unwrap_or_default()
-        .hash(&mut h);
-    h.finish()
-}
-
 impl eframe::App for CloudApp {
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         let ctx = ui.ctx().clone();
         self.shortcuts(&ctx);
-        self.sketch_shortcuts(&ctx);
-        self.guide_input(&ctx);
+        self.guide.input(&ctx);
         egui::Panel::right("controls")
             .resizable(true)
             .default_size(270.0)
             .show(ui, |ui| {
                 egui::ScrollArea::vertical().show(ui, |ui| self.side_panel(ui));
             });
-        egui::CentralPanel::no_frame().show(ui, |ui| self.viewport(ui));
+        egui::CentralPanel::no_frame().show(ui, |ui| {
+            self.viewport.show(
+                ui,
+                ViewportContext {
+                    doc: &mut self.doc,
+                    derived: &mut self.derived,
+                    tool: &mut self.tool,
+                    selection: &mut self.selection,
+                    notices: &mut self.notices,
+                    guide: &self.guide,
+                },
+            )
+        });
         if !ctx.input(|i| i.pointer.any_down()) {
-            self.history.end_merge();
+            self.doc.end_merge();
         }
         self.publish();
     }

@@ -4,8 +4,7 @@
 
 use egui::{Color32, Rect, Ui};
 
-use super::app::CloudApp;
-use super::files;
+use super::platform as files;
 
 /// A file's name and bytes, or why it could not be read.
 pub type Loaded = Result<(String, Vec<u8>), String>;
@@ -81,9 +80,9 @@ pub fn decode(bytes: &[u8]) -> Result<egui::ColorImage, String> {
     ))
 }
 
-impl CloudApp {
+impl Guide {
     /// Takes dropped and picked files; an image becomes the guide.
-    pub(super) fn guide_input(&mut self, ctx: &egui::Context) {
+    pub fn input(&mut self, ctx: &egui::Context) {
         let dropped = ctx.input_mut(|i| std::mem::take(&mut i.raw.dropped_files));
         let mut loaded: Vec<Loaded> = dropped
             .into_iter()
@@ -91,11 +90,11 @@ impl CloudApp {
             .collect();
         loaded.extend(files::take_loaded());
         for item in loaded {
-            self.load_guide(ctx, item);
+            self.load(ctx, item);
         }
     }
 
-    fn load_guide(&mut self, ctx: &egui::Context, item: Loaded) {
+    fn load(&mut self, ctx: &egui::Context, item: Loaded) {
         let result = item.and_then(|(name, bytes)| {
             decode(&bytes)
                 .map(|img| (name, img))
@@ -105,30 +104,30 @@ impl CloudApp {
             Ok((name, img)) => {
                 let size = [img.size[0] as u32, img.size[1] as u32];
                 let texture = ctx.load_texture("guide image", img, egui::TextureOptions::LINEAR);
-                self.guide.image = Some(GuideImage {
+                self.image = Some(GuideImage {
                     name,
                     size,
                     texture,
                 });
-                self.guide.visible = true;
-                self.guide.error = None;
+                self.visible = true;
+                self.error = None;
             }
             Err(e) => {
                 log::warn!("guide image: {e}");
-                self.guide.error = Some(e);
+                self.error = Some(e);
             }
         }
     }
 
     /// Paints the guide under the cloud, fitted into the viewport and centred.
-    pub(super) fn paint_guide(&self, painter: &egui::Painter, rect: Rect) {
-        let Some(image) = self.guide.image.as_ref().filter(|_| self.guide.visible) else {
+    pub fn paint(&self, painter: &egui::Painter, rect: Rect) {
+        let Some(image) = self.image.as_ref().filter(|_| self.visible) else {
             return;
         };
         let [w, h] = image.size.map(|v| v.max(1) as f32);
         let scale = (rect.width() / w).min(rect.height() / h);
         let fitted = Rect::from_center_size(rect.center(), egui::vec2(w * scale, h * scale));
-        let alpha = (self.guide.opacity.clamp(0.0, 1.0) * 255.0).round() as u8;
+        let alpha = (self.opacity.clamp(0.0, 1.0) * 255.0).round() as u8;
         painter.image(
             image.texture.id(),
             fitted,
@@ -138,7 +137,7 @@ impl CloudApp {
     }
 
     /// The Guide image group of the side panel.
-    pub(super) fn guide_group(&mut self, ui: &mut Ui) {
+    pub fn ui(&mut self, ui: &mut Ui) {
         egui::CollapsingHeader::new("Guide image")
             .default_open(false)
             .show(ui, |ui| {
@@ -151,31 +150,31 @@ impl CloudApp {
                     {
                         files::open_picker();
                     }
-                    if self.guide.image.is_some() && ui.button("Remove").clicked() {
-                        self.guide.image = None;
+                    if self.image.is_some() && ui.button("Remove").clicked() {
+                        self.image = None;
                     }
                 });
                 if !files::HAS_PICKER {
                     ui.horizontal(|ui| {
-                        ui.text_edit_singleline(&mut self.guide.path)
+                        ui.text_edit_singleline(&mut self.path)
                             .on_hover_text("path of a PNG or JPEG; or drop one on the view");
                         if ui.button("Load").clicked() {
-                            let item = files::read_path(self.guide.path.trim());
-                            self.load_guide(ui.ctx(), item);
+                            let item = files::read_path(self.path.trim());
+                            self.load(ui.ctx(), item);
                         }
                     });
                 }
-                if let Some(image) = &self.guide.image {
+                if let Some(image) = &self.image {
                     ui.label(format!(
                         "{} ({}×{})",
                         image.name, image.size[0], image.size[1]
                     ));
-                    ui.checkbox(&mut self.guide.visible, "show");
-                    ui.add(egui::Slider::new(&mut self.guide.opacity, 0.0..=1.0).text("opacity"));
+                    ui.checkbox(&mut self.visible, "show");
+                    ui.add(egui::Slider::new(&mut self.opacity, 0.0..=1.0).text("opacity"));
                 } else {
                     ui.label("Drop a PNG or JPEG on the view to sketch over it.");
                 }
-                if let Some(e) = &self.guide.error {
+                if let Some(e) = &self.error {
                     ui.colored_label(Color32::LIGHT_RED, e);
                 }
             });

@@ -1,18 +1,31 @@
-//! The eframe app: panels, the 3D viewport and its tools. The only module that uses egui
-//! widgets; it edits the scene document through [`crate::scene::History`] and hands the
-//! renderer a per-frame snapshot.
+//! The eframe app: the side panel's views, the 3D viewport and its tools. The only module
+//! that uses egui widgets; it changes the scene only through [`crate::scene::Document`] and
+//! hands the renderer a per-frame snapshot.
+//!
+//! - `app`: [`CloudApp`], the frame loop, shortcuts and the page status;
+//! - `viewport`: the 3D view (progressive quality, camera input, status line);
+//! - `sketch_tool`: the Sketch, Cut, Move and Rotate tools and their overlay;
+//! - `guide`: the guide image;
+//! - `panels`: one struct per side-panel group, each with its own `ui()`;
+//! - `selection`, `notice`, `widgets`: small shared pieces;
+//! - `platform_native` / `platform_web`: the one platform seam (chosen by `cfg` on the module).
 
 mod app;
 mod camera_input;
-#[cfg(not(target_arch = "wasm32"))]
-#[path = "files_native.rs"]
-mod files;
-#[cfg(target_arch = "wasm32")]
-#[path = "files_web.rs"]
-mod files;
 mod guide;
+mod notice;
 mod panels;
+#[cfg(not(target_arch = "wasm32"))]
+#[path = "platform_native.rs"]
+mod platform;
+#[cfg(target_arch = "wasm32")]
+#[path = "platform_web.rs"]
+mod platform;
+mod selection;
 mod sketch_tool;
+mod viewport;
+mod widgets;
 
 pub use app::{CloudApp, Host, PageStatus, StartOptions};
+pub use selection::Selection;
 pub use sketch_tool::Tool;

@@ -1,13 +1,15 @@
-//! The Sketch and Cut tools and the drawing planes (Wither et al. §2): capturing a stroke in
-//! the viewport, placing its plane, the plane list and each plane's controls, and the overlay
-//! that shows strokes and the selected plane's grid.
+//! The Sketch, Cut, Move and Rotate tools (Wither et al. §2): capturing a stroke in the
+//! viewport, placing its drawing plane, transforming the selected plane, and the overlay that
+//! shows strokes and the selected plane's grid.
 
 use egui::{Color32, Pos2, Rect, Response, Stroke, Ui};
-use glam::{EulerRot, Quat, Vec2, Vec3};
+use glam::{Quat, Vec2, Vec3};
 
-use super::app::CloudApp;
-use crate::field::Field;
-use crate::scene::{DrawingPlane, Edit, MAX_PLANE_POINTS, MAX_PLANES, OrbitCamera, StrokeKind};
+use super::notice::Notices;
+use super::selection::{Item, Selection};
+use crate::derive::{Derived, Shape};
+use crate::scene::{DrawingPlane, Document, Edit, MAX_PLANE_POINTS, MAX_PLANES, OrbitCamera, StrokeKind};
+use crate::seeded::hash64;
 use crate::sketch::outline;
 
 /// What a primary drag in the viewport does.
@@ -39,32 +41,29 @@ impl Tool {
     }
 }
 
-/// A message for the user (errors stay until replaced; notes fade).
-#[derive(Clone, Debug)]
-pub struct Notice {
-    /// Text.
-    pub text: String,
-    /// Whether it reports a refusal.
-    pub error: bool,
-    /// When it was posted (egui time).
-    pub at: f64,
-}
-
 /// State of the sketch tools.
 #[derive(Default)]
-pub struct SketchUi {
+pub struct SketchTool {
     /// Active tool.
     pub tool: Tool,
     /// Screen points of the stroke being drawn.
     pub stroke: Vec<Pos2>,
-    /// Selected drawing plane.
-    pub selected: Option<usize>,
-    /// Last message.
-    pub notice: Option<Notice>,
     /// Show every plane's grid, not only the selected one's.
     pub show_all_planes: bool,
     /// Hide strokes and grids (H), to look at the cloud alone.
     pub hide_guides: bool,
+}
+
+/// What the tools need from the app for one frame.
+pub struct ToolContext<'a> {
+    /// The document.
+    pub doc: &'a mut Document,
+    /// The derivation cache (field for ray casts, stroke interpretation).
+    pub derived: &'a mut Derived,
+    /// The selection.
+    pub selection: &'a mut Selection,
+    /// Where messages go.
+    pub notices: &'a mut Notices,
 }
 
 fn ndc(rect: Rect, p: Pos2) -> Vec2 {
@@ -87,137 +86,163 @@ fn project(camera: &OrbitCamera, rect: Rect, p: Vec3) -> Option<Pos2> {
         .map(|n| screen(rect, n))
 }
 
-impl CloudApp {
-    fn notify(&mut self, ui: &Ui, text: String, error: bool) {
-        self.sketch.notice = Some(Notice {
-            text,
-            error,
-            at: ui.input(|i| i.time),
-        });
-    }
+/// Deletes the selected plane; returns what was done.
+pub fn delete_selected(doc: &mut Document, selection: &mut Selection) -> Option<String> {
+    let i = selection.plane()?;
+    let name = doc.scene().planes.get(i)?.name.clone();
+    doc.apply(Edit::RemovePlane(i), None)
+        .then(|| {
+            selection.clear();
+            format!("Deleted {name} (Ctrl+Z undoes)")
+        })
+}
 
+/// Duplicates the selected plane behind the original; returns what was done.
+pub fn duplicate_selected(doc: &mut Document, selection: &mut Selection) -> Option<String> {
+    let i = selection.plane()?;
+    let planes = &doc.scene().planes;
+    if planes.len() >= MAX_PLANES {
+        return Some(format!("at most {MAX_PLANES} drawing planes: delete one first"));
+    }
+    let mut copy = (**planes.get(i)?).clone();
+    let (lo, hi) = copy
+        .points
+        .iter()
+        .fold((f32::MAX, f32::MIN), |(a, b), p| (a.min(p.x), b.max(p.x)));
+    // Behind the original by a third of its width, so the copy thickens the cloud.
+    copy.origin -= copy.normal() * ((hi - lo).max(0.1) / 3.0);
+    copy.name = format!("{} copy", copy.name);
+    copy.seed = hash64(copy.seed);
+    let name = copy.name.clone();
+    doc.apply(Edit::InsertPlane(i + 1, copy), None).then(|| {
+        selection.set(Item::Plane(i + 1));
+        format!("Added {name}")
+    })
+}
+
+impl SketchTool {
     /// Tool shortcuts: V navigate, D draw, C cut, G move, R rotate, H hides guides, Esc cancels
     /// a stroke (or clears the selection), Delete removes the selected plane, Ctrl+D duplicates it.
-    pub(super) fn sketch_shortcuts(&mut self, ctx: &egui::Context) {
+    pub fn shortcuts(&mut self, ctx: &egui::Context, tc: &mut ToolContext<'_>) {
         if ctx.egui_wants_keyboard_input() {
             return;
         }
-        let (g, r) = ctx.input_mut(|i| {
-            (
-                i.consume_key(egui::Modifiers::NONE, egui::Key::G),
-                i.consume_key(egui::Modifiers::NONE, egui::Key::R),
-            )
+        use egui::{Key, Modifiers};
+        let keys = ctx.input_mut(|i| {
+            [
+                i.consume_key(Modifiers::COMMAND, Key::D),
+                i.consume_key(Modifiers::NONE, Key::V),
+                i.consume_key(Modifiers::NONE, Key::D),
+                i.consume_key(Modifiers::NONE, Key::C),
+                i.consume_key(Modifiers::NONE, Key::G),
+                i.consume_key(Modifiers::NONE, Key::R),
+                i.consume_key(Modifiers::NONE, Key::H),
+                i.consume_key(Modifiers::NONE, Key::Escape),
+                i.consume_key(Modifiers::NONE, Key::Delete),
+            ]
         });
-        if g {
-            self.sketch.tool = Tool::Move;
+        let [dup, v, d, c, g, r, h, esc, del] = keys;
+        let now = ctx.input(|i| i.time);
+        for (pressed, tool) in [
+            (v, Tool::Navigate),
+            (d, Tool::Sketch),
+            (c, Tool::Cut),
+            (g, Tool::Move),
+            (r, Tool::Rotate),
+        ] {
+            if pressed {
+                self.tool = tool;
+            }
         }
-        if r {
-            self.sketch.tool = Tool::Rotate;
-        }
-        let (v, d, c, esc, del, dup, h) = ctx.input_mut(|i| {
-            (
-                i.consume_key(egui::Modifiers::NONE, egui::Key::V),
-                i.consume_key(egui::Modifiers::NONE, egui::Key::D),
-                i.consume_key(egui::Modifiers::NONE, egui::Key::C),
-                i.consume_key(egui::Modifiers::NONE, egui::Key::Escape),
-                i.consume_key(egui::Modifiers::NONE, egui::Key::Delete),
-                i.consume_key(egui::Modifiers::COMMAND, egui::Key::D),
-                i.consume_key(egui::Modifiers::NONE, egui::Key::H),
-            )
-        });
         if h {
-            self.sketch.hide_guides = !self.sketch.hide_guides;
-        }
-        if dup {
-            self.duplicate_selected();
-        } else if d {
-            self.sketch.tool = Tool::Sketch;
-        }
-        if v {
-            self.sketch.tool = Tool::Navigate;
-        }
-        if c {
-            self.sketch.tool = Tool::Cut;
+            self.hide_guides = !self.hide_guides;
         }
         if esc {
-            if self.sketch.stroke.is_empty() {
-                self.sketch.selected = None;
+            if self.stroke.is_empty() {
+                tc.selection.clear();
             }
-            self.sketch.stroke.clear();
+            self.stroke.clear();
         }
-        if del {
-            self.delete_selected();
+        if dup && let Some(m) = duplicate_selected(tc.doc, tc.selection) {
+            tc.notices.note(now, m);
+        }
+        if del && let Some(m) = delete_selected(tc.doc, tc.selection) {
+            tc.notices.note(now, m);
         }
     }
 
     /// Stroke capture in the viewport. Returns whether the primary button draws (so the camera
     /// must not orbit with it). In Navigate, a click selects the drawing plane under the pointer.
-    pub(super) fn sketch_input(&mut self, ui: &Ui, response: &Response, rect: Rect) -> bool {
-        if matches!(self.sketch.tool, Tool::Navigate | Tool::Move | Tool::Rotate)
+    pub fn input(
+        &mut self,
+        ui: &Ui,
+        response: &Response,
+        rect: Rect,
+        tc: &mut ToolContext<'_>,
+    ) -> bool {
+        if matches!(self.tool, Tool::Navigate | Tool::Move | Tool::Rotate)
             && response.clicked()
             && let Some(p) = response.interact_pointer_pos()
         {
-            self.sketch.selected = self.plane_at(rect, p);
+            tc.selection.set_plane(plane_at(tc.doc, rect, p));
         }
-        match self.sketch.tool {
+        match self.tool {
             Tool::Navigate => return false,
-            Tool::Move | Tool::Rotate => return self.manipulate(ui, response, rect),
+            Tool::Move | Tool::Rotate => return self.manipulate(ui, response, rect, tc),
             Tool::Sketch | Tool::Cut => {}
         }
         let (alt, multi) = ui.input(|i| (i.modifiers.alt, i.multi_touch().is_some()));
         if alt || multi {
-            self.sketch.stroke.clear();
+            self.stroke.clear();
             return true;
         }
         if response.drag_started_by(egui::PointerButton::Primary) {
-            self.sketch.stroke.clear();
+            self.stroke.clear();
             // Start where the button went down, not where the drag was recognised.
             if let Some(p) = ui
                 .input(|i| i.pointer.press_origin())
                 .or(response.interact_pointer_pos())
             {
-                self.sketch.stroke.push(p);
+                self.stroke.push(p);
             }
         }
         if response.dragged_by(egui::PointerButton::Primary)
             && let Some(p) = response.interact_pointer_pos()
-            && self
-                .sketch
-                .stroke
-                .last()
-                .is_none_or(|q| q.distance(p) >= 1.0)
-            && self.sketch.stroke.len() < MAX_PLANE_POINTS
+            && self.stroke.last().is_none_or(|q| q.distance(p) >= 1.0)
+            && self.stroke.len() < MAX_PLANE_POINTS
         {
-            self.sketch.stroke.push(p);
+            self.stroke.push(p);
         }
         if response.drag_stopped_by(egui::PointerButton::Primary) {
-            let stroke = std::mem::take(&mut self.sketch.stroke);
-            self.finish_stroke(ui, rect, &stroke);
+            let stroke = std::mem::take(&mut self.stroke);
+            let now = ui.input(|i| i.time);
+            self.finish_stroke(now, rect, &stroke, tc);
         }
         true
     }
 
     /// Turns a finished screen stroke into a drawing plane: parallel to the view, through the
-    /// point where the first point's ray meets the cloud, or through the focus point.
-    fn finish_stroke(&mut self, ui: &Ui, rect: Rect, stroke: &[Pos2]) {
-        if self.scene.planes.len() >= MAX_PLANES {
-            self.notify(
-                ui,
+    /// point where the first point's ray meets the cloud, or through the focus point. The
+    /// stroke is interpreted once, through the derivation cache.
+    fn finish_stroke(&mut self, now: f64, rect: Rect, stroke: &[Pos2], tc: &mut ToolContext<'_>) {
+        let scene = tc.doc.scene();
+        if scene.planes.len() >= MAX_PLANES {
+            tc.notices.error(
+                now,
                 format!("at most {MAX_PLANES} drawing planes: delete one first"),
-                true,
             );
             return;
         }
-        let kind = if self.sketch.tool == Tool::Cut {
+        let kind = if self.tool == Tool::Cut {
             StrokeKind::Cut
         } else {
             StrokeKind::Outline
         };
-        let camera = self.scene.camera.clone();
+        let camera = scene.camera.clone();
         let aspect = rect.aspect_ratio();
         let Some(&first) = stroke.first() else { return };
         let first_ray = camera.ray(ndc(rect, first), aspect);
-        let field = Field::from_scene(&self.scene);
+        let field = tc.derived.field(scene, Some(tc.doc.revisions().geometry));
         let step = field
             .bounding_sphere()
             .map(|(_, r)| r / 200.0)
@@ -231,14 +256,13 @@ impl CloudApp {
                 ray.hit_plane(anchor, normal).map(|t| ray.at(t))
             })
             .collect();
-        let count = self.scene.planes.iter().filter(|p| p.kind == kind).count() + 1;
+        let count = scene.planes.iter().filter(|p| p.kind == kind).count() + 1;
         let name = match kind {
             StrokeKind::Outline => format!("Outline {count}"),
             StrokeKind::Cut => format!("Cut {count}"),
         };
-        let seed = crate::render::noise::hash64(
-            self.scene.seed ^ ((self.scene.planes.len() as u64) << 32) ^ world.len() as u64,
-        );
+        let seed =
+            hash64(scene.seed ^ ((scene.planes.len() as u64) << 32) ^ world.len() as u64);
         let plane = DrawingPlane::facing(
             name,
             kind,
@@ -248,42 +272,40 @@ impl CloudApp {
             &world,
             seed,
         );
-        let result = match kind {
-            StrokeKind::Outline => {
-                crate::sketch::interpret(&plane.stroke(), true, &plane.sketch, plane.seed)
-                    .map(|s| s.warnings)
+        let warnings = match &*tc.derived.shape_of(&plane) {
+            Shape::Unusable(e) => {
+                tc.notices.error(now, format!("Stroke not used: {e}"));
+                return;
             }
-            StrokeKind::Cut => crate::sketch::cut_line(&plane.stroke()).map(|_| Vec::new()),
+            Shape::Outline { warnings, .. } => warnings.clone(),
+            Shape::Cut(_) => Vec::new(),
         };
-        match result {
-            Err(e) => self.notify(ui, format!("Stroke not used: {e}"), true),
-            Ok(warnings) => {
-                let mut planes = self.scene.planes.clone();
-                planes.push(plane);
-                let index = planes.len() - 1;
-                self.apply(Edit::SetPlanes(planes), None);
-                self.sketch.selected = Some(index);
-                let text = if warnings.is_empty() {
-                    format!("Added {} (Ctrl+Z undoes)", self.scene.planes[index].name)
-                } else {
-                    format!(
-                        "Added {}: {}",
-                        self.scene.planes[index].name,
-                        warnings.join("; ")
-                    )
-                };
-                self.notify(ui, text, false);
-            }
+        let index = scene.planes.len();
+        let name = plane.name.clone();
+        if tc.doc.apply(Edit::InsertPlane(index, plane), None) {
+            tc.selection.set(Item::Plane(index));
+            let text = if warnings.is_empty() {
+                format!("Added {name} (Ctrl+Z undoes)")
+            } else {
+                format!("Added {name}: {}", warnings.join("; "))
+            };
+            tc.notices.note(now, text);
         }
     }
 
     /// Move and Rotate: a primary drag transforms the selected plane (one undo step per drag).
     /// Without a selection the drag orbits as in Navigate.
-    fn manipulate(&mut self, ui: &Ui, response: &Response, rect: Rect) -> bool {
-        let Some(i) = self
-            .sketch
-            .selected
-            .filter(|&i| i < self.scene.planes.len())
+    fn manipulate(
+        &mut self,
+        ui: &Ui,
+        response: &Response,
+        rect: Rect,
+        tc: &mut ToolContext<'_>,
+    ) -> bool {
+        let Some(i) = tc
+            .selection
+            .plane()
+            .filter(|&i| i < tc.doc.scene().planes.len())
         else {
             return false;
         };
@@ -297,14 +319,12 @@ impl CloudApp {
         if delta == egui::Vec2::ZERO {
             return true;
         }
-        let camera = &self.scene.camera;
-        let mut plane = self.scene.planes[i].clone();
-        match self.sketch.tool {
+        let camera = &tc.doc.scene().camera;
+        let mut plane = (*tc.doc.scene().planes[i]).clone();
+        match self.tool {
             Tool::Move => {
-                // World units per pixel at the plane's depth.
                 let depth = (plane.origin - camera.eye()).dot(camera.forward()).max(0.1);
-                let per_px = 2.0 * depth * (camera.fov_y_deg.to_radians() * 0.5).tan()
-                    / rect.height().max(1.0);
+                let per_px = camera.world_per_px(depth, rect.height());
                 let shift = ui.input(|i| i.modifiers.shift);
                 plane.origin += if shift {
                     camera.forward() * (delta.y * per_px)
@@ -319,95 +339,23 @@ impl CloudApp {
                 plane.rotation = (turn * plane.rotation).normalize();
             }
         }
-        let mut planes = self.scene.planes.clone();
-        planes[i] = plane;
-        self.apply(Edit::SetPlanes(planes), Some("plane-drag"));
+        tc.doc.apply(Edit::SetPlane(i, plane), Some("plane-drag"));
         true
     }
 
-    /// The drawing plane whose stroke encloses screen point `p` (outlines by their inside, cuts
-    /// within a few pixels of their line), the nearest to the camera when several do.
-    fn plane_at(&self, rect: Rect, p: Pos2) -> Option<usize> {
-        let camera = &self.scene.camera;
-        let eye = camera.eye();
-        let mut best: Option<(f32, usize)> = None;
-        for (i, plane) in self.scene.planes.iter().enumerate() {
-            // Screen points in f64, for the sketch core's polygon helpers.
-            let pts: Vec<glam::DVec2> = plane
-                .points
-                .iter()
-                .filter_map(|q| project(camera, rect, plane.to_world(q.extend(0.0))))
-                .map(|q| glam::DVec2::new(q.x as f64, q.y as f64))
-                .collect();
-            if pts.len() < 2 {
-                continue;
-            }
-            let at = glam::DVec2::new(p.x as f64, p.y as f64);
-            let hit = match plane.kind {
-                StrokeKind::Outline => outline::contains(&pts, at),
-                StrokeKind::Cut => pts
-                    .windows(2)
-                    .any(|w| outline::segment_distance(at, w[0], w[1]) < 6.0),
-            };
-            let depth = plane.origin.distance(eye);
-            if hit && best.is_none_or(|(d, _)| depth < d) {
-                best = Some((depth, i));
-            }
-        }
-        best.map(|(_, i)| i)
-    }
-
-    fn delete_selected(&mut self) {
-        if let Some(i) = self
-            .sketch
-            .selected
-            .filter(|&i| i < self.scene.planes.len())
-        {
-            let mut planes = self.scene.planes.clone();
-            planes.remove(i);
-            self.apply(Edit::SetPlanes(planes), None);
-            self.sketch.selected = None;
-        }
-    }
-
-    fn duplicate_selected(&mut self) {
-        let Some(i) = self
-            .sketch
-            .selected
-            .filter(|&i| i < self.scene.planes.len())
-        else {
-            return;
-        };
-        if self.scene.planes.len() >= MAX_PLANES {
-            return;
-        }
-        let mut copy = self.scene.planes[i].clone();
-        let width = copy
-            .points
-            .iter()
-            .fold((f32::MAX, f32::MIN), |(a, b), p| (a.min(p.x), b.max(p.x)));
-        // Behind the original by a third of its width, so the copy thickens the cloud.
-        copy.origin -= copy.normal() * ((width.1 - width.0).max(0.1) / 3.0);
-        copy.name = format!("{} copy", copy.name);
-        copy.seed = crate::render::noise::hash64(copy.seed);
-        let mut planes = self.scene.planes.clone();
-        planes.insert(i + 1, copy);
-        self.apply(Edit::SetPlanes(planes), None);
-        self.sketch.selected = Some(i + 1);
-    }
-
-    /// Strokes of every plane, the selected plane's grid, the stroke being drawn and the notice.
-    pub(super) fn sketch_overlay(&mut self, ui: &Ui, rect: Rect) {
+    /// Strokes of every plane, the selected plane's grid, the stroke being drawn and the hints.
+    pub fn overlay(&self, ui: &Ui, rect: Rect, doc: &Document, selection: &Selection) {
         let painter = ui.painter_at(rect);
-        let camera = &self.scene.camera;
-        let planes = if self.sketch.hide_guides {
+        let scene = doc.scene();
+        let camera = &scene.camera;
+        let planes = if self.hide_guides {
             &[][..]
         } else {
-            &self.scene.planes[..]
+            &scene.planes[..]
         };
         for (i, plane) in planes.iter().enumerate() {
-            let selected = self.sketch.selected == Some(i);
-            if selected || self.sketch.show_all_planes {
+            let selected = selection.contains(Item::Plane(i));
+            if selected || self.show_all_planes {
                 draw_grid(&painter, camera, rect, plane, selected);
             }
             let color = match (plane.kind, selected) {
@@ -415,13 +363,12 @@ impl CloudApp {
                 (_, true) => Color32::from_rgb(255, 90, 90),
                 _ => Color32::from_white_alpha(70),
             };
-            let pts: Vec<Pos2> = plane
+            let mut pts: Vec<Pos2> = plane
                 .points
                 .iter()
                 .filter_map(|p| project(camera, rect, plane.to_world(p.extend(0.0))))
                 .collect();
             if pts.len() >= 2 {
-                let mut pts = pts;
                 if plane.kind == StrokeKind::Outline {
                     pts.push(pts[0]);
                 }
@@ -431,57 +378,30 @@ impl CloudApp {
                 ));
             }
         }
-        if self.sketch.stroke.len() >= 2 {
-            let color = if self.sketch.tool == Tool::Cut {
+        if self.stroke.len() >= 2 {
+            let color = if self.tool == Tool::Cut {
                 Color32::from_rgb(255, 150, 60)
             } else {
                 Color32::WHITE
             };
             painter.add(egui::Shape::line(
-                self.sketch.stroke.clone(),
+                self.stroke.clone(),
                 Stroke::new(2.0, color),
             ));
         }
-        let now = ui.input(|i| i.time);
-        if let Some(n) = &self.sketch.notice {
-            let age = now - n.at;
-            if n.error || age < 6.0 {
-                let color = if n.error {
-                    Color32::from_rgb(255, 140, 140)
-                } else {
-                    Color32::from_white_alpha(220)
-                };
-                painter.text(
-                    rect.left_top() + egui::vec2(10.0, 10.0),
-                    egui::Align2::LEFT_TOP,
-                    &n.text,
-                    egui::FontId::proportional(14.0),
-                    color,
-                );
-                if !n.error {
-                    ui.ctx()
-                        .request_repaint_after(std::time::Duration::from_millis(500));
-                }
+        let hint = match self.tool {
+            Tool::Move | Tool::Rotate if selection.plane().is_none() => {
+                Some("Click a drawing plane (or pick one in the list) to move or rotate it")
             }
-        }
-        if matches!(self.sketch.tool, Tool::Move | Tool::Rotate) && self.sketch.selected.is_none() {
-            painter.text(
-                rect.center_top() + egui::vec2(0.0, 36.0),
-                egui::Align2::CENTER_TOP,
-                "Click a drawing plane (or pick one in the list) to move or rotate it",
-                egui::FontId::proportional(15.0),
-                Color32::from_white_alpha(200),
-            );
-        }
-        if matches!(self.sketch.tool, Tool::Sketch | Tool::Cut)
-            && self.scene.planes.is_empty()
-            && self.sketch.stroke.is_empty()
-        {
-            let hint = if self.sketch.tool == Tool::Cut {
-                "Drag to draw a cut line: the cloud is removed below it"
-            } else {
-                "Drag to draw a cloud's outline"
-            };
+            Tool::Sketch if scene.planes.is_empty() && self.stroke.is_empty() => {
+                Some("Drag to draw a cloud's outline")
+            }
+            Tool::Cut if scene.planes.is_empty() && self.stroke.is_empty() => {
+                Some("Drag to draw a cut line: the cloud is removed below it")
+            }
+            _ => None,
+        };
+        if let Some(hint) = hint {
             painter.text(
                 rect.center_top() + egui::vec2(0.0, 36.0),
                 egui::Align2::CENTER_TOP,
@@ -491,116 +411,38 @@ impl CloudApp {
             );
         }
     }
+}
 
-    /// The Sketch group of the side panel: tools, the plane list and the selected plane.
-    pub(super) fn sketch_group(&mut self, ui: &mut Ui) {
-        egui::CollapsingHeader::new("Sketch")
-            .default_open(true)
-            .show(ui, |ui| {
-                ui.horizontal_wrapped(|ui| {
-                    for (tool, label, key) in [
-                        (Tool::Navigate, "Navigate", "V"),
-                        (Tool::Sketch, "✏ Sketch", "D"),
-                        (Tool::Cut, "✂ Cut", "C"),
-                        (Tool::Move, "✥ Move", "G"),
-                        (Tool::Rotate, "⟳ Rotate", "R"),
-                    ] {
-                        ui.selectable_value(&mut self.sketch.tool, tool, label)
-                            .on_hover_text(key);
-                    }
-                });
-                ui.horizontal(|ui| {
-                    ui.checkbox(&mut self.sketch.show_all_planes, "all grids");
-                    ui.checkbox(&mut self.sketch.hide_guides, "hide guides")
-                        .on_hover_text("H");
-                });
-                if self.scene.planes.is_empty() {
-                    ui.label("No drawing planes yet. Pick Sketch and drag an outline in the view.");
-                    return;
-                }
-                ui.label("Drawing planes:");
-                for i in 0..self.scene.planes.len() {
-                    let selected = self.sketch.selected == Some(i);
-                    let name = self.scene.planes[i].name.clone();
-                    if ui.selectable_label(selected, name).clicked() {
-                        self.sketch.selected = if selected { None } else { Some(i) };
-                    }
-                }
-                if let Some(i) = self
-                    .sketch
-                    .selected
-                    .filter(|&i| i < self.scene.planes.len())
-                {
-                    ui.separator();
-                    self.plane_controls(ui, i);
-                }
-            });
+/// The drawing plane whose stroke encloses screen point `p` (outlines by their inside, cuts
+/// within a few pixels of their line), the nearest to the camera when several do.
+fn plane_at(doc: &Document, rect: Rect, p: Pos2) -> Option<usize> {
+    let camera = &doc.scene().camera;
+    let eye = camera.eye();
+    let mut best: Option<(f32, usize)> = None;
+    for (i, plane) in doc.scene().planes.iter().enumerate() {
+        // Screen points in f64, for the sketch core's polygon helpers.
+        let pts: Vec<glam::DVec2> = plane
+            .points
+            .iter()
+            .filter_map(|q| project(camera, rect, plane.to_world(q.extend(0.0))))
+            .map(|q| glam::DVec2::new(q.x as f64, q.y as f64))
+            .collect();
+        if pts.len() < 2 {
+            continue;
+        }
+        let at = glam::DVec2::new(p.x as f64, p.y as f64);
+        let hit = match plane.kind {
+            StrokeKind::Outline => outline::contains(&pts, at),
+            StrokeKind::Cut => pts
+                .windows(2)
+                .any(|w| outline::segment_distance(at, w[0], w[1]) < 6.0),
+        };
+        let depth = plane.origin.distance(eye);
+        if hit && best.is_none_or(|(d, _)| depth < d) {
+            best = Some((depth, i));
+        }
     }
-
-    fn plane_controls(&mut self, ui: &mut Ui, i: usize) {
-        let mut plane = self.scene.planes[i].clone();
-        ui.label(egui::RichText::new(&plane.name).strong());
-        if plane.kind == StrokeKind::Outline {
-            ui.add(egui::Slider::new(&mut plane.sketch.inflate, 0.0..=1.0).text("deflate (t)"))
-                .on_hover_text("0 keeps the maximal balls; 1 shrinks the big body spheres to the feature radius");
-            ui.add(egui::Slider::new(&mut plane.sketch.simplify, 0.0..=0.08).text("simplify"));
-            ui.add(egui::Slider::new(&mut plane.sketch.prune, 0.0..=0.2).text("prune branches"));
-            ui.checkbox(&mut plane.sketch.extend, "3D extension");
-            ui.add_enabled(
-                plane.sketch.extend,
-                egui::Slider::new(&mut plane.sketch.copies, 0..=6).text("branch copies"),
-            );
-        }
-        ui.horizontal(|ui| {
-            ui.label("move");
-            for (axis, v) in ["x", "y", "z"].iter().zip(plane.origin.as_mut()) {
-                ui.add(
-                    egui::DragValue::new(v)
-                        .speed(0.05)
-                        .prefix(format!("{axis} ")),
-                );
-            }
-        });
-        let (mut yaw, mut pitch, mut roll) = plane.rotation.to_euler(EulerRot::YXZ);
-        let before = (yaw, pitch, roll);
-        ui.horizontal(|ui| {
-            ui.label("rotate");
-            for (label, v) in [
-                ("yaw ", &mut yaw),
-                ("pitch ", &mut pitch),
-                ("roll ", &mut roll),
-            ] {
-                let mut deg = v.to_degrees();
-                if ui
-                    .add(
-                        egui::DragValue::new(&mut deg)
-                            .speed(0.5)
-                            .prefix(label)
-                            .suffix("°"),
-                    )
-                    .changed()
-                {
-                    *v = deg.to_radians();
-                }
-            }
-        });
-        if (yaw, pitch, roll) != before {
-            plane.rotation = Quat::from_euler(EulerRot::YXZ, yaw, pitch, roll);
-        }
-        if plane != self.scene.planes[i] {
-            let mut planes = self.scene.planes.clone();
-            planes[i] = plane;
-            self.apply(Edit::SetPlanes(planes), Some("plane"));
-        }
-        ui.horizontal(|ui| {
-            if ui.button("Duplicate").on_hover_text("Ctrl+D").clicked() {
-                self.duplicate_selected();
-            }
-            if ui.button("Delete").on_hover_text("Delete").clicked() {
-                self.delete_selected();
-            }
-        });
-    }
+    best.map(|(_, i)| i)
 }
 
 /// The selected plane's grid: its stroke's box, padded, with a few lines each way.

@@ -1,5 +1,7 @@
-//! Reading user files in the browser: the page's hidden `<input type=file id="guide_input">`
-//! and dropped files, both read asynchronously into an inbox the app polls each frame.
+//! The browser side of the UI's one platform seam (`platform_native.rs` is the desktop's):
+//! what the GL backend is called, and reading user files — the page's hidden
+//! `<input type=file id="guide_input">` and dropped files, both read asynchronously into an
+//! inbox the app polls each frame.
 
 use std::cell::RefCell;
 
@@ -8,11 +10,16 @@ use wasm_bindgen::prelude::*;
 
 use super::guide::Loaded;
 
+use crate::limits::MAX_FILE_BYTES;
+
+/// What the GL backend is called here.
+pub const GL_BACKEND_NAME: &str = "webgl2";
+
 /// Whether this platform has a file picker button.
 pub const HAS_PICKER: bool = true;
 
 /// Largest file read.
-const MAX_BYTES: f64 = 64.0 * 1024.0 * 1024.0;
+const MAX_BYTES: f64 = MAX_FILE_BYTES as f64;
 
 thread_local! {
     static INBOX: RefCell<Vec<Loaded>> = const { RefCell::new(Vec::new()) };
@@ -31,7 +38,7 @@ fn deliver(loaded: Loaded) {
 async fn read_file(file: web_sys::File) -> Loaded {
     let name = file.name();
     if file.size() > MAX_BYTES {
-        return Err(format!("{name}: larger than 64 MiB"));
+        return Err(format!("{name}: larger than {} MiB", MAX_FILE_BYTES >> 20));
     }
     let buffer = wasm_bindgen_futures::JsFuture::from(file.array_buffer())
         .await
@@ -44,11 +51,14 @@ pub fn read_dropped(file: egui::DroppedFileHandle, ctx: &egui::Context) -> Optio
     REPAINT.with(|c| *c.borrow_mut() = Some(ctx.clone()));
     let name = file.path().display().to_string();
     wasm_bindgen_futures::spawn_local(async move {
-        let result = file
-            .bytes_async()
-            .await
-            .map(|b| (name.clone(), b))
-            .map_err(|e| format!("{name}: {e}"));
+        let result = match file.bytes_async().await {
+            Ok(b) if b.len() as u64 > MAX_FILE_BYTES => Err(format!(
+                "{name}: larger than {} MiB",
+                MAX_FILE_BYTES >> 20
+            )),
+            Ok(b) => Ok((name.clone(), b)),
+            Err(e) => Err(format!("{name}: {e}")),
+        };
         deliver(result);
     });
     None

@@ -1,17 +1,23 @@
-//! Reading user files on the desktop: dropped files and typed paths (the native side of the
-//! one platform seam; `files_web.rs` is the browser's).
+//! The desktop side of the UI's one platform seam (`platform_web.rs` is the browser's): what
+//! the GL backend is called, and reading user files (dropped files and typed paths).
 
 use super::guide::Loaded;
+use crate::limits::MAX_FILE_BYTES as MAX_BYTES;
+
+/// What the GL backend is called here.
+pub const GL_BACKEND_NAME: &str = "gl";
 
 /// Whether this platform has a file picker button (the browser's file input).
 pub const HAS_PICKER: bool = false;
 
-/// Largest file read (images and documents).
-const MAX_BYTES: u64 = 64 << 20;
-
 /// Reads a dropped file at once.
 pub fn read_dropped(file: egui::DroppedFileHandle, _ctx: &egui::Context) -> Option<Loaded> {
     let name = file.path().display().to_string();
+    if let Ok(meta) = std::fs::metadata(file.path())
+        && meta.len() > MAX_BYTES
+    {
+        return Some(Err(format!("{name}: larger than {} MiB", MAX_BYTES >> 20)));
+    }
     Some(
         file.bytes()
             .map(|b| (name.clone(), b))

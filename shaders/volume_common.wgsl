@@ -1,0 +1,41 @@
+// Shared by the slice shaders (volume.wgsl, plain_slices.wgsl): the `Volume` uniforms and the
+// bind group. WGSL has no include, so src/render/shaders.rs prepends this file to each of them
+// and the tests validate the composed modules; `Volume` mirrors `VolumeUniforms` in
+// src/render/gpu_types.rs, and a test compares their sizes and member offsets.
+
+const MAX_OCTAVES: i32 = 8;
+
+struct Volume {
+    // World → clip.
+    view_proj: mat4x4<f32>,
+    // Camera position (xyz).
+    eye: vec4<f32>,
+    // Unit view direction, image-plane right and up (xyz).
+    forward: vec4<f32>,
+    right: vec4<f32>,
+    up: vec4<f32>,
+    // Density grid: minimum corner and 1 / size (xyz).
+    grid_min: vec4<f32>,
+    grid_inv_size: vec4<f32>,
+    // Bounding sphere: centre (xyz), radius (w).
+    sphere: vec4<f32>,
+    // x: total slices, y: first slice of this draw (0 = farthest), z: slice spacing (world).
+    slicing: vec4<f32>,
+    // Linear sun colour × intensity, sky colour × ambient (rgb).
+    sun_color: vec4<f32>,
+    sky_color: vec4<f32>,
+    // x: extinction per world unit, y: iso-level, z: soft-edge half-width, w: noise amount.
+    media: vec4<f32>,
+    // x: amplitude gain per octave, y: octaves.
+    noise: vec4<f32>,
+    // Per-octave transform of world positions into noise-texture coordinates
+    // (scale × rotation × translation; the scale grows by the lacunarity per octave).
+    octaves: array<mat4x4<f32>, MAX_OCTAVES>,
+};
+
+@group(0) @binding(0) var<uniform> u: Volume;
+@group(0) @binding(1) var density_tex: texture_3d<f32>;
+@group(0) @binding(2) var clamp_smp: sampler;
+@group(0) @binding(3) var noise_tex: texture_3d<f32>;
+@group(0) @binding(4) var repeat_smp: sampler;
+@group(0) @binding(5) var light_tex: texture_3d<f32>;

@@ -1,0 +1,28 @@
+//! No subcommand: the desktop app in a window.
+
+use crate::ui::{CloudApp, StartOptions};
+
+/// Opens the desktop window on the default scene.
+pub fn run() -> Result<(), String> {
+    let options = eframe::NativeOptions {
+        viewport: egui::ViewportBuilder::default()
+            .with_title("cloudsketch")
+            .with_inner_size([1280.0, 800.0]),
+        ..Default::default()
+    };
+    eframe::run_native(
+        "cloudsketch",
+        options,
+        Box::new(|cc| {
+            Ok(Box::new(CloudApp::new(
+                cc,
+                StartOptions {
+                    initial_cost: 1e-8,
+                    ..Default::default()
+                },
+            )))
+        }),
+    )
+    .map_err(|e| format!("could not open the desktop window: {e}"))
+}
+

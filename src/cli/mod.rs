@@ -1,0 +1,147 @@
+//! The native command line: `cloudsketch` alone opens the desktop app; subcommands work
+//! headless. One file per subcommand: `new`, `render`, `sketch` (`bench` is `crate::bench`);
+//! `desktop` opens the window.
+
+mod desktop;
+mod new;
+mod render;
+mod sketch;
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+use crate::limits::MAX_FILE_BYTES;
+use crate::scene::Scene;
+
+pub use render::parse_size;
+
+#[derive(Parser)]
+#[command(
+    name = "cloudsketch",
+    version,
+    about = "Sketch a cloud's outline, get a volumetric 3D cloud."
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Write a new scene document.
+    New {
+        /// Starting point: cumulus (default) or empty.
+        #[arg(long, default_value = "cumulus")]
+        preset: String,
+        /// Where to write the scene JSON.
+        #[arg(short, long)]
+        output: PathBuf,
+    },
+    /// Render a scene offscreen to PNG with the app's renderer (full quality).
+    Render {
+        /// Scene JSON; the default scene when left out.
+        scene: Option<PathBuf>,
+        /// Output PNG.
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Image size as WIDTHxHEIGHT.
+        #[arg(long, default_value = "1280x720")]
+        size: String,
+        /// Override a scene value by JSON Pointer, e.g. /render/slices=256 (repeatable).
+        #[arg(long = "set", value_name = "PATH=VALUE")]
+        set: Vec<String>,
+    },
+    /// Turn drawn outlines into a scene (one drawing plane per stroke), headless.
+    Sketch {
+        /// Stroke files: {"points": [[x, y], ...], "closed": true|false}, y pointing down.
+        #[arg(required = true)]
+        strokes: Vec<PathBuf>,
+        /// Where to write the scene JSON.
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Also write the first stroke's final spheres, in its own units and axes.
+        #[arg(long)]
+        spheres_out: Option<PathBuf>,
+        /// Inflation slider t in [0, 1] (0 keeps the maximal balls).
+        #[arg(long, default_value_t = 0.0)]
+        inflate: f64,
+        /// Turn the automatic 3D extension off.
+        #[arg(long)]
+        no_extend: bool,
+        /// Seed of the 3D extension.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+    },
+    /// Run the benchmark suite.
+    Bench {
+        /// Print one JSON object instead of a table.
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+/// Entry point of the native binary.
+pub fn main() -> ExitCode {
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
+    let cli = Cli::parse();
+    let result = match cli.command {
+        None => desktop::run(),
+        Some(Command::New { preset, output }) => new::run(&preset, &output),
+        Some(Command::Render {
+            scene,
+            output,
+            size,
+            set,
+        }) => render::run(scene.as_deref(), &output, &size, &set),
+        Some(Command::Sketch {
+            strokes,
+            output,
+            spheres_out,
+            inflate,
+            no_extend,
+            seed,
+        }) => sketch::run(
+            &strokes,
+            &output,
+            spheres_out.as_deref(),
+            inflate,
+            !no_extend,
+            seed,
+        ),
+        Some(Command::Bench { json }) => crate::bench::run(json),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(message) => {
+            eprintln!("error: {message}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// Reads a text file with a size cap.
+pub fn read_capped(path: &Path) -> Result<String, String> {
+    let meta = std::fs::metadata(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    if meta.len() > MAX_FILE_BYTES {
+        return Err(format!(
+            "{}: {} bytes is more than the {} MiB limit",
+            path.display(),
+            meta.len(),
+            MAX_FILE_BYTES >> 20
+        ));
+    }
+    std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// Reads and validates a scene document.
+pub fn read_scene(path: &Path) -> Result<Scene, String> {
+    Scene::from_json(&read_capped(path)?).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// Writes a file, with the path in the error.
+pub fn write(path: &Path, bytes: &[u8]) -> Result<(), String> {
+    std::fs::write(path, bytes).map_err(|e| format!("cannot write {}: {e}", path.display()))
+}
+

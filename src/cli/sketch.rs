@@ -1,0 +1,124 @@
+//! `sketch`: drawn outlines (stroke files) into a scene, headless.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use super::{read_capped, write};
+use crate::scene::Scene;
+
+/// A stroke file.
+#[derive(serde::Deserialize)]
+struct StrokeFile {
+    points: Vec<[f64; 2]>,
+    #[serde(default = "yes")]
+    closed: bool,
+}
+
+fn yes() -> bool {
+    true
+}
+
+/// World height the strokes are scaled to, so the default camera frames them.
+const SKETCH_WORLD_HEIGHT: f64 = 6.0;
+
+/// `cloudsketch sketch STROKE.json… -o SCENE.json`.
+pub fn run(
+    paths: &[PathBuf],
+    output: &Path,
+    spheres_out: Option<&Path>,
+    inflate: f64,
+    extend: bool,
+    seed: u64,
+) -> Result<(), String> {
+    use crate::scene::{DrawingPlane, MAX_PLANES, StrokeKind};
+    use crate::sketch::{SketchParams, interpret};
+    if !(0.0..=1.0).contains(&inflate) {
+        return Err(format!("--inflate {inflate} is outside 0..=1"));
+    }
+    if paths.len() > MAX_PLANES {
+        return Err(format!("{} strokes (at most {MAX_PLANES})", paths.len()));
+    }
+    let params = SketchParams {
+        inflate,
+        extend,
+        ..Default::default()
+    };
+    let mut strokes = Vec::new();
+    for path in paths {
+        let file: StrokeFile = serde_json::from_str(&read_capped(path)?).map_err(|e| {
+            format!(
+                "{}: not a stroke file ({{\"points\": [[x, y], ...]}}): {e}",
+                path.display()
+            )
+        })?;
+        // y down → y up, so the plane's points read like the world.
+        let points: Vec<[f64; 2]> = file.points.iter().map(|&[x, y]| [x, -y]).collect();
+        let sketch = interpret(
+            &points,
+            file.closed,
+            &params,
+            seed.wrapping_add(strokes.len() as u64),
+        )
+        .map_err(|e| format!("{}: {e}", path.display()))?;
+        for w in &sketch.warnings {
+            eprintln!("warning: {}: {w}", path.display());
+        }
+        strokes.push((points, file.closed, sketch));
+    }
+    // One frame for all strokes (they were drawn on one canvas): fit their box to the view.
+    let all: Vec<glam::DVec2> = strokes
+        .iter()
+        .flat_map(|(_, _, s)| s.outline.points.iter().copied())
+        .collect();
+    let (lo, hi) = all
+        .iter()
+        .fold((glam::DVec2::MAX, glam::DVec2::MIN), |(a, b), &q| {
+            (a.min(q), b.max(q))
+        });
+    let scale = SKETCH_WORLD_HEIGHT / (hi.y - lo.y).max((hi.x - lo.x) * 0.5).max(1e-9);
+    let mut scene = Scene::preset(crate::scene::Preset::Empty);
+    let target = scene.camera.target.as_dvec3();
+    let centre = (lo + hi) * 0.5;
+    for (i, (points, closed, _)) in strokes.iter().enumerate() {
+        let c = crate::scene::centre_of(
+            &points
+                .iter()
+                .map(|&[x, y]| glam::DVec2::new(x, y))
+                .collect::<Vec<_>>(),
+        );
+        let origin = target + ((c - centre) * scale).extend(0.0);
+        scene.planes.push(Arc::new(DrawingPlane {
+            name: format!("Outline {}", i + 1),
+            kind: StrokeKind::Outline,
+            origin: origin.as_vec3(),
+            points: points
+                .iter()
+                .map(|&[x, y]| ((glam::DVec2::new(x, y) - c) * scale).as_vec2())
+                .collect(),
+            closed: *closed,
+            sketch: params.clone(),
+            seed: seed.wrapping_add(i as u64),
+            ..Default::default()
+        }));
+    }
+    scene.validate().map_err(|e| e.to_string())?;
+    write(output, scene.to_json().as_bytes())?;
+    if let Some(path) = spheres_out {
+        let spheres: Vec<serde_json::Value> = strokes[0]
+            .2
+            .spheres
+            .iter()
+            .map(|s| serde_json::json!({"center": [s.center.x, -s.center.y, s.center.z], "radius": s.radius}))
+            .collect();
+        let text = serde_json::to_string_pretty(&serde_json::json!({ "spheres": spheres }))
+            .map_err(|e| e.to_string())?;
+        write(path, text.as_bytes())?;
+    }
+    let total: usize = strokes.iter().map(|s| s.2.spheres.len()).sum();
+    eprintln!(
+        "{} stroke(s) → {total} spheres → {}",
+        strokes.len(),
+        output.display()
+    );
+    Ok(())
+}

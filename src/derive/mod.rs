@@ -1,0 +1,201 @@
+//! The one pure derivation layer: document → spheres per plane (cached per plane) → field →
+//! density volume, and density volume + sun → light volume (cached apart, so a light slider
+//! re-interprets no stroke and re-bakes no geometry). Everything here is a deterministic
+//! function of the document; the renderer, the CLI and the app all consume [`Volumes`].
+
+mod light;
+mod planes;
+
+use std::sync::Arc;
+
+pub use light::{LightParams, LightVolume, sweep};
+pub use planes::{PlaneCache, Shape};
+
+use crate::field::{Blob, Clip, DensityVolume, Field, MAX_PRIMITIVES, bake};
+use crate::scene::{DrawingPlane, Revisions, Scene};
+
+/// A derived value with a generation that changes whenever the value does.
+#[derive(Debug)]
+pub struct Versioned<T> {
+    /// Bumped on every change; consumers (GPU uploads) compare it instead of the data.
+    pub generation: u64,
+    /// The value.
+    pub data: Arc<T>,
+}
+
+impl<T> Clone for Versioned<T> {
+    fn clone(&self) -> Self {
+        Self {
+            generation: self.generation,
+            data: self.data.clone(),
+        }
+    }
+}
+
+/// What the renderer draws: the density volume, its light, and the noise seed.
+#[derive(Clone, Debug)]
+pub struct Volumes {
+    /// Field values on a grid.
+    pub density: Versioned<DensityVolume>,
+    /// Transmittance toward the sun on the same grid.
+    pub light: Versioned<LightVolume>,
+    /// Seed of the noise media.
+    pub noise_seed: u64,
+}
+
+/// Counts of the work done, for tests and benchmarks.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Work {
+    /// Strokes interpreted (stroke → spheres).
+    pub interpretations: u64,
+    /// Fields assembled and baked into a density volume.
+    pub bakes: u64,
+    /// Light sweeps.
+    pub sweeps: u64,
+}
+
+/// The planes' drawing-plane placement applied to their shapes: the field of a document.
+fn assemble(scene: &Scene, shapes: &[Arc<Shape>]) -> Field {
+    let mut field = Field {
+        blobs: scene.ellipsoids.iter().map(|e| Blob::ellipsoid(e)).collect(),
+        groups: Vec::new(),
+        clips: Vec::new(),
+    };
+    field.blobs.truncate(MAX_PRIMITIVES);
+    let mut budget = MAX_PRIMITIVES.saturating_sub(field.blobs.len());
+    for (plane, shape) in scene.planes.iter().zip(shapes) {
+        match &**shape {
+            Shape::Outline { spheres, .. } => {
+                let group: Vec<Blob> = spheres
+                    .iter()
+                    .take(budget)
+                    .map(|s| Blob::sphere(plane.to_world(s.center.as_vec3()), s.radius as f32))
+                    .collect();
+                budget -= group.len();
+                field.groups.push(group);
+            }
+            Shape::Cut(line) => field.clips.push(clip(plane, line.clone())),
+            Shape::Unusable(_) => {}
+        }
+    }
+    field
+}
+
+fn clip(plane: &DrawingPlane, line: Vec<glam::Vec2>) -> Clip {
+    Clip {
+        origin: plane.origin,
+        right: plane.right(),
+        up: plane.up(),
+        line,
+    }
+}
+
+/// The field a document describes, derived from scratch (no cache).
+pub fn field_of(scene: &Scene) -> Field {
+    Arc::unwrap_or_clone(Derived::default().field(scene, None))
+}
+
+#[derive(Clone, Copy, PartialEq)]
+struct GeometryKey {
+    geometry: u64,
+    resolution: u32,
+}
+
+#[derive(Clone, Copy, PartialEq)]
+struct LightKey {
+    density: u64,
+    params: LightParams,
+}
+
+/// The derivation cache of one document (keep one per viewport or offscreen device).
+#[derive(Default)]
+pub struct Derived {
+    planes: PlaneCache,
+    field: Option<(u64, Arc<Field>)>,
+    density: Option<(GeometryKey, Versioned<DensityVolume>)>,
+    light: Option<(LightKey, Versioned<LightVolume>)>,
+    generation: u64,
+    work: Work,
+}
+
+impl Derived {
+    /// The field of `scene` at geometry revision `revision` (`None`: derive it afresh).
+    pub fn field(&mut self, scene: &Scene, revision: Option<u64>) -> Arc<Field> {
+        if let (Some(rev), Some((cached, field))) = (revision, &self.field)
+            && rev == *cached
+        {
+            return field.clone();
+        }
+        let shapes = self.planes.shapes(&scene.planes);
+        self.work.interpretations = self.planes.interpretations();
+        let field = Arc::new(assemble(scene, &shapes));
+        if let Some(rev) = revision {
+            self.field = Some((rev, field.clone()));
+        }
+        field
+    }
+
+    /// The volumes of `scene` whose parts are at `revisions`; derives only what changed.
+    pub fn update(&mut self, scene: &Scene, revisions: Revisions) -> Volumes {
+        let gkey = GeometryKey {
+            geometry: revisions.geometry,
+            resolution: scene.render.field_resolution,
+        };
+        let density = match &self.density {
+            Some((k, v)) if *k == gkey => v.clone(),
+            _ => {
+                let field = self.field(scene, Some(revisions.geometry));
+                self.generation += 1;
+                self.work.bakes += 1;
+                let v = Versioned {
+                    generation: self.generation,
+                    data: Arc::new(bake(&field, gkey.resolution)),
+                };
+                self.density = Some((gkey, v.clone()));
+                v
+            }
+        };
+        let lkey = LightKey {
+            density: density.generation,
+            params: LightParams {
+                sun_dir: scene.light.sun_direction(),
+                extinction: scene.render.opacity,
+                softness: scene.render.softness,
+            },
+        };
+        let light = match &self.light {
+            Some((k, v)) if *k == lkey => v.clone(),
+            _ => {
+                self.generation += 1;
+                self.work.sweeps += 1;
+                let v = Versioned {
+                    generation: self.generation,
+                    data: Arc::new(sweep(&density.data, &lkey.params)),
+                };
+                self.light = Some((lkey, v.clone()));
+                v
+            }
+        };
+        Volumes {
+            density,
+            light,
+            noise_seed: scene.seed,
+        }
+    }
+
+    /// The shape of a plane (not yet in the document, say), interpreted through the plane
+    /// cache so deriving a document that holds it later costs nothing more.
+    pub fn shape_of(&mut self, plane: &DrawingPlane) -> Arc<Shape> {
+        let shape = self.planes.shape(plane);
+        self.work.interpretations = self.planes.interpretations();
+        shape
+    }
+
+    /// The work done so far.
+    pub fn work(&self) -> Work {
+        self.work
+    }
+}
+
+#[cfg(test)]
+mod tests;

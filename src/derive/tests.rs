@@ -1,0 +1,184 @@
+use std::sync::Arc;
+
+use glam::{Vec2, Vec3};
+
+use super::*;
+use crate::scene::{Document, Edit, Preset, StrokeKind};
+
+fn cloud_outline() -> Vec<Vec2> {
+    let mut v: Vec<Vec2> = (0..=40)
+        .map(|i| Vec2::new(-5.0 + i as f32 * 0.25, -2.0))
+        .collect();
+    for i in 1..120 {
+        let a = i as f32 / 120.0 * std::f32::consts::PI;
+        let bump = 1.0 + 0.3 * (a * 5.0).sin().abs();
+        v.push(Vec2::new(5.0 * a.cos(), -2.0 + 3.5 * a.sin() * bump));
+    }
+    v
+}
+
+fn plane(kind: StrokeKind, points: Vec<Vec2>) -> DrawingPlane {
+    DrawingPlane {
+        kind,
+        points,
+        closed: kind == StrokeKind::Outline,
+        ..Default::default()
+    }
+}
+
+#[test]
+fn sketched_field_outline_in_its_plane_matches_the_stroke() {
+    let outline = cloud_outline();
+    let mut scene = Scene::preset(crate::scene::Preset::Empty);
+    scene.planes.push(Arc::new(plane(StrokeKind::Outline, outline.clone())));
+    let field = field_of(&scene);
+    assert_eq!(field.groups.len(), 1);
+    let stroke: Vec<glam::DVec2> = outline.iter().map(|p| p.as_dvec2()).collect();
+    let (mut inter, mut union) = (0, 0);
+    for j in 0..100 {
+        for i in 0..140 {
+            let q = Vec2::new(
+                -6.0 + i as f32 * 12.0 / 140.0,
+                -3.0 + j as f32 * 8.0 / 100.0,
+            );
+            let a = crate::sketch::outline::contains(&stroke, q.as_dvec2());
+            let b = field.inside(q.extend(0.0));
+            inter += (a && b) as usize;
+            union += (a || b) as usize;
+        }
+    }
+    let iou = inter as f64 / union as f64;
+    assert!(iou >= 0.85, "field outline vs stroke IoU {iou:.3}");
+    // The 3D extension gives the cloud depth in front of and behind the plane.
+    assert!(field.inside(Vec3::new(0.0, 0.0, 1.0)) || field.inside(Vec3::new(0.0, 0.0, -1.0)));
+}
+
+#[test]
+fn cut_stroke_flattens_the_base() {
+    let mut scene = Scene::preset(crate::scene::Preset::Empty);
+    scene.planes.push(Arc::new(plane(StrokeKind::Outline, cloud_outline())));
+    let before = field_of(&scene);
+    assert!(before.inside(Vec3::new(0.0, -1.0, 0.0)));
+    scene.planes.push(Arc::new(plane(
+        StrokeKind::Cut,
+        vec![Vec2::new(-8.0, -0.5), Vec2::new(8.0, -0.5)],
+    )));
+    let after = field_of(&scene);
+    for x in [-3.0, 0.0, 3.0] {
+        for z in [-2.0, 0.0, 2.0] {
+            assert!(
+                !after.inside(Vec3::new(x, -1.0, z)),
+                "cloud below the cut at x {x} z {z}"
+            );
+        }
+    }
+    assert!(after.inside(Vec3::new(0.0, 0.5, 0.0)));
+}
+
+#[test]
+fn default_scene_field_is_bounded() {
+    let f = field_of(&Scene::default());
+    let (c, r) = f.bounding_sphere().unwrap();
+    assert!(r > 2.0 && r < 20.0, "{r}");
+    assert!(f.inside(Vec3::new(0.0, 2.5, 0.0)));
+    assert!(c.is_finite());
+}
+
+/// A cloud-like outline of `n` points, scaled and shifted, in plane units.
+fn outline_at(dx: f32, scale: f32) -> Vec<Vec2> {
+    cloud_outline()
+        .into_iter()
+        .map(|p| p * scale + Vec2::new(dx, 0.0))
+        .collect()
+}
+
+fn ten_strokes() -> Document {
+    let mut doc = Document::new(Scene::preset(Preset::Empty));
+    for i in 0..10 {
+        let mut p = plane(StrokeKind::Outline, outline_at(i as f32 * 0.7, 0.6));
+        p.origin.z = i as f32 * 0.3;
+        p.seed = i;
+        doc.apply(Edit::InsertPlane(i as usize, p), None);
+    }
+    doc
+}
+
+#[test]
+fn caches_derive_only_what_changed() {
+    let mut doc = ten_strokes();
+    let mut derived = Derived::default();
+    derived.update(doc.scene(), doc.revisions());
+    let w0 = derived.work();
+    assert_eq!((w0.interpretations, w0.bakes, w0.sweeps), (10, 1, 1));
+
+    // Nothing changed: nothing derived.
+    derived.update(doc.scene(), doc.revisions());
+    assert_eq!(derived.work(), w0);
+
+    // Slices and the camera: nothing derived.
+    let mut r = doc.scene().render.clone();
+    r.slices = 64;
+    doc.apply(Edit::SetRender(r), None);
+    let mut cam = doc.scene().camera.clone();
+    cam.yaw_deg += 40.0;
+    doc.set_camera(cam);
+    derived.update(doc.scene(), doc.revisions());
+    assert_eq!(derived.work(), w0);
+
+    // A sun tick and an opacity tick: one light sweep each, no stroke, no bake.
+    let mut l = doc.scene().light.clone();
+    l.sun_azimuth_deg += 15.0;
+    doc.apply(Edit::SetLight(l), None);
+    derived.update(doc.scene(), doc.revisions());
+    let mut r = doc.scene().render.clone();
+    r.opacity *= 2.0;
+    doc.apply(Edit::SetRender(r), None);
+    derived.update(doc.scene(), doc.revisions());
+    let w1 = derived.work();
+    assert_eq!((w1.interpretations, w1.bakes, w1.sweeps), (10, 1, 3));
+
+    // An 11th stroke interprets one stroke.
+    let p = plane(StrokeKind::Outline, outline_at(-3.0, 0.5));
+    doc.apply(Edit::InsertPlane(10, p), None);
+    derived.update(doc.scene(), doc.revisions());
+    let w2 = derived.work();
+    assert_eq!((w2.interpretations, w2.bakes, w2.sweeps), (11, 2, 4));
+
+    // Moving a plane re-interprets nothing; a slider on one plane re-interprets that plane.
+    let mut moved = (*doc.scene().planes[3]).clone();
+    moved.origin += Vec3::new(1.0, 0.5, 0.0);
+    doc.apply(Edit::SetPlane(3, moved), None);
+    derived.update(doc.scene(), doc.revisions());
+    assert_eq!(derived.work().interpretations, 11);
+    let mut deflated = (*doc.scene().planes[5]).clone();
+    deflated.sketch.inflate = 0.8;
+    doc.apply(Edit::SetPlane(5, deflated), None);
+    derived.update(doc.scene(), doc.revisions());
+    assert_eq!(derived.work().interpretations, 12);
+
+    // Undo brings the previous shape back from the cache.
+    doc.undo();
+    derived.update(doc.scene(), doc.revisions());
+    assert_eq!(derived.work().interpretations, 12);
+}
+
+#[test]
+fn cached_volumes_equal_a_fresh_derivation() {
+    let mut doc = ten_strokes();
+    let mut derived = Derived::default();
+    derived.update(doc.scene(), doc.revisions());
+    let mut moved = (*doc.scene().planes[2]).clone();
+    moved.origin.y += 2.0;
+    moved.sketch.copies = 4;
+    doc.apply(Edit::SetPlane(2, moved), None);
+    doc.apply(Edit::RemovePlane(7), None);
+    let mut l = doc.scene().light.clone();
+    l.sun_elevation_deg = 70.0;
+    doc.apply(Edit::SetLight(l), None);
+    let cached = derived.update(doc.scene(), doc.revisions());
+    let fresh = Derived::default().update(doc.scene(), doc.revisions());
+    assert_eq!(*cached.density.data, *fresh.density.data);
+    assert_eq!(*cached.light.data, *fresh.light.data);
+    let brute = bake(&field_of(doc.scene()), doc.scene().render.field_resolution);
+    assert_eq!(*cached.density.data, brute);
+}

@@ -1,0 +1,187 @@
+//! The neutral density volume: a field (or, later, a simulation) sampled on a capped regular
+//! grid. The renderer uploads it as a 3D texture (WebGL2 has no storage buffers or compute),
+//! the light sweep reads it, and exporters will write it.
+
+use glam::{UVec3, Vec3};
+
+use super::{Field, ISO};
+
+/// Most texels along one side of the grid.
+pub const MAX_RESOLUTION: u32 = 128;
+/// Fewest texels along one side.
+const MIN_SIDE: u32 = 4;
+
+/// Field values on a regular grid over a box.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct DensityVolume {
+    /// Texels per axis (x, y, z). All zero for an empty volume.
+    pub dims: UVec3,
+    /// World position of the grid's minimum corner.
+    pub min: Vec3,
+    /// World size of the grid.
+    pub size: Vec3,
+    /// Field value at each texel centre (iso-surface at [`ISO`]); x fastest, then y, then z.
+    pub values: Vec<f32>,
+}
+
+impl DensityVolume {
+    /// Whether there is nothing to draw.
+    pub fn is_empty(&self) -> bool {
+        self.values.is_empty()
+    }
+
+    /// Bounding sphere of the grid box (centre, radius).
+    pub fn bounding_sphere(&self) -> (Vec3, f32) {
+        (self.min + self.size * 0.5, self.size.length() * 0.5)
+    }
+
+    /// World size of one texel.
+    pub fn texel_size(&self) -> Vec3 {
+        self.size / self.dims.max(UVec3::ONE).as_vec3()
+    }
+
+    /// Index of texel (x, y, z) in [`DensityVolume::values`].
+    pub fn index(&self, x: u32, y: u32, z: u32) -> usize {
+        (x + self.dims.x * (y + self.dims.y * z)) as usize
+    }
+
+    /// Field value at a texel.
+    pub fn value(&self, x: u32, y: u32, z: u32) -> f32 {
+        self.values[self.index(x, y, z)]
+    }
+
+    /// The texel holding world point `p`, if inside the grid.
+    pub fn texel_at(&self, p: Vec3) -> Option<UVec3> {
+        let t = (p - self.min) / self.size;
+        (!self.is_empty() && t.cmpge(Vec3::ZERO).all() && t.cmplt(Vec3::ONE).all())
+            .then(|| (t * self.dims.as_vec3()).as_uvec3().min(self.dims - 1))
+    }
+}
+
+/// Smooth density of a field value: 0 outside, 1 inside, soft across the surface.
+#[inline]
+pub fn density(field: f32, softness: f32) -> f32 {
+    let t = ((field - (ISO - softness)) / (2.0 * softness)).clamp(0.0, 1.0);
+    t * t * (3.0 - 2.0 * t)
+}
+
+/// Samples `field` on a grid over its bounds, `resolution` texels along the longest side.
+pub fn bake(field: &Field, resolution: u32) -> DensityVolume {
+    let Some((lo, hi)) = field.bounds() else {
+        return DensityVolume::default();
+    };
+    let size = (hi - lo).max(Vec3::splat(1e-3));
+    let res = resolution.clamp(MIN_SIDE, MAX_RESOLUTION) as f32;
+    let longest = size.max_element();
+    let dims = (size / longest * res)
+        .ceil()
+        .as_uvec3()
+        .max(UVec3::splat(MIN_SIDE));
+    let h = size / dims.as_vec3();
+    let (nx, ny, nz) = (dims.x as usize, dims.y as usize, dims.z as usize);
+    let mut values = vec![0f32; nx * ny * nz];
+    let center_of =
+        |i: usize, j: usize, k: usize| lo + (Vec3::new(i as f32, j as f32, k as f32) + 0.5) * h;
+
+    // Accumulate each primitive over the texels of its influence box only.
+    let splat = |blob: &super::Blob, out: &mut [f32], combine: fn(f32, f32) -> f32| {
+        let reach = blob.extent * super::SUPPORT;
+        let a = ((blob.center - reach - lo) / h - 0.5)
+            .floor()
+            .max(Vec3::ZERO)
+            .as_uvec3();
+        let b = ((blob.center + reach - lo) / h - 0.5)
+            .ceil()
+            .as_ivec3()
+            .min(dims.as_ivec3() - 1);
+        if b.min_element() < 0 {
+            return;
+        }
+        let b = b.as_uvec3();
+        for k in a.z..=b.z {
+            for j in a.y..=b.y {
+                let row = (k as usize * ny + j as usize) * nx;
+                for i in a.x..=b.x {
+                    let v = &mut out[row + i as usize];
+                    *v = combine(
+                        *v,
+                        blob.value(center_of(i as usize, j as usize, k as usize)),
+                    );
+                }
+            }
+        }
+    };
+    for blob in &field.blobs {
+        splat(blob, &mut values, |a, b| a + b);
+    }
+    if !field.groups.is_empty() {
+        let mut group_values = vec![0f32; values.len()];
+        for group in &field.groups {
+            group_values.iter_mut().for_each(|v| *v = 0.0);
+            for blob in group {
+                splat(blob, &mut group_values, f32::max);
+            }
+            values
+                .iter_mut()
+                .zip(&group_values)
+                .for_each(|(v, g)| *v += g);
+        }
+    }
+    if !field.clips.is_empty() {
+        for k in 0..nz {
+            for j in 0..ny {
+                for i in 0..nx {
+                    if field.clips.iter().any(|c| c.removes(center_of(i, j, k))) {
+                        values[(k * ny + j) * nx + i] = 0.0;
+                    }
+                }
+            }
+        }
+    }
+
+    DensityVolume {
+        dims,
+        min: lo,
+        size,
+        values,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::Blob;
+    use super::*;
+
+    #[test]
+    fn empty_field_bakes_empty_volume() {
+        assert!(bake(&Field::default(), 32).is_empty());
+    }
+
+    #[test]
+    fn volume_is_capped_and_matches_the_field() {
+        let f = Field {
+            blobs: vec![Blob::sphere(Vec3::ZERO, 2.0)],
+            ..Default::default()
+        };
+        let v = bake(&f, 100_000);
+        assert!(v.dims.max_element() <= MAX_RESOLUTION);
+        let v = bake(&f, 32);
+        assert_eq!(v.values.len(), (v.dims.x * v.dims.y * v.dims.z) as usize);
+        let c = v.texel_at(Vec3::ZERO).unwrap();
+        assert!(v.value(c.x, c.y, c.z) > 0.9);
+        assert!(v.value(0, 0, 0) < 0.05);
+        // Brute force: every texel equals the field at its centre.
+        let h = v.texel_size();
+        for (z, y, x) in [(3, 5, 7), (16, 16, 16), (0, 31, 2)] {
+            let p = v.min + (Vec3::new(x as f32, y as f32, z as f32) + 0.5) * h;
+            assert!((v.value(x, y, z) - f.value(p)).abs() < 1e-5);
+        }
+    }
+
+    #[test]
+    fn density_is_half_at_the_surface() {
+        assert!((density(ISO, 0.1) - 0.5).abs() < 1e-6);
+        assert_eq!(density(0.0, 0.1), 0.0);
+        assert_eq!(density(1.0, 0.1), 1.0);
+    }
+}

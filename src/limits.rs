@@ -1,0 +1,139 @@
+//! Every cap and every parameter range, defined once (pure). Validation of documents, the CLI and the
+//! UI's sliders all read these, so opening a scene never clamps a value the panel could set, and
+//! every way a file comes in (open, drop, CLI, guide image) has the same size limit.
+
+/// Largest file read from any source: scene documents, stroke files, guide images.
+pub const MAX_FILE_BYTES: u64 = 64 << 20;
+/// Most ellipsoids a document may hold.
+pub const MAX_ELLIPSOIDS: usize = 4096;
+/// Most drawing planes in a document.
+pub const MAX_PLANES: usize = 256;
+/// Most points a stored stroke may have.
+pub const MAX_PLANE_POINTS: usize = 20_000;
+
+/// A numeric parameter's range, default and the way its slider moves.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Param {
+    /// Smallest value.
+    pub min: f64,
+    /// Largest value.
+    pub max: f64,
+    /// Value of a new document, and of a non-finite one in a loaded document.
+    pub default: f64,
+    /// Whether its slider is logarithmic.
+    pub logarithmic: bool,
+}
+
+impl Param {
+    const fn linear(min: f64, max: f64, default: f64) -> Self {
+        Self {
+            min,
+            max,
+            default,
+            logarithmic: false,
+        }
+    }
+
+    const fn log(min: f64, max: f64, default: f64) -> Self {
+        Self {
+            min,
+            max,
+            default,
+            logarithmic: true,
+        }
+    }
+
+    /// `v` clamped into range; the default when it is not finite.
+    pub fn fix(&self, v: f64) -> f64 {
+        if v.is_finite() {
+            v.clamp(self.min, self.max)
+        } else {
+            self.default
+        }
+    }
+
+    /// [`Param::fix`] for `f32` values.
+    pub fn fix_f32(&self, v: f32) -> f32 {
+        self.fix(v as f64) as f32
+    }
+
+    /// [`Param::fix`] for integer values.
+    pub fn fix_u32(&self, v: u32) -> u32 {
+        (v as f64).clamp(self.min, self.max) as u32
+    }
+
+    /// The range as `f32`s, for sliders.
+    pub fn range_f32(&self) -> std::ops::RangeInclusive<f32> {
+        self.min as f32..=self.max as f32
+    }
+
+    /// The range as `u32`s, for integer sliders.
+    pub fn range_u32(&self) -> std::ops::RangeInclusive<u32> {
+        self.min as u32..=self.max as u32
+    }
+}
+
+/// Quality: slices at full quality.
+pub const SLICES: Param = Param::log(8.0, 512.0, 128.0);
+/// Resolution of the baked field grid along its longest side.
+pub const FIELD_RESOLUTION: Param = Param::linear(16.0, 128.0, 64.0);
+/// Noise octaves.
+pub const OCTAVES: Param = Param::linear(0.0, 4.0, 3.0);
+/// Opacity: extinction per world unit of the densest cloud.
+pub const OPACITY: Param = Param::log(0.01, 50.0, 2.5);
+/// Width of the soft edge around the surface, in field units.
+pub const SOFTNESS: Param = Param::linear(0.005, 0.5, 0.12);
+/// How far noise moves the surface.
+pub const NOISE_AMOUNT: Param = Param::linear(0.0, 1.0, 0.35);
+/// Size of the first noise octave in world units.
+pub const NOISE_SCALE: Param = Param::log(0.1, 100.0, 3.0);
+/// Lacunarity: frequency step between octaves.
+pub const DETAIL: Param = Param::linear(1.1, 4.0, 2.2);
+/// Sun azimuth in degrees.
+pub const SUN_AZIMUTH: Param = Param::linear(0.0, 360.0, 20.0);
+/// Sun elevation in degrees.
+pub const SUN_ELEVATION: Param = Param::linear(-89.0, 89.0, 35.0);
+/// Sun intensity multiplier.
+pub const SUN_INTENSITY: Param = Param::linear(0.0, 10.0, 1.6);
+/// Ambient sky light multiplier.
+pub const AMBIENT: Param = Param::linear(0.0, 3.0, 0.45);
+/// Sketch: simplification tolerance as a fraction of the outline's size.
+pub const SIMPLIFY: Param = Param::linear(0.0, 0.2, 0.01);
+/// Sketch: branches adding less than this fraction of the outline's area are pruned.
+pub const PRUNE: Param = Param::linear(0.0, 0.5, 0.02);
+/// Sketch: the inflation (deflate) slider t.
+pub const INFLATE: Param = Param::linear(0.0, 1.0, 0.0);
+/// Sketch: copies of each terminal branch made by the 3D extension.
+pub const COPIES: Param = Param::linear(0.0, 6.0, 2.0);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_lie_in_range_and_non_finite_values_take_them() {
+        for p in [
+            SLICES,
+            FIELD_RESOLUTION,
+            OCTAVES,
+            OPACITY,
+            SOFTNESS,
+            NOISE_AMOUNT,
+            NOISE_SCALE,
+            DETAIL,
+            SUN_AZIMUTH,
+            SUN_ELEVATION,
+            SUN_INTENSITY,
+            AMBIENT,
+            SIMPLIFY,
+            PRUNE,
+            INFLATE,
+            COPIES,
+        ] {
+            assert!(p.min < p.max && (p.min..=p.max).contains(&p.default), "{p:?}");
+            assert_eq!(p.fix(f64::NAN), p.default);
+            assert_eq!(p.fix(p.max * 10.0 + 1.0), p.max);
+            assert!(!p.logarithmic || p.min > 0.0, "log slider from 0: {p:?}");
+        }
+    }
+}

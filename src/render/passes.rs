@@ -1,0 +1,240 @@
+//! The two render passes: slices (view-aligned slices back to front into an accumulation
+//! target) and composite (the accumulated image over the output). Pipelines are created once.
+//! The slice pass has its own ring of uniform slots addressed by dynamic offsets, so several
+//! slice draws recorded before one submit never overwrite each other's uniforms.
+
+use std::num::NonZeroU64;
+
+use super::gpu_types::VolumeUniforms;
+use super::shaders;
+
+/// Slice draws one frame (one submit) may record.
+pub const MAX_SLICE_DRAWS_PER_FRAME: u32 = 8;
+
+fn texture_3d(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: true },
+            view_dimension: wgpu::TextureViewDimension::D3,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
+fn sampler_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+        count: None,
+    }
+}
+
+const PREMULTIPLIED_OVER: wgpu::BlendState = wgpu::BlendState {
+    color: wgpu::BlendComponent {
+        src_factor: wgpu::BlendFactor::One,
+        dst_factor: wgpu::BlendFactor::OneMinusSrcAlpha,
+        operation: wgpu::BlendOperation::Add,
+    },
+    alpha: wgpu::BlendComponent {
+        src_factor: wgpu::BlendFactor::One,
+        dst_factor: wgpu::BlendFactor::OneMinusSrcAlpha,
+        operation: wgpu::BlendOperation::Add,
+    },
+};
+
+fn pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    source: &str,
+    layout: &wgpu::BindGroupLayout,
+    format: wgpu::TextureFormat,
+) -> wgpu::RenderPipeline {
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(label),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    });
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(label),
+        bind_group_layouts: &[Some(layout)],
+        immediate_size: 0,
+    });
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(label),
+        layout: Some(&pipeline_layout),
+        vertex: wgpu::VertexState {
+            module: &module,
+            entry_point: Some("vs_main"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        primitive: wgpu::PrimitiveState::default(),
+        depth_stencil: None,
+        multisample: wgpu::MultisampleState::default(),
+        fragment: Some(wgpu::FragmentState {
+            module: &module,
+            entry_point: Some("fs_main"),
+            compilation_options: Default::default(),
+            targets: &[Some(wgpu::ColorTargetState {
+                format,
+                blend: Some(PREMULTIPLIED_OVER),
+                write_mask: wgpu::ColorWrites::ALL,
+            })],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+/// The slice pass: pipeline, bind group layout and its ring of uniform slots.
+pub struct SlicePass {
+    /// The slice pipeline.
+    pub pipeline: wgpu::RenderPipeline,
+    /// Layout of its bind group (uniforms, density, sampler, noise, sampler, light).
+    pub layout: wgpu::BindGroupLayout,
+    /// Uniform ring, [`MAX_SLICE_DRAWS_PER_FRAME`] slots of `stride` bytes.
+    pub uniforms: wgpu::Buffer,
+    stride: u64,
+    next_slot: u32,
+    format: wgpu::TextureFormat,
+}
+
+impl SlicePass {
+    /// Creates the pass accumulating into `format`.
+    pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat) -> Self {
+        let size = std::mem::size_of::<VolumeUniforms>() as u64;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("volume"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: true,
+                        min_binding_size: NonZeroU64::new(size),
+                    },
+                    count: None,
+                },
+                texture_3d(1),
+                sampler_entry(2),
+                texture_3d(3),
+                sampler_entry(4),
+                texture_3d(5),
+            ],
+        });
+        let align = device.limits().min_uniform_buffer_offset_alignment.max(16) as u64;
+        let stride = size.div_ceil(align) * align;
+        let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("volume uniforms"),
+            size: stride * MAX_SLICE_DRAWS_PER_FRAME as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        Self {
+            pipeline: pipeline(device, "volume slices", shaders::VOLUME, &layout, format),
+            layout,
+            uniforms,
+            stride,
+            next_slot: 0,
+            format,
+        }
+    }
+
+    /// A pipeline for the benchmark baseline (`plain_slices.wgsl`) with the same layout.
+    pub fn baseline(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
+        pipeline(
+            device,
+            "plain slices (baseline)",
+            shaders::PLAIN_SLICES,
+            &self.layout,
+            self.format,
+        )
+    }
+
+    /// Starts a frame: uniform slots are reused from the first.
+    pub fn begin_frame(&mut self) {
+        self.next_slot = 0;
+    }
+
+    /// Writes `uniforms` into the next free slot; returns its dynamic offset. Past
+    /// [`MAX_SLICE_DRAWS_PER_FRAME`] draws in one frame the last slot is reused (and logged).
+    pub fn write(&mut self, queue: &wgpu::Queue, uniforms: &VolumeUniforms) -> u32 {
+        let slot = if self.next_slot < MAX_SLICE_DRAWS_PER_FRAME {
+            self.next_slot += 1;
+            self.next_slot - 1
+        } else {
+            log::warn!("more than {MAX_SLICE_DRAWS_PER_FRAME} slice draws in one frame");
+            MAX_SLICE_DRAWS_PER_FRAME - 1
+        };
+        let offset = slot as u64 * self.stride;
+        queue.write_buffer(&self.uniforms, offset, bytemuck::bytes_of(uniforms));
+        offset as u32
+    }
+}
+
+/// The composite pass: draws an accumulation target over the output.
+pub struct CompositePass {
+    /// The composite pipeline.
+    pub pipeline: wgpu::RenderPipeline,
+    /// Layout of its bind group (source texture, sampler).
+    pub layout: wgpu::BindGroupLayout,
+}
+
+impl CompositePass {
+    /// Creates the pass writing into `output_format`.
+    pub fn new(device: &wgpu::Device, output_format: wgpu::TextureFormat) -> Self {
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("composite"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                sampler_entry(1),
+            ],
+        });
+        Self {
+            pipeline: pipeline(
+                device,
+                "volume composite",
+                shaders::COMPOSITE,
+                &layout,
+                output_format,
+            ),
+            layout,
+        }
+    }
+
+    /// The bind group that composites `source`.
+    pub fn bind_group(
+        &self,
+        device: &wgpu::Device,
+        source: &wgpu::TextureView,
+        sampler: &wgpu::Sampler,
+    ) -> wgpu::BindGroup {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("composite"),
+            layout: &self.layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::TextureView(source),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::Sampler(sampler),
+                },
+            ],
+        })
+    }
+}

@@ -1,0 +1,206 @@
+//! The volume renderer: passes and resources together, used by the app's viewport (through an
+//! egui paint callback) and by offscreen rendering alike.
+
+use std::ops::Range;
+
+use super::gpu_types::{View, VolumeUniforms};
+use super::passes::{CompositePass, SlicePass};
+use super::resources::{TARGETS, Target, VolumeTextures, accumulation_texture, sampler};
+use crate::derive::Volumes;
+
+/// One volume draw: slices `range` of `total`, into accumulation target `target`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SliceJob {
+    /// Which accumulation target (0 or 1).
+    pub target: usize,
+    /// Target size in pixels.
+    pub size: [u32; 2],
+    /// Slices in the whole image.
+    pub total: u32,
+    /// Slices of the whole image drawn by this job (0 = farthest).
+    pub range: Range<u32>,
+    /// Clear the target first (the first chunk of an image).
+    pub clear: bool,
+    /// Camera, light and media of the image.
+    pub view: View,
+}
+
+/// Pipelines, samplers, textures and the accumulation targets.
+pub struct VolumeRenderer {
+    accum_format: wgpu::TextureFormat,
+    slices: SlicePass,
+    composite: CompositePass,
+    clamp_sampler: wgpu::Sampler,
+    repeat_sampler: wgpu::Sampler,
+    textures: VolumeTextures,
+    bind_group: Option<wgpu::BindGroup>,
+    targets: [Option<Target>; TARGETS],
+}
+
+impl VolumeRenderer {
+    /// Creates pipelines for compositing into `output_format`, accumulating in `accum_format`.
+    pub fn new(
+        device: &wgpu::Device,
+        output_format: wgpu::TextureFormat,
+        accum_format: wgpu::TextureFormat,
+    ) -> Self {
+        Self {
+            accum_format,
+            slices: SlicePass::new(device, accum_format),
+            composite: CompositePass::new(device, output_format),
+            clamp_sampler: sampler(device, wgpu::AddressMode::ClampToEdge),
+            repeat_sampler: sampler(device, wgpu::AddressMode::Repeat),
+            textures: VolumeTextures::new(),
+            bind_group: None,
+            targets: [None, None],
+        }
+    }
+
+    /// The accumulation format in use.
+    pub fn accumulation_format(&self) -> wgpu::TextureFormat {
+        self.accum_format
+    }
+
+    /// Starts a frame (one submit): call before the frame's uploads and draws.
+    pub fn begin_frame(&mut self) {
+        self.slices.begin_frame();
+    }
+
+    /// Uploads whatever changed in `volumes` since the last call.
+    pub fn upload(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, volumes: &Volumes) {
+        if !self.textures.upload(device, queue, volumes) && self.bind_group.is_some() {
+            return;
+        }
+        let t = &self.textures;
+        let (Some((_, density)), Some((_, light)), Some((_, noise))) =
+            (&t.density, &t.light, &t.noise)
+        else {
+            return;
+        };
+        let entries = [
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: &self.slices.uniforms,
+                    offset: 0,
+                    size: wgpu::BufferSize::new(std::mem::size_of::<VolumeUniforms>() as u64),
+                }),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: wgpu::BindingResource::TextureView(density),
+            },
+            wgpu::BindGroupEntry {
+                binding: 2,
+                resource: wgpu::BindingResource::Sampler(&self.clamp_sampler),
+            },
+            wgpu::BindGroupEntry {
+                binding: 3,
+                resource: wgpu::BindingResource::TextureView(noise),
+            },
+            wgpu::BindGroupEntry {
+                binding: 4,
+                resource: wgpu::BindingResource::Sampler(&self.repeat_sampler),
+            },
+            wgpu::BindGroupEntry {
+                binding: 5,
+                resource: wgpu::BindingResource::TextureView(light),
+            },
+        ];
+        self.bind_group = Some(device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("volume"),
+            layout: &self.slices.layout,
+            entries: &entries,
+        }));
+    }
+
+    fn ensure_target(&mut self, device: &wgpu::Device, index: usize, size: [u32; 2]) {
+        let size = [size[0].max(1), size[1].max(1)];
+        if self.targets[index].as_ref().is_some_and(|t| t.size == size) {
+            return;
+        }
+        let view = accumulation_texture(device, size, self.accum_format);
+        let composite = self
+            .composite
+            .bind_group(device, &view, &self.clamp_sampler);
+        self.targets[index] = Some(Target {
+            size,
+            view,
+            composite,
+        });
+    }
+
+    /// A pipeline for the benchmark baseline, for [`VolumeRenderer::draw_slices_with`].
+    pub fn baseline_pipeline(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
+        self.slices.baseline(device)
+    }
+
+    /// Records one volume draw (see [`SliceJob`]). Call [`VolumeRenderer::upload`] first.
+    pub fn draw_slices(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        job: &SliceJob,
+    ) {
+        self.draw_slices_with(device, queue, encoder, job, None);
+    }
+
+    /// Like [`VolumeRenderer::draw_slices`] with another slice pipeline of the same layout.
+    pub fn draw_slices_with(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        job: &SliceJob,
+        pipeline: Option<&wgpu::RenderPipeline>,
+    ) {
+        let index = job.target.min(TARGETS - 1);
+        self.ensure_target(device, index, job.size);
+        let volume = &self.textures.density_volume;
+        let uniforms = VolumeUniforms::new(&job.view, volume, job.total, job.range.start);
+        let offset = self.slices.write(queue, &uniforms);
+        let empty = volume.is_empty();
+        let (Some(target), Some(bind_group)) = (&self.targets[index], &self.bind_group) else {
+            return;
+        };
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("volume slices"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &target.view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: if job.clear {
+                        wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT)
+                    } else {
+                        wgpu::LoadOp::Load
+                    },
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        let count = job.range.end.saturating_sub(job.range.start);
+        if empty || count == 0 {
+            return;
+        }
+        pass.set_pipeline(pipeline.unwrap_or(&self.slices.pipeline));
+        pass.set_bind_group(0, bind_group, &[offset]);
+        // Instances start at 0 (WebGL2 has no base instance); the first slice is a uniform.
+        pass.draw(0..6, 0..count);
+    }
+
+    /// Draws accumulation target `index` over the current render pass's viewport.
+    pub fn composite(&self, pass: &mut wgpu::RenderPass<'_>, index: usize) {
+        let Some(target) = self.targets.get(index).and_then(|t| t.as_ref()) else {
+            return;
+        };
+        pass.set_pipeline(&self.composite.pipeline);
+        pass.set_bind_group(0, &target.composite, &[]);
+        pass.draw(0..3, 0..1);
+    }
+}

@@ -1,0 +1,225 @@
+//! GPU resources of the volume renderer: the density, light and noise 3D textures (uploaded
+//! only when their generation changes), samplers, and the accumulation targets.
+
+use std::sync::Arc;
+
+use super::noise::{NOISE_SIZE, noise_volume};
+use crate::derive::Volumes;
+use crate::field::DensityVolume;
+
+/// Number of accumulation targets (a preview and a refinement).
+pub const TARGETS: usize = 2;
+
+/// Quantises values in [0, 1] to bytes for an `R8Unorm` texture.
+fn to_bytes(values: &[f32]) -> Vec<u8> {
+    values
+        .iter()
+        .map(|v| (v.clamp(0.0, 1.0) * 255.0).round() as u8)
+        .collect()
+}
+
+/// Creates a 3D texture holding `data` and returns its view.
+pub fn upload_3d(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    label: &str,
+    dims: [u32; 3],
+    format: wgpu::TextureFormat,
+    data: &[u8],
+) -> wgpu::TextureView {
+    let size = wgpu::Extent3d {
+        width: dims[0],
+        height: dims[1],
+        depth_or_array_layers: dims[2],
+    };
+    let texture = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size,
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D3,
+        format,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    let bytes_per_texel = format.block_copy_size(None).unwrap_or(1);
+    queue.write_texture(
+        wgpu::TexelCopyTextureInfo {
+            texture: &texture,
+            mip_level: 0,
+            origin: wgpu::Origin3d::ZERO,
+            aspect: wgpu::TextureAspect::All,
+        },
+        data,
+        wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(dims[0] * bytes_per_texel),
+            rows_per_image: Some(dims[1]),
+        },
+        size,
+    );
+    texture.create_view(&wgpu::TextureViewDescriptor::default())
+}
+
+fn r8_volume(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    label: &str,
+    dims: glam::UVec3,
+    values: &[f32],
+    empty_value: u8,
+) -> wgpu::TextureView {
+    if values.is_empty() {
+        return upload_3d(
+            device,
+            queue,
+            label,
+            [1, 1, 1],
+            wgpu::TextureFormat::R8Unorm,
+            &[empty_value],
+        );
+    }
+    upload_3d(
+        device,
+        queue,
+        label,
+        dims.to_array(),
+        wgpu::TextureFormat::R8Unorm,
+        &to_bytes(values),
+    )
+}
+
+/// The volume's textures as uploaded.
+pub struct VolumeTextures {
+    /// Generation of the uploaded density and its view.
+    pub density: Option<(u64, wgpu::TextureView)>,
+    /// The density volume uploaded (its box places the slices).
+    pub density_volume: Arc<DensityVolume>,
+    /// Generation of the uploaded light volume and its view.
+    pub light: Option<(u64, wgpu::TextureView)>,
+    /// Seed of the uploaded noise and its view.
+    pub noise: Option<(u64, wgpu::TextureView)>,
+}
+
+impl VolumeTextures {
+    /// Nothing uploaded yet.
+    pub fn new() -> Self {
+        Self {
+            density: None,
+            density_volume: Arc::new(DensityVolume::default()),
+            light: None,
+            noise: None,
+        }
+    }
+
+    /// Uploads whatever changed in `volumes`; returns whether any texture was replaced.
+    pub fn upload(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, v: &Volumes) -> bool {
+        let mut changed = false;
+        if self
+            .density
+            .as_ref()
+            .is_none_or(|(g, _)| *g != v.density.generation)
+        {
+            let d = &v.density.data;
+            let view = r8_volume(device, queue, "density", d.dims, &d.values, 0);
+            self.density = Some((v.density.generation, view));
+            self.density_volume = d.clone();
+            changed = true;
+        }
+        if self
+            .light
+            .as_ref()
+            .is_none_or(|(g, _)| *g != v.light.generation)
+        {
+            let l = &v.light.data;
+            let view = r8_volume(device, queue, "light", l.dims, &l.values, 255);
+            self.light = Some((v.light.generation, view));
+            changed = true;
+        }
+        if self.noise.as_ref().is_none_or(|(s, _)| *s != v.noise_seed) {
+            let n = NOISE_SIZE;
+            let view = upload_3d(
+                device,
+                queue,
+                "noise",
+                [n, n, n],
+                wgpu::TextureFormat::R8Unorm,
+                &noise_volume(v.noise_seed),
+            );
+            self.noise = Some((v.noise_seed, view));
+            changed = true;
+        }
+        changed
+    }
+}
+
+impl Default for VolumeTextures {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// An accumulation target and the bind group that composites it.
+pub struct Target {
+    /// Size in pixels.
+    pub size: [u32; 2],
+    /// The render target view.
+    pub view: wgpu::TextureView,
+    /// Composite bind group reading it.
+    pub composite: wgpu::BindGroup,
+}
+
+/// Creates an accumulation target of `size` in `format`.
+pub fn accumulation_texture(
+    device: &wgpu::Device,
+    size: [u32; 2],
+    format: wgpu::TextureFormat,
+) -> wgpu::TextureView {
+    device
+        .create_texture(&wgpu::TextureDescriptor {
+            label: Some("volume accumulation"),
+            size: wgpu::Extent3d {
+                width: size[0],
+                height: size[1],
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        })
+        .create_view(&wgpu::TextureViewDescriptor::default())
+}
+
+/// Picks the accumulation format: 16-bit float where the adapter can render and blend it
+/// (smooth gradients over many faint slices), 8-bit otherwise (plain WebGL2).
+pub fn accumulation_format(adapter: &wgpu::Adapter) -> wgpu::TextureFormat {
+    let f = adapter.get_texture_format_features(wgpu::TextureFormat::Rgba16Float);
+    let ok = f
+        .allowed_usages
+        .contains(wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING)
+        && f.flags.contains(
+            wgpu::TextureFormatFeatureFlags::BLENDABLE
+                | wgpu::TextureFormatFeatureFlags::FILTERABLE,
+        );
+    if ok {
+        wgpu::TextureFormat::Rgba16Float
+    } else {
+        wgpu::TextureFormat::Rgba8Unorm
+    }
+}
+
+/// A linear-filtering sampler with the given addressing.
+pub fn sampler(device: &wgpu::Device, mode: wgpu::AddressMode) -> wgpu::Sampler {
+    device.create_sampler(&wgpu::SamplerDescriptor {
+        label: Some("volume sampler"),
+        address_mode_u: mode,
+        address_mode_v: mode,
+        address_mode_w: mode,
+        mag_filter: wgpu::FilterMode::Linear,
+        min_filter: wgpu::FilterMode::Linear,
+        ..Default::default()
+    })
+}

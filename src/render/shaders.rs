@@ -1,0 +1,32 @@
+//! Shader sources, compiled into the binary. WGSL has no include: modules that share the
+//! `Volume` uniforms are composed here from `shaders/volume_common.wgsl` and their own file,
+//! and `tests/shaders.rs` validates every composed module with naga.
+
+/// `shaders/volume_common.wgsl`: the `Volume` uniforms and the slice bind group.
+pub const VOLUME_COMMON: &str = include_str!("../../shaders/volume_common.wgsl");
+
+/// The slice shader: `volume_common.wgsl` + `volume.wgsl`.
+pub const VOLUME: &str = concat!(
+    include_str!("../../shaders/volume_common.wgsl"),
+    include_str!("../../shaders/volume.wgsl")
+);
+
+/// The benchmark baseline: `volume_common.wgsl` + `plain_slices.wgsl`.
+pub const PLAIN_SLICES: &str = concat!(
+    include_str!("../../shaders/volume_common.wgsl"),
+    include_str!("../../shaders/plain_slices.wgsl")
+);
+
+/// `shaders/composite.wgsl`.
+pub const COMPOSITE: &str = include_str!("../../shaders/composite.wgsl");
+
+/// Every shader module with the files it is composed of, in order.
+pub const MODULES: [(&str, &[&str], &str); 3] = [
+    ("volume", &["volume_common.wgsl", "volume.wgsl"], VOLUME),
+    (
+        "plain_slices",
+        &["volume_common.wgsl", "plain_slices.wgsl"],
+        PLAIN_SLICES,
+    ),
+    ("composite", &["composite.wgsl"], COMPOSITE),
+];

@@ -1,0 +1,421 @@
+//! The document: the scene, its undo history and revision counters per part.
+//!
+//! Every change goes through [`Document::apply`] (undoable edits) or
+//! [`Document::set_camera`] (views, not undone). Each part of the scene — geometry (ellipsoids,
+//! drawing planes, seed), lighting, render settings, camera — carries a revision that changes
+//! exactly when that part does, so derived state asks "did the geometry change since revision
+//! N?" instead of comparing scenes. Undo steps are whole scenes, cheap to keep because a
+//! scene's primitives are shared through `Arc`: 200 steps of one slider on a scene at the caps
+//! hold one copy of its strokes, not 200.
+
+use std::collections::VecDeque;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use super::{Edit, OrbitCamera, Scene};
+use crate::limits::MAX_PLANES;
+
+/// Most undo steps kept.
+pub const MAX_UNDO: usize = 200;
+
+/// Source of revision numbers, shared by every document in the process: a revision never
+/// repeats, even across documents, so a cache keyed on one can never confuse two documents.
+static NEXT_REVISION: AtomicU64 = AtomicU64::new(1);
+
+fn next_revision() -> u64 {
+    NEXT_REVISION.fetch_add(1, Ordering::Relaxed)
+}
+
+/// Revision of each part of the document. A part's revision changes whenever the part does
+/// (and only then); revisions never repeat, so a cached value keyed on one stays valid exactly
+/// as long as the part is unchanged.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct Revisions {
+    /// Ellipsoids, drawing planes and the seed: what the field is made of.
+    pub geometry: u64,
+    /// Sun, sky and background.
+    pub light: u64,
+    /// Render quality and cloud media settings.
+    pub render: u64,
+    /// The camera.
+    pub camera: u64,
+}
+
+impl Revisions {
+    /// Changes whenever any part of the document does (camera included).
+    pub fn any(&self) -> u64 {
+        self.geometry
+            .max(self.light)
+            .max(self.render)
+            .max(self.camera)
+    }
+}
+
+/// Which parts an edit or an undo step changed.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+struct Changed {
+    geometry: bool,
+    light: bool,
+    render: bool,
+    camera: bool,
+}
+
+impl Changed {
+    fn any(&self) -> bool {
+        self.geometry || self.light || self.render || self.camera
+    }
+}
+
+/// The same primitives, compared by pointer first (shared `Arc`s are equal at once).
+fn same<T: PartialEq>(a: &[Arc<T>], b: &[Arc<T>]) -> bool {
+    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| Arc::ptr_eq(x, y) || **x == **y)
+}
+
+fn diff(a: &Scene, b: &Scene) -> Changed {
+    Changed {
+        geometry: a.seed != b.seed
+            || !same(&a.ellipsoids, &b.ellipsoids)
+            || !same(&a.planes, &b.planes),
+        light: a.light != b.light,
+        render: a.render != b.render,
+        camera: a.camera != b.camera,
+    }
+}
+
+struct Step {
+    scene: Scene,
+    label: &'static str,
+}
+
+/// The scene, its history and its revisions.
+pub struct Document {
+    scene: Scene,
+    undo: VecDeque<Step>,
+    redo: Vec<Step>,
+    /// Merge key of the last recorded edit; an edit with the same key folds into its step.
+    last_key: Option<&'static str>,
+    revisions: Revisions,
+}
+
+impl Default for Document {
+    fn default() -> Self {
+        Self::new(Scene::default())
+    }
+}
+
+impl Document {
+    /// A document holding `scene`, with an empty history.
+    pub fn new(scene: Scene) -> Self {
+        let n = next_revision();
+        Self {
+            scene,
+            undo: VecDeque::new(),
+            redo: Vec::new(),
+            last_key: None,
+            revisions: Revisions {
+                geometry: n,
+                light: n,
+                render: n,
+                camera: n,
+            },
+        }
+    }
+
+    /// The scene as it stands.
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
+    /// The revision of each part.
+    pub fn revisions(&self) -> Revisions {
+        self.revisions
+    }
+
+    fn bump(&mut self, changed: Changed) {
+        if !changed.any() {
+            return;
+        }
+        let n = next_revision();
+        let r = &mut self.revisions;
+        for (flag, rev) in [
+            (changed.geometry, &mut r.geometry),
+            (changed.light, &mut r.light),
+            (changed.render, &mut r.render),
+            (changed.camera, &mut r.camera),
+        ] {
+            if flag {
+                *rev = n;
+            }
+        }
+    }
+
+    /// Applies `edit` and records an undo step. Edits that share a `merge_key` with the
+    /// previous one (the same slider being dragged) fold into one step. Returns whether the
+    /// document changed (an edit that changes nothing or cannot apply records nothing).
+    pub fn apply(&mut self, edit: Edit, merge_key: Option<&'static str>) -> bool {
+        let label = edit.label();
+        let s = &self.scene;
+        let mut changed = Changed::default();
+        match &edit {
+            Edit::SetLight(l) => changed.light = *l != s.light,
+            Edit::SetRender(r) => changed.render = *r != s.render,
+            Edit::SetEllipsoids(e) => changed.geometry = !same(e, &s.ellipsoids),
+            Edit::SetPlanes(p) => {
+                changed.geometry = p.len() <= MAX_PLANES && !same(p, &s.planes);
+            }
+            Edit::SetPlane(i, p) => {
+                changed.geometry = s.planes.get(*i).is_some_and(|old| **old != *p);
+            }
+            Edit::InsertPlane(i, _) => {
+                changed.geometry = *i <= s.planes.len() && s.planes.len() < MAX_PLANES;
+            }
+            Edit::RemovePlane(i) => changed.geometry = *i < s.planes.len(),
+            Edit::Replace(new) => changed = diff(s, new),
+        }
+        if !changed.any() {
+            return false;
+        }
+        let before = self.scene.clone();
+        let s = &mut self.scene;
+        match edit {
+            Edit::SetLight(l) => s.light = l,
+            Edit::SetRender(r) => s.render = r,
+            Edit::SetEllipsoids(e) => s.ellipsoids = e,
+            Edit::SetPlanes(p) => s.planes = p,
+            Edit::SetPlane(i, p) => s.planes[i] = Arc::new(p),
+            Edit::InsertPlane(i, p) => s.planes.insert(i, Arc::new(p)),
+            Edit::RemovePlane(i) => {
+                s.planes.remove(i);
+            }
+            Edit::Replace(new) => *s = *new,
+        }
+        let merge = merge_key.is_some() && merge_key == self.last_key;
+        if !merge {
+            self.undo.push_back(Step {
+                scene: before,
+                label,
+            });
+            if self.undo.len() > MAX_UNDO {
+                self.undo.pop_front();
+            }
+        }
+        self.redo.clear();
+        self.last_key = merge_key;
+        self.bump(changed);
+        true
+    }
+
+    /// Moves the camera. Not an undo step; bumps only the camera's revision.
+    pub fn set_camera(&mut self, camera: OrbitCamera) {
+        if camera != self.scene.camera {
+            self.scene.camera = camera;
+            self.bump(Changed {
+                camera: true,
+                ..Default::default()
+            });
+        }
+    }
+
+    /// Ends the current merge run (pointer released), so the next edit is a new step.
+    pub fn end_merge(&mut self) {
+        self.last_key = None;
+    }
+
+    /// Steps back; the camera stays where the user put it. Returns what was undone, or `None`
+    /// when there is nothing to undo.
+    pub fn undo(&mut self) -> Option<&'static str> {
+        let step = self.undo.pop_back()?;
+        let label = step.label;
+        let current = self.restore(step.scene);
+        self.redo.push(Step {
+            scene: current,
+            label,
+        });
+        Some(label)
+    }
+
+    /// Steps forward again. Returns what was redone, or `None` when there is nothing to redo.
+    pub fn redo(&mut self) -> Option<&'static str> {
+        let step = self.redo.pop()?;
+        let label = step.label;
+        let current = self.restore(step.scene);
+        self.undo.push_back(Step {
+            scene: current,
+            label,
+        });
+        Some(label)
+    }
+
+    /// Puts `scene` in place (keeping the camera); returns the scene it replaced.
+    fn restore(&mut self, mut scene: Scene) -> Scene {
+        scene.camera = self.scene.camera.clone();
+        let changed = diff(&self.scene, &scene);
+        self.last_key = None;
+        let previous = std::mem::replace(&mut self.scene, scene);
+        self.bump(changed);
+        previous
+    }
+
+    /// Number of undo steps available.
+    pub fn undo_len(&self) -> usize {
+        self.undo.len()
+    }
+
+    /// Number of redo steps available.
+    pub fn redo_len(&self) -> usize {
+        self.redo.len()
+    }
+
+    /// Every plane stroke held by the history and the scene, counted once per allocation
+    /// (how much the undo history really holds).
+    pub fn distinct_planes_held(&self) -> usize {
+        let mut seen = std::collections::HashSet::new();
+        let scenes = self
+            .undo
+            .iter()
+            .chain(&self.redo)
+            .map(|s| &s.scene)
+            .chain(std::iter::once(&self.scene));
+        for scene in scenes {
+            for p in &scene.planes {
+                seen.insert(Arc::as_ptr(p));
+            }
+        }
+        seen.len()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{DrawingPlane, Ellipsoid};
+    use glam::{Vec2, Vec3};
+
+    #[test]
+    fn undo_redo_round_trip() {
+        let mut doc = Document::default();
+        let original = doc.scene().clone();
+        let mut r = doc.scene().render.clone();
+        r.slices = 64;
+        assert!(doc.apply(Edit::SetRender(r), None));
+        assert_eq!(doc.scene().render.slices, 64);
+        assert_eq!(doc.undo(), Some("render settings"));
+        assert_eq!(*doc.scene(), original);
+        assert!(doc.redo().is_some());
+        assert_eq!(doc.scene().render.slices, 64);
+        assert!(doc.redo().is_none());
+    }
+
+    #[test]
+    fn slider_drags_merge_into_one_step() {
+        let mut doc = Document::default();
+        for s in [20, 30, 40] {
+            let mut r = doc.scene().render.clone();
+            r.slices = s;
+            doc.apply(Edit::SetRender(r), Some("slices"));
+        }
+        assert_eq!(doc.undo_len(), 1);
+        doc.end_merge();
+        let mut r = doc.scene().render.clone();
+        r.slices = 50;
+        doc.apply(Edit::SetRender(r), Some("slices"));
+        assert_eq!(doc.undo_len(), 2);
+        doc.undo();
+        assert_eq!(doc.scene().render.slices, 40);
+    }
+
+    #[test]
+    fn no_op_and_invalid_edits_record_nothing() {
+        let mut doc = Document::default();
+        let revs = doc.revisions();
+        let same = doc.scene().render.clone();
+        assert!(!doc.apply(Edit::SetRender(same), None));
+        assert!(!doc.apply(Edit::RemovePlane(3), None));
+        assert!(!doc.apply(Edit::SetPlane(0, DrawingPlane::default()), None));
+        assert_eq!(doc.undo_len(), 0);
+        assert_eq!(doc.revisions(), revs);
+    }
+
+    #[test]
+    fn camera_moves_are_not_undone_and_touch_only_the_camera_revision() {
+        let mut doc = Document::default();
+        doc.apply(Edit::SetEllipsoids(vec![]), None);
+        let before = doc.revisions();
+        let mut cam = doc.scene().camera.clone();
+        cam.yaw_deg = 90.0;
+        doc.set_camera(cam);
+        let after = doc.revisions();
+        assert!(after.camera > before.camera);
+        assert_eq!(
+            (after.geometry, after.light, after.render),
+            (before.geometry, before.light, before.render)
+        );
+        assert_eq!(doc.undo_len(), 1, "a camera move is no undo step");
+        doc.undo();
+        assert_eq!(doc.scene().camera.yaw_deg, 90.0);
+        assert!(!doc.scene().ellipsoids.is_empty());
+    }
+
+    #[test]
+    fn each_edit_bumps_only_its_part() {
+        let mut doc = Document::default();
+        let r0 = doc.revisions();
+        let mut l = doc.scene().light.clone();
+        l.sun_azimuth_deg += 10.0;
+        doc.apply(Edit::SetLight(l), None);
+        let r1 = doc.revisions();
+        assert!(r1.light > r0.light);
+        assert_eq!((r1.geometry, r1.render, r1.camera), (r0.geometry, r0.render, r0.camera));
+        doc.apply(
+            Edit::InsertPlane(0, DrawingPlane {
+                points: vec![Vec2::ZERO, Vec2::X, Vec2::Y],
+                ..Default::default()
+            }),
+            None,
+        );
+        let r2 = doc.revisions();
+        assert!(r2.geometry > r1.geometry);
+        assert_eq!((r2.light, r2.render), (r1.light, r1.render));
+        // Undoing the plane changes the geometry back, not the light.
+        doc.undo();
+        let r3 = doc.revisions();
+        assert!(r3.geometry > r2.geometry);
+        assert_eq!(r3.light, r2.light);
+        // Undoing the light changes the light only.
+        doc.undo();
+        let r4 = doc.revisions();
+        assert!(r4.light > r3.light);
+        assert_eq!(r4.geometry, r3.geometry);
+    }
+
+    #[test]
+    fn history_shares_unchanged_primitives() {
+        // A scene at the plane cap with long strokes, then 200 slider steps and 50 single-plane
+        // edits: the history holds one copy of each unchanged plane.
+        let mut scene = Scene::preset(crate::scene::Preset::Empty);
+        let points: Vec<Vec2> = (0..2000)
+            .map(|i| Vec2::from_angle(i as f32 * 0.00314).rotate(Vec2::X))
+            .collect();
+        for i in 0..MAX_PLANES {
+            scene.planes.push(Arc::new(DrawingPlane {
+                name: format!("p{i}"),
+                points: points.clone(),
+                ..Default::default()
+            }));
+        }
+        scene.ellipsoids.push(Arc::new(Ellipsoid::new(Vec3::ZERO, Vec3::ONE)));
+        let mut doc = Document::new(scene);
+        for i in 0..200 {
+            let mut l = doc.scene().light.clone();
+            l.ambient = i as f32 * 0.01;
+            doc.apply(Edit::SetLight(l), None);
+        }
+        for i in 0..50 {
+            let mut p = (*doc.scene().planes[i]).clone();
+            p.origin.x += 1.0;
+            doc.apply(Edit::SetPlane(i, p), None);
+        }
+        assert_eq!(doc.undo_len(), MAX_UNDO);
+        assert_eq!(doc.distinct_planes_held(), MAX_PLANES + 50);
+    }
+}

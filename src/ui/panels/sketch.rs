@@ -1,0 +1,142 @@
+//! The Sketch group: the tools, the drawing-plane list and the selected plane's controls.
+
+use egui::Ui;
+use glam::{EulerRot, Quat};
+
+use crate::limits;
+use crate::scene::{Document, Edit, StrokeKind};
+use crate::ui::notice::Notices;
+use crate::ui::selection::{Item, Selection};
+use crate::ui::sketch_tool::{SketchTool, Tool, delete_selected, duplicate_selected};
+use crate::ui::widgets::{param_f64, param_u32};
+
+/// The Sketch group.
+#[derive(Default)]
+pub struct SketchPanel;
+
+impl SketchPanel {
+    /// Draws the group.
+    pub fn ui(
+        &mut self,
+        ui: &mut Ui,
+        doc: &mut Document,
+        tool: &mut SketchTool,
+        selection: &mut Selection,
+        notices: &mut Notices,
+    ) {
+        egui::CollapsingHeader::new("Sketch")
+            .default_open(true)
+            .show(ui, |ui| {
+                ui.horizontal_wrapped(|ui| {
+                    for (t, label, tip) in [
+                        (Tool::Navigate, "Navigate", "V: drag orbits the view"),
+                        (Tool::Sketch, "✏ Sketch", "D: drag draws a cloud's outline"),
+                        (Tool::Cut, "✂ Cut", "C: drag draws a line; the cloud below it is removed"),
+                        (Tool::Move, "✥ Move", "G: drag moves the selected drawing plane"),
+                        (Tool::Rotate, "⟳ Rotate", "R: drag turns the selected drawing plane"),
+                    ] {
+                        ui.selectable_value(&mut tool.tool, t, label).on_hover_text(tip);
+                    }
+                });
+                ui.horizontal(|ui| {
+                    ui.checkbox(&mut tool.show_all_planes, "all grids");
+                    ui.checkbox(&mut tool.hide_guides, "hide guides")
+                        .on_hover_text("H");
+                });
+                let planes = &doc.scene().planes;
+                if planes.is_empty() {
+                    ui.label("No drawing planes yet. Pick Sketch and drag an outline in the view.");
+                    return;
+                }
+                ui.label("Drawing planes:");
+                let mut clicked = None;
+                for (i, plane) in planes.iter().enumerate() {
+                    let selected = selection.contains(Item::Plane(i));
+                    if ui.selectable_label(selected, plane.name.as_str()).clicked() {
+                        clicked = Some((i, selected));
+                    }
+                }
+                if let Some((i, was)) = clicked {
+                    selection.set_plane((!was).then_some(i));
+                }
+                if let Some(i) = selection.plane().filter(|&i| i < doc.scene().planes.len()) {
+                    ui.separator();
+                    plane_controls(ui, doc, i);
+                    ui.horizontal(|ui| {
+                        let now = ui.input(|i| i.time);
+                        if ui.button("Duplicate").on_hover_text("Ctrl+D").clicked()
+                            && let Some(m) = duplicate_selected(doc, selection)
+                        {
+                            notices.note(now, m);
+                        }
+                        if ui.button("Delete").on_hover_text("Delete").clicked()
+                            && let Some(m) = delete_selected(doc, selection)
+                        {
+                            notices.note(now, m);
+                        }
+                    });
+                }
+            });
+    }
+}
+
+fn plane_controls(ui: &mut Ui, doc: &mut Document, i: usize) {
+    let mut plane = (*doc.scene().planes[i]).clone();
+    ui.label(egui::RichText::new(&plane.name).strong());
+    if plane.kind == StrokeKind::Outline {
+        let s = &mut plane.sketch;
+        param_f64(ui, &mut s.inflate, &limits::INFLATE, "deflate (t)",
+            "Thin the cloud's body toward its smallest features (0 keeps it as drawn)");
+        param_f64(ui, &mut s.simplify, &limits::SIMPLIFY, "simplify",
+            "Smooth away small wiggles of the stroke before building the cloud");
+        param_f64(ui, &mut s.prune, &limits::PRUNE, "prune branches",
+            "Ignore bumps of the outline smaller than this share of its area");
+        ui.checkbox(&mut s.extend, "3D extension")
+            .on_hover_text("Grow copies of the cloud's bumps toward and away from you, so it is round from the side");
+        ui.add_enabled_ui(s.extend, |ui| {
+            param_u32(ui, &mut s.copies, &limits::COPIES, "branch copies",
+                "Copies of each bump placed around the cloud's body");
+        });
+    }
+    ui.horizontal(|ui| {
+        ui.label("move");
+        for (axis, v) in ["x", "y", "z"].iter().zip(plane.origin.as_mut()) {
+            ui.add(
+                egui::DragValue::new(v)
+                    .speed(0.05)
+                    .max_decimals(2)
+                    .prefix(format!("{axis} ")),
+            );
+        }
+    });
+    let (mut yaw, mut pitch, mut roll) = plane.rotation.to_euler(EulerRot::YXZ);
+    let before = (yaw, pitch, roll);
+    ui.horizontal(|ui| {
+        ui.label("rotate");
+        for (label, v) in [
+            ("yaw ", &mut yaw),
+            ("pitch ", &mut pitch),
+            ("roll ", &mut roll),
+        ] {
+            let mut deg = v.to_degrees();
+            if ui
+                .add(
+                    egui::DragValue::new(&mut deg)
+                        .speed(0.5)
+                        .max_decimals(1)
+                        .prefix(label)
+                        .suffix("°"),
+                )
+                .changed()
+            {
+                *v = deg.to_radians();
+            }
+        }
+    });
+    if (yaw, pitch, roll) != before {
+        plane.rotation = Quat::from_euler(EulerRot::YXZ, yaw, pitch, roll);
+    }
+    if plane != *doc.scene().planes[i] {
+        doc.apply(Edit::SetPlane(i, plane), Some("plane"));
+    }
+}

@@ -1,0 +1,143 @@
+//! Architecture invariants, checked on the source text (in the style of rust-analyzer's tidy
+//! tests): the pure core imports no UI, GPU or browser crate; only `render` uses wgpu;
+//! `cfg(target_arch = "wasm32")` appears only in the files ARCHITECTURE.md lists; and every
+//! source and shader file is named in ARCHITECTURE.md's code map.
+
+use std::path::{Path, PathBuf};
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn files(dir: &Path, ext: &str, out: &mut Vec<PathBuf>) {
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.is_dir() {
+            files(&path, ext, out);
+        } else if path.extension().is_some_and(|e| e == ext) {
+            out.push(path);
+        }
+    }
+}
+
+/// Source files as (path relative to the repository, code): lines that are comments are left
+/// out, so a doc comment naming a crate is fine.
+fn sources() -> Vec<(String, String)> {
+    let mut paths = Vec::new();
+    files(&root().join("src"), "rs", &mut paths);
+    paths.sort();
+    paths
+        .into_iter()
+        .map(|p| {
+            let rel = p
+                .strip_prefix(root())
+                .unwrap()
+                .to_string_lossy()
+                .replace('\\', "/");
+            let code: String = std::fs::read_to_string(&p)
+                .unwrap()
+                .lines()
+                .filter(|l| !l.trim_start().starts_with("//"))
+                .collect::<Vec<_>>()
+                .join("\n");
+            (rel, code)
+        })
+        .collect()
+}
+
+/// Whether `code` uses crate `name` as a path (`name::` not preceded by a word character).
+fn uses(code: &str, name: &str) -> bool {
+    let pat = format!("{name}::");
+    code.match_indices(&pat).any(|(i, _)| {
+        i == 0
+            || !code[..i]
+                .chars()
+                .next_back()
+                .is_some_and(|c| c.is_alphanumeric() || c == '_')
+    })
+}
+
+const PURE: [&str; 6] = [
+    "src/scene/",
+    "src/sketch/",
+    "src/field/",
+    "src/derive/",
+    "src/limits.rs",
+    "src/seeded.rs",
+];
+
+#[test]
+fn the_pure_core_imports_no_ui_gpu_or_browser_crate() {
+    let mut bad = Vec::new();
+    for (path, code) in sources() {
+        if !PURE.iter().any(|p| path.starts_with(p)) {
+            continue;
+        }
+        for krate in ["egui", "eframe", "egui_wgpu", "wgpu", "web_sys", "js_sys", "wasm_bindgen"] {
+            if uses(&code, krate) {
+                bad.push(format!("{path} uses {krate}"));
+            }
+        }
+    }
+    assert!(bad.is_empty(), "{bad:#?}");
+}
+
+#[test]
+fn only_render_uses_wgpu() {
+    let bad: Vec<String> = sources()
+        .into_iter()
+        .filter(|(path, code)| !path.starts_with("src/render/") && uses(code, "wgpu"))
+        .map(|(path, _)| path)
+        .collect();
+    assert!(bad.is_empty(), "wgpu used outside src/render/: {bad:?}");
+}
+
+fn architecture() -> String {
+    std::fs::read_to_string(root().join("ARCHITECTURE.md")).unwrap()
+}
+
+#[test]
+fn wasm_cfg_appears_only_in_the_listed_files() {
+    let doc = architecture();
+    let line = doc
+        .lines()
+        .find(|l| l.contains("cfg(target_arch = \"wasm32\")") && l.contains("appears only in"))
+        .expect("ARCHITECTURE.md lists where cfg(target_arch = \"wasm32\") appears");
+    let listed: Vec<&str> = line.split('`').skip(1).step_by(2).collect();
+    let mut bad = Vec::new();
+    for (path, code) in sources() {
+        let has = code.contains("target_arch = \"wasm32\"");
+        if has && !listed.contains(&path.as_str()) {
+            bad.push(path);
+        }
+    }
+    assert!(bad.is_empty(), "cfg on wasm32 outside the listed files: {bad:?} (listed: {listed:?})");
+}
+
+#[test]
+fn every_source_and_shader_file_is_in_the_code_map() {
+    let doc = architecture();
+    let mut paths = Vec::new();
+    files(&root().join("src"), "rs", &mut paths);
+    files(&root().join("shaders"), "wgsl", &mut paths);
+    let missing: Vec<String> = paths
+        .iter()
+        .map(|p| {
+            p.strip_prefix(root())
+                .unwrap()
+                .to_string_lossy()
+                .replace('\\', "/")
+        })
+        .filter(|rel| !doc.contains(&format!("`{rel}`")))
+        .collect();
+    assert!(missing.is_empty(), "not in ARCHITECTURE.md's code map: {missing:#?}");
+}
+
+#[test]
+fn the_checks_catch_what_they_look_for() {
+    // The matcher itself: a plain use is found, a longer name or a comment is not.
+    assert!(uses("use wgpu::Device;", "wgpu"));
+    assert!(uses("let x = wgpu::Color::RED;", "wgpu"));
+    assert!(!uses("egui_wgpu::Callback::new()", "wgpu"));
+    assert!(!uses("my_wgpu::x", "wgpu"));
+}
