@@ -67,6 +67,11 @@ fn render_writes_a_png_of_the_scene() {
         "/render/slices=32",
     ]);
     assert!(out.status.success(), "{}", stderr(&out));
+    // A successful render says so and nothing that reads like a failure (on a machine with
+    // no display, Mesa's device-select layer would print XDG_RUNTIME_DIR errors).
+    let err = stderr(&out);
+    assert!(err.contains("rendered 96x64"), "{err}");
+    assert!(!err.to_lowercase().contains("error"), "{err}");
     let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&png).unwrap()));
     let reader = decoder.read_info().unwrap();
     let info = reader.info();

@@ -86,6 +86,9 @@ enum Command {
 pub fn main() -> ExitCode {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     let cli = Cli::parse();
+    if cli.command.is_some() {
+        headless_vulkan();
+    }
     let result = match cli.command {
         None => desktop::run(),
         Some(Command::New { preset, output }) => new::run(&preset, &output),
@@ -118,6 +121,18 @@ pub fn main() -> ExitCode {
             eprintln!("error: {message}");
             ExitCode::FAILURE
         }
+    }
+}
+
+/// Headless subcommands choose their adapter themselves, so Mesa's implicit Vulkan layer that
+/// picks a default GPU for windows (`VK_LAYER_MESA_device_select`) has nothing to do; on a
+/// machine without a display it connects to Wayland to look for one and prints two
+/// `error: XDG_RUNTIME_DIR is invalid…` lines that read like a failure. The layer's own switch
+/// turns it off for this process (unless the user set it).
+fn headless_vulkan() {
+    if std::env::var_os("NODEVICE_SELECT").is_none() {
+        // SAFETY: called at start-up, before this process starts any thread.
+        unsafe { std::env::set_var("NODEVICE_SELECT", "1") };
     }
 }
 

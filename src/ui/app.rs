@@ -89,6 +89,7 @@ impl CloudApp {
             log::error!("no wgpu render state: the volume cannot be drawn");
         }
         cc.egui_ctx.set_visuals(egui::Visuals::dark());
+        super::widgets::install_icon_font(&cc.egui_ctx);
         super::platform::install(&cc.egui_ctx);
         Self {
             doc: Document::new(options.scene),

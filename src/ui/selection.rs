@@ -10,6 +10,15 @@ pub enum Item {
     Plane(usize),
 }
 
+impl Item {
+    /// The plane index, if this is a plane.
+    pub fn plane(&self) -> Option<usize> {
+        match self {
+            Item::Plane(p) => Some(*p),
+        }
+    }
+}
+
 /// The selection; the last item added is the active one.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Selection {
@@ -29,9 +38,7 @@ impl Selection {
 
     /// The active drawing plane, if one is selected.
     pub fn plane(&self) -> Option<usize> {
-        self.items.iter().rev().find_map(|i| match i {
-            Item::Plane(p) => Some(*p),
-        })
+        self.items.iter().rev().find_map(Item::plane)
     }
 
     /// Selects plane `index` alone, or nothing for `None`.

@@ -32,7 +32,7 @@ impl SketchPanel {
                         (Tool::Navigate, "Navigate", "V: drag orbits the view"),
                         (Tool::Sketch, "✏ Sketch", "D: drag draws a cloud's outline"),
                         (Tool::Cut, "✂ Cut", "C: drag draws a line; the cloud below it is removed"),
-                        (Tool::Move, "✥ Move", "G: drag moves the selected drawing plane"),
+                        (Tool::Move, "⬌ Move", "G: drag moves the selected drawing plane"),
                         (Tool::Rotate, "⟳ Rotate", "R: drag turns the selected drawing plane"),
                     ] {
                         ui.selectable_value(&mut tool.tool, t, label).on_hover_text(tip);
