@@ -11,9 +11,14 @@ pub const MAX_PLANES: usize = 256;
 /// Most points a stored stroke may have.
 pub const MAX_PLANE_POINTS: usize = 20_000;
 
-/// A numeric parameter's range, default and the way its slider moves.
+/// A numeric parameter: its range, default, the way its slider moves, and its name and
+/// meaning in an artist's words.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Param {
+    /// Label of its slider.
+    pub label: &'static str,
+    /// What it does, for the slider's tooltip.
+    pub tip: &'static str,
     /// Smallest value.
     pub min: f64,
     /// Largest value.
@@ -25,22 +30,25 @@ pub struct Param {
 }
 
 impl Param {
-    const fn linear(min: f64, max: f64, default: f64) -> Self {
+    const fn new(text: [&'static str; 2], range: [f64; 3], logarithmic: bool) -> Self {
+        let [label, tip] = text;
+        let [min, max, default] = range;
         Self {
+            label,
+            tip,
             min,
             max,
             default,
-            logarithmic: false,
+            logarithmic,
         }
     }
 
-    const fn log(min: f64, max: f64, default: f64) -> Self {
-        Self {
-            min,
-            max,
-            default,
-            logarithmic: true,
-        }
+    const fn linear(label: &'static str, tip: &'static str, min: f64, max: f64, d: f64) -> Self {
+        Self::new([label, tip], [min, max, d], false)
+    }
+
+    const fn log(label: &'static str, tip: &'static str, min: f64, max: f64, d: f64) -> Self {
+        Self::new([label, tip], [min, max, d], true)
     }
 
     /// `v` clamped into range; the default when it is not finite.
@@ -61,50 +69,131 @@ impl Param {
     pub fn fix_u32(&self, v: u32) -> u32 {
         (v as f64).clamp(self.min, self.max) as u32
     }
-
-    /// The range as `f32`s, for sliders.
-    pub fn range_f32(&self) -> std::ops::RangeInclusive<f32> {
-        self.min as f32..=self.max as f32
-    }
-
-    /// The range as `u32`s, for integer sliders.
-    pub fn range_u32(&self) -> std::ops::RangeInclusive<u32> {
-        self.min as u32..=self.max as u32
-    }
 }
 
 /// Quality: slices at full quality.
-pub const SLICES: Param = Param::log(8.0, 512.0, 128.0);
+pub const SLICES: Param = Param::log(
+    "quality (slices)",
+    "Slices through the cloud at full quality: more is smoother and slower",
+    8.0,
+    512.0,
+    128.0,
+);
 /// Resolution of the baked field grid along its longest side.
-pub const FIELD_RESOLUTION: Param = Param::linear(16.0, 128.0, 64.0);
+pub const FIELD_RESOLUTION: Param = Param::linear(
+    "field grid",
+    "Resolution of the grid the cloud's shape is sampled on: finer shows smaller features, costs more after each edit",
+    16.0,
+    128.0,
+    64.0,
+);
 /// Noise octaves.
-pub const OCTAVES: Param = Param::linear(0.0, 4.0, 3.0);
+pub const OCTAVES: Param =
+    Param::linear("octaves", "Layers of finer and finer noise", 0.0, 4.0, 3.0);
 /// Opacity: extinction per world unit of the densest cloud.
-pub const OPACITY: Param = Param::log(0.01, 50.0, 2.5);
+pub const OPACITY: Param = Param::log(
+    "opacity",
+    "How much light the cloud's body stops",
+    0.01,
+    50.0,
+    2.5,
+);
 /// Width of the soft edge around the surface, in field units.
-pub const SOFTNESS: Param = Param::linear(0.005, 0.5, 0.12);
+pub const SOFTNESS: Param = Param::linear(
+    "edge softness",
+    "Width of the cloud's soft edge",
+    0.005,
+    0.5,
+    0.12,
+);
 /// How far noise moves the surface.
-pub const NOISE_AMOUNT: Param = Param::linear(0.0, 1.0, 0.35);
+pub const NOISE_AMOUNT: Param = Param::linear(
+    "noise amount",
+    "How far the noise breaks up the cloud's surface",
+    0.0,
+    1.0,
+    0.35,
+);
 /// Size of the first noise octave in world units.
-pub const NOISE_SCALE: Param = Param::log(0.1, 100.0, 3.0);
+pub const NOISE_SCALE: Param = Param::log(
+    "noise size",
+    "Size of the largest noise puffs, in world units",
+    0.1,
+    100.0,
+    3.0,
+);
 /// Lacunarity: frequency step between octaves.
-pub const DETAIL: Param = Param::linear(1.1, 4.0, 2.2);
+pub const DETAIL: Param = Param::linear(
+    "detail (lacunarity)",
+    "How much finer each noise layer is than the one before",
+    1.1,
+    4.0,
+    2.2,
+);
 /// Sun azimuth in degrees.
-pub const SUN_AZIMUTH: Param = Param::linear(0.0, 360.0, 20.0);
+pub const SUN_AZIMUTH: Param = Param::linear(
+    "sun azimuth °",
+    "Compass direction the sunlight comes from",
+    0.0,
+    360.0,
+    20.0,
+);
 /// Sun elevation in degrees.
-pub const SUN_ELEVATION: Param = Param::linear(-89.0, 89.0, 35.0);
+pub const SUN_ELEVATION: Param = Param::linear(
+    "sun elevation °",
+    "Height of the sun above the horizon",
+    -89.0,
+    89.0,
+    35.0,
+);
 /// Sun intensity multiplier.
-pub const SUN_INTENSITY: Param = Param::linear(0.0, 10.0, 1.6);
+pub const SUN_INTENSITY: Param = Param::linear(
+    "sun intensity",
+    "Brightness of direct sunlight",
+    0.0,
+    10.0,
+    1.6,
+);
 /// Ambient sky light multiplier.
-pub const AMBIENT: Param = Param::linear(0.0, 3.0, 0.45);
+pub const AMBIENT: Param = Param::linear(
+    "ambient",
+    "Brightness of the sky light that fills the shadowed side",
+    0.0,
+    3.0,
+    0.45,
+);
 /// Sketch: simplification tolerance as a fraction of the outline's size.
-pub const SIMPLIFY: Param = Param::linear(0.0, 0.2, 0.01);
+pub const SIMPLIFY: Param = Param::linear(
+    "simplify",
+    "Smooth away small wiggles of the stroke before building the cloud",
+    0.0,
+    0.2,
+    0.01,
+);
 /// Sketch: branches adding less than this fraction of the outline's area are pruned.
-pub const PRUNE: Param = Param::linear(0.0, 0.5, 0.02);
+pub const PRUNE: Param = Param::linear(
+    "prune branches",
+    "Ignore bumps of the outline smaller than this share of its area",
+    0.0,
+    0.5,
+    0.02,
+);
 /// Sketch: the inflation (deflate) slider t.
-pub const INFLATE: Param = Param::linear(0.0, 1.0, 0.0);
+pub const INFLATE: Param = Param::linear(
+    "deflate (t)",
+    "Thin the cloud's body toward its smallest features (0 keeps it as drawn)",
+    0.0,
+    1.0,
+    0.0,
+);
 /// Sketch: copies of each terminal branch made by the 3D extension.
-pub const COPIES: Param = Param::linear(0.0, 6.0, 2.0);
+pub const COPIES: Param = Param::linear(
+    "branch copies",
+    "Copies of each bump placed around the cloud's body",
+    0.0,
+    6.0,
+    2.0,
+);
 
 #[cfg(test)]
 mod tests {
@@ -130,7 +219,10 @@ mod tests {
             INFLATE,
             COPIES,
         ] {
-            assert!(p.min < p.max && (p.min..=p.max).contains(&p.default), "{p:?}");
+            assert!(
+                p.min < p.max && (p.min..=p.max).contains(&p.default),
+                "{p:?}"
+            );
             assert_eq!(p.fix(f64::NAN), p.default);
             assert_eq!(p.fix(p.max * 10.0 + 1.0), p.max);
             assert!(!p.logarithmic || p.min > 0.0, "log slider from 0: {p:?}");

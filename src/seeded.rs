@@ -43,7 +43,11 @@ mod tests {
         let mut a = SplitMix::new(5);
         let mut b = SplitMix::new(5);
         let xs: Vec<f64> = (0..4000).map(|_| a.next_f64()).collect();
-        assert!(xs.iter().zip((0..4000).map(|_| b.next_f64())).all(|(x, y)| *x == y));
+        assert!(
+            xs.iter()
+                .zip((0..4000).map(|_| b.next_f64()))
+                .all(|(x, y)| *x == y)
+        );
         assert!(xs.iter().all(|x| (0.0..1.0).contains(x)));
         let mean = xs.iter().sum::<f64>() / xs.len() as f64;
         assert!((mean - 0.5).abs() < 0.02, "{mean}");

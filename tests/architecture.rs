@@ -73,7 +73,15 @@ fn the_pure_core_imports_no_ui_gpu_or_browser_crate() {
         if !PURE.iter().any(|p| path.starts_with(p)) {
             continue;
         }
-        for krate in ["egui", "eframe", "egui_wgpu", "wgpu", "web_sys", "js_sys", "wasm_bindgen"] {
+        for krate in [
+            "egui",
+            "eframe",
+            "egui_wgpu",
+            "wgpu",
+            "web_sys",
+            "js_sys",
+            "wasm_bindgen",
+        ] {
             if uses(&code, krate) {
                 bad.push(format!("{path} uses {krate}"));
             }
@@ -111,7 +119,10 @@ fn wasm_cfg_appears_only_in_the_listed_files() {
             bad.push(path);
         }
     }
-    assert!(bad.is_empty(), "cfg on wasm32 outside the listed files: {bad:?} (listed: {listed:?})");
+    assert!(
+        bad.is_empty(),
+        "cfg on wasm32 outside the listed files: {bad:?} (listed: {listed:?})"
+    );
 }
 
 #[test]
@@ -130,7 +141,10 @@ fn every_source_and_shader_file_is_in_the_code_map() {
         })
         .filter(|rel| !doc.contains(&format!("`{rel}`")))
         .collect();
-    assert!(missing.is_empty(), "not in ARCHITECTURE.md's code map: {missing:#?}");
+    assert!(
+        missing.is_empty(),
+        "not in ARCHITECTURE.md's code map: {missing:#?}"
+    );
 }
 
 #[test]

@@ -78,6 +78,9 @@ fn wgsl_volume_struct_matches_the_rust_layout() {
         .iter()
         .map(|(n, o)| (n.to_string(), *o))
         .collect();
-    assert_eq!(wgsl, rust, "WGSL Volume vs Rust VolumeUniforms (name, offset; last: size)");
+    assert_eq!(
+        wgsl, rust,
+        "WGSL Volume vs Rust VolumeUniforms (name, offset; last: size)"
+    );
     assert_eq!(span as usize, std::mem::size_of::<VolumeUniforms>());
 }

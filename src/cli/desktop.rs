@@ -25,4 +25,3 @@ pub fn run() -> Result<(), String> {
     )
     .map_err(|e| format!("could not open the desktop window: {e}"))
 }
-

@@ -159,4 +159,3 @@ pub fn read_scene(path: &Path) -> Result<Scene, String> {
 pub fn write(path: &Path, bytes: &[u8]) -> Result<(), String> {
     std::fs::write(path, bytes).map_err(|e| format!("cannot write {}: {e}", path.display()))
 }
-

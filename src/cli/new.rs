@@ -16,4 +16,3 @@ pub fn run(preset: &str, output: &Path) -> Result<(), String> {
     })?;
     write(output, Scene::preset(preset).to_json().as_bytes())
 }
-

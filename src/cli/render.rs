@@ -22,12 +22,7 @@ pub fn parse_size(text: &str) -> Result<(u32, u32), String> {
 }
 
 /// `cloudsketch render [SCENE] -o OUT.png --size WxH --set PATH=VALUE…`.
-pub fn run(
-    scene: Option<&Path>,
-    output: &Path,
-    size: &str,
-    sets: &[String],
-) -> Result<(), String> {
+pub fn run(scene: Option<&Path>, output: &Path, size: &str, sets: &[String]) -> Result<(), String> {
     let (width, height) = parse_size(size)?;
     let mut scene = match scene {
         Some(path) => read_scene(path)?,
@@ -68,4 +63,3 @@ mod tests {
         }
     }
 }
-

@@ -57,7 +57,11 @@ pub struct Work {
 /// The planes' drawing-plane placement applied to their shapes: the field of a document.
 fn assemble(scene: &Scene, shapes: &[Arc<Shape>]) -> Field {
     let mut field = Field {
-        blobs: scene.ellipsoids.iter().map(|e| Blob::ellipsoid(e)).collect(),
+        blobs: scene
+            .ellipsoids
+            .iter()
+            .map(|e| Blob::ellipsoid(e))
+            .collect(),
         groups: Vec::new(),
         clips: Vec::new(),
     };

@@ -30,7 +30,9 @@ fn plane(kind: StrokeKind, points: Vec<Vec2>) -> DrawingPlane {
 fn sketched_field_outline_in_its_plane_matches_the_stroke() {
     let outline = cloud_outline();
     let mut scene = Scene::preset(crate::scene::Preset::Empty);
-    scene.planes.push(Arc::new(plane(StrokeKind::Outline, outline.clone())));
+    scene
+        .planes
+        .push(Arc::new(plane(StrokeKind::Outline, outline.clone())));
     let field = field_of(&scene);
     assert_eq!(field.groups.len(), 1);
     let stroke: Vec<glam::DVec2> = outline.iter().map(|p| p.as_dvec2()).collect();
@@ -56,7 +58,9 @@ fn sketched_field_outline_in_its_plane_matches_the_stroke() {
 #[test]
 fn cut_stroke_flattens_the_base() {
     let mut scene = Scene::preset(crate::scene::Preset::Empty);
-    scene.planes.push(Arc::new(plane(StrokeKind::Outline, cloud_outline())));
+    scene
+        .planes
+        .push(Arc::new(plane(StrokeKind::Outline, cloud_outline())));
     let before = field_of(&scene);
     assert!(before.inside(Vec3::new(0.0, -1.0, 0.0)));
     scene.planes.push(Arc::new(plane(

@@ -83,8 +83,8 @@ pub fn bake(field: &Field, resolution: u32) -> DensityVolume {
     let center_of =
         |i: usize, j: usize, k: usize| lo + (Vec3::new(i as f32, j as f32, k as f32) + 0.5) * h;
 
-    // Accumulate each primitive over the texels of its influence box only.
-    let splat = |blob: &super::Blob, out: &mut [f32], combine: fn(f32, f32) -> f32| {
+    // The texels a primitive's influence reaches (inclusive), if any.
+    let texel_box = |blob: &super::Blob| -> Option<(UVec3, UVec3)> {
         let reach = blob.extent * super::SUPPORT;
         let a = ((blob.center - reach - lo) / h - 0.5)
             .floor()
@@ -94,20 +94,27 @@ pub fn bake(field: &Field, resolution: u32) -> DensityVolume {
             .ceil()
             .as_ivec3()
             .min(dims.as_ivec3() - 1);
-        if b.min_element() < 0 {
-            return;
-        }
-        let b = b.as_uvec3();
-        for k in a.z..=b.z {
-            for j in a.y..=b.y {
-                let row = (k as usize * ny + j as usize) * nx;
-                for i in a.x..=b.x {
-                    let v = &mut out[row + i as usize];
-                    *v = combine(
-                        *v,
-                        blob.value(center_of(i as usize, j as usize, k as usize)),
-                    );
-                }
+        (b.min_element() >= 0).then(|| (a, b.as_uvec3()))
+    };
+    // Every texel row of a box: (row start index, x range).
+    let rows = move |(a, b): (UVec3, UVec3)| {
+        (a.z..=b.z).flat_map(move |k| {
+            (a.y..=b.y).map(move |j| {
+                (
+                    (k as usize * ny + j as usize) * nx,
+                    a.x as usize..=b.x as usize,
+                )
+            })
+        })
+    };
+    // Accumulate each primitive over the texels of its influence box only.
+    let splat = |blob: &super::Blob, out: &mut [f32], combine: fn(f32, f32) -> f32| {
+        let Some(bx) = texel_box(blob) else { return };
+        for (row, xs) in rows(bx) {
+            let (j, k) = ((row / nx) % ny, row / (nx * ny));
+            for i in xs {
+                let v = &mut out[row + i];
+                *v = combine(*v, blob.value(center_of(i, j, k)));
             }
         }
     };
@@ -115,16 +122,28 @@ pub fn bake(field: &Field, resolution: u32) -> DensityVolume {
         splat(blob, &mut values, |a, b| a + b);
     }
     if !field.groups.is_empty() {
+        // One scratch grid; each group clears and adds back only the box it reaches.
         let mut group_values = vec![0f32; values.len()];
         for group in &field.groups {
-            group_values.iter_mut().for_each(|v| *v = 0.0);
+            let Some(bx) = group
+                .iter()
+                .filter_map(texel_box)
+                .reduce(|(a, b), (c, d)| (a.min(c), b.max(d)))
+            else {
+                continue;
+            };
+            for (row, xs) in rows(bx) {
+                group_values[row + xs.start()..=row + xs.end()].fill(0.0);
+            }
             for blob in group {
                 splat(blob, &mut group_values, f32::max);
             }
-            values
-                .iter_mut()
-                .zip(&group_values)
-                .for_each(|(v, g)| *v += g);
+            for (row, xs) in rows(bx) {
+                let span = row + xs.start()..=row + xs.end();
+                for (v, g) in values[span.clone()].iter_mut().zip(&group_values[span]) {
+                    *v += g;
+                }
+            }
         }
     }
     if !field.clips.is_empty() {
@@ -175,6 +194,46 @@ mod tests {
         for (z, y, x) in [(3, 5, 7), (16, 16, 16), (0, 31, 2)] {
             let p = v.min + (Vec3::new(x as f32, y as f32, z as f32) + 0.5) * h;
             assert!((v.value(x, y, z) - f.value(p)).abs() < 1e-5);
+        }
+    }
+
+    #[test]
+    fn every_texel_equals_the_field_at_its_centre() {
+        // Summed blobs, two max-combined groups (one reaching the grid's edge) and a clip,
+        // against the field evaluated at every texel (brute force).
+        let group = |c: Vec3| -> Vec<Blob> {
+            (0..6)
+                .map(|i| {
+                    Blob::sphere(
+                        c + Vec3::new(i as f32 * 0.4, 0.0, 0.0),
+                        0.5 + 0.1 * i as f32,
+                    )
+                })
+                .collect()
+        };
+        let f = Field {
+            blobs: vec![Blob::sphere(Vec3::new(0.0, 1.0, 0.0), 1.2)],
+            groups: vec![
+                group(Vec3::new(-2.0, 0.0, 0.0)),
+                group(Vec3::new(1.0, -1.0, 0.5)),
+            ],
+            clips: vec![super::super::Clip {
+                origin: Vec3::ZERO,
+                right: Vec3::X,
+                up: Vec3::Y,
+                line: vec![glam::Vec2::new(-1.0, -1.2), glam::Vec2::new(1.0, -1.2)],
+            }],
+        };
+        let v = bake(&f, 24);
+        let h = v.texel_size();
+        for z in 0..v.dims.z {
+            for y in 0..v.dims.y {
+                for x in 0..v.dims.x {
+                    let p = v.min + (Vec3::new(x as f32, y as f32, z as f32) + 0.5) * h;
+                    let want = f.value(p);
+                    assert!((v.value(x, y, z) - want).abs() < 1e-5, "({x},{y},{z})");
+                }
+            }
         }
     }
 

@@ -58,8 +58,39 @@ pub struct View {
     pub light: Lighting,
     /// Media and quality.
     pub render: RenderSettings,
-    /// Image width / height.
+    /// Width / height of the whole view.
     pub aspect: f32,
+    /// The part of the view this image covers, in normalised device coordinates
+    /// (x0, y0, x1, y1; y up): the image is drawn only where the cloud can be. [`FULL_VIEW`]
+    /// covers it all.
+    pub crop: [f32; 4],
+}
+
+/// A [`View::crop`] covering the whole view.
+pub const FULL_VIEW: [f32; 4] = [-1.0, -1.0, 1.0, 1.0];
+
+/// Maps the crop rectangle of normalised device coordinates onto the whole image.
+pub fn crop_matrix(crop: [f32; 4]) -> Mat4 {
+    let [x0, y0, x1, y1] = crop;
+    let (w, h) = ((x1 - x0).max(1e-6), (y1 - y0).max(1e-6));
+    Mat4::from_cols_array(&[
+        2.0 / w,
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+        2.0 / h,
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+        1.0,
+        0.0,
+        -(x1 + x0) / w,
+        -(y1 + y0) / h,
+        0.0,
+        1.0,
+    ])
 }
 
 /// Transform of octave `i`: world → noise-texture coordinates, scale × rotate × translate with
@@ -102,7 +133,8 @@ impl VolumeUniforms {
         let inv_size = Vec3::ONE / volume.size.max(Vec3::splat(1e-6));
         let octaves = r.noise_octaves.min(MAX_OCTAVES as u32);
         Self {
-            view_proj: camera.view_projection(view.aspect).to_cols_array_2d(),
+            view_proj: (crop_matrix(view.crop) * camera.view_projection(view.aspect))
+                .to_cols_array_2d(),
             eye: camera.eye().extend(1.0).to_array(),
             forward: camera.forward().extend(0.0).to_array(),
             right: camera.right().extend(0.0).to_array(),
@@ -151,6 +183,7 @@ mod tests {
             light: scene.light.clone(),
             render: scene.render.clone(),
             aspect: 1.5,
+            crop: FULL_VIEW,
         };
         let u = VolumeUniforms::new(&view, &volume, 64, 10);
         let center = Vec3::from_slice(&u.sphere[..3]);
@@ -161,6 +194,19 @@ mod tests {
             scene.camera.view_projection(1.5)
         );
         assert_eq!(u.slicing[1], 10.0);
+    }
+
+    #[test]
+    fn a_crop_maps_its_rectangle_onto_the_image() {
+        let crop = [-0.5, 0.0, 0.25, 1.0];
+        let m = crop_matrix(crop);
+        let at = |x: f32, y: f32| {
+            let c = m * glam::Vec4::new(x * 3.0, y * 3.0, 0.4, 3.0);
+            (c.x / c.w, c.y / c.w)
+        };
+        assert_eq!(at(-0.5, 0.0), (-1.0, -1.0));
+        assert_eq!(at(0.25, 1.0), (1.0, 1.0));
+        assert_eq!(crop_matrix(FULL_VIEW), Mat4::IDENTITY);
     }
 
     #[test]

@@ -22,5 +22,5 @@ pub mod viewport;
 #[cfg(not(target_arch = "wasm32"))]
 pub mod offscreen;
 
-pub use gpu_types::View;
+pub use gpu_types::{FULL_VIEW, View};
 pub use renderer::{SliceJob, VolumeRenderer};

@@ -1,7 +1,8 @@
 //! Headless rendering on any wgpu adapter (lavapipe on CPU-only machines): `render`, `bench`
 //! and the image tests use it, with the same renderer and shaders as the app.
 
-use super::gpu_types::View;
+use super::gpu_types::{FULL_VIEW, View};
+use super::progressive::JobPlan;
 use super::renderer::{SliceJob, VolumeRenderer};
 use super::resources::accumulation_format;
 use crate::derive::Derived;
@@ -185,16 +186,19 @@ impl Offscreen {
         self.renderer.begin_frame();
         self.renderer.upload(&self.device, &self.queue, &volumes);
         SliceJob {
-            target: 0,
-            size: [width, height],
-            total: scene.render.slices,
-            range: 0..scene.render.slices,
-            clear: true,
+            plan: JobPlan {
+                target: 0,
+                size: [width, height],
+                total: scene.render.slices,
+                range: 0..scene.render.slices,
+                clear: true,
+            },
             view: View {
                 camera: scene.camera.clone(),
                 light: scene.light.clone(),
                 render: scene.render.clone(),
                 aspect: width as f32 / height as f32,
+                crop: FULL_VIEW,
             },
         }
     }
@@ -206,7 +210,7 @@ impl Offscreen {
         background: [f32; 3],
         pipeline: Option<&wgpu::RenderPipeline>,
     ) -> (wgpu::CommandEncoder, wgpu::Texture) {
-        let [width, height] = job.size;
+        let [width, height] = job.plan.size;
         let output = self.device.create_texture(&wgpu::TextureDescriptor {
             label: Some("offscreen output"),
             size: wgpu::Extent3d {
@@ -228,7 +232,7 @@ impl Offscreen {
                 label: Some("offscreen"),
             });
         self.renderer
-            .draw_slices_with(&self.device, &self.queue, &mut encoder, job, pipeline);
+            .draw_slices(&self.device, &self.queue, &mut encoder, job, pipeline);
         {
             let [r, g, b] = background.map(|v| v as f64);
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -247,13 +251,13 @@ impl Offscreen {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            self.renderer.composite(&mut pass, job.target);
+            self.renderer.composite(&mut pass, job.plan.target);
         }
         (encoder, output)
     }
 
     fn draw(&mut self, job: &SliceJob, background: [f32; 3]) -> Result<Image, OffscreenError> {
-        let [width, height] = job.size;
+        let [width, height] = job.plan.size;
         let row = (width * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
             * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
         let readback = self.device.create_buffer(&wgpu::BufferDescriptor {

@@ -11,17 +11,24 @@ use super::shaders;
 /// Slice draws one frame (one submit) may record.
 pub const MAX_SLICE_DRAWS_PER_FRAME: u32 = 8;
 
-fn texture_3d(binding: u32) -> wgpu::BindGroupLayoutEntry {
+fn texture_entry(
+    binding: u32,
+    view_dimension: wgpu::TextureViewDimension,
+) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility: wgpu::ShaderStages::FRAGMENT,
         ty: wgpu::BindingType::Texture {
             sample_type: wgpu::TextureSampleType::Float { filterable: true },
-            view_dimension: wgpu::TextureViewDimension::D3,
+            view_dimension,
             multisampled: false,
         },
         count: None,
     }
+}
+
+fn texture_3d(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    texture_entry(binding, wgpu::TextureViewDimension::D3)
 }
 
 fn sampler_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
@@ -190,16 +197,7 @@ impl CompositePass {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("composite"),
             entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
+                texture_entry(0, wgpu::TextureViewDimension::D2),
                 sampler_entry(1),
             ],
         });

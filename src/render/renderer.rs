@@ -1,26 +1,17 @@
 //! The volume renderer: passes and resources together, used by the app's viewport (through an
 //! egui paint callback) and by offscreen rendering alike.
 
-use std::ops::Range;
-
 use super::gpu_types::{View, VolumeUniforms};
 use super::passes::{CompositePass, SlicePass};
+use super::progressive::JobPlan;
 use super::resources::{TARGETS, Target, VolumeTextures, accumulation_texture, sampler};
 use crate::derive::Volumes;
 
-/// One volume draw: slices `range` of `total`, into accumulation target `target`.
+/// One volume draw: the planner's job (which slices, into which target) and what it shows.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SliceJob {
-    /// Which accumulation target (0 or 1).
-    pub target: usize,
-    /// Target size in pixels.
-    pub size: [u32; 2],
-    /// Slices in the whole image.
-    pub total: u32,
-    /// Slices of the whole image drawn by this job (0 = farthest).
-    pub range: Range<u32>,
-    /// Clear the target first (the first chunk of an image).
-    pub clear: bool,
+    /// Slices `range` of `total` into accumulation target `target`.
+    pub plan: JobPlan,
     /// Camera, light and media of the image.
     pub view: View,
 }
@@ -130,24 +121,14 @@ impl VolumeRenderer {
         });
     }
 
-    /// A pipeline for the benchmark baseline, for [`VolumeRenderer::draw_slices_with`].
+    /// A pipeline for the benchmark baseline, for [`VolumeRenderer::draw_slices`].
     pub fn baseline_pipeline(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
         self.slices.baseline(device)
     }
 
-    /// Records one volume draw (see [`SliceJob`]). Call [`VolumeRenderer::upload`] first.
+    /// Records one volume draw (see [`SliceJob`]), with the slice pipeline or `pipeline` (of
+    /// the same layout: the bench baseline). Call [`VolumeRenderer::upload`] first.
     pub fn draw_slices(
-        &mut self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        encoder: &mut wgpu::CommandEncoder,
-        job: &SliceJob,
-    ) {
-        self.draw_slices_with(device, queue, encoder, job, None);
-    }
-
-    /// Like [`VolumeRenderer::draw_slices`] with another slice pipeline of the same layout.
-    pub fn draw_slices_with(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
@@ -155,10 +136,11 @@ impl VolumeRenderer {
         job: &SliceJob,
         pipeline: Option<&wgpu::RenderPipeline>,
     ) {
-        let index = job.target.min(TARGETS - 1);
-        self.ensure_target(device, index, job.size);
+        let plan = &job.plan;
+        let index = plan.target.min(TARGETS - 1);
+        self.ensure_target(device, index, plan.size);
         let volume = &self.textures.density_volume;
-        let uniforms = VolumeUniforms::new(&job.view, volume, job.total, job.range.start);
+        let uniforms = VolumeUniforms::new(&job.view, volume, plan.total, plan.range.start);
         let offset = self.slices.write(queue, &uniforms);
         let empty = volume.is_empty();
         let (Some(target), Some(bind_group)) = (&self.targets[index], &self.bind_group) else {
@@ -171,7 +153,7 @@ impl VolumeRenderer {
                 depth_slice: None,
                 resolve_target: None,
                 ops: wgpu::Operations {
-                    load: if job.clear {
+                    load: if plan.clear {
                         wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT)
                     } else {
                         wgpu::LoadOp::Load
@@ -184,7 +166,7 @@ impl VolumeRenderer {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        let count = job.range.end.saturating_sub(job.range.start);
+        let count = plan.range.end.saturating_sub(plan.range.start);
         if empty || count == 0 {
             return;
         }

@@ -89,6 +89,20 @@ fn r8_volume(
     )
 }
 
+/// Replaces `slot`'s texture with `make()` unless it already holds version `key`; returns
+/// whether it did.
+fn refresh(
+    slot: &mut Option<(u64, wgpu::TextureView)>,
+    key: u64,
+    make: impl FnOnce() -> wgpu::TextureView,
+) -> bool {
+    if slot.as_ref().is_some_and(|(k, _)| *k == key) {
+        return false;
+    }
+    *slot = Some((key, make()));
+    true
+}
+
 /// The volume's textures as uploaded.
 pub struct VolumeTextures {
     /// Generation of the uploaded density and its view.
@@ -114,42 +128,29 @@ impl VolumeTextures {
 
     /// Uploads whatever changed in `volumes`; returns whether any texture was replaced.
     pub fn upload(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, v: &Volumes) -> bool {
-        let mut changed = false;
-        if self
-            .density
-            .as_ref()
-            .is_none_or(|(g, _)| *g != v.density.generation)
-        {
-            let d = &v.density.data;
-            let view = r8_volume(device, queue, "density", d.dims, &d.values, 0);
-            self.density = Some((v.density.generation, view));
+        let (d, l) = (&v.density.data, &v.light.data);
+        let density = refresh(&mut self.density, v.density.generation, || {
+            r8_volume(device, queue, "density", d.dims, &d.values, 0)
+        });
+        if density {
             self.density_volume = d.clone();
-            changed = true;
         }
-        if self
-            .light
-            .as_ref()
-            .is_none_or(|(g, _)| *g != v.light.generation)
-        {
-            let l = &v.light.data;
-            let view = r8_volume(device, queue, "light", l.dims, &l.values, 255);
-            self.light = Some((v.light.generation, view));
-            changed = true;
-        }
-        if self.noise.as_ref().is_none_or(|(s, _)| *s != v.noise_seed) {
+        let light = refresh(&mut self.light, v.light.generation, || {
+            r8_volume(device, queue, "light", l.dims, &l.values, 255)
+        });
+        let noise = refresh(&mut self.noise, v.noise_seed, || {
             let n = NOISE_SIZE;
-            let view = upload_3d(
+            let bytes = noise_volume(v.noise_seed);
+            upload_3d(
                 device,
                 queue,
                 "noise",
                 [n, n, n],
                 wgpu::TextureFormat::R8Unorm,
-                &noise_volume(v.noise_seed),
-            );
-            self.noise = Some((v.noise_seed, view));
-            changed = true;
-        }
-        changed
+                &bytes,
+            )
+        });
+        density || light || noise
     }
 }
 

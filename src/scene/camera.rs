@@ -135,6 +135,39 @@ impl OrbitCamera {
         (clip.w > 1e-6).then(|| clip.xy() / clip.w)
     }
 
+    /// The rectangle of normalised device coordinates (x0, y0, x1, y1) a box covers on screen,
+    /// clamped to the view; the whole view when part of the box is behind the camera, `None`
+    /// when it is entirely outside the view.
+    pub fn ndc_bounds(&self, lo: Vec3, hi: Vec3, aspect: f32) -> Option<[f32; 4]> {
+        let m = self.view_projection(aspect);
+        let (near, _) = self.clip_range();
+        let (mut a, mut b) = (Vec2::splat(f32::MAX), Vec2::splat(f32::MIN));
+        let mut behind = 0;
+        for i in 0..8 {
+            let p = Vec3::new(
+                if i & 1 == 0 { lo.x } else { hi.x },
+                if i & 2 == 0 { lo.y } else { hi.y },
+                if i & 4 == 0 { lo.z } else { hi.z },
+            );
+            let clip = m * p.extend(1.0);
+            if clip.w <= near {
+                behind += 1;
+                continue;
+            }
+            let q = clip.xy() / clip.w;
+            a = a.min(q);
+            b = b.max(q);
+        }
+        match behind {
+            0 => {
+                let (a, b) = (a.max(Vec2::NEG_ONE), b.min(Vec2::ONE));
+                (a.x < b.x && a.y < b.y).then_some([a.x, a.y, b.x, b.y])
+            }
+            8 => None,
+            _ => Some([-1.0, -1.0, 1.0, 1.0]),
+        }
+    }
+
     /// Orbits by a pointer movement in pixels (drag right turns the view right).
     pub fn orbit(&mut self, delta_px: Vec2) {
         const DEG_PER_PX: f32 = 0.35;
@@ -188,6 +221,39 @@ impl OrbitCamera {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn ndc_bounds_hold_every_projected_point_of_the_box() {
+        let cam = OrbitCamera::default();
+        let (lo, hi) = (Vec3::new(-2.0, 1.0, -1.0), Vec3::new(3.0, 4.0, 2.0));
+        let [x0, y0, x1, y1] = cam.ndc_bounds(lo, hi, 1.6).unwrap();
+        for i in 0..=10 {
+            for j in 0..=10 {
+                for k in 0..=10 {
+                    let t = Vec3::new(i as f32, j as f32, k as f32) / 10.0;
+                    let q = cam.project(lo + (hi - lo) * t, 1.6).unwrap();
+                    assert!(
+                        q.x >= x0 - 1e-5
+                            && q.x <= x1 + 1e-5
+                            && q.y >= y0 - 1e-5
+                            && q.y <= y1 + 1e-5
+                    );
+                }
+            }
+        }
+        assert!(x1 - x0 < 1.5, "a box in the middle does not fill the view");
+        // Behind the camera: nothing; around the camera: the whole view.
+        let back = cam.eye() - cam.forward() * 50.0;
+        assert_eq!(
+            cam.ndc_bounds(back - Vec3::ONE, back + Vec3::ONE, 1.6),
+            None
+        );
+        let eye = cam.eye();
+        assert_eq!(
+            cam.ndc_bounds(eye - Vec3::ONE, eye + Vec3::ONE, 1.6),
+            Some([-1.0, -1.0, 1.0, 1.0])
+        );
+    }
 
     #[test]
     fn basis_is_orthonormal_and_looks_at_target() {

@@ -68,7 +68,10 @@ impl Changed {
 
 /// The same primitives, compared by pointer first (shared `Arc`s are equal at once).
 fn same<T: PartialEq>(a: &[Arc<T>], b: &[Arc<T>]) -> bool {
-    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| Arc::ptr_eq(x, y) || **x == **y)
+    a.len() == b.len()
+        && a.iter()
+            .zip(b)
+            .all(|(x, y)| Arc::ptr_eq(x, y) || **x == **y)
 }
 
 fn diff(a: &Scene, b: &Scene) -> Changed {
@@ -224,36 +227,43 @@ impl Document {
     /// Steps back; the camera stays where the user put it. Returns what was undone, or `None`
     /// when there is nothing to undo.
     pub fn undo(&mut self) -> Option<&'static str> {
-        let step = self.undo.pop_back()?;
-        let label = step.label;
-        let current = self.restore(step.scene);
-        self.redo.push(Step {
-            scene: current,
-            label,
-        });
-        Some(label)
+        self.step(true)
     }
 
     /// Steps forward again. Returns what was redone, or `None` when there is nothing to redo.
     pub fn redo(&mut self) -> Option<&'static str> {
-        let step = self.redo.pop()?;
-        let label = step.label;
-        let current = self.restore(step.scene);
-        self.undo.push_back(Step {
-            scene: current,
-            label,
-        });
+        self.step(false)
+    }
+
+    fn step(&mut self, back: bool) -> Option<&'static str> {
+        let step = if back {
+            self.undo.pop_back()
+        } else {
+            self.redo.pop()
+        }?;
+        let done = self.restore(step);
+        let label = done.label;
+        if back {
+            self.redo.push(done);
+        } else {
+            self.undo.push_back(done);
+        }
         Some(label)
     }
 
-    /// Puts `scene` in place (keeping the camera); returns the scene it replaced.
-    fn restore(&mut self, mut scene: Scene) -> Scene {
+    /// Puts a step's scene in place (keeping the camera); returns the step that goes back to
+    /// the scene it replaced.
+    fn restore(&mut self, step: Step) -> Step {
+        let mut scene = step.scene;
         scene.camera = self.scene.camera.clone();
         let changed = diff(&self.scene, &scene);
         self.last_key = None;
         let previous = std::mem::replace(&mut self.scene, scene);
         self.bump(changed);
-        previous
+        Step {
+            scene: previous,
+            label: step.label,
+        }
     }
 
     /// Number of undo steps available.
@@ -365,12 +375,18 @@ mod tests {
         doc.apply(Edit::SetLight(l), None);
         let r1 = doc.revisions();
         assert!(r1.light > r0.light);
-        assert_eq!((r1.geometry, r1.render, r1.camera), (r0.geometry, r0.render, r0.camera));
+        assert_eq!(
+            (r1.geometry, r1.render, r1.camera),
+            (r0.geometry, r0.render, r0.camera)
+        );
         doc.apply(
-            Edit::InsertPlane(0, DrawingPlane {
-                points: vec![Vec2::ZERO, Vec2::X, Vec2::Y],
-                ..Default::default()
-            }),
+            Edit::InsertPlane(
+                0,
+                DrawingPlane {
+                    points: vec![Vec2::ZERO, Vec2::X, Vec2::Y],
+                    ..Default::default()
+                },
+            ),
             None,
         );
         let r2 = doc.revisions();
@@ -403,7 +419,9 @@ mod tests {
                 ..Default::default()
             }));
         }
-        scene.ellipsoids.push(Arc::new(Ellipsoid::new(Vec3::ZERO, Vec3::ONE)));
+        scene
+            .ellipsoids
+            .push(Arc::new(Ellipsoid::new(Vec3::ZERO, Vec3::ONE)));
         let mut doc = Document::new(scene);
         for i in 0..200 {
             let mut l = doc.scene().light.clone();

@@ -9,10 +9,10 @@ mod edit;
 mod plane;
 mod pointer;
 
+pub use crate::limits::{MAX_ELLIPSOIDS, MAX_PLANE_POINTS, MAX_PLANES};
 pub use camera::{OrbitCamera, Ray};
 pub use document::{Document, Revisions};
 pub use edit::Edit;
-pub use crate::limits::{MAX_ELLIPSOIDS, MAX_PLANE_POINTS, MAX_PLANES};
 pub use plane::{DrawingPlane, StrokeKind, centre_of};
 pub use pointer::{SetError, set_by_pointer};
 
@@ -399,7 +399,10 @@ mod tests {
     fn out_of_range_settings_are_clamped() {
         let s = Scene::from_json(r#"{"render":{"slices":100000,"field_resolution":3}}"#).unwrap();
         assert_eq!(s.render.slices, limits::SLICES.max as u32);
-        assert_eq!(s.render.field_resolution, limits::FIELD_RESOLUTION.min as u32);
+        assert_eq!(
+            s.render.field_resolution,
+            limits::FIELD_RESOLUTION.min as u32
+        );
     }
 
     #[test]

@@ -6,8 +6,8 @@
 use glam::{DQuat, DVec2, DVec3};
 
 use super::outline::{Boundary, Outline, contains};
-use crate::seeded::SplitMix;
 use super::skeleton::{BranchKind, Skeleton};
+use crate::seeded::SplitMix;
 
 /// Most spheres one stroke makes (copies from the 3D extension included).
 pub const MAX_SPHERES: usize = 3000;

@@ -3,7 +3,7 @@
 
 use super::guide::Guide;
 use super::notice::Notices;
-use super::panels::{LightPanel, RenderPanel, ScenePanel, SketchPanel, ViewPanel, ViewStats};
+use super::panels::{LIGHT, RENDER, ScenePanel, SketchPanel, ViewPanel, ViewStats};
 use super::selection::Selection;
 use super::sketch_tool::{SketchTool, ToolContext};
 use super::viewport::{Viewport, ViewportContext};
@@ -56,8 +56,6 @@ impl Default for StartOptions {
 #[derive(Default)]
 struct Panels {
     sketch: SketchPanel,
-    render: RenderPanel,
-    light: LightPanel,
     scene: ScenePanel,
     view: ViewPanel,
 }
@@ -74,6 +72,8 @@ pub struct CloudApp {
     panels: Panels,
     host: Option<Box<dyn Host>>,
     last_status: Option<PageStatus>,
+    /// CPU time of the last frame (app and rendering), as eframe measures it.
+    cpu_seconds: Option<f32>,
     /// The document's JSON as last published, with the revision it was made at.
     published: Option<(u64, String)>,
 }
@@ -89,7 +89,7 @@ impl CloudApp {
             log::error!("no wgpu render state: the volume cannot be drawn");
         }
         cc.egui_ctx.set_visuals(egui::Visuals::dark());
-        super::widgets::install_icon_font(&cc.egui_ctx);
+        super::widgets::install_fonts(&cc.egui_ctx);
         super::platform::install(&cc.egui_ctx);
         Self {
             doc: Document::new(options.scene),
@@ -108,6 +108,7 @@ impl CloudApp {
             panels: Panels::default(),
             host: options.host,
             last_status: None,
+            cpu_seconds: None,
             published: None,
         }
     }
@@ -197,8 +198,8 @@ impl CloudApp {
             &mut self.notices,
         );
         self.guide.ui(ui);
-        p.render.ui(ui, &mut self.doc);
-        p.light.ui(ui, &mut self.doc);
+        RENDER.ui(ui, &mut self.doc);
+        LIGHT.ui(ui, &mut self.doc);
         p.scene.ui(ui, &mut self.doc);
         p.view.ui(ui, &self.viewport.stats);
         self.selection.retain_valid(self.doc.scene());
@@ -229,6 +230,7 @@ impl CloudApp {
             "viewport": stats.viewport_px,
             "quality": quality,
             "frame_ms": stats.frame_seconds.map(|s| (s * 1000.0).round()),
+            "cpu_ms": self.cpu_seconds.map(|s| (s * 1000.0).round()),
             "refining": stats.refining,
             "backend": backend.backend,
             "adapter": backend.adapter,
@@ -259,7 +261,14 @@ impl CloudApp {
 }
 
 impl eframe::App for CloudApp {
-    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+    fn clear_color(&self, _visuals: &egui::Visuals) -> [f32; 4] {
+        // The sky behind the cloud, sRGB-encoded like egui's colours.
+        let [r, g, b] = self.doc.scene().light.background;
+        [r, g, b, 1.0]
+    }
+
+    fn ui(&mut self, ui: &mut egui::Ui, frame: &mut eframe::Frame) {
+        self.cpu_seconds = frame.info().cpu_usage;
         let ctx = ui.ctx().clone();
         self.shortcuts(&ctx);
         self.guide.input(&ctx);
@@ -273,11 +282,13 @@ impl eframe::App for CloudApp {
             self.viewport.show(
                 ui,
                 ViewportContext {
-                    doc: &mut self.doc,
-                    derived: &mut self.derived,
+                    cx: ToolContext {
+                        doc: &mut self.doc,
+                        derived: &mut self.derived,
+                        selection: &mut self.selection,
+                        notices: &mut self.notices,
+                    },
                     tool: &mut self.tool,
-                    selection: &mut self.selection,
-                    notices: &mut self.notices,
                     guide: &self.guide,
                 },
             )

@@ -52,10 +52,9 @@ pub fn read_dropped(file: egui::DroppedFileHandle, ctx: &egui::Context) -> Optio
     let name = file.path().display().to_string();
     wasm_bindgen_futures::spawn_local(async move {
         let result = match file.bytes_async().await {
-            Ok(b) if b.len() as u64 > MAX_FILE_BYTES => Err(format!(
-                "{name}: larger than {} MiB",
-                MAX_FILE_BYTES >> 20
-            )),
+            Ok(b) if b.len() as u64 > MAX_FILE_BYTES => {
+                Err(format!("{name}: larger than {} MiB", MAX_FILE_BYTES >> 20))
+            }
             Ok(b) => Ok((name.clone(), b)),
             Err(e) => Err(format!("{name}: {e}")),
         };

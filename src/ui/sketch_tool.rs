@@ -8,7 +8,9 @@ use glam::{Quat, Vec2, Vec3};
 use super::notice::Notices;
 use super::selection::{Item, Selection};
 use crate::derive::{Derived, Shape};
-use crate::scene::{DrawingPlane, Document, Edit, MAX_PLANE_POINTS, MAX_PLANES, OrbitCamera, StrokeKind};
+use crate::scene::{
+    Document, DrawingPlane, Edit, MAX_PLANE_POINTS, MAX_PLANES, OrbitCamera, StrokeKind,
+};
 use crate::seeded::hash64;
 use crate::sketch::outline;
 
@@ -54,6 +56,16 @@ pub struct SketchTool {
     pub hide_guides: bool,
 }
 
+/// The pointer in the viewport this frame.
+pub struct ViewInput<'a> {
+    /// The viewport's `Ui`.
+    pub ui: &'a Ui,
+    /// The viewport's response (drags, clicks).
+    pub response: &'a Response,
+    /// The viewport's rectangle.
+    pub rect: Rect,
+}
+
 /// What the tools need from the app for one frame.
 pub struct ToolContext<'a> {
     /// The document.
@@ -90,11 +102,10 @@ fn project(camera: &OrbitCamera, rect: Rect, p: Vec3) -> Option<Pos2> {
 pub fn delete_selected(doc: &mut Document, selection: &mut Selection) -> Option<String> {
     let i = selection.plane()?;
     let name = doc.scene().planes.get(i)?.name.clone();
-    doc.apply(Edit::RemovePlane(i), None)
-        .then(|| {
-            selection.clear();
-            format!("Deleted {name} (Ctrl+Z undoes)")
-        })
+    doc.apply(Edit::RemovePlane(i), None).then(|| {
+        selection.clear();
+        format!("Deleted {name} (Ctrl+Z undoes)")
+    })
 }
 
 /// Duplicates the selected plane behind the original; returns what was done.
@@ -102,7 +113,9 @@ pub fn duplicate_selected(doc: &mut Document, selection: &mut Selection) -> Opti
     let i = selection.plane()?;
     let planes = &doc.scene().planes;
     if planes.len() >= MAX_PLANES {
-        return Some(format!("at most {MAX_PLANES} drawing planes: delete one first"));
+        return Some(format!(
+            "at most {MAX_PLANES} drawing planes: delete one first"
+        ));
     }
     let mut copy = (**planes.get(i)?).clone();
     let (lo, hi) = copy
@@ -173,13 +186,8 @@ impl SketchTool {
 
     /// Stroke capture in the viewport. Returns whether the primary button draws (so the camera
     /// must not orbit with it). In Navigate, a click selects the drawing plane under the pointer.
-    pub fn input(
-        &mut self,
-        ui: &Ui,
-        response: &Response,
-        rect: Rect,
-        tc: &mut ToolContext<'_>,
-    ) -> bool {
+    pub fn input(&mut self, view: &ViewInput<'_>, tc: &mut ToolContext<'_>) -> bool {
+        let (ui, response, rect) = (view.ui, view.response, view.rect);
         if matches!(self.tool, Tool::Navigate | Tool::Move | Tool::Rotate)
             && response.clicked()
             && let Some(p) = response.interact_pointer_pos()
@@ -188,7 +196,7 @@ impl SketchTool {
         }
         match self.tool {
             Tool::Navigate => return false,
-            Tool::Move | Tool::Rotate => return self.manipulate(ui, response, rect, tc),
+            Tool::Move | Tool::Rotate => return self.manipulate(view, tc),
             Tool::Sketch | Tool::Cut => {}
         }
         let (alt, multi) = ui.input(|i| (i.modifiers.alt, i.multi_touch().is_some()));
@@ -261,8 +269,7 @@ impl SketchTool {
             StrokeKind::Outline => format!("Outline {count}"),
             StrokeKind::Cut => format!("Cut {count}"),
         };
-        let seed =
-            hash64(scene.seed ^ ((scene.planes.len() as u64) << 32) ^ world.len() as u64);
+        let seed = hash64(scene.seed ^ ((scene.planes.len() as u64) << 32) ^ world.len() as u64);
         let plane = DrawingPlane::facing(
             name,
             kind,
@@ -295,13 +302,8 @@ impl SketchTool {
 
     /// Move and Rotate: a primary drag transforms the selected plane (one undo step per drag).
     /// Without a selection the drag orbits as in Navigate.
-    fn manipulate(
-        &mut self,
-        ui: &Ui,
-        response: &Response,
-        rect: Rect,
-        tc: &mut ToolContext<'_>,
-    ) -> bool {
+    fn manipulate(&mut self, view: &ViewInput<'_>, tc: &mut ToolContext<'_>) -> bool {
+        let (ui, response, rect) = (view.ui, view.response, view.rect);
         let Some(i) = tc
             .selection
             .plane()

@@ -6,13 +6,12 @@ use egui::{Color32, Sense};
 use super::guide::Guide;
 use super::notice::Notices;
 use super::panels::ViewStats;
-use super::selection::Selection;
-use super::sketch_tool::{SketchTool, ToolContext};
+use super::sketch_tool::{SketchTool, ToolContext, ViewInput};
 use crate::derive::Derived;
+use crate::render::SliceJob;
 use crate::render::View;
 use crate::render::progressive::{Budget, Progressive};
 use crate::render::viewport::ViewportPaint;
-use crate::render::SliceJob;
 use crate::scene::Document;
 
 /// The viewport's own state.
@@ -26,18 +25,13 @@ pub struct Viewport {
     pub frame_request: bool,
 }
 
-/// Everything the viewport works on this frame.
+/// Everything the viewport works on this frame: what the tools work on, the tools, the
+/// guide image.
 pub struct ViewportContext<'a> {
-    /// The document.
-    pub doc: &'a mut Document,
-    /// The derivation cache.
-    pub derived: &'a mut Derived,
+    /// Document, derivation cache, selection and messages.
+    pub cx: ToolContext<'a>,
     /// The sketch tools.
     pub tool: &'a mut SketchTool,
-    /// The selection.
-    pub selection: &'a mut Selection,
-    /// Messages.
-    pub notices: &'a mut Notices,
     /// The guide image.
     pub guide: &'a Guide,
 }
@@ -67,30 +61,34 @@ impl Viewport {
     }
 
     /// Draws the viewport into the rest of `ui`.
-    pub fn show(&mut self, ui: &mut egui::Ui, cx: ViewportContext<'_>) {
+    pub fn show(&mut self, ui: &mut egui::Ui, vc: ViewportContext<'_>) {
         let rect = ui.available_rect_before_wrap();
         let response = ui.allocate_rect(rect, Sense::click_and_drag());
+        let ViewportContext {
+            mut cx,
+            tool,
+            guide,
+        } = vc;
         if self.frame_request {
             self.frame_request = false;
             self.frame_cloud(cx.doc, cx.derived, rect.aspect_ratio());
         }
-        let mut tc = ToolContext {
-            doc: cx.doc,
-            derived: cx.derived,
-            selection: cx.selection,
-            notices: cx.notices,
+        let input = ViewInput {
+            ui,
+            response: &response,
+            rect,
         };
-        let drawing = cx.tool.input(ui, &response, rect, &mut tc);
+        let drawing = tool.input(&input, &mut cx);
         let mut camera = cx.doc.scene().camera.clone();
         if super::camera_input::handle(ui, &response, &mut camera, !drawing) {
             cx.doc.set_camera(camera);
         }
 
+        // The background is the frame's clear colour (`CloudApp::clear_color`): no full-view
+        // fill of its own, one full-screen pass less on CPU adapters.
         let painter = ui.painter_at(rect);
         let scene = cx.doc.scene();
-        let [r, g, b] = scene.light.background.map(|v| (v * 255.0).round() as u8);
-        painter.rect_filled(rect, 0.0, Color32::from_rgb(r, g, b));
-        cx.guide.paint(&painter, rect);
+        guide.paint(&painter, rect);
 
         let ppp = ui.ctx().pixels_per_point();
         let px = [
@@ -99,12 +97,25 @@ impl Viewport {
         ];
         self.stats.viewport_px = px;
         let volumes = cx.derived.update(scene, cx.doc.revisions());
-        let key = view_key(cx.doc, px);
+        let aspect = rect.aspect_ratio();
+        // Draw the volume only over the part of the view its box covers: fewer pixels to
+        // slice, refine and composite on every frame.
+        let density = &volumes.density.data;
+        let crop = (!density.is_empty())
+            .then(|| {
+                scene
+                    .camera
+                    .ndc_bounds(density.min, density.min + density.size, aspect)
+            })
+            .flatten()
+            .map(|ndc| PixelCrop::snap(ndc, px));
+        let key = view_key(cx.doc, px, crop.map(|c| c.px));
         let now = ui.input(|i| i.time);
+        let crop_size = crop.map_or([1, 1], |c| c.size());
         let plan = self.progressive.plan(
             now,
             key,
-            px,
+            crop_size,
             scene.render.slices,
             response.is_pointer_button_down_on(),
         );
@@ -114,37 +125,48 @@ impl Viewport {
         if plan.shown.is_some_and(|q| q.full) {
             self.ready = true;
         }
-        let job = plan.job.map(|j| SliceJob {
-            target: j.target,
-            size: j.size,
-            total: j.total,
-            range: j.range,
-            clear: j.clear,
-            view: View {
-                camera: scene.camera.clone(),
-                light: scene.light.clone(),
-                render: scene.render.clone(),
-                aspect: rect.aspect_ratio(),
-            },
-        });
-        if self.stats.backend.is_some() {
-            painter.add(egui_wgpu::Callback::new_paint_callback(
-                rect,
-                ViewportPaint {
-                    volumes,
-                    job,
-                    display: plan.display,
+        if let Some(crop) = crop {
+            let job = plan.job.map(|plan| SliceJob {
+                plan,
+                view: View {
+                    camera: scene.camera.clone(),
+                    light: scene.light.clone(),
+                    render: scene.render.clone(),
+                    aspect,
+                    crop: crop.ndc(px),
                 },
-            ));
+            });
+            if self.stats.backend.is_some() {
+                let [x0, y0, x1, y1] = crop.px;
+                let area = egui::Rect::from_min_max(
+                    rect.min + egui::vec2(x0 as f32, y0 as f32) / ppp,
+                    rect.min + egui::vec2(x1 as f32, y1 as f32) / ppp,
+                );
+                painter.add(egui_wgpu::Callback::new_paint_callback(
+                    area,
+                    ViewportPaint {
+                        volumes,
+                        job,
+                        display: plan.display,
+                    },
+                ));
+            }
         }
         if plan.repaint {
             ui.ctx().request_repaint();
         }
         self.status_line(ui, rect, cx.doc, cx.notices, now);
-        cx.tool.overlay(ui, rect, cx.doc, cx.selection);
+        tool.overlay(ui, rect, cx.doc, cx.selection);
     }
 
-    fn status_line(&self, ui: &egui::Ui, rect: egui::Rect, doc: &Document, notices: &Notices, now: f64) {
+    fn status_line(
+        &self,
+        ui: &egui::Ui,
+        rect: egui::Rect,
+        doc: &Document,
+        notices: &Notices,
+        now: f64,
+    ) {
         let painter = ui.painter_at(rect);
         let mut text = String::new();
         if self.stats.backend.is_none() {
@@ -154,7 +176,7 @@ impl Viewport {
         }
         let scene = doc.scene();
         if scene.ellipsoids.is_empty() && scene.planes.is_empty() {
-            text.push_str("Empty scene: open Scene ▸ New cumulus, or sketch a cloud.");
+            text.push_str("Empty scene: open Scene › New cumulus, or sketch a cloud.");
         }
         // Status line: backend, adapter and the volume's current quality.
         if let Some(b) = &self.stats.backend {
@@ -212,12 +234,69 @@ impl Viewport {
     }
 }
 
+/// The part of the viewport the volume is drawn in, in whole pixels (x0, y0, x1, y1; y down).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct PixelCrop {
+    px: [u32; 4],
+}
+
+impl PixelCrop {
+    /// The pixels covering a rectangle of normalised device coordinates, one pixel of margin.
+    fn snap(ndc: [f32; 4], view: [u32; 2]) -> Self {
+        let [w, h] = view.map(|v| v as f32);
+        let [x0, y0, x1, y1] = ndc;
+        let px = |v: f32, max: u32| (v.max(0.0) as u32).min(max);
+        let left = px(((x0 + 1.0) * 0.5 * w).floor() - 1.0, view[0] - 1);
+        let right = px(((x1 + 1.0) * 0.5 * w).ceil() + 1.0, view[0]).max(left + 1);
+        let top = px(((1.0 - y1) * 0.5 * h).floor() - 1.0, view[1] - 1);
+        let bottom = px(((1.0 - y0) * 0.5 * h).ceil() + 1.0, view[1]).max(top + 1);
+        Self {
+            px: [left, top, right, bottom],
+        }
+    }
+
+    fn size(&self) -> [u32; 2] {
+        [self.px[2] - self.px[0], self.px[3] - self.px[1]]
+    }
+
+    /// The crop in normalised device coordinates of a `view`-sized viewport (y up).
+    fn ndc(&self, view: [u32; 2]) -> [f32; 4] {
+        let [w, h] = view.map(|v| v as f32);
+        let [x0, y0, x1, y1] = self.px.map(|v| v as f32);
+        [
+            x0 / w * 2.0 - 1.0,
+            1.0 - y1 / h * 2.0,
+            x1 / w * 2.0 - 1.0,
+            1.0 - y0 / h * 2.0,
+        ]
+    }
+}
+
 /// Identifies everything that changes the viewport's image: the revisions of the parts the
-/// image depends on, and the viewport's size (no hashing of the scene itself).
-fn view_key(doc: &Document, px: [u32; 2]) -> u64 {
+/// image depends on, the viewport's size and the crop (no hashing of the scene itself).
+fn view_key(doc: &Document, px: [u32; 2], crop: Option<[u32; 4]>) -> u64 {
     use std::hash::{Hash, Hasher};
     let mut h = std::collections::hash_map::DefaultHasher::new();
     doc.revisions().hash(&mut h);
     px.hash(&mut h);
+    crop.hash(&mut h);
     h.finish()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_pixel_crop_covers_its_rectangle_and_maps_back() {
+        let view = [800, 600];
+        let ndc = [-0.31, -0.52, 0.47, 0.2];
+        let c = PixelCrop::snap(ndc, view);
+        let back = c.ndc(view);
+        assert!(back[0] <= ndc[0] && back[1] <= ndc[1] && back[2] >= ndc[2] && back[3] >= ndc[3]);
+        assert!(back[2] - back[0] < ndc[2] - ndc[0] + 0.02);
+        let full = PixelCrop::snap([-1.0, -1.0, 1.0, 1.0], view);
+        assert_eq!(full.px, [0, 0, 800, 600]);
+        assert_eq!(full.ndc(view), [-1.0, -1.0, 1.0, 1.0]);
+    }
 }

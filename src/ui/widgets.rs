@@ -4,57 +4,52 @@ use egui::{Slider, Ui};
 
 use crate::limits::Param;
 
-/// The icon glyphs the UI's labels use (undo, redo, sketch, cut, move, rotate).
-pub const ICONS: &str = "⟲⟳✏✂⬌";
-
-/// Installs the icon font, a subset of emoji-icon-font (MIT, `assets/fonts/`) holding just
-/// [`ICONS`]: egui's default fonts lack them, and the browser's system-font fallback is not
-/// there natively, so both targets load the same glyphs from here.
-pub fn install_icon_font(ctx: &egui::Context) {
-    use egui::epaint::text::{FontData, FontInsert, FontPriority, InsertFontFamily};
-    ctx.add_font(FontInsert::new(
-        "cloudsketch-icons",
-        FontData::from_static(include_bytes!("../../assets/fonts/icons.ttf")),
-        [egui::FontFamily::Proportional, egui::FontFamily::Monospace]
-            .into_iter()
-            .map(|family| InsertFontFamily {
-                family,
-                priority: FontPriority::Lowest,
-            })
-            .collect(),
-    ));
+/// The UI's fonts: Ubuntu Light (egui's own text face, unmodified) for all text, then egui's
+/// icon font, then `assets/fonts/icons.ttf` — a subset of emoji-icon-font (MIT) holding just
+/// the icons the labels use (⟲⟳✏✂⬌). egui's default set adds a monospace face and two emoji
+/// fonts (about 1 MB of the web build) and still lacks these icons natively, where the
+/// browser's system-font fallback does not exist: with this set both targets show the same
+/// glyphs.
+fn font_definitions(with_icons: bool) -> egui::FontDefinitions {
+    use egui::{FontData, FontFamily};
+    let mut defs = egui::FontDefinitions::empty();
+    let mut add = |name: &str, data: &'static [u8]| {
+        defs.font_data.insert(
+            name.to_owned(),
+            std::sync::Arc::new(FontData::from_static(data)),
+        );
+        name.to_owned()
+    };
+    let mut chain = vec![
+        add("Ubuntu-Light", epaint_default_fonts::UBUNTU_LIGHT),
+        add("egui-icons", epaint_default_fonts::EGUI_ICONS),
+    ];
+    if with_icons {
+        chain.push(add(
+            "cloudsketch-icons",
+            include_bytes!("../../assets/fonts/icons.ttf"),
+        ));
+    }
+    for family in [FontFamily::Proportional, FontFamily::Monospace] {
+        defs.families.insert(family, chain.clone());
+    }
+    defs
 }
 
-/// A slider over a parameter's one range (see [`crate::limits`]). Returns whether it changed.
-pub fn param_f32(ui: &mut Ui, value: &mut f32, param: &Param, label: &str, tip: &str) -> bool {
-    ui.add(
-        Slider::new(value, param.range_f32())
-            .logarithmic(param.logarithmic)
-            .text(label),
-    )
-    .on_hover_text(tip)
-    .changed()
+/// Installs the UI's fonts (see [`font_definitions`]).
+pub fn install_fonts(ctx: &egui::Context) {
+    ctx.set_fonts(font_definitions(true));
 }
 
-/// [`param_f32`] for `f64` values.
-pub fn param_f64(ui: &mut Ui, value: &mut f64, param: &Param, label: &str, tip: &str) -> bool {
+/// A slider over a parameter's one range, with its label and tooltip (see [`crate::limits`]).
+/// Returns whether it changed.
+pub fn param<T: egui::emath::Numeric>(ui: &mut Ui, value: &mut T, param: &Param) -> bool {
     ui.add(
-        Slider::new(value, param.min..=param.max)
+        Slider::new(value, T::from_f64(param.min)..=T::from_f64(param.max))
             .logarithmic(param.logarithmic)
-            .text(label),
+            .text(param.label),
     )
-    .on_hover_text(tip)
-    .changed()
-}
-
-/// [`param_f32`] for integer values.
-pub fn param_u32(ui: &mut Ui, value: &mut u32, param: &Param, label: &str, tip: &str) -> bool {
-    ui.add(
-        Slider::new(value, param.range_u32())
-            .logarithmic(param.logarithmic)
-            .text(label),
-    )
-    .on_hover_text(tip)
+    .on_hover_text(param.tip)
     .changed()
 }
 
@@ -78,20 +73,46 @@ pub fn srgb_button(ui: &mut Ui, label: &str, color: &mut [f32; 3]) -> bool {
 mod tests {
     use super::*;
 
+    /// The icon glyphs the UI's labels use (undo, redo, sketch, cut, move, rotate).
+    const ICONS: &str = "⟲⟳✏✂⬌";
+
     #[test]
-    fn the_icon_glyphs_are_there_only_with_the_icon_font() {
+    fn text_and_icon_glyphs_are_there_only_with_the_icon_font() {
         let font = egui::FontId::proportional(14.0);
-        let frame = |ctx: &egui::Context| {
+        let has = |with_icons: bool, text: &str| {
+            let ctx = egui::Context::default();
+            ctx.set_fonts(font_definitions(with_icons));
             let mut out = ctx.run_ui(Default::default(), |_| {});
             out.textures_delta.clear();
+            ctx.fonts_mut(|f| f.has_glyphs(&font, text))
         };
-        let without = egui::Context::default();
-        frame(&without);
-        let missing = without.fonts_mut(|f| ICONS.chars().filter(|&c| !f.has_glyph(&font, c)).count());
-        assert!(missing > 0, "egui's own fonts now have the icons: the icon font can go");
-        let with = egui::Context::default();
-        install_icon_font(&with);
-        frame(&with);
-        assert!(with.fonts_mut(|f| f.has_glyphs(&font, ICONS)));
+        assert!(
+            !has(false, ICONS),
+            "egui's text face now has the icons: the icon font can go"
+        );
+        assert!(has(true, ICONS));
+        // Every character the UI's code writes (comments aside) has a glyph.
+        let mut used = String::new();
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src/ui");
+        let mut stack = vec![dir];
+        while let Some(d) = stack.pop() {
+            for e in std::fs::read_dir(d).unwrap() {
+                let p = e.unwrap().path();
+                if p.is_dir() {
+                    stack.push(p);
+                } else if p.extension().is_some_and(|x| x == "rs") {
+                    let text = std::fs::read_to_string(&p).unwrap();
+                    for line in text.lines().filter(|l| !l.trim_start().starts_with("//")) {
+                        used.extend(line.chars().filter(|c| !c.is_ascii()));
+                    }
+                }
+            }
+        }
+        assert!(used.contains('✏'), "the scan finds the labels");
+        let missing: String = used
+            .chars()
+            .filter(|&c| !has(true, &c.to_string()))
+            .collect();
+        assert!(missing.is_empty(), "no glyph for {missing:?}");
     }
 }

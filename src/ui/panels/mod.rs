@@ -1,4 +1,4 @@
-//! The side panel: one struct per collapsible group, each with its own `ui()` that takes only
+//! The side panel: one view per collapsible group, each with its own `ui()` that takes only
 //! what it needs (the document, the selection, the tool state), as egui's demo app does.
 
 mod light;
@@ -7,8 +7,40 @@ mod scene;
 mod sketch;
 mod view;
 
-pub use light::LightPanel;
-pub use render::RenderPanel;
+pub use light::LIGHT;
+pub use render::RENDER;
 pub use scene::ScenePanel;
 pub use sketch::SketchPanel;
 pub use view::{ViewPanel, ViewStats};
+
+use egui::Ui;
+
+use crate::scene::{Document, Edit, Scene};
+
+/// A group that edits one part of the document (the light, the render settings): `body`
+/// changes a copy, and a change becomes one undoable edit (a slider drag folds into one step).
+pub struct PartPanel<T: 'static> {
+    /// The group's title (also the merge key of its edits).
+    pub title: &'static str,
+    /// The part it edits.
+    pub part: fn(&Scene) -> &T,
+    /// The edit that replaces the part.
+    pub edit: fn(T) -> Edit,
+    /// The group's widgets.
+    pub body: fn(&mut Ui, &mut T),
+}
+
+impl<T: Clone + PartialEq> PartPanel<T> {
+    /// Draws the group.
+    pub fn ui(&self, ui: &mut Ui, doc: &mut Document) {
+        egui::CollapsingHeader::new(self.title)
+            .default_open(true)
+            .show(ui, |ui| {
+                let mut value = (self.part)(doc.scene()).clone();
+                (self.body)(ui, &mut value);
+                if value != *(self.part)(doc.scene()) {
+                    doc.apply((self.edit)(value), Some(self.title));
+                }
+            });
+    }
+}

@@ -8,7 +8,7 @@ use crate::scene::{Document, Edit, StrokeKind};
 use crate::ui::notice::Notices;
 use crate::ui::selection::{Item, Selection};
 use crate::ui::sketch_tool::{SketchTool, Tool, delete_selected, duplicate_selected};
-use crate::ui::widgets::{param_f64, param_u32};
+use crate::ui::widgets::param;
 
 /// The Sketch group.
 #[derive(Default)]
@@ -31,11 +31,24 @@ impl SketchPanel {
                     for (t, label, tip) in [
                         (Tool::Navigate, "Navigate", "V: drag orbits the view"),
                         (Tool::Sketch, "✏ Sketch", "D: drag draws a cloud's outline"),
-                        (Tool::Cut, "✂ Cut", "C: drag draws a line; the cloud below it is removed"),
-                        (Tool::Move, "⬌ Move", "G: drag moves the selected drawing plane"),
-                        (Tool::Rotate, "⟳ Rotate", "R: drag turns the selected drawing plane"),
+                        (
+                            Tool::Cut,
+                            "✂ Cut",
+                            "C: drag draws a line; the cloud below it is removed",
+                        ),
+                        (
+                            Tool::Move,
+                            "⬌ Move",
+                            "G: drag moves the selected drawing plane",
+                        ),
+                        (
+                            Tool::Rotate,
+                            "⟳ Rotate",
+                            "R: drag turns the selected drawing plane",
+                        ),
                     ] {
-                        ui.selectable_value(&mut tool.tool, t, label).on_hover_text(tip);
+                        ui.selectable_value(&mut tool.tool, t, label)
+                            .on_hover_text(tip);
                     }
                 });
                 ui.horizontal(|ui| {
@@ -85,17 +98,13 @@ fn plane_controls(ui: &mut Ui, doc: &mut Document, i: usize) {
     ui.label(egui::RichText::new(&plane.name).strong());
     if plane.kind == StrokeKind::Outline {
         let s = &mut plane.sketch;
-        param_f64(ui, &mut s.inflate, &limits::INFLATE, "deflate (t)",
-            "Thin the cloud's body toward its smallest features (0 keeps it as drawn)");
-        param_f64(ui, &mut s.simplify, &limits::SIMPLIFY, "simplify",
-            "Smooth away small wiggles of the stroke before building the cloud");
-        param_f64(ui, &mut s.prune, &limits::PRUNE, "prune branches",
-            "Ignore bumps of the outline smaller than this share of its area");
+        param(ui, &mut s.inflate, &limits::INFLATE);
+        param(ui, &mut s.simplify, &limits::SIMPLIFY);
+        param(ui, &mut s.prune, &limits::PRUNE);
         ui.checkbox(&mut s.extend, "3D extension")
             .on_hover_text("Grow copies of the cloud's bumps toward and away from you, so it is round from the side");
         ui.add_enabled_ui(s.extend, |ui| {
-            param_u32(ui, &mut s.copies, &limits::COPIES, "branch copies",
-                "Copies of each bump placed around the cloud's body");
+            param(ui, &mut s.copies, &limits::COPIES);
         });
     }
     ui.horizontal(|ui| {

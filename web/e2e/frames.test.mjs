@@ -1,0 +1,112 @@
+// Frame time while dragging, measured as a user feels it: requestAnimationFrame intervals in a
+// 1100×700 page while pointer events arrive at 60 Hz (not one awaited event per frame), for an
+// orbit drag and a plane-move drag, on the default scene and on a scene of 10 sketched strokes,
+// on both backends. Figures go to test-results/timings.json (the README quotes them); the
+// assertions are only the hard limit of the clarifications (every frame ≤ 0.3 s would be the
+// goal; a test fails on a frame over 1 s, which means the app blocked), never a timing goal.
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import { serve, launch, openApp, waitForBody, waitForFullQuality, state, until, recordTiming } from './harness.mjs';
+
+let server;
+before(async () => { server = await serve(); });
+after(async () => { await server?.close(); });
+
+const VIEWPORT = { width: 1100, height: 700 };
+const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+
+/** Drags from (x, y) by (dx, dy) with events at 60 Hz; returns rAF intervals (ms) meanwhile. */
+async function timedDrag(page, x, y, dx, dy, steps = 45) {
+  await page.evaluate(() => {
+    window.__frames = [];
+    window.__loop = true;
+    const loop = (t) => { window.__frames.push(t); if (window.__loop) requestAnimationFrame(loop); };
+    requestAnimationFrame(loop);
+  });
+  await page.mouse.move(x, y);
+  await page.mouse.down();
+  const t0 = Date.now();
+  for (let i = 1; i <= steps; i++) {
+    // Paced by the wall clock, not by frames: a slow frame means several events per frame.
+    const due = t0 + (i * 1000) / 60;
+    const wait = due - Date.now();
+    if (wait > 0) await sleep(wait);
+    page.mouse.move(x + (dx * i) / steps, y + (dy * i) / steps); // not awaited
+  }
+  await page.mouse.move(x + dx, y + dy);
+  await page.mouse.up();
+  const frames = await page.evaluate(() => { window.__loop = false; return window.__frames; });
+  const intervals = frames.slice(1).map((t, i) => t - frames[i]);
+  return intervals;
+}
+
+const median = (v) => { const s = [...v].sort((a, b) => a - b); return s[Math.floor(s.length / 2)]; };
+
+/** Draws a small cloud outline centred at (cx, cy) with pointer events. */
+async function outline(page, cx, cy, r) {
+  const pts = [];
+  for (let i = 0; i <= 36; i++) {
+    const a = (i / 36) * 2 * Math.PI;
+    const bump = 1 + 0.15 * Math.sin(a * 5);
+    pts.push([cx + r * 1.4 * Math.cos(a) * bump, cy - r * Math.max(Math.sin(a), -0.3) * bump]);
+  }
+  await page.mouse.move(pts[0][0], pts[0][1]);
+  await page.mouse.down();
+  for (const [x, y] of pts.slice(1)) await page.mouse.move(x, y);
+  await page.mouse.up();
+}
+
+for (const backend of ['webgpu', 'webgl2']) {
+  test(`frame time while dragging (${backend})`, { timeout: 420_000 }, async () => {
+    const { browser, close } = await launch({ webgpu: backend === 'webgpu' });
+    try {
+      const { page, errors, log } = await openApp(browser, server.url, '', VIEWPORT);
+      try {
+        await waitForBody(page, 'data-ready', (v) => v === 'true');
+        let s = await state(page);
+        const [vw, vh] = s.view.viewport;
+        const results = {};
+        const measure = async (name, x, y, dx, dy) => {
+          await waitForFullQuality(page);
+          const intervals = await timedDrag(page, x, y, dx, dy);
+          const after = await state(page);
+          results[name] = {
+            median_ms: Math.round(median(intervals)),
+            max_ms: Math.round(Math.max(...intervals)),
+            frames: intervals.length,
+            cpu_ms: after.view.cpu_ms,
+            quality: after.view.quality,
+          };
+          assert.ok(Math.max(...intervals) < 1000, `${name}: a frame took ${Math.max(...intervals)} ms`);
+        };
+        await measure('default_orbit', vw * 0.5, vh * 0.5, 220, 40);
+
+        // Ten strokes drawn as a user would, then an orbit and a plane move.
+        await page.mouse.click(vw * 0.05, vh * 0.95);
+        await page.keyboard.press('d');
+        await until(page, (s) => s.view.tool === 'sketch', 'sketch tool');
+        for (let i = 0; i < 10; i++) {
+          const cx = vw * (0.2 + 0.6 * ((i % 5) / 4));
+          const cy = vh * (i < 5 ? 0.35 : 0.7);
+          await outline(page, cx, cy, vw * 0.05);
+          await until(page, (s) => s.scene.planes.length === i + 1, `stroke ${i + 1}`);
+        }
+        await page.keyboard.press('v');
+        await measure('strokes10_orbit', vw * 0.5, vh * 0.5, -200, 30);
+        await page.keyboard.press('g');
+        s = await until(page, (s) => s.view.tool === 'move' && s.view.selected_plane != null, 'move tool with a selection');
+        await measure('strokes10_plane_move', vw * 0.5, vh * 0.5, 120, -40);
+        s = await state(page);
+        assert.equal(s.scene.planes.length, 10);
+        assert.deepEqual(errors, [], `errors logged:\n${errors.join('\n')}`);
+        recordTiming({ test: 'frames', backend, viewport: VIEWPORT, ...results });
+        console.log(backend, JSON.stringify(results));
+      } catch (e) {
+        console.error(log.slice(-40).join('\n'));
+        throw e;
+      }
+    } finally {
+      await close();
+    }
+  });
+}
