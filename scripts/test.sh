@@ -11,6 +11,9 @@ log() { printf '\033[1;34m[test]\033[0m %s\n' "$*" >&2; }
 bash scripts/setup.sh
 
 log "cargo test (native)"
+# Offscreen tests pick their adapter themselves: Mesa's device-select layer would only look for
+# a display (and print XDG_RUNTIME_DIR errors on a headless machine). The CLI does the same.
+export NODEVICE_SELECT=1
 cargo test --locked
 
 log "trunk build --release (wasm)"

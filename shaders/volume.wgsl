@@ -2,8 +2,8 @@
 // cloud's bounding sphere, drawn back to front in one instanced draw and composited with
 // premultiplied "over" blending into a linear RGBA target.
 //
-// Density = blended implicit field (a 3D texture) perturbed by octaves of periodic noise;
-// lighting = sun × transmittance toward the sun (a second 3D texture) + ambient sky.
+// Density = blended implicit field (red of the volume texture) perturbed by octaves of
+// periodic noise; lighting = sun × transmittance toward the sun (green) + ambient sky.
 // Composed after volume_common.wgsl (uniforms and bindings).
 
 struct VsOut {
@@ -55,7 +55,8 @@ fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
     if any(uvw < vec3<f32>(0.0)) || any(uvw > vec3<f32>(1.0)) {
         discard;
     }
-    let field = textureSampleLevel(density_tex, clamp_smp, uvw, 0.0).r;
+    let sample = textureSampleLevel(volume_tex, clamp_smp, uvw, 0.0);
+    let field = sample.r;
     let iso = u.media.y;
     let soft = u.media.z;
     let amount = u.media.w;
@@ -71,7 +72,6 @@ fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
     let view_dir = normalize(in.world - u.eye.xyz);
     let path = u.slicing.z / max(dot(view_dir, u.forward.xyz), 0.2);
     let alpha = 1.0 - exp(-u.media.x * density * path);
-    let sun = textureSampleLevel(light_tex, clamp_smp, uvw, 0.0).r;
-    let light = u.sun_color.rgb * sun + u.sky_color.rgb;
+    let light = u.sun_color.rgb * sample.g + u.sky_color.rgb;
     return vec4<f32>(light * alpha, alpha);
 }

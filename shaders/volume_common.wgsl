@@ -34,8 +34,8 @@ struct Volume {
 };
 
 @group(0) @binding(0) var<uniform> u: Volume;
-@group(0) @binding(1) var density_tex: texture_3d<f32>;
+// Density (red: the field value) and light (green: transmittance toward the sun).
+@group(0) @binding(1) var volume_tex: texture_3d<f32>;
 @group(0) @binding(2) var clamp_smp: sampler;
 @group(0) @binding(3) var noise_tex: texture_3d<f32>;
 @group(0) @binding(4) var repeat_smp: sampler;
-@group(0) @binding(5) var light_tex: texture_3d<f32>;

@@ -8,8 +8,24 @@ pub const MAX_FILE_BYTES: u64 = 64 << 20;
 pub const MAX_ELLIPSOIDS: usize = 4096;
 /// Most drawing planes in a document.
 pub const MAX_PLANES: usize = 256;
-/// Most points a stored stroke may have.
+/// Most points a stored stroke may have (longer strokes are thinned to this).
 pub const MAX_PLANE_POINTS: usize = 20_000;
+/// Most vertices an outline keeps after simplification and resampling.
+pub const MAX_OUTLINE_POINTS: usize = 320;
+/// Most spheres one stroke makes (copies from the 3D extension included).
+pub const MAX_SPHERES: usize = 3000;
+/// Most primitives in one field (sketches make many spheres; the cap keeps baking bounded).
+pub const MAX_PRIMITIVES: usize = 20_000;
+/// Most texels along one side of the density volume.
+pub const MAX_GRID_RESOLUTION: u32 = 128;
+/// Largest image side rendered offscreen.
+pub const MAX_RENDER_SIDE: u32 = 8192;
+/// Largest image side decoded at all (guide images).
+pub const MAX_DECODE_SIDE: u32 = 16_384;
+/// Largest guide image side kept (larger images are scaled down before upload).
+pub const MAX_GUIDE_SIDE: u32 = 2048;
+/// Most undo steps kept.
+pub const MAX_UNDO: usize = 200;
 
 /// A numeric parameter: its range, default, the way its slider moves, and its name and
 /// meaning in an artist's words.

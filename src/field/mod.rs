@@ -22,8 +22,7 @@ pub const SUPPORT: f32 = 2.0;
 /// How far (in visible radii) the field can reach the surface level once blended; grid bounds
 /// use it so nothing visible is cut off while the grid stays tight.
 pub const BOUNDS_MARGIN: f32 = 1.6;
-/// Most primitives in one field (sketches make many spheres; the cap keeps baking bounded).
-pub const MAX_PRIMITIVES: usize = 20_000;
+pub use crate::limits::MAX_PRIMITIVES;
 
 /// Wyvill's kernel as a function of s = r²/R².
 #[inline]

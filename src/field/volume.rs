@@ -6,8 +6,7 @@ use glam::{UVec3, Vec3};
 
 use super::{Field, ISO};
 
-/// Most texels along one side of the grid.
-pub const MAX_RESOLUTION: u32 = 128;
+pub use crate::limits::MAX_GRID_RESOLUTION as MAX_RESOLUTION;
 /// Fewest texels along one side.
 const MIN_SIDE: u32 = 4;
 

@@ -8,8 +8,7 @@ use super::resources::accumulation_format;
 use crate::derive::Derived;
 use crate::scene::{Document, Scene};
 
-/// Largest offscreen image side.
-pub const MAX_SIDE: u32 = 8192;
+pub use crate::limits::MAX_RENDER_SIDE as MAX_SIDE;
 /// Output format: the same 8-bit, non-sRGB kind of target egui composites into.
 const OUTPUT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 

@@ -100,7 +100,7 @@ fn pipeline(
 pub struct SlicePass {
     /// The slice pipeline.
     pub pipeline: wgpu::RenderPipeline,
-    /// Layout of its bind group (uniforms, density, sampler, noise, sampler, light).
+    /// Layout of its bind group (uniforms, volume, sampler, noise, sampler).
     pub layout: wgpu::BindGroupLayout,
     /// Uniform ring, [`MAX_SLICE_DRAWS_PER_FRAME`] slots of `stride` bytes.
     pub uniforms: wgpu::Buffer,
@@ -130,7 +130,6 @@ impl SlicePass {
                 sampler_entry(2),
                 texture_3d(3),
                 sampler_entry(4),
-                texture_3d(5),
             ],
         });
         let align = device.limits().min_uniform_buffer_offset_alignment.max(16) as u64;

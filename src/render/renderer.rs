@@ -63,9 +63,7 @@ impl VolumeRenderer {
             return;
         }
         let t = &self.textures;
-        let (Some((_, density)), Some((_, light)), Some((_, noise))) =
-            (&t.density, &t.light, &t.noise)
-        else {
+        let (Some((_, volume)), Some((_, noise))) = (&t.volume, &t.noise) else {
             return;
         };
         let entries = [
@@ -79,7 +77,7 @@ impl VolumeRenderer {
             },
             wgpu::BindGroupEntry {
                 binding: 1,
-                resource: wgpu::BindingResource::TextureView(density),
+                resource: wgpu::BindingResource::TextureView(volume),
             },
             wgpu::BindGroupEntry {
                 binding: 2,
@@ -92,10 +90,6 @@ impl VolumeRenderer {
             wgpu::BindGroupEntry {
                 binding: 4,
                 resource: wgpu::BindingResource::Sampler(&self.repeat_sampler),
-            },
-            wgpu::BindGroupEntry {
-                binding: 5,
-                resource: wgpu::BindingResource::TextureView(light),
             },
         ];
         self.bind_group = Some(device.create_bind_group(&wgpu::BindGroupDescriptor {

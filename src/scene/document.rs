@@ -15,8 +15,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use super::{Edit, OrbitCamera, Scene};
 use crate::limits::MAX_PLANES;
 
-/// Most undo steps kept.
-pub const MAX_UNDO: usize = 200;
+pub use crate::limits::MAX_UNDO;
 
 /// Source of revision numbers, shared by every document in the process: a revision never
 /// repeats, even across documents, so a cache keyed on one can never confuse two documents.

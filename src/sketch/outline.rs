@@ -6,10 +6,7 @@ use glam::DVec2;
 
 use super::SketchError;
 
-/// Most points a stroke may have; longer strokes are thinned evenly first.
-pub const MAX_STROKE_POINTS: usize = 20_000;
-/// Most vertices of the resampled outline that goes to the triangulation.
-pub const MAX_OUTLINE_POINTS: usize = 320;
+pub use crate::limits::{MAX_OUTLINE_POINTS, MAX_PLANE_POINTS as MAX_STROKE_POINTS};
 /// Fewest vertices of the resampled outline.
 const MIN_OUTLINE_POINTS: usize = 24;
 

@@ -9,8 +9,7 @@ use super::outline::{Boundary, Outline, contains};
 use super::skeleton::{BranchKind, Skeleton};
 use crate::seeded::SplitMix;
 
-/// Most spheres one stroke makes (copies from the 3D extension included).
-pub const MAX_SPHERES: usize = 3000;
+pub use crate::limits::MAX_SPHERES;
 /// Spacing of spheres along the skeleton as a fraction of the smaller neighbouring radius:
 /// well below 1, so neighbours overlap deeply and the body never splits.
 const SPACING: f64 = 0.4;

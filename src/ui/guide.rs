@@ -9,10 +9,7 @@ use super::platform as files;
 /// A file's name and bytes, or why it could not be read.
 pub type Loaded = Result<(String, Vec<u8>), String>;
 
-/// Largest image side kept (larger images are scaled down before upload).
-pub const MAX_GUIDE_SIDE: u32 = 2048;
-/// Largest image side decoded at all.
-const MAX_DECODE_SIDE: u32 = 16_384;
+use crate::limits::{MAX_DECODE_SIDE, MAX_GUIDE_SIDE};
 
 /// A loaded guide image.
 pub struct GuideImage {
