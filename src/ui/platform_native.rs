@@ -36,6 +36,11 @@ pub fn read_path(path: &str) -> Loaded {
         .map_err(|e| format!("{path}: {e}"))
 }
 
+/// Pointer samples beyond egui's events: none natively, where every cursor move is an event.
+pub fn take_pointer_samples() -> Option<Vec<egui::Pos2>> {
+    None
+}
+
 /// Nothing to install natively (dropped files arrive through egui).
 pub fn install(_ctx: &egui::Context) {}
 

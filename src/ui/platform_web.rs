@@ -23,6 +23,7 @@ const MAX_BYTES: f64 = MAX_FILE_BYTES as f64;
 
 thread_local! {
     static INBOX: RefCell<Vec<Loaded>> = const { RefCell::new(Vec::new()) };
+    static SAMPLES: RefCell<Vec<egui::Pos2>> = const { RefCell::new(Vec::new()) };
     static REPAINT: RefCell<Option<egui::Context>> = const { RefCell::new(None) };
 }
 
@@ -78,9 +79,76 @@ fn input() -> Option<web_sys::HtmlInputElement> {
         .ok()
 }
 
-/// Installs the change listener of the page's file input (once, at start-up).
+/// Every position of the primary pointer while a button is held, coalesced samples
+/// included: the browser hands the page one move per frame, and a frame on a CPU adapter can
+/// take 150 ms, so a stroke drawn from the per-frame moves alone loses its shape.
+fn install_pointer_samples(ctx: &egui::Context) {
+    let Some(document) = web_sys::window().and_then(|w| w.document()) else {
+        return;
+    };
+    let Some(canvas) = document.get_element_by_id("cloudsketch_canvas") else {
+        return;
+    };
+    let on_down = Closure::<dyn FnMut(web_sys::PointerEvent)>::new(|e: web_sys::PointerEvent| {
+        if e.is_primary() {
+            SAMPLES.with(|s| s.borrow_mut().clear());
+        }
+    });
+    let _ =
+        canvas.add_event_listener_with_callback("pointerdown", on_down.as_ref().unchecked_ref());
+    on_down.forget(); // lives as long as the page
+    let ctx = ctx.clone();
+    let on_move =
+        Closure::<dyn FnMut(web_sys::PointerEvent)>::new(move |e: web_sys::PointerEvent| {
+            if !e.is_primary() || e.buttons() == 0 {
+                return;
+            }
+            let Some(canvas) = web_sys::window()
+                .and_then(|w| w.document())
+                .and_then(|d| d.get_element_by_id("cloudsketch_canvas"))
+            else {
+                return;
+            };
+            let rect = canvas.get_bounding_client_rect();
+            let zoom = ctx.zoom_factor();
+            let at = |m: &web_sys::MouseEvent| {
+                egui::pos2(
+                    (m.client_x() as f32 - rect.left() as f32) / zoom,
+                    (m.client_y() as f32 - rect.top() as f32) / zoom,
+                )
+            };
+            let coalesced = e.get_coalesced_events();
+            SAMPLES.with(|s| {
+                let mut s = s.borrow_mut();
+                if coalesced.length() == 0 {
+                    s.push(at(&e));
+                }
+                for c in coalesced.iter() {
+                    if let Ok(m) = c.dyn_into::<web_sys::MouseEvent>() {
+                        s.push(at(&m));
+                    }
+                }
+                // A held button with no stroke being drawn must not grow this without bound.
+                let excess = s.len().saturating_sub(crate::limits::MAX_PLANE_POINTS);
+                s.drain(..excess);
+            });
+        });
+    let _ =
+        document.add_event_listener_with_callback("pointermove", on_move.as_ref().unchecked_ref());
+    on_move.forget(); // lives as long as the page
+}
+
+/// Pointer positions (in points) since the last call, every sample the browser saw while the
+/// primary pointer was down; `None` where egui's own events already carry every sample.
+pub fn take_pointer_samples() -> Option<Vec<egui::Pos2>> {
+    Some(SAMPLES.with(|s| std::mem::take(&mut *s.borrow_mut())))
+}
+
+/// Installs the page's listeners: pointer samples, and the file input's change (once, at
+/// start-up).
 pub fn install(ctx: &egui::Context) {
     REPAINT.with(|c| *c.borrow_mut() = Some(ctx.clone()));
+    install_pointer_samples(ctx);
     let Some(el) = input() else {
         log::warn!("the page has no #guide_input: the Load… button will do nothing");
         return;

@@ -54,6 +54,8 @@ pub struct SketchTool {
     pub show_all_planes: bool,
     /// Hide strokes and grids (H), to look at the cloud alone.
     pub hide_guides: bool,
+    /// A stroke is being drawn (between drag start and stop).
+    drawing: bool,
 }
 
 /// The pointer in the viewport this frame.
@@ -175,6 +177,7 @@ impl SketchTool {
                 tc.selection.clear();
             }
             self.stroke.clear();
+            self.drawing = false;
         }
         if dup && let Some(m) = duplicate_selected(tc.doc, tc.selection) {
             tc.notices.note(now, m);
@@ -202,8 +205,22 @@ impl SketchTool {
         let (alt, multi) = ui.input(|i| (i.modifiers.alt, i.multi_touch().is_some()));
         if alt || multi {
             self.stroke.clear();
+            self.drawing = false;
             return true;
         }
+        // Every pointer sample since the last frame, not one position per frame: on a slow
+        // adapter a frame can hold a dozen samples of a fast stroke.
+        let samples = super::platform::take_pointer_samples().unwrap_or_else(|| {
+            ui.input(|i| {
+                i.events
+                    .iter()
+                    .filter_map(|e| match e {
+                        egui::Event::PointerMoved(p) => Some(*p),
+                        _ => None,
+                    })
+                    .collect()
+            })
+        });
         if response.drag_started_by(egui::PointerButton::Primary) {
             self.stroke.clear();
             // Start where the button went down, not where the drag was recognised.
@@ -213,15 +230,17 @@ impl SketchTool {
             {
                 self.stroke.push(p);
             }
+            self.drawing = true;
         }
-        if response.dragged_by(egui::PointerButton::Primary)
-            && let Some(p) = response.interact_pointer_pos()
-            && self.stroke.last().is_none_or(|q| q.distance(p) >= 1.0)
-            && self.stroke.len() < MAX_PLANE_POINTS
-        {
-            self.stroke.push(p);
+        if self.drawing {
+            for p in samples {
+                if self.stroke.last() != Some(&p) && self.stroke.len() < MAX_PLANE_POINTS {
+                    self.stroke.push(p);
+                }
+            }
         }
         if response.drag_stopped_by(egui::PointerButton::Primary) {
+            self.drawing = false;
             let stroke = std::mem::take(&mut self.stroke);
             let now = ui.input(|i| i.time);
             self.finish_stroke(now, rect, &stroke, tc);

@@ -1,0 +1,89 @@
+// Strokes keep their shape when input outpaces frames: a bumpy 104-point outline sent as real
+// pointer events at 60 Hz and at 240 Hz, dispatched on the clock without waiting for frames
+// (frames take 100–300 ms on a CPU adapter), is stored with ≥ 90% of its samples and the shape
+// that was drawn. One sample per frame — what egui's per-frame pointer position gives — keeps
+// about a tenth of them and fails here. Both backends.
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import { serve, launch, openApp, waitForBody, state, until, recordTiming } from './harness.mjs';
+
+let server;
+before(async () => { server = await serve(); });
+after(async () => { await server?.close(); });
+
+const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+
+/** A bumpy cloud outline of n points around (cx, cy), in page pixels. */
+function bumpy(cx, cy, r, n = 104) {
+  return Array.from({ length: n }, (_, i) => {
+    const a = (i / n) * 2 * Math.PI;
+    const rr = r * (1 + 0.18 * Math.sin(a * 7));
+    return [cx + rr * Math.cos(a) * 1.3, cy - rr * Math.sin(a)];
+  });
+}
+
+/** Sends the points as pointer events at `hz`, paced by the clock, never awaiting a frame. */
+async function drawAt(page, pts, hz) {
+  await page.mouse.move(pts[0][0], pts[0][1]);
+  await page.mouse.down();
+  const t0 = Date.now();
+  const pending = [];
+  for (let i = 1; i < pts.length; i++) {
+    const wait = t0 + (i * 1000) / hz - Date.now();
+    if (wait > 0) await sleep(wait);
+    pending.push(page.mouse.move(pts[i][0], pts[i][1]));
+  }
+  await Promise.all(pending);
+  await page.mouse.up();
+  return (Date.now() - t0) / 1000;
+}
+
+/** Centred and scaled to unit height, y up. */
+function normalise(pts) {
+  const xs = pts.map((p) => p[0]), ys = pts.map((p) => p[1]);
+  const cx = (Math.min(...xs) + Math.max(...xs)) / 2, cy = (Math.min(...ys) + Math.max(...ys)) / 2;
+  const h = Math.max(...ys) - Math.min(...ys);
+  return pts.map(([x, y]) => [(x - cx) / h, (y - cy) / h]);
+}
+
+/** Mean distance from each point of `a` to the nearest point of `b`. */
+function meanNearest(a, b) {
+  return a.reduce((s, [x, y]) => s + Math.min(...b.map(([u, v]) => Math.hypot(x - u, y - v))), 0) / a.length;
+}
+
+for (const backend of ['webgpu', 'webgl2']) {
+  test(`every pointer sample is kept at 60 and 240 Hz (${backend})`, { timeout: 300_000 }, async () => {
+    const { browser, close } = await launch({ webgpu: backend === 'webgpu' });
+    try {
+      const { page, errors, log } = await openApp(browser, server.url, '?preset=empty', { width: 1280, height: 800 });
+      try {
+        await waitForBody(page, 'data-ready', (v) => v === 'true');
+        const [vw, vh] = (await state(page)).view.viewport;
+        await page.mouse.click(vw * 0.05, vh * 0.95);
+        await page.keyboard.press('d');
+        await until(page, (s) => s.view.tool === 'sketch', 'sketch tool');
+        const record = { test: 'input', backend };
+        for (const [i, hz] of [60, 240].entries()) {
+          const sent = bumpy(vw * (0.3 + 0.4 * i), vh * 0.5, vh * 0.16);
+          const seconds = await drawAt(page, sent, hz);
+          const s = await until(page, (s) => s.scene.planes.length === i + 1, `the ${hz} Hz stroke`);
+          const stored = s.scene.planes[i].points;
+          // The plane faces the default view (yaw 0): plane x is screen x, plane y is screen up.
+          const drawn = normalise(sent.map(([x, y]) => [x, -y]));
+          const kept = normalise(stored);
+          const error = Math.max(meanNearest(drawn, kept), meanNearest(kept, drawn));
+          record[`hz${hz}`] = { sent: sent.length, stored: stored.length, seconds, shapeError: error };
+          assert.ok(stored.length >= 0.9 * sent.length, `${hz} Hz: ${stored.length} of ${sent.length} samples stored`);
+          assert.ok(error < 0.02, `${hz} Hz: the stored stroke is off the drawn one by ${error.toFixed(3)} of its height`);
+        }
+        assert.deepEqual(errors, [], `errors logged:\n${errors.join('\n')}`);
+        recordTiming(record);
+      } catch (e) {
+        console.error(log.slice(-40).join('\n'));
+        throw e;
+      }
+    } finally {
+      await close();
+    }
+  });
+}
