@@ -52,6 +52,9 @@ impl Default for StartOptions {
     }
 }
 
+/// Width of the side panel in points.
+const PANEL_WIDTH: f32 = 300.0;
+
 /// The side panel's views.
 #[derive(Default)]
 struct Panels {
@@ -70,6 +73,8 @@ pub struct CloudApp {
     notices: Notices,
     guide: Guide,
     panels: Panels,
+    /// The side panel is shown (N or its button toggles it, as Blender's sidebar).
+    panel_open: bool,
     host: Option<Box<dyn Host>>,
     last_status: Option<PageStatus>,
     /// CPU time of the last frame (app and rendering), as eframe measures it.
@@ -106,6 +111,7 @@ impl CloudApp {
             notices: Notices::default(),
             guide: Guide::default(),
             panels: Panels::default(),
+            panel_open: true,
             host: options.host,
             last_status: None,
             cpu_seconds: None,
@@ -135,13 +141,17 @@ impl CloudApp {
             return;
         }
         use egui::{Key, Modifiers};
-        let (undo, redo, frame) = ctx.input_mut(|i| {
+        let (undo, redo, frame, panel) = ctx.input_mut(|i| {
             let redo = i.consume_key(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z)
                 || i.consume_key(Modifiers::COMMAND, Key::Y);
             let undo = i.consume_key(Modifiers::COMMAND, Key::Z);
             let frame = i.consume_key(Modifiers::NONE, Key::F);
-            (undo, redo, frame)
+            let panel = i.consume_key(Modifiers::NONE, Key::N);
+            (undo, redo, frame, panel)
         });
+        if panel {
+            self.panel_open = !self.panel_open;
+        }
         let now = ctx.input(|i| i.time);
         if undo {
             self.undo(now);
@@ -163,7 +173,18 @@ impl CloudApp {
 
     /// The side panel: undo/redo/frame buttons, then each group's view.
     fn side_panel(&mut self, ui: &mut egui::Ui) {
-        ui.heading("cloudsketch");
+        ui.horizontal(|ui| {
+            ui.heading("cloudsketch");
+            ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
+                if ui
+                    .small_button("»")
+                    .on_hover_text("N: hide this panel")
+                    .clicked()
+                {
+                    self.panel_open = false;
+                }
+            });
+        });
         ui.horizontal(|ui| {
             let now = ui.input(|i| i.time);
             if ui
@@ -239,6 +260,7 @@ impl CloudApp {
             "tool": self.tool.tool.name(),
             "selected_plane": self.selection.plane(),
             "guides_hidden": self.tool.hide_guides,
+            "panel_open": self.panel_open,
             "guide_image": self.guide.image.as_ref().map(|g| serde_json::json!({
                 "name": g.name, "size": g.size, "opacity": self.guide.opacity, "visible": self.guide.visible,
             })),
@@ -261,6 +283,34 @@ impl CloudApp {
 }
 
 impl eframe::App for CloudApp {
+    /// Keys that would press a button the user is not looking at: Tab means nothing here (as
+    /// in Blender it is no focus key), and while the pointer is over the view no widget keeps
+    /// the keyboard, so Space and Enter press nothing and the view's shortcuts always work.
+    fn raw_input_hook(&mut self, ctx: &egui::Context, raw: &mut egui::RawInput) {
+        use egui::{Event, Key};
+        raw.events
+            .retain(|e| !matches!(e, Event::Key { key: Key::Tab, .. }));
+        let over_view = ctx
+            .pointer_hover_pos()
+            .is_some_and(|p| self.viewport.rect.contains(p));
+        if over_view {
+            ctx.memory_mut(|m| {
+                if let Some(id) = m.focused() {
+                    m.surrender_focus(id);
+                }
+            });
+            raw.events.retain(|e| {
+                !matches!(
+                    e,
+                    Event::Key {
+                        key: Key::Space | Key::Enter,
+                        ..
+                    }
+                )
+            });
+        }
+    }
+
     fn clear_color(&self, _visuals: &egui::Visuals) -> [f32; 4] {
         // The sky behind the cloud, sRGB-encoded like egui's colours.
         let [r, g, b] = self.doc.scene().light.background;
@@ -272,12 +322,28 @@ impl eframe::App for CloudApp {
         let ctx = ui.ctx().clone();
         self.shortcuts(&ctx);
         self.guide.input(&ctx);
+        // Fixed width: growing values never shift the buttons under the pointer.
+        let mut open = self.panel_open;
         egui::Panel::right("controls")
-            .resizable(true)
-            .default_size(270.0)
-            .show(ui, |ui| {
+            .resizable(false)
+            .exact_size(PANEL_WIDTH)
+            .show_collapsible(ui, &mut open, |ui| {
                 egui::ScrollArea::vertical().show(ui, |ui| self.side_panel(ui));
             });
+        self.panel_open &= open;
+        if !self.panel_open {
+            egui::Area::new(egui::Id::unique("show panel"))
+                .anchor(egui::Align2::RIGHT_TOP, egui::vec2(-8.0, 8.0))
+                .show(&ctx, |ui| {
+                    if ui
+                        .button("« panel")
+                        .on_hover_text("N: show the side panel")
+                        .clicked()
+                    {
+                        self.panel_open = true;
+                    }
+                });
+        }
         egui::CentralPanel::no_frame().show(ui, |ui| {
             self.viewport.show(
                 ui,

@@ -354,7 +354,8 @@ impl SketchTool {
                 };
             }
             _ => {
-                const RAD_PER_PX: f32 = 0.01;
+                // About 1° per 5 px: a 150 px drag turns 30°, as the gizmos will.
+                const RAD_PER_PX: f32 = 0.2 * std::f32::consts::PI / 180.0;
                 let turn = Quat::from_axis_angle(Vec3::Y, delta.x * RAD_PER_PX)
                     * Quat::from_axis_angle(camera.right(), delta.y * RAD_PER_PX);
                 plane.rotation = (turn * plane.rotation).normalize();

@@ -23,6 +23,8 @@ pub struct Viewport {
     pub ready: bool,
     /// Set by panels and F; applied once the viewport's size is known.
     pub frame_request: bool,
+    /// Where the view was drawn last frame (in points).
+    pub rect: egui::Rect,
 }
 
 /// Everything the viewport works on this frame: what the tools work on, the tools, the
@@ -44,6 +46,7 @@ impl Viewport {
             stats,
             ready: false,
             frame_request: false,
+            rect: egui::Rect::NOTHING,
         }
     }
 
@@ -63,6 +66,7 @@ impl Viewport {
     /// Draws the viewport into the rest of `ui`.
     pub fn show(&mut self, ui: &mut egui::Ui, vc: ViewportContext<'_>) {
         let rect = ui.available_rect_before_wrap();
+        self.rect = rect;
         let response = ui.allocate_rect(rect, Sense::click_and_drag());
         let ViewportContext {
             mut cx,

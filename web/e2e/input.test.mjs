@@ -2,7 +2,9 @@
 // pointer events at 60 Hz and at 240 Hz, dispatched on the clock without waiting for frames
 // (frames take 100–300 ms on a CPU adapter), is stored with ≥ 90% of its samples and the shape
 // that was drawn. One sample per frame — what egui's per-frame pointer position gives — keeps
-// about a tenth of them and fails here. Both backends.
+// about a tenth of them and fails here. Then Tab, Space and Enter over the view press nothing
+// and the view's shortcuts still work; the side panel keeps its width while values change and
+// N hides and shows it. Both backends.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { serve, launch, openApp, waitForBody, state, until, recordTiming } from './harness.mjs';
@@ -76,6 +78,32 @@ for (const backend of ['webgpu', 'webgl2']) {
           assert.ok(stored.length >= 0.9 * sent.length, `${hz} Hz: ${stored.length} of ${sent.length} samples stored`);
           assert.ok(error < 0.02, `${hz} Hz: the stored stroke is off the drawn one by ${error.toFixed(3)} of its height`);
         }
+        // Tab, then Space and Enter with the pointer over the view: nothing is pressed (Tab
+        // used to focus Undo, and Space then undid the last stroke), and the shortcuts work.
+        let s = await state(page);
+        const undo = s.view.undo;
+        await page.mouse.move(vw * 0.5, vh * 0.2);
+        for (const key of ['Tab', 'Tab', 'Space', 'Enter', 'Tab', 'Space']) await page.keyboard.press(key);
+        await page.keyboard.press('g');
+        s = await until(page, (s) => s.view.tool === 'move', 'G after Tab and Space');
+        assert.equal(s.scene.planes.length, 2, 'Space pressed no Undo');
+        assert.equal(s.view.undo, undo);
+
+        // The side panel keeps its width while values grow (rotating the selected plane
+        // rewrites its angle fields), and N hides and shows it.
+        await page.keyboard.press('r');
+        await until(page, (s) => s.view.tool === 'rotate', 'rotate tool');
+        const rot0 = JSON.stringify(s.scene.planes[1].rotation);
+        await page.mouse.move(vw * 0.7, vh * 0.5);
+        await page.mouse.down();
+        for (let i = 1; i <= 10; i++) await page.mouse.move(vw * 0.7 + i * 25, vh * 0.5 - i * 6);
+        await page.mouse.up();
+        s = await until(page, (s) => JSON.stringify(s.scene.planes[1].rotation) !== rot0, 'the plane rotated');
+        assert.deepEqual(s.view.viewport, [vw, vh], 'the view kept its width while the angles changed');
+        await page.keyboard.press('n');
+        s = await until(page, (s) => !s.view.panel_open && s.view.viewport[0] === 1280, 'panel hidden, view full width');
+        await page.keyboard.press('n');
+        s = await until(page, (s) => s.view.panel_open && s.view.viewport[0] === vw, 'panel back at its width');
         assert.deepEqual(errors, [], `errors logged:\n${errors.join('\n')}`);
         recordTiming(record);
       } catch (e) {

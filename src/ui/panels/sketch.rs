@@ -110,10 +110,11 @@ fn plane_controls(ui: &mut Ui, doc: &mut Document, i: usize) {
     ui.horizontal(|ui| {
         ui.label("move");
         for (axis, v) in ["x", "y", "z"].iter().zip(plane.origin.as_mut()) {
-            ui.add(
+            ui.add_sized(
+                [62.0, 18.0],
                 egui::DragValue::new(v)
                     .speed(0.05)
-                    .max_decimals(2)
+                    .fixed_decimals(2)
                     .prefix(format!("{axis} ")),
             );
         }
@@ -122,17 +123,14 @@ fn plane_controls(ui: &mut Ui, doc: &mut Document, i: usize) {
     let before = (yaw, pitch, roll);
     ui.horizontal(|ui| {
         ui.label("rotate");
-        for (label, v) in [
-            ("yaw ", &mut yaw),
-            ("pitch ", &mut pitch),
-            ("roll ", &mut roll),
-        ] {
+        for (label, v) in [("y ", &mut yaw), ("p ", &mut pitch), ("r ", &mut roll)] {
             let mut deg = v.to_degrees();
             if ui
-                .add(
+                .add_sized(
+                    [62.0, 18.0],
                     egui::DragValue::new(&mut deg)
                         .speed(0.5)
-                        .max_decimals(1)
+                        .fixed_decimals(0)
                         .prefix(label)
                         .suffix("°"),
                 )
