@@ -69,7 +69,7 @@ fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
     if density <= 0.0 {
         discard;
     }
-    let view_dir = normalize(in.world - u.eye.xyz);
+    let view_dir = select(u.forward.xyz, normalize(in.world - u.eye.xyz), u.eye.w > 0.5);
     let path = u.slicing.z / max(dot(view_dir, u.forward.xyz), 0.2);
     let alpha = 1.0 - exp(-u.media.x * density * path);
     let light = u.sun_color.rgb * sample.g + u.sky_color.rgb;

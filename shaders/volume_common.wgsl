@@ -8,7 +8,7 @@ const MAX_OCTAVES: i32 = 8;
 struct Volume {
     // World → clip.
     view_proj: mat4x4<f32>,
-    // Camera position (xyz).
+    // Camera position (xyz); w: 1 perspective, 0 orthographic.
     eye: vec4<f32>,
     // Unit view direction, image-plane right and up (xyz).
     forward: vec4<f32>,

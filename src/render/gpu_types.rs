@@ -19,7 +19,7 @@ pub const MAX_OCTAVES: usize = 8;
 pub struct VolumeUniforms {
     /// World → clip.
     pub view_proj: [[f32; 4]; 4],
-    /// Camera position (xyz).
+    /// Camera position (xyz); w: 1 perspective, 0 orthographic.
     pub eye: [f32; 4],
     /// Unit view direction (xyz).
     pub forward: [f32; 4],
@@ -135,7 +135,11 @@ impl VolumeUniforms {
         Self {
             view_proj: (crop_matrix(view.crop) * camera.view_projection(view.aspect))
                 .to_cols_array_2d(),
-            eye: camera.eye().extend(1.0).to_array(),
+            // w: 1 perspective, 0 orthographic (every view ray is `forward`).
+            eye: camera
+                .eye()
+                .extend(if camera.orthographic { 0.0 } else { 1.0 })
+                .to_array(),
             forward: camera.forward().extend(0.0).to_array(),
             right: camera.right().extend(0.0).to_array(),
             up: camera.up().extend(0.0).to_array(),

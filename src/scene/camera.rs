@@ -19,6 +19,26 @@ pub struct OrbitCamera {
     pub distance: f32,
     /// Vertical field of view in degrees.
     pub fov_y_deg: f32,
+    /// Orthographic projection (5 toggles it): the view is as tall as the perspective view
+    /// is at the target's distance, and parallel lines stay parallel (how outlines are drawn).
+    pub orthographic: bool,
+}
+
+/// The standard views (numpad 1, 3, 7 and Ctrl for the opposite side, as in Blender).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StandardView {
+    /// Looking along −z.
+    Front,
+    /// Looking along +z.
+    Back,
+    /// Looking along −x (from the right).
+    Right,
+    /// Looking along +x.
+    Left,
+    /// Looking down.
+    Top,
+    /// Looking up.
+    Bottom,
 }
 
 impl Default for OrbitCamera {
@@ -29,6 +49,7 @@ impl Default for OrbitCamera {
             pitch_deg: 8.0,
             distance: 19.0,
             fov_y_deg: 45.0,
+            orthographic: false,
         }
     }
 }
@@ -105,10 +126,35 @@ impl OrbitCamera {
         Mat4::look_at_rh(self.eye(), self.target, Vec3::Y)
     }
 
+    /// Half the view's height in world units at the target (the orthographic view's size).
+    fn half_height(&self) -> f32 {
+        self.distance * (self.fov_y_deg.to_radians() * 0.5).tan()
+    }
+
     /// View → clip matrix (wgpu depth range 0..1).
     pub fn projection(&self, aspect: f32) -> Mat4 {
         let (near, far) = self.clip_range();
-        Mat4::perspective_rh(self.fov_y_deg.to_radians(), aspect.max(1e-3), near, far)
+        let aspect = aspect.max(1e-3);
+        if self.orthographic {
+            let h = self.half_height();
+            Mat4::orthographic_rh(-h * aspect, h * aspect, -h, h, near, far)
+        } else {
+            Mat4::perspective_rh(self.fov_y_deg.to_radians(), aspect, near, far)
+        }
+    }
+
+    /// Turns the camera to a standard view, keeping its target and distance.
+    pub fn set_view(&mut self, view: StandardView) {
+        let (yaw, pitch) = match view {
+            StandardView::Front => (0.0, 0.0),
+            StandardView::Back => (180.0, 0.0),
+            StandardView::Right => (90.0, 0.0),
+            StandardView::Left => (270.0, 0.0),
+            StandardView::Top => (0.0, PITCH_LIMIT),
+            StandardView::Bottom => (0.0, -PITCH_LIMIT),
+        };
+        self.yaw_deg = yaw;
+        self.pitch_deg = pitch;
     }
 
     /// World → clip matrix.
@@ -119,10 +165,17 @@ impl OrbitCamera {
     /// The ray through a point of the image given in normalised device coordinates
     /// (x right, y up, both in −1..1).
     pub fn ray(&self, ndc: Vec2, aspect: f32) -> Ray {
+        let aspect = aspect.max(1e-3);
+        if self.orthographic {
+            let h = self.half_height();
+            return Ray {
+                origin: self.eye() + self.right() * (ndc.x * h * aspect) + self.up() * (ndc.y * h),
+                dir: self.forward(),
+            };
+        }
         let tan = (self.fov_y_deg.to_radians() * 0.5).tan();
-        let dir = self.forward()
-            + self.right() * (ndc.x * tan * aspect.max(1e-3))
-            + self.up() * (ndc.y * tan);
+        let dir =
+            self.forward() + self.right() * (ndc.x * tan * aspect) + self.up() * (ndc.y * tan);
         Ray {
             origin: self.eye(),
             dir: dir.normalize(),
@@ -141,6 +194,7 @@ impl OrbitCamera {
     pub fn ndc_bounds(&self, lo: Vec3, hi: Vec3, aspect: f32) -> Option<[f32; 4]> {
         let m = self.view_projection(aspect);
         let (near, _) = self.clip_range();
+        let (eye, forward) = (self.eye(), self.forward());
         let (mut a, mut b) = (Vec2::splat(f32::MAX), Vec2::splat(f32::MIN));
         let mut behind = 0;
         for i in 0..8 {
@@ -150,7 +204,7 @@ impl OrbitCamera {
                 if i & 4 == 0 { lo.z } else { hi.z },
             );
             let clip = m * p.extend(1.0);
-            if clip.w <= near {
+            if (p - eye).dot(forward) <= near {
                 behind += 1;
                 continue;
             }
@@ -179,6 +233,12 @@ impl OrbitCamera {
     /// World units per pixel at `depth` along the view direction, in a viewport
     /// `viewport_height_px` pixels tall.
     pub fn world_per_px(&self, depth: f32, viewport_height_px: f32) -> f32 {
+        // Orthographic: the same everywhere, as at the target's depth.
+        let depth = if self.orthographic {
+            self.distance
+        } else {
+            depth
+        };
         2.0 * depth * (self.fov_y_deg.to_radians() * 0.5).tan() / viewport_height_px.max(1.0)
     }
 
@@ -253,6 +313,59 @@ mod tests {
             cam.ndc_bounds(eye - Vec3::ONE, eye + Vec3::ONE, 1.6),
             Some([-1.0, -1.0, 1.0, 1.0])
         );
+    }
+
+    #[test]
+    fn rays_go_through_the_points_they_project_from_in_both_projections() {
+        for orthographic in [false, true] {
+            let mut cam = OrbitCamera {
+                yaw_deg: 30.0,
+                pitch_deg: 20.0,
+                ..Default::default()
+            };
+            cam.orthographic = orthographic;
+            for p in [Vec3::new(1.0, 4.0, -2.0), Vec3::new(-3.0, 2.0, 1.5)] {
+                let ndc = cam.project(p, 1.5).unwrap();
+                let ray = cam.ray(ndc, 1.5);
+                let closest = ray.at((p - ray.origin).dot(ray.dir));
+                assert!(
+                    closest.distance(p) < 1e-3,
+                    "{orthographic}: {closest} vs {p}"
+                );
+            }
+        }
+        // Orthographic rays are parallel; perspective ones are not.
+        let mut cam = OrbitCamera::default();
+        cam.orthographic = true;
+        assert_eq!(
+            cam.ray(Vec2::new(-0.9, 0.3), 1.5).dir,
+            cam.ray(Vec2::new(0.8, -0.7), 1.5).dir
+        );
+        cam.orthographic = false;
+        assert_ne!(
+            cam.ray(Vec2::new(-0.9, 0.3), 1.5).dir,
+            cam.ray(Vec2::new(0.8, -0.7), 1.5).dir
+        );
+    }
+
+    #[test]
+    fn standard_views_look_along_the_axes() {
+        let mut cam = OrbitCamera::default();
+        for (view, forward) in [
+            (StandardView::Front, Vec3::NEG_Z),
+            (StandardView::Back, Vec3::Z),
+            (StandardView::Right, Vec3::NEG_X),
+            (StandardView::Left, Vec3::X),
+            (StandardView::Top, Vec3::NEG_Y),
+            (StandardView::Bottom, Vec3::Y),
+        ] {
+            cam.set_view(view);
+            assert!(
+                cam.forward().dot(forward) > 0.999,
+                "{view:?}: {}",
+                cam.forward()
+            );
+        }
     }
 
     #[test]

@@ -10,7 +10,7 @@ mod plane;
 mod pointer;
 
 pub use crate::limits::{MAX_ELLIPSOIDS, MAX_PLANE_POINTS, MAX_PLANES};
-pub use camera::{OrbitCamera, Ray};
+pub use camera::{OrbitCamera, Ray, StandardView};
 pub use document::{Document, Revisions};
 pub use edit::Edit;
 pub use plane::{DrawingPlane, StrokeKind, centre_of};

@@ -152,6 +152,11 @@ impl CloudApp {
         if panel {
             self.panel_open = !self.panel_open;
         }
+        if let Some(change) = super::panels::view_keys(ctx) {
+            let mut camera = self.doc.scene().camera.clone();
+            change(&mut camera);
+            self.doc.set_camera(camera);
+        }
         let now = ctx.input(|i| i.time);
         if undo {
             self.undo(now);
@@ -222,7 +227,7 @@ impl CloudApp {
         RENDER.ui(ui, &mut self.doc);
         LIGHT.ui(ui, &mut self.doc);
         p.scene.ui(ui, &mut self.doc);
-        p.view.ui(ui, &self.viewport.stats);
+        p.view.ui(ui, &self.viewport.stats, &mut self.doc);
         self.selection.retain_valid(self.doc.scene());
     }
 

@@ -239,11 +239,26 @@ impl SketchTool {
                 }
             }
         }
+        let now = ui.input(|i| i.time);
+        if response.clicked_by(egui::PointerButton::Primary) {
+            tc.notices.error(
+                now,
+                "A click draws nothing: drag to draw an outline (a cut: a line across the cloud)",
+            );
+        }
         if response.drag_stopped_by(egui::PointerButton::Primary) {
             self.drawing = false;
-            let stroke = std::mem::take(&mut self.stroke);
-            let now = ui.input(|i| i.time);
-            self.finish_stroke(now, rect, &stroke, tc);
+            let mut stroke = std::mem::take(&mut self.stroke);
+            // A stroke that leaves the view (over the side panel, off the window) is clipped
+            // to the view's edge, and the user is told.
+            let outside = stroke.iter().filter(|p| !rect.contains(**p)).count();
+            for p in &mut stroke {
+                *p = rect.clamp(*p);
+            }
+            let clipped = (outside > 0).then(|| {
+                format!("{outside} of its points were outside the view and were moved to its edge")
+            });
+            self.finish_stroke(now, rect, &stroke, clipped, tc);
         }
         true
     }
@@ -251,7 +266,14 @@ impl SketchTool {
     /// Turns a finished screen stroke into a drawing plane: parallel to the view, through the
     /// point where the first point's ray meets the cloud, or through the focus point. The
     /// stroke is interpreted once, through the derivation cache.
-    fn finish_stroke(&mut self, now: f64, rect: Rect, stroke: &[Pos2], tc: &mut ToolContext<'_>) {
+    fn finish_stroke(
+        &mut self,
+        now: f64,
+        rect: Rect,
+        stroke: &[Pos2],
+        clipped: Option<String>,
+        tc: &mut ToolContext<'_>,
+    ) {
         let scene = tc.doc.scene();
         if scene.planes.len() >= MAX_PLANES {
             tc.notices.error(
@@ -298,7 +320,7 @@ impl SketchTool {
             &world,
             seed,
         );
-        let warnings = match &*tc.derived.shape_of(&plane) {
+        let mut warnings = match &*tc.derived.shape_of(&plane) {
             Shape::Unusable(e) => {
                 tc.notices.error(now, format!("Stroke not used: {e}"));
                 return;
@@ -306,6 +328,7 @@ impl SketchTool {
             Shape::Outline { warnings, .. } => warnings.clone(),
             Shape::Cut(_) => Vec::new(),
         };
+        warnings.extend(clipped);
         let index = scene.planes.len();
         let name = plane.name.clone();
         if tc.doc.apply(Edit::InsertPlane(index, plane), None) {

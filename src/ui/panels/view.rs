@@ -4,6 +4,39 @@ use egui::Ui;
 
 use crate::render::progressive::Quality;
 use crate::render::viewport::BackendInfo;
+use crate::scene::{Document, OrbitCamera, StandardView};
+
+/// The standard views with their keys (the number row or the numpad; Ctrl: the opposite side).
+const VIEWS: [(StandardView, &str, &str); 6] = [
+    (StandardView::Front, "Front", "1"),
+    (StandardView::Right, "Right", "3"),
+    (StandardView::Top, "Top", "7"),
+    (StandardView::Back, "Back", "Ctrl+1"),
+    (StandardView::Left, "Left", "Ctrl+3"),
+    (StandardView::Bottom, "Bottom", "Ctrl+7"),
+];
+
+/// A camera change asked for by the keyboard: 1/3/7 standard views (Ctrl: opposite side), 5
+/// orthographic on/off.
+pub fn view_keys(ctx: &egui::Context) -> Option<Box<dyn FnOnce(&mut OrbitCamera)>> {
+    use egui::{Key, Modifiers};
+    ctx.input_mut(|i| {
+        for (key, view, opposite) in [
+            (Key::Num1, StandardView::Front, StandardView::Back),
+            (Key::Num3, StandardView::Right, StandardView::Left),
+            (Key::Num7, StandardView::Top, StandardView::Bottom),
+        ] {
+            if i.consume_key(Modifiers::NONE, key) {
+                return Some(Box::new(move |c: &mut OrbitCamera| c.set_view(view)) as Box<_>);
+            }
+            if i.consume_key(Modifiers::COMMAND, key) {
+                return Some(Box::new(move |c: &mut OrbitCamera| c.set_view(opposite)) as Box<_>);
+            }
+        }
+        i.consume_key(Modifiers::NONE, Key::Num5)
+            .then(|| Box::new(|c: &mut OrbitCamera| c.orthographic = !c.orthographic) as Box<_>)
+    })
+}
 
 /// What the viewport reports about itself.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -25,11 +58,22 @@ pub struct ViewStats {
 pub struct ViewPanel;
 
 impl ViewPanel {
-    /// Draws the group.
-    pub fn ui(&mut self, ui: &mut Ui, stats: &ViewStats) {
+    /// Draws the group: standard views and the projection, then what the viewport draws.
+    pub fn ui(&mut self, ui: &mut Ui, stats: &ViewStats, doc: &mut Document) {
         egui::CollapsingHeader::new("View")
             .default_open(false)
             .show(ui, |ui| {
+                let mut camera = doc.scene().camera.clone();
+                ui.horizontal_wrapped(|ui| {
+                    for (view, label, key) in VIEWS {
+                        if ui.button(label).on_hover_text(key).clicked() {
+                            camera.set_view(view);
+                        }
+                    }
+                });
+                ui.checkbox(&mut camera.orthographic, "orthographic")
+                    .on_hover_text("5: parallel projection, as for drawing outlines");
+                doc.set_camera(camera);
                 match &stats.backend {
                     Some(b) => ui.label(format!("backend: {}\nadapter: {}", b.backend, b.adapter)),
                     None => ui.colored_label(egui::Color32::LIGHT_RED, "no GPU renderer"),
