@@ -116,7 +116,7 @@ const MIN_PREVIEW_SLICES: u32 = 16;
 /// Smallest preview resolution scale.
 const MIN_PREVIEW_SCALE: f64 = 0.15;
 /// Smallest resolution scale of the refined (full-quality) image.
-pub const MIN_REFINE_SCALE: f64 = 0.5;
+pub const MIN_REFINE_SCALE: f64 = 0.35;
 
 impl Progressive {
     /// A planner starting from a guessed cost in seconds per pixel·slice.

@@ -110,3 +110,36 @@ for (const backend of ['webgpu', 'webgl2']) {
     }
   });
 }
+
+// Full quality after an orbit and after a stroke, at the window sizes people have. Figures to
+// timings.json; the assertion is only that refinement finishes (no fixed time limit here).
+for (const backend of ['webgpu', 'webgl2']) {
+  test(`refinement at 1280×800 and 1920×1080 (${backend})`, { timeout: 420_000 }, async () => {
+    const { browser, close } = await launch({ webgpu: backend === 'webgpu' });
+    try {
+      const record = { test: 'refine', backend };
+      for (const viewport of [{ width: 1280, height: 800 }, { width: 1920, height: 1080 }]) {
+        const { page, errors } = await openApp(browser, server.url, '', viewport);
+        await waitForBody(page, 'data-ready', (v) => v === 'true');
+        const [vw, vh] = (await state(page)).view.viewport;
+        await waitForFullQuality(page);
+        await timedDrag(page, vw * 0.5, vh * 0.5, 150, 20, 20);
+        const orbit = await waitForFullQuality(page, 60_000);
+        await page.keyboard.press('d');
+        await until(page, (s) => s.view.tool === 'sketch', 'sketch tool');
+        await outline(page, vw * 0.3, vh * 0.75, vw * 0.06);
+        await until(page, (s) => s.scene.planes.length === 1, 'a stroke');
+        const stroke = await waitForFullQuality(page, 60_000);
+        record[`${viewport.width}x${viewport.height}`] = {
+          orbit_s: orbit.seconds, orbit_quality: orbit.quality, stroke_s: stroke.seconds, stroke_quality: stroke.quality,
+        };
+        assert.deepEqual(errors, []);
+        await page.close();
+      }
+      recordTiming(record);
+      console.log(JSON.stringify(record));
+    } finally {
+      await close();
+    }
+  });
+}
