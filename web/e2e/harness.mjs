@@ -146,3 +146,24 @@ export async function until(page, pred, what, timeout = 60_000) {
     await page.waitForTimeout(100);
   }
 }
+
+/**
+ * Runs `body(page)` in a fresh Chromium (WebGPU on or off) with the app at `base + query` open
+ * and ready; on failure prints the page's last log lines; fails if the page logged an error.
+ */
+export async function withApp({ base, webgpu, query = '', viewport }, body) {
+  const { browser, close } = await launch({ webgpu });
+  try {
+    const { page, errors, log } = await openApp(browser, base, query, viewport);
+    try {
+      await waitForBody(page, 'data-ready', (v) => v === 'true');
+      await body(page);
+      if (errors.length) throw new Error(`errors logged:\n${errors.join('\n')}`);
+    } catch (e) {
+      console.error(log.slice(-40).join('\n'));
+      throw e;
+    }
+  } finally {
+    await close();
+  }
+}

@@ -7,7 +7,7 @@
 // N hides and shows it. Both backends.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { serve, launch, openApp, waitForBody, waitForFullQuality, state, until, recordTiming, screenshot, countDiffering } from './harness.mjs';
+import { serve, withApp, waitForFullQuality, state, until, recordTiming, screenshot, countDiffering } from './harness.mjs';
 
 let server;
 before(async () => { server = await serve(); });
@@ -55,129 +55,109 @@ function meanNearest(a, b) {
 
 for (const backend of ['webgpu', 'webgl2']) {
   test(`every pointer sample is kept at 60 and 240 Hz (${backend})`, { timeout: 300_000 }, async () => {
-    const { browser, close } = await launch({ webgpu: backend === 'webgpu' });
-    try {
-      const { page, errors, log } = await openApp(browser, server.url, '?preset=empty', { width: 1280, height: 800 });
-      try {
-        await waitForBody(page, 'data-ready', (v) => v === 'true');
-        const [vw, vh] = (await state(page)).view.viewport;
-        await page.mouse.click(vw * 0.05, vh * 0.95);
-        await page.keyboard.press('d');
-        await until(page, (s) => s.view.tool === 'sketch', 'sketch tool');
-        const record = { test: 'input', backend };
-        for (const [i, hz] of [60, 240].entries()) {
-          const sent = bumpy(vw * (0.3 + 0.4 * i), vh * 0.5, vh * 0.16);
-          const seconds = await drawAt(page, sent, hz);
-          const s = await until(page, (s) => s.scene.planes.length === i + 1, `the ${hz} Hz stroke`);
-          const stored = s.scene.planes[i].points;
-          // The plane faces the default view (yaw 0): plane x is screen x, plane y is screen up.
-          const drawn = normalise(sent.map(([x, y]) => [x, -y]));
-          const kept = normalise(stored);
-          const error = Math.max(meanNearest(drawn, kept), meanNearest(kept, drawn));
-          record[`hz${hz}`] = { sent: sent.length, stored: stored.length, seconds, shapeError: error };
-          assert.ok(stored.length >= 0.9 * sent.length, `${hz} Hz: ${stored.length} of ${sent.length} samples stored`);
-          assert.ok(error < 0.02, `${hz} Hz: the stored stroke is off the drawn one by ${error.toFixed(3)} of its height`);
-        }
-        // Tab, then Space and Enter with the pointer over the view: nothing is pressed (Tab
-        // used to focus Undo, and Space then undid the last stroke), and the shortcuts work.
-        let s = await state(page);
-        const undo = s.view.undo;
-        await page.mouse.move(vw * 0.5, vh * 0.2);
-        for (const key of ['Tab', 'Tab', 'Space', 'Enter', 'Tab', 'Space']) await page.keyboard.press(key);
-        await page.keyboard.press('g');
-        s = await until(page, (s) => s.view.tool === 'move', 'G after Tab and Space');
-        assert.equal(s.scene.planes.length, 2, 'Space pressed no Undo');
-        assert.equal(s.view.undo, undo);
-
-        // The side panel keeps its width while values grow (rotating the selected plane
-        // rewrites its angle fields), and N hides and shows it.
-        await page.keyboard.press('r');
-        await until(page, (s) => s.view.tool === 'rotate', 'rotate tool');
-        const rot0 = JSON.stringify(s.scene.planes[1].rotation);
-        await page.mouse.move(vw * 0.7, vh * 0.5);
-        await page.mouse.down();
-        for (let i = 1; i <= 10; i++) await page.mouse.move(vw * 0.7 + i * 25, vh * 0.5 - i * 6);
-        await page.mouse.up();
-        s = await until(page, (s) => JSON.stringify(s.scene.planes[1].rotation) !== rot0, 'the plane rotated');
-        assert.deepEqual(s.view.viewport, [vw, vh], 'the view kept its width while the angles changed');
-        await page.keyboard.press('n');
-        s = await until(page, (s) => !s.view.panel_open && s.view.viewport[0] === 1280, 'panel hidden, view full width');
-        await page.keyboard.press('n');
-        s = await until(page, (s) => s.view.panel_open && s.view.viewport[0] === vw, 'panel back at its width');
-
-        // A stroke released over the side panel is clipped to the view, and says so; a click
-        // with the Sketch tool says that it draws nothing; the Scene group counts what is there.
-        await page.keyboard.press('d');
-        await until(page, (s) => s.view.tool === 'sketch', 'sketch tool again');
-        // It starts inside the view (its leftmost point) and swings out over the panel.
-        const round = bumpy(vw * 0.9, vh * 0.75, vh * 0.1, 40);
-        const off = [...round.slice(20), ...round.slice(0, 20)];
-        await page.mouse.move(off[0][0], off[0][1]);
-        await page.mouse.down();
-        for (const [x, y] of off.slice(1)) await page.mouse.move(x, y);
-        await page.mouse.up();
-        s = await until(page, (s) => s.scene.planes.length === 3, 'the clipped stroke');
-        assert.match(s.view.notice.text, /outside the view/);
-        const maxX = Math.max(...s.scene.planes[2].points.map((p) => p[0]));
-        const minX = Math.min(...s.scene.planes[2].points.map((p) => p[0]));
-        assert.ok(maxX - minX > 0, 'the clipped stroke has width');
-        await page.mouse.click(vw * 0.5, vh * 0.9);
-        s = await until(page, (s) => s.view.notice && /click draws nothing/.test(s.view.notice.text), 'the click message');
-        assert.equal(s.scene.planes.length, 3);
-        assert.deepEqual(errors, [], `errors logged:\n${errors.join('\n')}`);
-        recordTiming(record);
-      } catch (e) {
-        console.error(log.slice(-40).join('\n'));
-        throw e;
+    const app = { base: server.url, webgpu: backend === 'webgpu', query: '?preset=empty', viewport: { width: 1280, height: 800 } };
+    await withApp(app, async (page) => {
+      const [vw, vh] = (await state(page)).view.viewport;
+      await page.mouse.click(vw * 0.05, vh * 0.95);
+      await page.keyboard.press('d');
+      await until(page, (s) => s.view.tool === 'sketch', 'sketch tool');
+      const record = { test: 'input', backend };
+      for (const [i, hz] of [60, 240].entries()) {
+        const sent = bumpy(vw * (0.3 + 0.4 * i), vh * 0.5, vh * 0.16);
+        const seconds = await drawAt(page, sent, hz);
+        const s = await until(page, (s) => s.scene.planes.length === i + 1, `the ${hz} Hz stroke`);
+        const stored = s.scene.planes[i].points;
+        // The plane faces the default view (yaw 0): plane x is screen x, plane y is screen up.
+        const drawn = normalise(sent.map(([x, y]) => [x, -y]));
+        const kept = normalise(stored);
+        const error = Math.max(meanNearest(drawn, kept), meanNearest(kept, drawn));
+        record[`hz${hz}`] = { sent: sent.length, stored: stored.length, seconds, shapeError: error };
+        assert.ok(stored.length >= 0.9 * sent.length, `${hz} Hz: ${stored.length} of ${sent.length} samples stored`);
+        assert.ok(error < 0.02, `${hz} Hz: the stored stroke is off the drawn one by ${error.toFixed(3)} of its height`);
       }
-    } finally {
-      await close();
-    }
+      // Tab, then Space and Enter with the pointer over the view: nothing is pressed (Tab
+      // used to focus Undo, and Space then undid the last stroke), and the shortcuts work.
+      let s = await state(page);
+      const undo = s.view.undo;
+      await page.mouse.move(vw * 0.5, vh * 0.2);
+      for (const key of ['Tab', 'Tab', 'Space', 'Enter', 'Tab', 'Space']) await page.keyboard.press(key);
+      await page.keyboard.press('g');
+      s = await until(page, (s) => s.view.tool === 'move', 'G after Tab and Space');
+      assert.equal(s.scene.planes.length, 2, 'Space pressed no Undo');
+      assert.equal(s.view.undo, undo);
+
+      // The side panel keeps its width while values grow (rotating the selected plane
+      // rewrites its angle fields), and N hides and shows it.
+      await page.keyboard.press('r');
+      await until(page, (s) => s.view.tool === 'rotate', 'rotate tool');
+      const rot0 = JSON.stringify(s.scene.planes[1].rotation);
+      await page.mouse.move(vw * 0.7, vh * 0.5);
+      await page.mouse.down();
+      for (let i = 1; i <= 10; i++) await page.mouse.move(vw * 0.7 + i * 25, vh * 0.5 - i * 6);
+      await page.mouse.up();
+      s = await until(page, (s) => JSON.stringify(s.scene.planes[1].rotation) !== rot0, 'the plane rotated');
+      assert.deepEqual(s.view.viewport, [vw, vh], 'the view kept its width while the angles changed');
+      await page.keyboard.press('n');
+      s = await until(page, (s) => !s.view.panel_open && s.view.viewport[0] === 1280, 'panel hidden, view full width');
+      await page.keyboard.press('n');
+      s = await until(page, (s) => s.view.panel_open && s.view.viewport[0] === vw, 'panel back at its width');
+
+      // A stroke released over the side panel is clipped to the view, and says so; a click
+      // with the Sketch tool says that it draws nothing; the Scene group counts what is there.
+      await page.keyboard.press('d');
+      await until(page, (s) => s.view.tool === 'sketch', 'sketch tool again');
+      // It starts inside the view (its leftmost point) and swings out over the panel.
+      const round = bumpy(vw * 0.9, vh * 0.75, vh * 0.1, 40);
+      const off = [...round.slice(20), ...round.slice(0, 20)];
+      await page.mouse.move(off[0][0], off[0][1]);
+      await page.mouse.down();
+      for (const [x, y] of off.slice(1)) await page.mouse.move(x, y);
+      await page.mouse.up();
+      s = await until(page, (s) => s.scene.planes.length === 3, 'the clipped stroke');
+      assert.match(s.view.notice.text, /outside the view/);
+      const maxX = Math.max(...s.scene.planes[2].points.map((p) => p[0]));
+      const minX = Math.min(...s.scene.planes[2].points.map((p) => p[0]));
+      assert.ok(maxX - minX > 0, 'the clipped stroke has width');
+      await page.mouse.click(vw * 0.5, vh * 0.9);
+      s = await until(page, (s) => s.view.notice && /click draws nothing/.test(s.view.notice.text), 'the click message');
+      assert.equal(s.scene.planes.length, 3);
+      recordTiming(record);
+    });
   });
 }
 
 for (const backend of ['webgpu', 'webgl2']) {
   test(`standard views, and an outline drawn in the orthographic front view (${backend})`, { timeout: 300_000 }, async () => {
-    const { browser, close } = await launch({ webgpu: backend === 'webgpu' });
-    try {
-      const { page, errors, log } = await openApp(browser, server.url, '?preset=empty', { width: 1280, height: 800 });
-      try {
-        await waitForBody(page, 'data-ready', (v) => v === 'true');
-        const [vw, vh] = (await state(page)).view.viewport;
-        // Orbit away first, so each key visibly sets the view.
-        await page.mouse.move(vw * 0.5, vh * 0.5);
-        await page.mouse.down();
-        for (let i = 1; i <= 8; i++) await page.mouse.move(vw * 0.5 + i * 15, vh * 0.5 + i * 8);
-        await page.mouse.up();
-        await until(page, (s) => Math.abs(s.scene.camera.yaw_deg) > 5 && Math.abs(s.scene.camera.yaw_deg - 360) > 5, 'orbited');
-        const near = (a, b) => Math.abs(a - b) < 1e-3;
-        for (const [key, yaw, pitch] of [['3', 90, 0], ['7', 0, 89], ['1', 0, 0]]) {
-          await page.keyboard.press(key);
-          await until(page, (s) => near(s.scene.camera.yaw_deg, yaw) && near(s.scene.camera.pitch_deg, pitch), `view ${key}`);
-        }
-        await page.keyboard.press('5');
-        await until(page, (s) => s.scene.camera.orthographic, 'orthographic');
-        await page.keyboard.press('d');
-        await until(page, (s) => s.view.tool === 'sketch', 'sketch tool');
-        const sent = bumpy(vw * 0.5, vh * 0.5, vh * 0.2, 80);
-        await drawAt(page, sent, 120);
-        let s = await until(page, (s) => s.scene.planes.length === 1, 'the outline');
-        const error = meanNearest(normalise(sent.map(([x, y]) => [x, -y])), normalise(s.scene.planes[0].points));
-        assert.ok(error < 0.02, `the stored outline is off by ${error.toFixed(3)} of its height`);
-        await page.keyboard.press('h');
-        await waitForFullQuality(page);
-        const img = await screenshot(page, `${backend}-ortho-front-outline`);
-        const bg = s.scene.light.background.map((v) => Math.round(v * 255));
-        const box = { x: Math.round(vw * 0.5 - vh * 0.2), y: Math.round(vh * 0.4), w: Math.round(vh * 0.4), h: Math.round(vh * 0.2) };
-        const covered = countDiffering(img, box, bg);
-        assert.ok(covered > 0.6 * box.w * box.h, `the cloud fills ${covered} of ${box.w * box.h} px at the outline's middle`);
-        assert.deepEqual(errors, [], `errors logged:\n${errors.join('\n')}`);
-      } catch (e) {
-        console.error(log.slice(-40).join('\n'));
-        throw e;
+    const app = { base: server.url, webgpu: backend === 'webgpu', query: '?preset=empty', viewport: { width: 1280, height: 800 } };
+    await withApp(app, async (page) => {
+      const [vw, vh] = (await state(page)).view.viewport;
+      // Orbit away first, so each key visibly sets the view.
+      await page.mouse.move(vw * 0.5, vh * 0.5);
+      await page.mouse.down();
+      for (let i = 1; i <= 8; i++) await page.mouse.move(vw * 0.5 + i * 15, vh * 0.5 + i * 8);
+      await page.mouse.up();
+      await until(page, (s) => Math.abs(s.scene.camera.yaw_deg) > 5 && Math.abs(s.scene.camera.yaw_deg - 360) > 5, 'orbited');
+      const near = (a, b) => Math.abs(a - b) < 1e-3;
+      for (const [key, yaw, pitch] of [['3', 90, 0], ['7', 0, 89], ['1', 0, 0]]) {
+        await page.keyboard.press(key);
+        await until(page, (s) => near(s.scene.camera.yaw_deg, yaw) && near(s.scene.camera.pitch_deg, pitch), `view ${key}`);
       }
-    } finally {
-      await close();
-    }
+      await page.keyboard.press('5');
+      await until(page, (s) => s.scene.camera.orthographic, 'orthographic');
+      await page.keyboard.press('d');
+      await until(page, (s) => s.view.tool === 'sketch', 'sketch tool');
+      const sent = bumpy(vw * 0.5, vh * 0.5, vh * 0.2, 80);
+      await drawAt(page, sent, 120);
+      let s = await until(page, (s) => s.scene.planes.length === 1, 'the outline');
+      const error = meanNearest(normalise(sent.map(([x, y]) => [x, -y])), normalise(s.scene.planes[0].points));
+      assert.ok(error < 0.02, `the stored outline is off by ${error.toFixed(3)} of its height`);
+      await page.keyboard.press('h');
+      await waitForFullQuality(page);
+      const img = await screenshot(page, `${backend}-ortho-front-outline`);
+      const bg = s.scene.light.background.map((v) => Math.round(v * 255));
+      const box = { x: Math.round(vw * 0.5 - vh * 0.2), y: Math.round(vh * 0.4), w: Math.round(vh * 0.4), h: Math.round(vh * 0.2) };
+      const covered = countDiffering(img, box, bg);
+      assert.ok(covered > 0.6 * box.w * box.h, `the cloud fills ${covered} of ${box.w * box.h} px at the outline's middle`);
+    });
   });
 }
