@@ -124,6 +124,8 @@ for (const backend of ['webgpu', 'webgl2']) {
         const [vw, vh] = (await state(page)).view.viewport;
         await waitForFullQuality(page);
         await timedDrag(page, vw * 0.5, vh * 0.5, 150, 20, 20);
+        // The drag's last frames may still be queued: wait for its preview before timing.
+        await waitForBody(page, 'data-quality', (v) => typeof v === 'string' && v.startsWith('preview'), 3_000).catch(() => {});
         const orbit = await waitForFullQuality(page, 60_000);
         await page.keyboard.press('d');
         await until(page, (s) => s.view.tool === 'sketch', 'sketch tool');
