@@ -116,10 +116,7 @@ mod tests {
 
     #[test]
     fn sun_side_is_brighter_than_the_far_side() {
-        let f = Field {
-            blobs: vec![Blob::sphere(Vec3::ZERO, 2.0)],
-            ..Default::default()
-        };
+        let f = Field::of_blobs(vec![Blob::sphere(Vec3::ZERO, 2.0)]);
         let v = bake(&f, 32);
         for sun in [
             Vec3::X,
@@ -150,10 +147,7 @@ mod tests {
 
     #[test]
     fn clear_sky_transmits_everything() {
-        let f = Field {
-            blobs: vec![Blob::sphere(Vec3::ZERO, 2.0)],
-            ..Default::default()
-        };
+        let f = Field::of_blobs(vec![Blob::sphere(Vec3::ZERO, 2.0)]);
         let v = bake(&f, 16);
         let l = sweep(
             &v,

@@ -143,6 +143,14 @@ pub struct Field {
 }
 
 impl Field {
+    /// A field of summed primitives only (no sketched outlines, no cuts).
+    pub fn of_blobs(blobs: Vec<Blob>) -> Self {
+        Self {
+            blobs,
+            ..Default::default()
+        }
+    }
+
     /// Every primitive, summed ones and grouped ones.
     pub fn all_blobs(&self) -> impl Iterator<Item = &Blob> {
         self.blobs.iter().chain(self.groups.iter().flatten())
@@ -255,10 +263,7 @@ mod tests {
             let p = e.center + e.rotation * axis * r;
             assert!((b.value(p) - ISO).abs() < 1e-4, "{axis}");
         }
-        let f = Field {
-            blobs: vec![b],
-            ..Default::default()
-        };
+        let f = Field::of_blobs(vec![b]);
         let (lo, hi) = f.bounds().unwrap();
         for axis in [Vec3::X, Vec3::Y, Vec3::Z] {
             let p = e.center + e.rotation * axis * [3.0, 1.0, 2.0][axis.abs().max_position()];
@@ -270,10 +275,7 @@ mod tests {
     fn blending_grows_the_union() {
         let a = Blob::sphere(Vec3::ZERO, 1.0);
         let b = Blob::sphere(Vec3::new(2.2, 0.0, 0.0), 1.0);
-        let f = Field {
-            blobs: vec![a, b],
-            ..Default::default()
-        };
+        let f = Field::of_blobs(vec![a, b]);
         // The midpoint is outside both spheres alone but the blend bridges them.
         assert!(f.inside(Vec3::new(1.1, 0.0, 0.0)));
     }
@@ -303,10 +305,7 @@ mod tests {
 
     #[test]
     fn raycast_finds_the_surface() {
-        let f = Field {
-            blobs: vec![Blob::sphere(Vec3::ZERO, 2.0)],
-            ..Default::default()
-        };
+        let f = Field::of_blobs(vec![Blob::sphere(Vec3::ZERO, 2.0)]);
         let ray = Ray {
             origin: Vec3::new(0.0, 0.0, 10.0),
             dir: Vec3::NEG_Z,

@@ -177,10 +177,7 @@ mod tests {
 
     #[test]
     fn volume_is_capped_and_matches_the_field() {
-        let f = Field {
-            blobs: vec![Blob::sphere(Vec3::ZERO, 2.0)],
-            ..Default::default()
-        };
+        let f = Field::of_blobs(vec![Blob::sphere(Vec3::ZERO, 2.0)]);
         let v = bake(&f, 100_000);
         assert!(v.dims.max_element() <= MAX_RESOLUTION);
         let v = bake(&f, 32);
