@@ -8,12 +8,7 @@ use crate::scene::{Edit, Lighting};
 use crate::ui::widgets::{param, srgb_button};
 
 /// The Light group.
-pub const LIGHT: PartPanel<Lighting> = PartPanel {
-    title: "Light",
-    part: |s| &s.light,
-    edit: Edit::SetLight,
-    body,
-};
+pub const LIGHT: PartPanel<Lighting> = PartPanel::new("Light", |s| &s.light, Edit::SetLight, body);
 
 fn body(ui: &mut Ui, l: &mut Lighting) {
     param(ui, &mut l.sun_azimuth_deg, &limits::SUN_AZIMUTH);

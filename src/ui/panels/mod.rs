@@ -31,6 +31,21 @@ pub struct PartPanel<T: 'static> {
 }
 
 impl<T: Clone + PartialEq> PartPanel<T> {
+    /// A group titled `title` whose `body` edits the `part` that `edit` replaces.
+    pub const fn new(
+        title: &'static str,
+        part: fn(&Scene) -> &T,
+        edit: fn(T) -> Edit,
+        body: fn(&mut Ui, &mut T),
+    ) -> Self {
+        Self {
+            title,
+            part,
+            edit,
+            body,
+        }
+    }
+
     /// Draws the group.
     pub fn ui(&self, ui: &mut Ui, doc: &mut Document) {
         egui::CollapsingHeader::new(self.title)

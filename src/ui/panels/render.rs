@@ -8,12 +8,8 @@ use crate::scene::{Edit, RenderSettings};
 use crate::ui::widgets::param;
 
 /// The Render group.
-pub const RENDER: PartPanel<RenderSettings> = PartPanel {
-    title: "Render",
-    part: |s| &s.render,
-    edit: Edit::SetRender,
-    body,
-};
+pub const RENDER: PartPanel<RenderSettings> =
+    PartPanel::new("Render", |s| &s.render, Edit::SetRender, body);
 
 fn body(ui: &mut Ui, r: &mut RenderSettings) {
     param(ui, &mut r.slices, &limits::SLICES);
