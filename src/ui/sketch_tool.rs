@@ -56,6 +56,66 @@ pub struct SketchTool {
     pub hide_guides: bool,
     /// A stroke is being drawn (between drag start and stop).
     drawing: bool,
+    /// The world axis Rotate turns about (X, Y or Z), or free.
+    pub axis_lock: Option<Axis>,
+    /// The Rotate drag under way: the plane's rotation at its start and the drag so far.
+    turning: Option<(Quat, Vec2)>,
+}
+
+/// A world axis the Rotate tool can be locked to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Axis {
+    /// World X (right in the front view).
+    X,
+    /// World Y (up).
+    Y,
+    /// World Z (toward the front view's camera).
+    Z,
+}
+
+impl Axis {
+    fn vector(self) -> Vec3 {
+        match self {
+            Axis::X => Vec3::X,
+            Axis::Y => Vec3::Y,
+            Axis::Z => Vec3::Z,
+        }
+    }
+
+    /// The axis's letter.
+    pub fn name(self) -> &'static str {
+        match self {
+            Axis::X => "X",
+            Axis::Y => "Y",
+            Axis::Z => "Z",
+        }
+    }
+}
+
+/// Turn per pixel of drag: about 1° per 5 px (a 150 px drag turns 30°), as the gizmos will.
+const TURN_PER_PX: f32 = 0.2 * std::f32::consts::PI / 180.0;
+/// The step Ctrl snaps turns to.
+const SNAP_STEP: f32 = 15.0 * std::f32::consts::PI / 180.0;
+
+/// The turn a Rotate drag of `drag` pixels (screen x right, y down) gives. Locked to an axis,
+/// a drag right or up turns positively about it; free, sideways turns about the vertical and
+/// up/down tilts about the view's right axis. `snap` rounds each angle to 15°.
+pub fn drag_turn(drag: Vec2, lock: Option<Axis>, snap: bool, view_right: Vec3) -> Quat {
+    let angle = |px: f32| {
+        let a = px * TURN_PER_PX;
+        if snap {
+            (a / SNAP_STEP).round() * SNAP_STEP
+        } else {
+            a
+        }
+    };
+    match lock {
+        Some(axis) => Quat::from_axis_angle(axis.vector(), angle(drag.x - drag.y)),
+        None => {
+            Quat::from_axis_angle(Vec3::Y, angle(drag.x))
+                * Quat::from_axis_angle(view_right, angle(drag.y))
+        }
+    }
 }
 
 /// The pointer in the viewport this frame.
@@ -136,8 +196,9 @@ pub fn duplicate_selected(doc: &mut Document, selection: &mut Selection) -> Opti
 }
 
 impl SketchTool {
-    /// Tool shortcuts: V navigate, D draw, C cut, G move, R rotate, H hides guides, Esc cancels
-    /// a stroke (or clears the selection), Delete removes the selected plane, Ctrl+D duplicates it.
+    /// Tool shortcuts: V navigate, D draw, C cut, G move, R rotate (then X, Y or Z locks the
+    /// axis, the same key again frees it), H hides guides, Esc cancels a stroke (or clears the
+    /// selection), Delete removes the selected plane, Ctrl+D duplicates it.
     pub fn shortcuts(&mut self, ctx: &egui::Context, tc: &mut ToolContext<'_>) {
         if ctx.egui_wants_keyboard_input() {
             return;
@@ -157,6 +218,13 @@ impl SketchTool {
             ]
         });
         let [dup, v, d, c, g, r, h, esc, del] = keys;
+        if self.tool == Tool::Rotate {
+            for (key, axis) in [(Key::X, Axis::X), (Key::Y, Axis::Y), (Key::Z, Axis::Z)] {
+                if ctx.input_mut(|i| i.consume_key(Modifiers::NONE, key)) {
+                    self.axis_lock = (self.axis_lock != Some(axis)).then_some(axis);
+                }
+            }
+        }
         let now = ctx.input(|i| i.time);
         for (pressed, tool) in [
             (v, Tool::Navigate),
@@ -357,6 +425,7 @@ impl SketchTool {
             return true;
         }
         if !response.dragged_by(egui::PointerButton::Primary) {
+            self.turning = None;
             return true;
         }
         let delta = response.drag_delta();
@@ -365,6 +434,9 @@ impl SketchTool {
         }
         let camera = &tc.doc.scene().camera;
         let mut plane = (*tc.doc.scene().planes[i]).clone();
+        if response.drag_started() || self.turning.is_none() {
+            self.turning = Some((plane.rotation, Vec2::ZERO));
+        }
         match self.tool {
             Tool::Move => {
                 let depth = (plane.origin - camera.eye()).dot(camera.forward()).max(0.1);
@@ -377,11 +449,12 @@ impl SketchTool {
                 };
             }
             _ => {
-                // About 1° per 5 px: a 150 px drag turns 30°, as the gizmos will.
-                const RAD_PER_PX: f32 = 0.2 * std::f32::consts::PI / 180.0;
-                let turn = Quat::from_axis_angle(Vec3::Y, delta.x * RAD_PER_PX)
-                    * Quat::from_axis_angle(camera.right(), delta.y * RAD_PER_PX);
-                plane.rotation = (turn * plane.rotation).normalize();
+                // The turn is taken from the whole drag, so snapping sees the total angle.
+                let (start, drag) = self.turning.get_or_insert((plane.rotation, Vec2::ZERO));
+                *drag += Vec2::new(delta.x, delta.y);
+                let snap = ui.input(|i| i.modifiers.ctrl || i.modifiers.command);
+                let turn = drag_turn(*drag, self.axis_lock, snap, camera.right());
+                plane.rotation = (turn * *start).normalize();
             }
         }
         tc.doc.apply(Edit::SetPlane(i, plane), Some("plane-drag"));
@@ -434,9 +507,21 @@ impl SketchTool {
                 Stroke::new(2.0, color),
             ));
         }
+        let rotate_hint;
         let hint = match self.tool {
             Tool::Move | Tool::Rotate if selection.plane().is_none() => {
                 Some("Click a drawing plane (or pick one in the list) to move or rotate it")
+            }
+            Tool::Rotate => {
+                rotate_hint = match self.axis_lock {
+                    Some(a) => format!(
+                        "Turning about {} (X/Y/Z: another axis, {} again: free) · Ctrl snaps to 15°",
+                        a.name(),
+                        a.name()
+                    ),
+                    None => "Drag to turn · X/Y/Z lock an axis · Ctrl snaps to 15°".to_owned(),
+                };
+                Some(rotate_hint.as_str())
             }
             Tool::Sketch if scene.planes.is_empty() && self.stroke.is_empty() => {
                 Some("Drag to draw a cloud's outline")
@@ -528,5 +613,43 @@ fn draw_grid(
                 painter.line_segment([a, b], Stroke::new(1.0, color));
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn axis_angle(q: Quat) -> (Vec3, f32) {
+        let (axis, angle) = q.to_axis_angle();
+        (axis, angle.to_degrees())
+    }
+
+    #[test]
+    fn a_150_px_drag_turns_30_degrees_about_the_vertical() {
+        let (axis, deg) = axis_angle(drag_turn(Vec2::new(150.0, 0.0), None, false, Vec3::X));
+        assert!(axis.abs_diff_eq(Vec3::Y, 1e-5), "{axis}");
+        assert!((deg - 30.0).abs() < 1e-3, "{deg}");
+    }
+
+    #[test]
+    fn a_locked_axis_takes_the_whole_drag_and_ctrl_snaps_to_15_degrees() {
+        // Right 160 and up 60: 220 px, 44° about Z; snapped, 45°.
+        let drag = Vec2::new(160.0, -60.0);
+        let (axis, deg) = axis_angle(drag_turn(drag, Some(Axis::Z), false, Vec3::X));
+        assert!(
+            axis.abs_diff_eq(Vec3::Z, 1e-5) && (deg - 44.0).abs() < 1e-3,
+            "{axis} {deg}"
+        );
+        let (axis, deg) = axis_angle(drag_turn(drag, Some(Axis::Z), true, Vec3::X));
+        assert!(
+            axis.abs_diff_eq(Vec3::Z, 1e-5) && (deg - 45.0).abs() < 1e-3,
+            "{axis} {deg}"
+        );
+        // Free, the same drag turns about two axes, each snapped on its own.
+        let free = drag_turn(drag, None, true, Vec3::X);
+        let expected =
+            Quat::from_rotation_y(30f32.to_radians()) * Quat::from_rotation_x(-15f32.to_radians());
+        assert!(free.abs_diff_eq(expected, 1e-5), "{free} {expected}");
     }
 }

@@ -103,6 +103,35 @@ test('draw an outline, then cut its base', { timeout: 300_000 }, async () => {
       const rot0 = JSON.stringify(s.scene.planes[0].rotation);
       await stroke(page, Array.from({ length: 8 }, (_, i) => [cx + i * 10, base - h * 0.4]));
       s = await until(page, (s) => JSON.stringify(s.scene.planes[0].rotation) !== rot0, 'the plane rotated');
+      // Z locks the turn to world Z and Ctrl snaps it to 15°: right 160 px and up 60 px make
+      // 44°, snapped to 45° (free and unsnapped, the same drag turns 32° about Y and 12° about X).
+      await page.keyboard.press('Control+z');
+      s = await until(page, (s) => JSON.stringify(s.scene.planes[0].rotation) === rot0, 'the turn undone');
+      await page.keyboard.press('z');
+      await page.keyboard.down('Control');
+      await stroke(page, Array.from({ length: 21 }, (_, i) => [cx + i * 8, base - h * 0.4 - i * 3]));
+      await page.keyboard.up('Control');
+      await until(page, (s) => JSON.stringify(s.scene.planes[0].rotation) !== rot0, 'the locked, snapped turn');
+      // The whole drag is in once a few more frames have run.
+      await page.evaluate(() => new Promise((r) => {
+        let n = 4;
+        const tick = () => (--n ? requestAnimationFrame(tick) : r());
+        requestAnimationFrame(tick);
+      }));
+      s = await state(page);
+      const [x0, y0, z0, w0] = JSON.parse(rot0);
+      const [x1, y1, z1, w1] = s.scene.planes[0].rotation;
+      // rel = q1 · conj(q0): the turn the drag applied, in world axes.
+      const rel = [
+        -w1 * x0 + x1 * w0 - y1 * z0 + z1 * y0,
+        -w1 * y0 + y1 * w0 - z1 * x0 + x1 * z0,
+        -w1 * z0 + z1 * w0 - x1 * y0 + y1 * x0,
+        w1 * w0 + x1 * x0 + y1 * y0 + z1 * z0,
+      ];
+      const sign = Math.sign(rel[3]) || 1;
+      const deg = (2 * Math.acos(Math.min(1, Math.abs(rel[3]))) * 180) / Math.PI;
+      assert.ok(Math.abs(rel[0]) < 1e-4 && Math.abs(rel[1]) < 1e-4, `a turn about Z only: ${rel}`);
+      assert.ok(Math.abs(deg - 45) < 0.01 && sign * rel[2] > 0, `snapped to 45°: ${deg}°`);
       await page.keyboard.press('Control+d');
       s = await until(page, (s) => s.scene.planes.length === 2, 'a duplicate');
       assert.equal(s.scene.planes[1].name, 'Outline 1 copy');
