@@ -18,7 +18,7 @@ fn main() {
         let mut sp = spheres::sample(&o, &sk);
         let s3 = Instant::now();
         let rf = spheres::feature_radius(&sp);
-        spheres::inflate(&mut sp, rf, 0.0);
+        spheres::inflate(&o.boundary, &mut sp, rf, params.inflate);
         let s4 = Instant::now();
         let ext = spheres::extend(&o, &sk, &sp, 1, 2);
         let s5 = Instant::now();

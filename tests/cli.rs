@@ -25,15 +25,17 @@ fn new_writes_the_default_scene() {
     let path = temp("new.json");
     let out = cloudsketch(&["new", "-o", path.to_str().unwrap()]);
     assert!(out.status.success(), "{}", stderr(&out));
-    let scene =
-        cloudsketch::scene::Scene::from_json(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    let scene = cloudsketch::scene::Scene::from_json(&std::fs::read_to_string(&path).unwrap())
+        .unwrap()
+        .0;
     assert_eq!(scene, cloudsketch::scene::Scene::default());
 
     let empty = temp("empty.json");
     let out = cloudsketch(&["new", "--preset", "empty", "-o", empty.to_str().unwrap()]);
     assert!(out.status.success(), "{}", stderr(&out));
-    let scene =
-        cloudsketch::scene::Scene::from_json(&std::fs::read_to_string(&empty).unwrap()).unwrap();
+    let scene = cloudsketch::scene::Scene::from_json(&std::fs::read_to_string(&empty).unwrap())
+        .unwrap()
+        .0;
     assert!(scene.ellipsoids.is_empty());
 
     let out = cloudsketch(&[
@@ -158,7 +160,8 @@ fn sketch_makes_a_scene_and_spheres_that_fit_the_outline() {
     assert!(out.status.success(), "{}", stderr(&out));
     let scene =
         cloudsketch::scene::Scene::from_json(&std::fs::read_to_string(&scene_path).unwrap())
-            .unwrap();
+            .unwrap()
+            .0;
     assert_eq!(scene.planes.len(), 1);
     let spheres: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&spheres_path).unwrap()).unwrap();
@@ -241,6 +244,30 @@ fn sketch_repairs_or_refuses_bad_strokes() {
     ]);
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(stderr(&out).contains("warning"), "{}", stderr(&out));
+
+    // A stroke over the point cap is thinned with a warning, and the scene holds the stroke
+    // that was used (it used to be thinned, then refused by validation: exit 1).
+    let dense: Vec<[f64; 2]> = (0..30_000)
+        .map(|i| i as f64 / 30_000.0 * std::f64::consts::TAU)
+        .map(|a| [200.0 + 150.0 * a.cos(), 200.0 + 100.0 * a.sin()])
+        .collect();
+    let path = write_stroke("dense.json", &dense, true);
+    let scene_path = temp("dense-scene.json");
+    let out = cloudsketch(&[
+        "sketch",
+        path.to_str().unwrap(),
+        "-o",
+        scene_path.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stderr(&out).contains("thinned to"), "{}", stderr(&out));
+    let (scene, _) =
+        cloudsketch::scene::Scene::from_json(&std::fs::read_to_string(&scene_path).unwrap())
+            .unwrap();
+    assert_eq!(
+        scene.planes[0].points.len(),
+        cloudsketch::limits::MAX_PLANE_POINTS
+    );
 
     for (name, points) in [
         ("line.json", vec![[0.0, 0.0], [10.0, 10.0], [20.0, 20.0]]),

@@ -24,7 +24,7 @@ fn render(scene: &Scene) -> Image {
 
 fn with(scene: &Scene, sets: &[&str]) -> Scene {
     sets.iter()
-        .fold(scene.clone(), |s, a| set_by_pointer(&s, a).unwrap())
+        .fold(scene.clone(), |s, a| set_by_pointer(&s, a).unwrap().0)
 }
 
 fn background(scene: &Scene) -> [u8; 3] {

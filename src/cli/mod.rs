@@ -150,9 +150,14 @@ pub fn read_capped(path: &Path) -> Result<String, String> {
     std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))
 }
 
-/// Reads and validates a scene document.
+/// Reads and validates a scene document; each repair validation made is a warning.
 pub fn read_scene(path: &Path) -> Result<Scene, String> {
-    Scene::from_json(&read_capped(path)?).map_err(|e| format!("{}: {e}", path.display()))
+    let (scene, repairs) =
+        Scene::from_json(&read_capped(path)?).map_err(|e| format!("{}: {e}", path.display()))?;
+    for r in repairs {
+        eprintln!("warning: {}: repaired {r}", path.display());
+    }
+    Ok(scene)
 }
 
 /// Writes a file, with the path in the error.

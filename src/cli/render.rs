@@ -29,7 +29,11 @@ pub fn run(scene: Option<&Path>, output: &Path, size: &str, sets: &[String]) -> 
         None => Scene::default(),
     };
     for assignment in sets {
-        scene = set_by_pointer(&scene, assignment).map_err(|e| e.to_string())?;
+        let (set, repairs) = set_by_pointer(&scene, assignment).map_err(|e| e.to_string())?;
+        for r in repairs {
+            eprintln!("warning: --set {assignment}: repaired {r}");
+        }
+        scene = set;
     }
     let mut offscreen = Offscreen::new().map_err(|e| e.to_string())?;
     let start = std::time::Instant::now();

@@ -52,7 +52,12 @@ pub fn run(
             )
         })?;
         // y down → y up, so the plane's points read like the world.
-        let points: Vec<[f64; 2]> = file.points.iter().map(|&[x, y]| [x, -y]).collect();
+        let flipped: Vec<[f64; 2]> = file.points.iter().map(|&[x, y]| [x, -y]).collect();
+        // The scene stores the stroke that was used: thinned here, not refused later.
+        let (points, thinned) = crate::sketch::outline::thin(&flipped);
+        if let Some(w) = thinned {
+            eprintln!("warning: {}: {w}", path.display());
+        }
         let sketch = interpret(
             &points,
             file.closed,

@@ -195,6 +195,11 @@ impl Derived {
         shape
     }
 
+    /// The shape last derived for a plane of the document (see [`PlaneCache::derived`]).
+    pub fn derived_shape(&self, plane: &Arc<DrawingPlane>) -> Option<Arc<Shape>> {
+        self.planes.derived(plane)
+    }
+
     /// The work done so far.
     pub fn work(&self) -> Work {
         self.work

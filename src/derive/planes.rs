@@ -123,6 +123,13 @@ impl PlaneCache {
         entry.0.clone()
     }
 
+    /// The shape last derived for this plane of the document, if any (no interpretation: a
+    /// lookup by the plane's allocation, cheap enough for every frame of the UI).
+    pub fn derived(&self, plane: &Arc<DrawingPlane>) -> Option<Arc<Shape>> {
+        let (_, key) = self.keys.get(&(Arc::as_ptr(plane) as usize))?;
+        self.shapes.get(key).map(|(shape, _)| shape.clone())
+    }
+
     /// Strokes interpreted since the cache was made (for tests and benchmarks).
     pub fn interpretations(&self) -> u64 {
         self.interpretations

@@ -186,3 +186,32 @@ fn cached_volumes_equal_a_fresh_derivation() {
     let brute = bake(&field_of(doc.scene()), doc.scene().render.field_resolution);
     assert_eq!(*cached.density.data, brute);
 }
+
+#[test]
+fn the_ui_learns_which_planes_the_field_cannot_use() {
+    let mut scene = Scene::preset(Preset::Empty);
+    scene
+        .planes
+        .push(Arc::new(plane(StrokeKind::Outline, cloud_outline())));
+    // A stored stroke with no inside (a loaded document can hold one).
+    let line = (0..10).map(|i| Vec2::new(i as f32, i as f32)).collect();
+    scene
+        .planes
+        .push(Arc::new(plane(StrokeKind::Outline, line)));
+    let mut derived = Derived::default();
+    assert!(
+        derived.derived_shape(&scene.planes[0]).is_none(),
+        "nothing derived yet"
+    );
+    derived.field(&scene, Some(1));
+    let work = derived.work();
+    assert!(matches!(
+        derived.derived_shape(&scene.planes[0]).as_deref(),
+        Some(Shape::Outline { .. })
+    ));
+    assert!(matches!(
+        derived.derived_shape(&scene.planes[1]).as_deref(),
+        Some(Shape::Unusable(_))
+    ));
+    assert_eq!(derived.work(), work, "asking interprets nothing");
+}

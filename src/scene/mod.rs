@@ -22,6 +22,7 @@ use crate::limits;
 
 use glam::{Quat, Vec3};
 use serde::{Deserialize, Serialize};
+use serde_json::Value;
 
 /// Version written by this build. Older documents are upgraded on load; newer ones are refused.
 pub const SCENE_VERSION: u32 = 1;
@@ -133,14 +134,15 @@ impl Scene {
         }
     }
 
-    /// Parses a document, upgrading older versions and checking every limit.
-    pub fn from_json(text: &str) -> Result<Self, SceneError> {
+    /// Parses a document, upgrading older versions and checking every limit. Returns the scene
+    /// and what validation repaired in it, in words (see [`Scene::validate`]): tell the user.
+    pub fn from_json(text: &str) -> Result<(Self, Vec<String>), SceneError> {
         let value: serde_json::Value = serde_json::from_str(text)?;
         Self::from_value(value)
     }
 
     /// Like [`Scene::from_json`] for an already parsed value.
-    pub fn from_value(value: serde_json::Value) -> Result<Self, SceneError> {
+    pub fn from_value(value: serde_json::Value) -> Result<(Self, Vec<String>), SceneError> {
         if !value.is_object() {
             return Err(SceneError::Invalid(
                 "a scene document is a JSON object".into(),
@@ -157,8 +159,8 @@ impl Scene {
         }
         let mut scene: Scene = serde_json::from_value(value)?;
         scene.version = SCENE_VERSION;
-        scene.validate()?;
-        Ok(scene)
+        let repairs = scene.validate()?;
+        Ok((scene, repairs))
     }
 
     /// Pretty JSON of the document.
@@ -167,8 +169,27 @@ impl Scene {
         serde_json::to_string_pretty(self).unwrap_or_default()
     }
 
-    /// Checks sizes and ranges; clamps what can be clamped, refuses what cannot.
-    pub fn validate(&mut self) -> Result<(), SceneError> {
+    /// Checks sizes and ranges; repairs what can be repaired (a value out of range is clamped,
+    /// a non-finite setting takes its default, a zero rotation becomes none) and refuses what
+    /// cannot (too many primitives or points, non-finite geometry). Returns each repair in
+    /// words, as `/path: old → new`, so nothing is changed silently.
+    pub fn validate(&mut self) -> Result<Vec<String>, SceneError> {
+        let before = serde_json::to_value(&*self).ok();
+        self.check_and_repair()?;
+        let mut repairs = Vec::new();
+        if let (Some(before), Ok(after)) = (before, serde_json::to_value(&*self)) {
+            describe_repairs("", &before, &after, &mut repairs);
+        }
+        const SHOWN: usize = 12;
+        if repairs.len() > SHOWN {
+            let more = repairs.len() - SHOWN;
+            repairs.truncate(SHOWN);
+            repairs.push(format!("and {more} more values repaired"));
+        }
+        Ok(repairs)
+    }
+
+    fn check_and_repair(&mut self) -> Result<(), SceneError> {
         if self.ellipsoids.len() > MAX_ELLIPSOIDS {
             return Err(SceneError::Invalid(format!(
                 "{} ellipsoids (at most {MAX_ELLIPSOIDS})",
@@ -189,6 +210,11 @@ impl Scene {
                 return Err(SceneError::Invalid(format!(
                     "ellipsoid {i} has a radius ≤ 0"
                 )));
+            }
+        }
+        for e in &mut self.ellipsoids {
+            if let Some(r) = unit_rotation(e.rotation) {
+                Arc::make_mut(e).rotation = r;
             }
         }
         if self.planes.len() > MAX_PLANES {
@@ -354,6 +380,60 @@ impl RenderSettings {
     }
 }
 
+/// `q` made a unit rotation when it is not one already (a zero quaternion becomes none).
+pub(crate) fn unit_rotation(q: Quat) -> Option<Quat> {
+    if q.is_normalized() {
+        None
+    } else if q.length_squared() < 1e-12 {
+        Some(Quat::IDENTITY)
+    } else {
+        Some(q.normalize())
+    }
+}
+
+/// Lists the leaves of `after` that differ from `before` (the same document before and after
+/// repair), as `/path: old → new`; short arrays (vectors, rotations, colours) as a whole.
+fn describe_repairs(path: &str, before: &Value, after: &Value, out: &mut Vec<String>) {
+    let same = |a: &Value, b: &Value| match (a.as_f64(), b.as_f64()) {
+        (Some(x), Some(y)) => (x - y).abs() <= 1e-5 * x.abs().max(1.0),
+        _ => a == b,
+    };
+    let show = |v: &Value| match v {
+        Value::Null => "not a number".to_owned(),
+        Value::Number(n) => n.as_f64().map_or_else(|| n.to_string(), |f| format!("{f}")),
+        Value::Array(items) => {
+            let parts: Vec<String> = items
+                .iter()
+                .map(|x| x.as_f64().map_or("NaN".to_owned(), |f| format!("{f}")))
+                .collect();
+            format!("[{}]", parts.join(", "))
+        }
+        other => other.to_string(),
+    };
+    match (before, after) {
+        (Value::Object(a), Value::Object(b)) => {
+            for (key, vb) in b {
+                let va = a.get(key).unwrap_or(&Value::Null);
+                describe_repairs(&format!("{path}/{key}"), va, vb, out);
+            }
+        }
+        (Value::Array(a), Value::Array(b)) if a.len() == b.len() => {
+            let short = b.len() <= 4 && b.iter().all(Value::is_number);
+            if short {
+                if a.iter().zip(b).any(|(x, y)| !same(x, y)) {
+                    out.push(format!("{path}: {} → {}", show(before), show(after)));
+                }
+            } else {
+                for (i, (x, y)) in a.iter().zip(b).enumerate() {
+                    describe_repairs(&format!("{path}/{i}"), x, y, out);
+                }
+            }
+        }
+        _ if same(before, after) => {}
+        _ => out.push(format!("{path}: {} → {}", show(before), show(after))),
+    }
+}
+
 pub(crate) fn finite_or(v: f32, fallback: f32) -> f32 {
     if v.is_finite() { v } else { fallback }
 }
@@ -365,13 +445,14 @@ mod tests {
     #[test]
     fn json_round_trip_is_lossless() {
         let scene = Scene::default();
-        let back = Scene::from_json(&scene.to_json()).expect("round trip");
+        let (back, repairs) = Scene::from_json(&scene.to_json()).expect("round trip");
+        assert!(repairs.is_empty(), "{repairs:?}");
         assert_eq!(scene, back);
     }
 
     #[test]
     fn missing_fields_take_defaults() {
-        let s = Scene::from_json(r#"{"version":1,"ellipsoids":[]}"#).unwrap();
+        let (s, _) = Scene::from_json(r#"{"version":1,"ellipsoids":[]}"#).unwrap();
         assert_eq!(s.render, RenderSettings::default());
         assert!(s.ellipsoids.is_empty());
     }
@@ -397,11 +478,59 @@ mod tests {
 
     #[test]
     fn out_of_range_settings_are_clamped() {
-        let s = Scene::from_json(r#"{"render":{"slices":100000,"field_resolution":3}}"#).unwrap();
+        let (s, repairs) =
+            Scene::from_json(r#"{"render":{"slices":100000,"field_resolution":3}}"#).unwrap();
         assert_eq!(s.render.slices, limits::SLICES.max as u32);
         assert_eq!(
             s.render.field_resolution,
             limits::FIELD_RESOLUTION.min as u32
+        );
+        assert_eq!(
+            repairs,
+            [
+                "/render/field_resolution: 3 → 16",
+                "/render/slices: 100000 → 512"
+            ],
+        );
+    }
+
+    #[test]
+    fn degenerate_values_are_repaired_with_a_word_or_refused() {
+        // A zero rotation used to pass and turn the field, bounds and framing into NaN.
+        let text = r#"{
+            "ellipsoids": [{"center": [0, 2, 0], "radii": [1, 1, 1], "rotation": [0, 0, 0, 0]}],
+            "planes": [{"points": [[0, 0], [1, 0], [0, 1]], "rotation": [0, 0, 0, 0]},
+                       {"points": [[0, 0], [1, 0], [0, 1]], "rotation": [0, 2, 0, 0]}],
+            "camera": {"distance": 1e300, "fov_y_deg": 1e39},
+            "light": {"sun_intensity": -4}
+        }"#;
+        let (s, repairs) = Scene::from_json(text).unwrap();
+        assert_eq!(s.ellipsoids[0].rotation, Quat::IDENTITY);
+        assert_eq!(s.planes[0].rotation, Quat::IDENTITY);
+        assert_eq!(s.planes[1].rotation, Quat::from_xyzw(0.0, 1.0, 0.0, 0.0));
+        for needle in [
+            "/ellipsoids/0/rotation: [0, 0, 0, 0] → [0, 0, 0, 1]",
+            "/planes/0/rotation: [0, 0, 0, 0] → [0, 0, 0, 1]",
+            "/planes/1/rotation: [0, 2, 0, 0] → [0, 1, 0, 0]",
+            "/camera/distance: not a number →",
+            "/camera/fov_y_deg: not a number →",
+            "/light/sun_intensity: -4 → 0",
+        ] {
+            assert!(
+                repairs.iter().any(|r| r.starts_with(needle)),
+                "{needle} not in {repairs:#?}"
+            );
+        }
+        let (lo, hi) = crate::derive::field_of(&s).bounds().expect("a field");
+        assert!(lo.is_finite() && hi.is_finite(), "{lo} {hi}");
+        // Geometry that cannot be repaired is refused with a message.
+        let err = Scene::from_json(
+            r#"{"planes": [{"points": [[0, 0], [1, 0], [0, 1]], "origin": [0, 1e39, 0]}]}"#,
+        )
+        .unwrap_err();
+        assert!(
+            err.to_string().contains("plane 0 has a non-finite value"),
+            "{err}"
         );
     }
 

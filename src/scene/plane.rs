@@ -142,10 +142,9 @@ impl DrawingPlane {
         {
             return Err(format!("plane {index} has a non-finite value"));
         }
-        if self.rotation.length_squared() < 1e-6 {
-            self.rotation = Quat::IDENTITY;
+        if let Some(r) = super::unit_rotation(self.rotation) {
+            self.rotation = r;
         }
-        self.rotation = self.rotation.normalize();
         self.sketch.sanitize();
         Ok(())
     }

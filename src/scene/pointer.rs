@@ -27,7 +27,7 @@ pub enum SetError {
 
 /// Applies `PATH=VALUE`. VALUE is read as JSON (`256`, `true`, `[1,2,3]`); anything that is not
 /// JSON is taken as a string.
-pub fn set_by_pointer(scene: &Scene, assignment: &str) -> Result<Scene, SetError> {
+pub fn set_by_pointer(scene: &Scene, assignment: &str) -> Result<(Scene, Vec<String>), SetError> {
     let (path, raw) = assignment
         .split_once('=')
         .ok_or_else(|| SetError::Syntax(assignment.to_string()))?;
@@ -81,11 +81,11 @@ mod tests {
     #[test]
     fn sets_numbers_and_arrays() {
         let s = Scene::default();
-        let s = set_by_pointer(&s, "/render/slices=256").unwrap();
+        let (s, _) = set_by_pointer(&s, "/render/slices=256").unwrap();
         assert_eq!(s.render.slices, 256);
-        let s = set_by_pointer(&s, "/ellipsoids/0/center=[1,2,3]").unwrap();
+        let (s, _) = set_by_pointer(&s, "/ellipsoids/0/center=[1,2,3]").unwrap();
         assert_eq!(s.ellipsoids[0].center, glam::Vec3::new(1.0, 2.0, 3.0));
-        let s = set_by_pointer(&s, "/light/sun_color/0=0.25").unwrap();
+        let (s, _) = set_by_pointer(&s, "/light/sun_color/0=0.25").unwrap();
         assert_eq!(s.light.sun_color[0], 0.25);
     }
 

@@ -118,7 +118,12 @@ pub fn interpret(
         return Err(SketchError::NoArea);
     }
     let feature_radius = spheres::feature_radius(&spheres);
-    spheres::inflate(&mut spheres, feature_radius, params.inflate);
+    spheres::inflate(
+        &outline.boundary,
+        &mut spheres,
+        feature_radius,
+        params.inflate,
+    );
     if params.extend {
         spheres = spheres::extend(&outline, &skeleton, &spheres, seed, params.copies as usize);
     }

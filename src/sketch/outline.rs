@@ -216,18 +216,8 @@ pub fn clean(raw: &[[f64; 2]], closed: bool, simplify: f64) -> Result<Outline, S
             raw.len() - finite.len()
         ));
     }
-    let mut points = if finite.len() > MAX_STROKE_POINTS {
-        warnings.push(format!(
-            "the stroke had {} points; thinned to {MAX_STROKE_POINTS}",
-            finite.len()
-        ));
-        let step = finite.len() as f64 / MAX_STROKE_POINTS as f64;
-        (0..MAX_STROKE_POINTS)
-            .map(|i| finite[(i as f64 * step) as usize])
-            .collect()
-    } else {
-        finite
-    };
+    let (mut points, thinned) = thin(&finite);
+    warnings.extend(thinned);
     if points.len() < 3 {
         return Err(SketchError::TooFewPoints(points.len()));
     }
@@ -248,9 +238,22 @@ pub fn clean(raw: &[[f64; 2]], closed: bool, simplify: f64) -> Result<Outline, S
         }
     }
 
-    // Simplify first so the self-intersection repair works on few vertices.
-    let tolerance = simplify.clamp(0.0, 0.2) * size;
+    // Simplify first so the self-intersection repair works on few vertices. The outline keeps
+    // at most MAX_OUTLINE_POINTS corners: past that the tolerance grows until it fits, so a long
+    // stroke at simplify 0 is simplified a little more, never cut short.
+    let mut tolerance = simplify.clamp(0.0, 0.2) * size;
     let mut simple = douglas_peucker_closed(&points, tolerance.max(eps * 10.0));
+    let asked = tolerance;
+    while simple.len() > MAX_OUTLINE_POINTS {
+        tolerance = (tolerance * 1.5).max(size * 1e-4);
+        simple = douglas_peucker_closed(&points, tolerance);
+    }
+    if tolerance > asked {
+        warnings.push(format!(
+            "the outline had more than {MAX_OUTLINE_POINTS} corners; simplified to within {:.2}% of its size",
+            100.0 * tolerance / size
+        ));
+    }
     dedup(&mut simple, eps);
     if simple.len() < 3 || signed_area(&simple).abs() < size * size * 1e-6 {
         return Err(SketchError::NoArea);
@@ -348,27 +351,42 @@ fn douglas_peucker_closed(p: &[DVec2], tolerance: f64) -> Vec<DVec2> {
 }
 
 /// Resamples a closed polygon evenly, keeping every vertex (the corners of the simplified outline).
+/// With `p` of at most [`MAX_OUTLINE_POINTS`] corners the result has at most twice that many
+/// points: each edge gets ⌊length / spacing⌋ pieces, at least one, and the whole of every edge.
 fn resample(p: &[DVec2], tolerance: f64) -> Vec<DVec2> {
     let total = perimeter(p);
     let target =
         (total / (tolerance * 2.0).max(total / MAX_OUTLINE_POINTS as f64)).round() as usize;
-    let count = target
-        .clamp(MIN_OUTLINE_POINTS, MAX_OUTLINE_POINTS)
-        .max(p.len());
+    let count = target.clamp(MIN_OUTLINE_POINTS, MAX_OUTLINE_POINTS);
     let spacing = total / count as f64;
     let n = p.len();
     let mut out = Vec::with_capacity(count + n);
     for i in 0..n {
         let (a, b) = (p[i], p[(i + 1) % n]);
-        let pieces = ((a.distance(b) / spacing).round() as usize).max(1);
+        let pieces = ((a.distance(b) / spacing) as usize).max(1);
         for k in 0..pieces {
             out.push(a.lerp(b, k as f64 / pieces as f64));
         }
-        if out.len() > MAX_OUTLINE_POINTS * 2 {
-            break;
-        }
     }
     out
+}
+
+/// A stroke of more than [`MAX_STROKE_POINTS`] points thinned to that many, evenly by index,
+/// with the repair in words. Whoever stores a stroke stores the thinned one, so a document
+/// never holds a stroke its own validation would refuse.
+pub fn thin<T: Copy>(points: &[T]) -> (Vec<T>, Option<String>) {
+    if points.len() <= MAX_STROKE_POINTS {
+        return (points.to_vec(), None);
+    }
+    let step = points.len() as f64 / MAX_STROKE_POINTS as f64;
+    let kept = (0..MAX_STROKE_POINTS)
+        .map(|i| points[(i as f64 * step) as usize])
+        .collect();
+    let why = format!(
+        "the stroke had {} points; thinned to {MAX_STROKE_POINTS}",
+        points.len()
+    );
+    (kept, Some(why))
 }
 
 fn orient(a: DVec2, b: DVec2, c: DVec2) -> f64 {

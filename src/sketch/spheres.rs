@@ -88,12 +88,18 @@ pub fn sample(outline: &Outline, skeleton: &Skeleton) -> Vec<Sphere> {
             along += len;
         }
     }
-    bridge(p, &mut out);
+    bridge(p, &mut out, |r| r);
     out
 }
 
 /// Which spheres are joined to the first one through a chain of overlapping spheres.
 pub fn body_of_first(spheres: &[Sphere]) -> Vec<bool> {
+    joined_to_first(spheres, 1.0)
+}
+
+/// Which spheres are joined to the first one through neighbours closer than `overlap` × the
+/// sum of their radii.
+fn joined_to_first(spheres: &[Sphere], overlap: f64) -> Vec<bool> {
     let n = spheres.len();
     let mut seen = vec![false; n];
     let mut stack = Vec::new();
@@ -105,7 +111,7 @@ pub fn body_of_first(spheres: &[Sphere]) -> Vec<bool> {
         for j in 0..n {
             if !seen[j]
                 && spheres[i].center.distance(spheres[j].center)
-                    < spheres[i].radius + spheres[j].radius
+                    < overlap * (spheres[i].radius + spheres[j].radius)
             {
                 seen[j] = true;
                 stack.push(j);
@@ -115,15 +121,16 @@ pub fn body_of_first(spheres: &[Sphere]) -> Vec<bool> {
     seen
 }
 
-/// Joins spheres that do not overlap the main body to it with spheres along the shortest
-/// link inside the outline, so the cloud's body never splits.
-fn bridge(p: &Boundary, spheres: &mut Vec<Sphere>) {
+/// Joins spheres that do not overlap the main body firmly to it with spheres along the
+/// shortest link inside the outline, so the cloud's body never splits; `radius` maps a maximal
+/// ball's radius to the radius the link's spheres get.
+fn bridge(p: &Boundary, spheres: &mut Vec<Sphere>, radius: impl Fn(f64) -> f64) {
     for _ in 0..64 {
         let n = spheres.len();
         if n < 2 {
             return;
         }
-        let seen = body_of_first(spheres);
+        let seen = joined_to_first(spheres, FIRM_OVERLAP);
         if seen.iter().all(|&s| s) {
             return;
         }
@@ -144,16 +151,17 @@ fn bridge(p: &Boundary, spheres: &mut Vec<Sphere>) {
         let len = qa.distance(qb);
         let mut t = 0.0;
         let mut added = false;
-        while t < len {
+        while t < len && spheres.len() < MAX_SPHERES {
             let q = qa.lerp(qb, t / len);
-            let r = p.distance(q);
-            if r <= 0.0 || !contains(p, q) {
+            let r_max = p.distance(q);
+            if r_max <= 0.0 || !contains(p, q) {
                 break;
             }
+            let r = radius(r_max);
             spheres.push(Sphere {
                 center: q.extend(0.0),
                 radius: r,
-                max_radius: r,
+                max_radius: r_max,
                 ..b
             });
             added = true;
@@ -185,15 +193,65 @@ pub fn feature_radius(spheres: &[Sphere]) -> f64 {
     }
 }
 
+/// The radius a maximal ball of radius `r` gets at inflation `t` (see [`inflate`]).
+fn deflated(r: f64, r_f: f64, t: f64) -> f64 {
+    if r > r_f { r + (r_f - r) * t } else { r }
+}
+
 /// Inflation slider: t = 0 keeps the maximal balls, t = 1 shrinks every sphere above r_f to
-/// r_f; spheres at or below r_f never change.
-pub fn inflate(spheres: &mut [Sphere], r_f: f64, t: f64) {
+/// r_f; spheres at or below r_f never change. Then neighbours along a branch that no longer
+/// overlap firmly (the body was sampled for its full radii: at t = 1 fat parts would fall
+/// into beads) get spheres in between, at the deflated radius of their own maximal ball, and
+/// any piece still apart is bridged to the body: at every t the body stays one piece.
+pub fn inflate(outline: &Boundary, spheres: &mut Vec<Sphere>, r_f: f64, t: f64) {
     let t = t.clamp(0.0, 1.0);
-    for s in spheres {
-        if s.max_radius > r_f {
-            s.radius = s.max_radius + (r_f - s.max_radius) * t;
+    for s in spheres.iter_mut() {
+        s.radius = deflated(s.max_radius, r_f, t);
+    }
+    if t > 0.0 {
+        let fill = fill_gaps(outline, spheres, |r| deflated(r, r_f, t));
+        spheres.extend(fill);
+        bridge(outline, spheres, |r| deflated(r, r_f, t));
+    }
+}
+
+/// Neighbours closer than this fraction of their radii's sum count as one piece: enough overlap
+/// that a grid of a few cells per sphere still sees them joined.
+const FIRM_OVERLAP: f64 = 0.8;
+
+/// Spheres between consecutive spheres of one branch that do not overlap firmly.
+fn fill_gaps(p: &Boundary, spheres: &[Sphere], radius: impl Fn(f64) -> f64) -> Vec<Sphere> {
+    let mut fill = Vec::new();
+    for w in spheres.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        let (qa, qb) = (a.center.truncate(), b.center.truncate());
+        let len = qa.distance(qb);
+        if a.branch != b.branch || len <= FIRM_OVERLAP * (a.radius + b.radius) {
+            continue;
+        }
+        let mut t = 0.0;
+        let mut r = a.radius;
+        loop {
+            t += SPACING * r.max(len * 1e-3);
+            if t >= len || spheres.len() + fill.len() >= MAX_SPHERES {
+                break;
+            }
+            let q = qa.lerp(qb, t / len);
+            let r_max = p.distance(q);
+            if r_max <= 0.0 || !contains(p, q) {
+                break;
+            }
+            r = radius(r_max);
+            fill.push(Sphere {
+                center: q.extend(0.0),
+                radius: r,
+                max_radius: r_max,
+                along: a.along + (b.along - a.along) * t / len,
+                ..a
+            });
         }
     }
+    fill
 }
 
 /// The trunk: the longest chain of body branches, or the longest path of the skeleton when it

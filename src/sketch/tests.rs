@@ -328,3 +328,190 @@ proptest! {
         prop_assert!(connected(&s.spheres));
     }
 }
+
+/// A circle with bumps at several scales, `n` samples.
+fn wobbly(n: usize) -> Vec<[f64; 2]> {
+    (0..n)
+        .map(|i| i as f64 / n as f64 * TAU)
+        .map(|a| {
+            let r =
+                3.0 + 0.25 * (7.0 * a).sin() + 0.08 * (41.0 * a).sin() + 0.02 * (173.0 * a).cos();
+            [r * a.cos(), r * a.sin()]
+        })
+        .collect()
+}
+
+/// Intersection over union of two polygons, by sampling a grid over both.
+fn polygon_iou(a: &[DVec2], b: &[DVec2]) -> f64 {
+    let (lo, hi) = a.iter().chain(b).fold(
+        (DVec2::splat(f64::MAX), DVec2::splat(f64::MIN)),
+        |(l, h), &q| (l.min(q), h.max(q)),
+    );
+    let n = 200;
+    let (mut inter, mut union) = (0, 0);
+    for j in 0..n {
+        for i in 0..n {
+            let q = lo
+                + (hi - lo) * DVec2::new((i as f64 + 0.5) / n as f64, (j as f64 + 0.5) / n as f64);
+            let (x, y) = (contains(a, q), contains(b, q));
+            inter += (x && y) as usize;
+            union += (x || y) as usize;
+        }
+    }
+    inter as f64 / union as f64
+}
+
+#[test]
+fn long_strokes_keep_their_whole_outline_at_any_simplify() {
+    // The resampler used to stop at 640 points and close the rest with a chord: a 1,200-point
+    // stroke at simplify 0 kept about half its area.
+    for (n, simplify) in [(1_200, 0.0), (1_200, 0.002), (4_096, 0.0), (30_000, 0.0)] {
+        let raw = wobbly(n);
+        let drawn: Vec<DVec2> = raw.iter().map(|&p| DVec2::from(p)).collect();
+        let o = outline::clean(&raw, true, simplify).unwrap();
+        assert!(
+            o.points.len() <= 2 * outline::MAX_OUTLINE_POINTS,
+            "{}",
+            o.points.len()
+        );
+        let iou = polygon_iou(&drawn, &o.points);
+        assert!(
+            iou > 0.97,
+            "{n} points at simplify {simplify}: IoU {iou:.3} with the stroke as drawn"
+        );
+        if n >= 1_200 && simplify < 0.001 {
+            assert!(
+                o.warnings.iter().any(|w| w.contains("corners")),
+                "{:?}",
+                o.warnings
+            );
+        }
+    }
+}
+
+/// The paper's sheep: a fat body (an ellipse 6 × 4.4) on four thin legs (0.4 wide, about 4.5 long).
+fn sheep() -> Vec<[f64; 2]> {
+    let below = |x: f64| -2.2 * (1.0 - (x / 3.0) * (x / 3.0)).max(0.0).sqrt();
+    let mut v = Vec::new();
+    // The underside, left to right, with the legs.
+    let legs = [-2.0, -1.0, 0.6, 1.6];
+    let mut x = -3.0;
+    while x < 3.0 {
+        if let Some(&l) = legs.iter().find(|&&l| x <= l && l < x + 0.1) {
+            v.extend([
+                [l, below(l)],
+                [l, -6.5],
+                [l + 0.4, -6.5],
+                [l + 0.4, below(l + 0.4)],
+            ]);
+            x = l + 0.5;
+            continue;
+        }
+        v.push([x, below(x)]);
+        x += 0.1;
+    }
+    // The back, right to left.
+    for i in 0..60 {
+        let a = i as f64 / 60.0 * PI;
+        v.push([3.0 * a.cos(), 2.2 * a.sin()]);
+    }
+    v
+}
+
+/// Pieces of the union of the spheres' discs on a raster of about 6 cells per smallest radius
+/// (spheres that barely touch fall apart at this resolution, as they would on the grid).
+fn pieces(spheres: &[Sphere]) -> usize {
+    let (lo, hi) = spheres.iter().fold(
+        (DVec2::splat(f64::MAX), DVec2::splat(f64::MIN)),
+        |(l, h), s| {
+            let c = s.center.truncate();
+            (l.min(c - s.radius), h.max(c + s.radius))
+        },
+    );
+    let r_min = spheres.iter().map(|s| s.radius).fold(f64::MAX, f64::min);
+    let cell = (r_min / 6.0).max((hi - lo).max_element() / 1500.0);
+    let (w, h) = (
+        ((hi.x - lo.x) / cell) as usize + 1,
+        ((hi.y - lo.y) / cell) as usize + 1,
+    );
+    let mut inside = vec![false; w * h];
+    for s in spheres {
+        let c = s.center.truncate();
+        let (x0, x1) = (
+            ((c.x - s.radius - lo.x) / cell) as usize,
+            ((c.x + s.radius - lo.x) / cell) as usize,
+        );
+        let (y0, y1) = (
+            ((c.y - s.radius - lo.y) / cell) as usize,
+            ((c.y + s.radius - lo.y) / cell) as usize,
+        );
+        for y in y0..=y1.min(h - 1) {
+            for x in x0..=x1.min(w - 1) {
+                let q = lo + DVec2::new(x as f64 + 0.5, y as f64 + 0.5) * cell;
+                if q.distance_squared(c) <= s.radius * s.radius {
+                    inside[y * w + x] = true;
+                }
+            }
+        }
+    }
+    let mut count = 0;
+    let mut stack = Vec::new();
+    for start in 0..w * h {
+        if !inside[start] {
+            continue;
+        }
+        count += 1;
+        inside[start] = false;
+        stack.push(start);
+        while let Some(i) = stack.pop() {
+            let (x, y) = (i % w, i / w);
+            for (nx, ny) in [
+                (x.wrapping_sub(1), y),
+                (x + 1, y),
+                (x, y.wrapping_sub(1)),
+                (x, y + 1),
+            ] {
+                if nx < w && ny < h && inside[ny * w + nx] {
+                    inside[ny * w + nx] = false;
+                    stack.push(ny * w + nx);
+                }
+            }
+        }
+    }
+    count
+}
+
+#[test]
+fn the_body_stays_one_piece_at_every_inflation() {
+    // Spheres are spaced for their full radii; at t = 1 the sheep's fat body shrank to the
+    // legs' radius and fell into beads.
+    for (name, shape) in [
+        ("sheep", sheep()),
+        ("star", star(5, 5.0, 1.2)),
+        ("cumulus", cumulus()),
+    ] {
+        if name == "sheep" {
+            // Fatter than 4 r_f, the body's spheres (spaced 0.4 r) part at t = 1 unless filled.
+            let base = interpret(&shape, true, &no_extend(), 1).unwrap();
+            let fattest = base
+                .spheres
+                .iter()
+                .map(|s| s.max_radius)
+                .fold(0.0, f64::max);
+            assert!(
+                fattest > 8.0 * base.feature_radius,
+                "{fattest} vs r_f {}",
+                base.feature_radius
+            );
+        }
+        for t in [0.0, 0.25, 0.5, 0.75, 1.0] {
+            let params = SketchParams {
+                inflate: t,
+                ..no_extend()
+            };
+            let s = interpret(&shape, true, &params, 1).unwrap();
+            assert_eq!(pieces(&s.spheres), 1, "{name} at t = {t}");
+            assert!(s.spheres.len() <= spheres::MAX_SPHERES);
+        }
+    }
+}

@@ -219,6 +219,7 @@ impl CloudApp {
         p.sketch.ui(
             ui,
             &mut self.doc,
+            &self.derived,
             &mut self.tool,
             &mut self.selection,
             &mut self.notices,

@@ -3,6 +3,7 @@
 use egui::Ui;
 use glam::{EulerRot, Quat};
 
+use crate::derive::{Derived, Shape};
 use crate::limits;
 use crate::scene::{Document, Edit, StrokeKind};
 use crate::ui::notice::Notices;
@@ -20,6 +21,7 @@ impl SketchPanel {
         &mut self,
         ui: &mut Ui,
         doc: &mut Document,
+        derived: &Derived,
         tool: &mut SketchTool,
         selection: &mut Selection,
         notices: &mut Notices,
@@ -65,7 +67,19 @@ impl SketchPanel {
                 let mut clicked = None;
                 for (i, plane) in planes.iter().enumerate() {
                     let selected = selection.contains(Item::Plane(i));
-                    if ui.selectable_label(selected, plane.name.as_str()).clicked() {
+                    // A plane whose stroke the field cannot use says so, and why.
+                    let shape = derived.derived_shape(plane);
+                    let response = match shape.as_deref() {
+                        Some(Shape::Unusable(e)) => ui
+                            .selectable_label(
+                                selected,
+                                egui::RichText::new(format!("{} (not used)", plane.name))
+                                    .color(ui.visuals().warn_fg_color),
+                            )
+                            .on_hover_text(format!("This stroke adds nothing to the cloud: {e}")),
+                        _ => ui.selectable_label(selected, plane.name.as_str()),
+                    };
+                    if response.clicked() {
                         clicked = Some((i, selected));
                     }
                 }
@@ -74,6 +88,18 @@ impl SketchPanel {
                 }
                 if let Some(i) = selection.plane().filter(|&i| i < doc.scene().planes.len()) {
                     ui.separator();
+                    let notes = match derived.derived_shape(&doc.scene().planes[i]).as_deref() {
+                        Some(Shape::Unusable(e)) => vec![format!("Not used: {e}")],
+                        Some(Shape::Outline { warnings, .. }) => warnings.clone(),
+                        _ => Vec::new(),
+                    };
+                    for note in notes {
+                        ui.label(
+                            egui::RichText::new(note)
+                                .small()
+                                .color(ui.visuals().warn_fg_color),
+                        );
+                    }
                     plane_controls(ui, doc, i);
                     ui.horizontal(|ui| {
                         let now = ui.input(|i| i.time);
