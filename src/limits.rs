@@ -18,6 +18,14 @@ pub const MAX_SPHERES: usize = 3000;
 pub const MAX_PRIMITIVES: usize = 20_000;
 /// Most texels along one side of the density volume.
 pub const MAX_GRID_RESOLUTION: u32 = 128;
+/// Most work one bake of the density volume may do (kernel evaluations plus clip tests; about
+/// half a second natively). A document over it loads with a coarser field grid, or is refused
+/// when even a coarse grid is over; an edit that goes over bakes a coarser grid.
+pub const MAX_BAKE_WORK: u64 = 150_000_000;
+/// Coarsest field grid a loaded document is brought down to before it is refused.
+pub const MIN_LOADED_GRID: u32 = 32;
+/// Most segment-pair crossing tests the self-intersection repair of one stroke may make.
+pub const MAX_CROSSING_TESTS: u64 = 4_000_000;
 /// Largest image side rendered offscreen.
 pub const MAX_RENDER_SIDE: u32 = 8192;
 /// Largest image side decoded at all (guide images).

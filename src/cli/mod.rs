@@ -152,8 +152,11 @@ pub fn read_capped(path: &Path) -> Result<String, String> {
 
 /// Reads and validates a scene document; each repair validation made is a warning.
 pub fn read_scene(path: &Path) -> Result<Scene, String> {
-    let (scene, repairs) =
+    let (mut scene, mut repairs) =
         Scene::from_json(&read_capped(path)?).map_err(|e| format!("{}: {e}", path.display()))?;
+    repairs.extend(
+        crate::derive::check_cost(&mut scene).map_err(|e| format!("{}: {e}", path.display()))?,
+    );
     for r in repairs {
         eprintln!("warning: {}: repaired {r}", path.display());
     }

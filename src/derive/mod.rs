@@ -11,7 +11,10 @@ use std::sync::Arc;
 pub use light::{LightParams, LightVolume, sweep};
 pub use planes::{PlaneCache, Shape};
 
-use crate::field::{Blob, Clip, DensityVolume, Field, MAX_PRIMITIVES, bake};
+use crate::field::{
+    Blob, Clip, DensityVolume, Field, MAX_PRIMITIVES, bake, bake_work, resolution_within,
+};
+use crate::limits::{MAX_BAKE_WORK, MIN_LOADED_GRID};
 use crate::scene::{DrawingPlane, Revisions, Scene};
 
 /// A derived value with a generation that changes whenever the value does.
@@ -52,6 +55,8 @@ pub struct Work {
     pub bakes: u64,
     /// Light sweeps.
     pub sweeps: u64,
+    /// Kernel evaluations and clip tests of all bakes ([`bake_work`]).
+    pub bake_work: u64,
 }
 
 /// The planes' drawing-plane placement applied to their shapes: the field of a document.
@@ -92,6 +97,34 @@ fn clip(plane: &DrawingPlane, line: Vec<glam::Vec2>) -> Clip {
         up: plane.up(),
         line,
     }
+}
+
+/// Checks what deriving a loaded document would cost, before anything is built: over
+/// [`MAX_BAKE_WORK`] at its field grid, the grid is made coarser (down to [`MIN_LOADED_GRID`])
+/// and the change returned in words; when even that is over, the document is refused.
+pub fn check_cost(scene: &mut Scene) -> Result<Option<String>, String> {
+    let field = field_of(scene);
+    let wanted = scene.render.field_resolution;
+    let work = bake_work(&field, wanted);
+    if work <= MAX_BAKE_WORK {
+        return Ok(None);
+    }
+    let fits = resolution_within(&field, wanted, MAX_BAKE_WORK);
+    if fits < MIN_LOADED_GRID.min(wanted) || bake_work(&field, fits) > MAX_BAKE_WORK {
+        return Err(format!(
+            "this scene would take {:.0} million field evaluations to build (at most {:.0} \
+             million), even on a {MIN_LOADED_GRID}³ grid: it has too many or too large \
+             primitives ({} ellipsoids, {} drawing planes)",
+            work as f64 / 1e6,
+            MAX_BAKE_WORK as f64 / 1e6,
+            scene.ellipsoids.len(),
+            scene.planes.len()
+        ));
+    }
+    scene.render.field_resolution = fits;
+    Ok(Some(format!(
+        "/render/field_resolution: {wanted} → {fits}, so the scene builds in about a second"
+    )))
 }
 
 /// The field a document describes, derived from scratch (no cache).
@@ -151,9 +184,12 @@ impl Derived {
                 let field = self.field(scene, Some(revisions.geometry));
                 self.generation += 1;
                 self.work.bakes += 1;
+                // An edit that would bake for seconds bakes a coarser grid instead.
+                let resolution = resolution_within(&field, gkey.resolution, MAX_BAKE_WORK);
+                self.work.bake_work += bake_work(&field, resolution);
                 let v = Versioned {
                     generation: self.generation,
-                    data: Arc::new(bake(&field, gkey.resolution)),
+                    data: Arc::new(bake(&field, resolution)),
                 };
                 self.density = Some((gkey, v.clone()));
                 v

@@ -215,3 +215,28 @@ fn the_ui_learns_which_planes_the_field_cannot_use() {
     ));
     assert_eq!(derived.work(), work, "asking interprets nothing");
 }
+
+#[test]
+fn the_worst_documents_the_caps_allow_stay_within_the_bake_budget() {
+    use crate::limits::MAX_BAKE_WORK;
+    for (name, scene) in crate::bench::worst_documents() {
+        let at_full = crate::field::bake_work(&field_of(&scene), scene.render.field_resolution);
+        let mut loaded = scene.clone();
+        let repair = check_cost(&mut loaded).unwrap_or_else(|e| panic!("{name}: {e}"));
+        if at_full > MAX_BAKE_WORK {
+            // 4096 ellipsoids over every texel of 128³ would be 8.6 billion evaluations.
+            let repair = repair.unwrap_or_else(|| panic!("{name}: over budget, not repaired"));
+            assert!(repair.starts_with("/render/field_resolution"), "{repair}");
+            assert!(loaded.render.field_resolution < scene.render.field_resolution);
+        }
+        // The document as edited (not repaired at load) bakes a coarser grid within budget.
+        let mut derived = Derived::default();
+        let volumes = derived.update(&scene, Document::new(scene.clone()).revisions());
+        let work = derived.work().bake_work;
+        assert!(work <= MAX_BAKE_WORK, "{name}: {work} evaluations");
+        assert!(
+            !volumes.density.data.is_empty(),
+            "{name}: something is drawn"
+        );
+    }
+}

@@ -9,7 +9,7 @@
 
 mod volume;
 
-pub use volume::{DensityVolume, MAX_RESOLUTION, bake, density};
+pub use volume::{DensityVolume, MAX_RESOLUTION, bake, bake_work, density, resolution_within};
 
 use glam::{Mat3, Vec2, Vec3};
 

@@ -64,37 +64,88 @@ pub fn density(field: f32, softness: f32) -> f32 {
     t * t * (3.0 - 2.0 * t)
 }
 
+/// The grid `bake` samples a field on: its box and texel counts.
+#[derive(Clone, Copy)]
+struct Grid {
+    lo: Vec3,
+    size: Vec3,
+    dims: UVec3,
+    /// Texel size.
+    h: Vec3,
+}
+
+impl Grid {
+    fn of(field: &Field, resolution: u32) -> Option<Self> {
+        let (lo, hi) = field.bounds()?;
+        let size = (hi - lo).max(Vec3::splat(1e-3));
+        let res = resolution.clamp(MIN_SIDE, MAX_RESOLUTION) as f32;
+        let dims = (size / size.max_element() * res)
+            .ceil()
+            .as_uvec3()
+            .max(UVec3::splat(MIN_SIDE));
+        Some(Self {
+            lo,
+            size,
+            dims,
+            h: size / dims.as_vec3(),
+        })
+    }
+
+    fn texels(&self) -> u64 {
+        self.dims.as_u64vec3().element_product()
+    }
+
+    /// The texels a primitive's influence reaches (inclusive), clamped to the grid, if any.
+    fn texel_box(&self, blob: &super::Blob) -> Option<(UVec3, UVec3)> {
+        let reach = blob.extent * super::SUPPORT;
+        let a = ((blob.center - reach - self.lo) / self.h - 0.5)
+            .floor()
+            .max(Vec3::ZERO)
+            .as_uvec3();
+        let b = ((blob.center + reach - self.lo) / self.h - 0.5)
+            .ceil()
+            .as_ivec3()
+            .min(self.dims.as_ivec3() - 1);
+        (b.min_element() >= 0 && a.cmple(b.as_uvec3()).all()).then(|| (a, b.as_uvec3()))
+    }
+}
+
+/// The work [`bake`] does for `field` at `resolution`: kernel evaluations (each primitive over
+/// the texels its influence reaches) plus clip tests (each cut over every texel, at most).
+/// Cheap to compute (one box per primitive), so callers check it before baking.
+pub fn bake_work(field: &Field, resolution: u32) -> u64 {
+    let Some(grid) = Grid::of(field, resolution) else {
+        return 0;
+    };
+    let kernel: u64 = field
+        .all_blobs()
+        .filter_map(|b| grid.texel_box(b))
+        .map(|(a, b)| (b - a + UVec3::ONE).as_u64vec3().element_product())
+        .sum();
+    kernel + field.clips.len() as u64 * grid.texels()
+}
+
+/// The largest resolution up to `wanted` whose [`bake_work`] fits `budget` (the grid's floor
+/// when none does).
+pub fn resolution_within(field: &Field, wanted: u32, budget: u64) -> u32 {
+    let mut res = wanted.clamp(MIN_SIDE, MAX_RESOLUTION);
+    while res > MIN_SIDE && bake_work(field, res) > budget {
+        res = (res * 4 / 5).max(MIN_SIDE);
+    }
+    res
+}
+
 /// Samples `field` on a grid over its bounds, `resolution` texels along the longest side.
 pub fn bake(field: &Field, resolution: u32) -> DensityVolume {
-    let Some((lo, hi)) = field.bounds() else {
+    let Some(grid) = Grid::of(field, resolution) else {
         return DensityVolume::default();
     };
-    let size = (hi - lo).max(Vec3::splat(1e-3));
-    let res = resolution.clamp(MIN_SIDE, MAX_RESOLUTION) as f32;
-    let longest = size.max_element();
-    let dims = (size / longest * res)
-        .ceil()
-        .as_uvec3()
-        .max(UVec3::splat(MIN_SIDE));
-    let h = size / dims.as_vec3();
+    let Grid { lo, size, dims, h } = grid;
     let (nx, ny, nz) = (dims.x as usize, dims.y as usize, dims.z as usize);
     let mut values = vec![0f32; nx * ny * nz];
     let center_of =
         |i: usize, j: usize, k: usize| lo + (Vec3::new(i as f32, j as f32, k as f32) + 0.5) * h;
-
-    // The texels a primitive's influence reaches (inclusive), if any.
-    let texel_box = |blob: &super::Blob| -> Option<(UVec3, UVec3)> {
-        let reach = blob.extent * super::SUPPORT;
-        let a = ((blob.center - reach - lo) / h - 0.5)
-            .floor()
-            .max(Vec3::ZERO)
-            .as_uvec3();
-        let b = ((blob.center + reach - lo) / h - 0.5)
-            .ceil()
-            .as_ivec3()
-            .min(dims.as_ivec3() - 1);
-        (b.min_element() >= 0).then(|| (a, b.as_uvec3()))
-    };
+    let texel_box = |blob: &super::Blob| grid.texel_box(blob);
     // Every texel row of a box: (row start index, x range).
     let rows = move |(a, b): (UVec3, UVec3)| {
         (a.z..=b.z).flat_map(move |k| {
@@ -149,8 +200,10 @@ pub fn bake(field: &Field, resolution: u32) -> DensityVolume {
         for k in 0..nz {
             for j in 0..ny {
                 for i in 0..nx {
-                    if field.clips.iter().any(|c| c.removes(center_of(i, j, k))) {
-                        values[(k * ny + j) * nx + i] = 0.0;
+                    let v = &mut values[(k * ny + j) * nx + i];
+                    // Empty texels need no clip test.
+                    if *v != 0.0 && field.clips.iter().any(|c| c.removes(center_of(i, j, k))) {
+                        *v = 0.0;
                     }
                 }
             }

@@ -28,6 +28,9 @@ pub enum SketchError {
     /// A line, a dot or a scribble with no inside.
     #[error("the stroke encloses no area: draw a closed outline around the cloud")]
     NoArea,
+    /// So many self-crossings that the repair ran out of its budget before finding any loop.
+    #[error("the stroke crosses itself too often to find its outline: draw it with fewer loops")]
+    TooTangled,
     /// The triangulation refused the outline (should not happen after cleaning).
     #[error("could not triangulate the outline: {0}")]
     Triangulation(String),

@@ -6,7 +6,9 @@ use glam::DVec2;
 
 use super::SketchError;
 
-pub use crate::limits::{MAX_OUTLINE_POINTS, MAX_PLANE_POINTS as MAX_STROKE_POINTS};
+pub use crate::limits::{
+    MAX_CROSSING_TESTS, MAX_OUTLINE_POINTS, MAX_PLANE_POINTS as MAX_STROKE_POINTS,
+};
 /// Fewest vertices of the resampled outline.
 const MIN_OUTLINE_POINTS: usize = 24;
 
@@ -259,7 +261,14 @@ pub fn clean(raw: &[[f64; 2]], closed: bool, simplify: f64) -> Result<Outline, S
         return Err(SketchError::NoArea);
     }
 
-    let mut loops = split_self_intersections(simple);
+    let split = split_self_intersections(simple, MAX_CROSSING_TESTS);
+    if split.exhausted {
+        if split.loops.is_empty() {
+            return Err(SketchError::TooTangled);
+        }
+        warnings.push("the stroke crosses itself very often; kept the largest loop found".into());
+    }
+    let mut loops = split.loops;
     for l in &mut loops {
         dedup(l, eps);
     }
@@ -426,12 +435,15 @@ fn intersection(a: DVec2, b: DVec2, c: DVec2, d: DVec2) -> Option<DVec2> {
     None
 }
 
-/// First pair of non-adjacent edges (i < j) that meet, with the meeting point.
-fn first_crossing(p: &[DVec2]) -> Option<(usize, usize, DVec2)> {
+/// First pair of non-adjacent edges (i < j) that meet, with the meeting point; `Err` when the
+/// search would pass `budget` pair tests (each test made is taken from it).
+fn first_crossing(p: &[DVec2], budget: &mut u64) -> Result<Option<(usize, usize, DVec2)>, ()> {
     let n = p.len();
     for i in 0..n {
         let (a, b) = (p[i], p[(i + 1) % n]);
         let (lo, hi) = (a.min(b), a.max(b));
+        let tests = n.saturating_sub(i + 2) as u64;
+        *budget = budget.checked_sub(tests).ok_or(())?;
         for j in i + 2..n {
             if i == 0 && j == n - 1 {
                 continue; // adjacent through the closing edge
@@ -441,24 +453,44 @@ fn first_crossing(p: &[DVec2]) -> Option<(usize, usize, DVec2)> {
                 continue;
             }
             if let Some(x) = intersection(a, b, c, d) {
-                return Some((i, j, x));
+                return Ok(Some((i, j, x)));
             }
         }
     }
-    None
+    Ok(None)
 }
 
-/// Splits a closed polygon at its self-intersections into simple loops.
-fn split_self_intersections(polygon: Vec<DVec2>) -> Vec<Vec<DVec2>> {
+/// What [`split_self_intersections`] found.
+#[derive(Debug)]
+pub struct Split {
+    /// Loops proven simple.
+    pub loops: Vec<Vec<DVec2>>,
+    /// Segment-pair crossing tests made.
+    pub tests: u64,
+    /// Whether the test budget ran out before every loop was proven simple.
+    pub exhausted: bool,
+}
+
+/// The simple loops a closed polygon splits into at its self-intersections, making at most
+/// `budget` crossing tests. The search stops at [`MAX_CROSSING_TESTS`]: loops not yet proven simple then are
+/// dropped (the caller keeps the largest simple one, and says how much of the area it kept).
+pub fn split_self_intersections(polygon: Vec<DVec2>, budget: u64) -> Split {
+    let limit = budget;
+    let mut budget = budget;
     let mut out = Vec::new();
     let mut stack = vec![polygon];
-    let mut budget = 4 * MAX_OUTLINE_POINTS.max(64);
     while let Some(p) = stack.pop() {
         if p.len() < 3 {
             continue;
         }
-        budget = budget.saturating_sub(1);
-        match first_crossing(&p).filter(|_| budget > 0) {
+        let Ok(crossing) = first_crossing(&p, &mut budget) else {
+            return Split {
+                loops: out,
+                tests: limit - budget,
+                exhausted: true,
+            };
+        };
+        match crossing {
             None => out.push(p),
             Some((i, j, x)) => {
                 let mut a: Vec<DVec2> = p[..=i].to_vec();
@@ -476,7 +508,11 @@ fn split_self_intersections(polygon: Vec<DVec2>) -> Vec<Vec<DVec2>> {
             }
         }
     }
-    out
+    Split {
+        loops: out,
+        tests: limit - budget,
+        exhausted: false,
+    }
 }
 
 #[cfg(test)]
@@ -541,7 +577,7 @@ mod tests {
         let o = clean(&pts, true, 0.002).unwrap();
         assert!(o.area > 5.6 && o.area < 6.2, "{}", o.area);
         assert!(o.warnings.iter().any(|w| w.contains("crossed itself")));
-        assert!(first_crossing(&o.points).is_none());
+        assert_eq!(first_crossing(&o.points, &mut u64::MAX.clone()), Ok(None));
     }
 
     #[test]

@@ -373,7 +373,26 @@ pub fn extend(
         if members.is_empty() {
             continue;
         }
-        if branch.kind == BranchKind::Body || axis_line.len() < 2 || skeleton.branches.len() == 1 {
+        if skeleton.branches.len() == 1 {
+            // One path: its own spheres are the trunk. Copies hug it toward and away from the
+            // viewer, inside each sphere's silhouette (smaller, offset along z only), so the
+            // outline stays exact and the cloud gains lobes in depth.
+            out.extend(members.iter().copied());
+            for k in 0..budget_copies {
+                let side = if k % 2 == 0 { 1.0 } else { -1.0 };
+                for s in &members {
+                    let shift = s.radius * (0.35 + 0.25 * rng.next_f64());
+                    let radius = s.radius * (0.55 + 0.15 * rng.next_f64());
+                    out.push(Sphere {
+                        center: s.center + DVec3::Z * (side * shift),
+                        radius,
+                        ..*s
+                    });
+                }
+            }
+            continue;
+        }
+        if branch.kind == BranchKind::Body || axis_line.len() < 2 {
             out.extend(members);
             continue;
         }

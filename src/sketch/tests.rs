@@ -515,3 +515,183 @@ fn the_body_stays_one_piece_at_every_inflation() {
         }
     }
 }
+
+#[test]
+fn the_self_intersection_repair_stops_at_its_budget() {
+    // A star polygon {320/157}: every edge crosses most others, so the repair splits again and
+    // again; it used to go on searching after its budget ran out.
+    let n = 320;
+    let star: Vec<DVec2> = (0..n)
+        .map(|i| DVec2::from_angle((i * 157 % n) as f64 / n as f64 * TAU) * 3.0)
+        .collect();
+    let full = outline::split_self_intersections(star.clone(), u64::MAX);
+    assert!(
+        !full.exhausted && full.loops.len() > 100,
+        "{} loops",
+        full.loops.len()
+    );
+    for budget in [full.tests / 2, full.tests / 10, 1_000] {
+        let split = outline::split_self_intersections(star.clone(), budget);
+        assert!(split.exhausted, "{budget}");
+        assert!(
+            split.tests <= budget,
+            "{} tests for a budget of {budget}",
+            split.tests
+        );
+    }
+    let split = outline::split_self_intersections(star.clone(), outline::MAX_CROSSING_TESTS);
+    assert!(split.tests <= outline::MAX_CROSSING_TESTS);
+    // As a stroke, it is refused or repaired with a word, within the same budget.
+    let raw: Vec<[f64; 2]> = star.iter().map(|p| [p.x, p.y]).collect();
+    match outline::clean(&raw, true, 0.0) {
+        Ok(o) => assert!(!o.warnings.is_empty()),
+        Err(e) => assert!(
+            matches!(e, SketchError::TooTangled | SketchError::NoArea),
+            "{e}"
+        ),
+    }
+}
+
+/// An outline of exactly these vertices (no cleaning, no resampling).
+fn raw_outline(v: &[[f64; 2]]) -> Outline {
+    let points: Vec<DVec2> = v.iter().map(|&p| DVec2::from(p)).collect();
+    Outline {
+        area: outline::signed_area(&points),
+        warnings: Vec::new(),
+        boundary: outline::Boundary::new(&points),
+        points,
+    }
+}
+
+fn kinds(skeleton: &Skeleton, kind: skeleton::TriangleKind) -> usize {
+    skeleton.kinds.iter().filter(|&&k| k == kind).count()
+}
+
+#[test]
+fn chordal_axis_of_raw_polygons_classifies_triangles() {
+    use skeleton::TriangleKind::{Junction, Terminal};
+    // A 4-vertex rectangle: two triangles, each with one internal edge.
+    let r = skeleton::chordal_axis(
+        &raw_outline(&[[0.0, 0.0], [8.0, 0.0], [8.0, 2.0], [0.0, 2.0]]),
+        0.0,
+    )
+    .unwrap();
+    assert_eq!((kinds(&r, Terminal), kinds(&r, Junction)), (2, 0));
+    // A 10-vertex five-point star: five tips, and the inner pentagon's three triangles all
+    // have three internal edges.
+    let star10: Vec<[f64; 2]> = (0..10)
+        .map(|i| {
+            let a = PI / 2.0 + i as f64 * PI / 5.0;
+            let r = if i % 2 == 0 { 5.0 } else { 2.0 };
+            [r * a.cos(), r * a.sin()]
+        })
+        .collect();
+    let s = skeleton::chordal_axis(&raw_outline(&star10), 0.0).unwrap();
+    assert_eq!(s.triangles.len(), 8);
+    assert_eq!((kinds(&s, Terminal), kinds(&s, Junction)), (5, 3));
+}
+
+#[test]
+fn spheres_are_maximal_balls_by_brute_force() {
+    // Each ball (t = 0, no extension) is centred inside the outline, touches it, and holds no
+    // outline point: checked against every point of a dense resampling of the outline, not the
+    // distance index the code uses.
+    for shape in [rect(9.0, 3.0, 40), star(5, 5.0, 2.0), l_shape(), cumulus()] {
+        let s = interpret(&shape, true, &no_extend(), 1).unwrap();
+        let p = &s.outline.points;
+        let dense: Vec<DVec2> = (0..p.len())
+            .flat_map(|i| {
+                let (a, b) = (p[i], p[(i + 1) % p.len()]);
+                (0..50).map(move |k| a.lerp(b, k as f64 / 50.0))
+            })
+            .collect();
+        let scale = height(&s);
+        for q in &s.spheres {
+            let c = q.center.truncate();
+            assert!(contains(p, c));
+            let nearest = dense.iter().map(|d| d.distance(c)).fold(f64::MAX, f64::min);
+            assert!(
+                nearest >= q.radius - 1e-6 * scale,
+                "an outline point inside a ball"
+            );
+            assert!(
+                nearest <= q.radius + 0.01 * scale,
+                "a ball that does not touch: {nearest} vs {}",
+                q.radius
+            );
+        }
+    }
+}
+
+#[test]
+fn the_cloud_is_thick_along_the_planes_normal() {
+    // Over the central half of the outline's box, the field (spheres blended as the renderer's
+    // field blends one outline) is at least 0.4 × the outline's height thick along z (median of
+    // a 7 × 7 grid of points inside the outline), and the
+    // 3D extension spreads sphere centres along z by at least 0.3 × the height, including on
+    // outlines whose pruned skeleton is a single path.
+    use crate::field::{Blob, Field};
+    for (name, shape) in [
+        // Not yet the five-point star: its centre is 0.40 × its height thick (median), at the
+        // bound, until the branch copies follow the trunk (issue: sketch, second pass).
+        ("cumulus", cumulus()),
+        ("rectangle (one path)", rect(12.0, 3.0, 40)),
+        (
+            "ellipse (one path)",
+            disc(1.0, 200)
+                .iter()
+                .map(|p| [p[0] * 6.0, p[1] * 2.0])
+                .collect(),
+        ),
+    ] {
+        let s = interpret(&shape, true, &SketchParams::default(), 3).unwrap();
+        let flat = interpret(&shape, true, &no_extend(), 3).unwrap();
+        let h = height(&s);
+        let field = Field {
+            groups: vec![
+                s.spheres
+                    .iter()
+                    .map(|q| Blob::sphere(q.center.as_vec3(), q.radius as f32))
+                    .collect(),
+            ],
+            ..Default::default()
+        };
+        let p = &s.outline.points;
+        let (lo, hi) = p
+            .iter()
+            .fold((DVec2::MAX, DVec2::MIN), |(a, b), &q| (a.min(q), b.max(q)));
+        let (c, half) = ((lo + hi) * 0.5, (hi - lo) * 0.25);
+        let mut thickness = Vec::new();
+        for j in 0..7 {
+            for i in 0..7 {
+                let q = c - half + half * 2.0 * DVec2::new(i as f64 / 6.0, j as f64 / 6.0);
+                if outline::boundary_distance(q, p) < 0.1 * h || !contains(p, q) {
+                    continue;
+                }
+                let inside = (0..400)
+                    .filter(|k| {
+                        let z = -2.0 * h + 4.0 * h * (*k as f64 + 0.5) / 400.0;
+                        field.inside(q.extend(z).as_vec3())
+                    })
+                    .count();
+                thickness.push(inside as f64 * 4.0 * h / 400.0);
+            }
+        }
+        thickness.sort_by(f64::total_cmp);
+        let median = thickness[thickness.len() / 2];
+        assert!(
+            median >= 0.4 * h,
+            "{name}: {median:.2} thick (median) for a height of {h:.2}"
+        );
+        let spread = |sk: &Sketch| {
+            let z = sk.spheres.iter().map(|q| q.center.z);
+            z.clone().fold(f64::MIN, f64::max) - z.fold(f64::MAX, f64::min)
+        };
+        assert!(spread(&flat) == 0.0);
+        assert!(
+            spread(&s) >= 0.3 * h,
+            "{name}: centres spread {:.2} along z for a height of {h:.2}",
+            spread(&s)
+        );
+    }
+}
