@@ -18,6 +18,8 @@ pub enum Shape {
     Outline {
         /// Spheres in plane coordinates.
         spheres: Vec<Sphere>,
+        /// The pruned chordal axis, as segments in plane coordinates (for the overlay).
+        skeleton: Vec<[Vec2; 2]>,
         /// Repairs made to the stroke.
         warnings: Vec<String>,
     },
@@ -52,6 +54,15 @@ fn interpret(plane: &DrawingPlane) -> Shape {
             match crate::sketch::interpret(&plane.stroke(), plane.closed, &plane.sketch, plane.seed)
             {
                 Ok(sketch) => Shape::Outline {
+                    skeleton: sketch
+                        .skeleton
+                        .segments
+                        .iter()
+                        .map(|&[a, b]| {
+                            let node = |i: usize| sketch.skeleton.nodes[i].pos.as_vec2();
+                            [node(a), node(b)]
+                        })
+                        .collect(),
                     spheres: sketch.spheres,
                     warnings: sketch.warnings,
                 },

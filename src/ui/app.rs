@@ -266,6 +266,7 @@ impl CloudApp {
             "tool": self.tool.tool.name(),
             "selected_plane": self.selection.plane(),
             "guides_hidden": self.tool.hide_guides,
+            "skeleton_shown": self.tool.show_skeleton,
             "panel_open": self.panel_open,
             "guide_image": self.guide.image.as_ref().map(|g| serde_json::json!({
                 "name": g.name, "size": g.size, "opacity": self.guide.opacity, "visible": self.guide.visible,

@@ -54,6 +54,8 @@ pub struct SketchTool {
     pub show_all_planes: bool,
     /// Hide strokes and grids (H), to look at the cloud alone.
     pub hide_guides: bool,
+    /// Show the selected outline's skeleton and spheres (K), as in Wither et al.'s Figure 4.
+    pub show_skeleton: bool,
     /// A stroke is being drawn (between drag start and stop).
     drawing: bool,
     /// The world axis Rotate turns about (X, Y or Z), or free.
@@ -197,7 +199,7 @@ pub fn duplicate_selected(doc: &mut Document, selection: &mut Selection) -> Opti
 
 impl SketchTool {
     /// Tool shortcuts: V navigate, D draw, C cut, G move, R rotate (then X, Y or Z locks the
-    /// axis, the same key again frees it), H hides guides, Esc cancels a stroke (or clears the
+    /// axis, the same key again frees it), H hides guides, K shows the skeleton and spheres, Esc cancels a stroke (or clears the
     /// selection), Delete removes the selected plane, Ctrl+D duplicates it.
     pub fn shortcuts(&mut self, ctx: &egui::Context, tc: &mut ToolContext<'_>) {
         if ctx.egui_wants_keyboard_input() {
@@ -213,11 +215,12 @@ impl SketchTool {
                 i.consume_key(Modifiers::NONE, Key::G),
                 i.consume_key(Modifiers::NONE, Key::R),
                 i.consume_key(Modifiers::NONE, Key::H),
+                i.consume_key(Modifiers::NONE, Key::K),
                 i.consume_key(Modifiers::NONE, Key::Escape),
                 i.consume_key(Modifiers::NONE, Key::Delete),
             ]
         });
-        let [dup, v, d, c, g, r, h, esc, del] = keys;
+        let [dup, v, d, c, g, r, h, k, esc, del] = keys;
         if self.tool == Tool::Rotate {
             for (key, axis) in [(Key::X, Axis::X), (Key::Y, Axis::Y), (Key::Z, Axis::Z)] {
                 if ctx.input_mut(|i| i.consume_key(Modifiers::NONE, key)) {
@@ -239,6 +242,9 @@ impl SketchTool {
         }
         if h {
             self.hide_guides = !self.hide_guides;
+        }
+        if k {
+            self.show_skeleton = !self.show_skeleton;
         }
         if esc {
             if self.stroke.is_empty() {
@@ -461,11 +467,29 @@ impl SketchTool {
         true
     }
 
-    /// Strokes of every plane, the selected plane's grid, the stroke being drawn and the hints.
-    pub fn overlay(&self, ui: &Ui, rect: Rect, doc: &Document, selection: &Selection) {
+    /// Strokes of every plane, the selected plane's grid (and, with K, its skeleton and
+    /// spheres), the stroke being drawn and the hints.
+    pub fn overlay(
+        &self,
+        ui: &Ui,
+        rect: Rect,
+        doc: &Document,
+        derived: &Derived,
+        selection: &Selection,
+    ) {
         let painter = ui.painter_at(rect);
         let scene = doc.scene();
         let camera = &scene.camera;
+        if self.show_skeleton
+            && !self.hide_guides
+            && let Some(plane) = selection.plane().and_then(|i| scene.planes.get(i))
+            && let Some(shape) = derived.derived_shape(plane)
+            && let Shape::Outline {
+                spheres, skeleton, ..
+            } = &*shape
+        {
+            draw_skeleton(&painter, camera, rect, plane, spheres, skeleton);
+        }
         let planes = if self.hide_guides {
             &[][..]
         } else {
@@ -573,6 +597,42 @@ fn plane_at(doc: &Document, rect: Rect, p: Pos2) -> Option<usize> {
         }
     }
     best.map(|(_, i)| i)
+}
+
+/// Wither et al.'s Figure 4 for one plane: its spheres as circles (the 3D extension's copies
+/// fainter) and its pruned skeleton as lines.
+fn draw_skeleton(
+    painter: &egui::Painter,
+    camera: &OrbitCamera,
+    rect: Rect,
+    plane: &DrawingPlane,
+    spheres: &[crate::sketch::Sphere],
+    skeleton: &[[Vec2; 2]],
+) {
+    let eye = camera.eye();
+    for s in spheres {
+        let centre = plane.to_world(s.center.as_vec3());
+        let Some(at) = project(camera, rect, centre) else {
+            continue;
+        };
+        let depth = (centre - eye).dot(camera.forward()).max(1e-3);
+        let radius = s.radius as f32 / camera.world_per_px(depth, rect.height());
+        let in_plane = s.center.z.abs() < 1e-9;
+        let color = if in_plane {
+            Color32::from_rgba_unmultiplied(120, 200, 255, 150)
+        } else {
+            Color32::from_rgba_unmultiplied(120, 200, 255, 50)
+        };
+        painter.circle_stroke(at, radius, Stroke::new(1.0, color));
+    }
+    for [a, b] in skeleton {
+        if let (Some(a), Some(b)) = (
+            project(camera, rect, plane.to_world(a.extend(0.0))),
+            project(camera, rect, plane.to_world(b.extend(0.0))),
+        ) {
+            painter.line_segment([a, b], Stroke::new(2.0, Color32::from_rgb(255, 220, 60)));
+        }
+    }
 }
 
 /// The selected plane's grid: its stroke's box, padded, with a few lines each way.

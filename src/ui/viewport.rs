@@ -160,7 +160,7 @@ impl Viewport {
             ui.ctx().request_repaint();
         }
         self.status_line(ui, rect, cx.doc, cx.notices, now);
-        tool.overlay(ui, rect, cx.doc, cx.selection);
+        tool.overlay(ui, rect, cx.doc, cx.derived, cx.selection);
     }
 
     fn status_line(

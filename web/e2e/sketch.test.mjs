@@ -61,6 +61,26 @@ test('draw an outline, then cut its base', { timeout: 300_000 }, async () => {
       assert.equal(countDiffering(drawn, left, bg), 0, 'cloud left of the stroke');
       assert.equal(countDiffering(drawn, right, bg), 0, 'cloud right of the stroke');
 
+      // K shows the selected outline's skeleton (yellow lines) and spheres (Figure 4 of the
+      // paper) over the cloud; K again hides them.
+      const frames = (n) => page.evaluate((n) => new Promise((r) => {
+        const tick = () => (--n ? requestAnimationFrame(tick) : r());
+        requestAnimationFrame(tick);
+      }), n);
+      const yellow = (img) => box.w * box.h - countDiffering(img, box, [255, 220, 60], 40);
+      await page.keyboard.press('h');
+      await until(page, (s) => !s.view.guides_hidden, 'guides shown');
+      await frames(3);
+      const plain = yellow(await screenshot(page, 'sketch-1b-guides'));
+      await page.keyboard.press('k');
+      await until(page, (s) => s.view.skeleton_shown, 'skeleton shown');
+      await frames(3);
+      const withSkeleton = yellow(await screenshot(page, 'sketch-1c-skeleton'));
+      assert.ok(withSkeleton > plain + 200, `skeleton pixels: ${plain} → ${withSkeleton}`);
+      await page.keyboard.press('k');
+      await page.keyboard.press('h');
+      await until(page, (s) => !s.view.skeleton_shown && s.view.guides_hidden, 'skeleton and guides hidden');
+
       // Cut: a horizontal line through the lower part of the cloud, wider than it.
       const cutY = base - h * 0.35;
       const lower = { x: box.x, y: Math.round(cutY + 6), w: box.w, h: Math.round(base - cutY - 6) };

@@ -57,6 +57,8 @@ impl SketchPanel {
                     ui.checkbox(&mut tool.show_all_planes, "all grids");
                     ui.checkbox(&mut tool.hide_guides, "hide guides")
                         .on_hover_text("H");
+                    ui.checkbox(&mut tool.show_skeleton, "skeleton")
+                        .on_hover_text("K: the selected outline's skeleton and spheres");
                 });
                 let planes = &doc.scene().planes;
                 if planes.is_empty() {
