@@ -216,3 +216,40 @@ test('touch: one finger sketches, two fingers orbit', { timeout: 240_000 }, asyn
     await close();
   }
 });
+
+test('a stroke that starts over the cloud lands on a plane through its surface', { timeout: 240_000 }, async () => {
+  const { browser, close } = await launch({ webgpu: true });
+  try {
+    const { page, errors } = await openApp(browser, server.url, '');
+    await waitForBody(page, 'data-ready', (v) => v === 'true');
+    let s = await state(page);
+    const [vw, vh] = s.view.viewport;
+    await page.mouse.click(vw * 0.05, vh * 0.95);
+    await page.keyboard.press('d');
+    await until(page, (s) => s.view.tool === 'sketch', 'sketch tool');
+    const loop = (x, y, r) => Array.from({ length: 41 }, (_, i) => {
+      const a = (i / 40) * 2 * Math.PI;
+      return [x + r * Math.cos(a), y + r * Math.sin(a)];
+    });
+    // Starts at the view's centre, over the default cumulus; then one over the empty sky.
+    const over = loop(vw * 0.5, vh * 0.5, vh * 0.08).map(([x, y]) => [x - vh * 0.08, y]);
+    await stroke(page, [[vw * 0.5, vh * 0.5], ...over.slice(1)]);
+    await until(page, (s) => s.scene.planes.length === 1, 'the plane over the cloud');
+    await stroke(page, loop(vw * 0.12, vh * 0.12, vh * 0.06));
+    s = await until(page, (s) => s.scene.planes.length === 2, 'the plane over the sky');
+    const t = s.scene.camera.target;
+    // Depth of each plane along its normal (toward the camera), from the orbit target.
+    const depth = (p) => {
+      const [x, y, z, w] = p.rotation;
+      // The plane's z axis: the rotation applied to (0, 0, 1).
+      const n = [2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y)];
+      return p.origin.reduce((acc, o, i) => acc + (o - t[i]) * n[i], 0);
+    };
+    const [onCloud, onSky] = s.scene.planes.map(depth);
+    assert.ok(Math.abs(onSky) < 1e-3, `a stroke over the sky lies on the target's plane: ${onSky}`);
+    assert.ok(onCloud > 0.5, `a stroke over the cloud lies on its surface, in front of the target: ${onCloud}`);
+    assert.deepEqual(errors, []);
+  } finally {
+    await close();
+  }
+});
