@@ -401,6 +401,7 @@ fn describe_repairs(path: &str, before: &Value, after: &Value, out: &mut Vec<Str
     let show = |v: &Value| match v {
         Value::Null => "not a number".to_owned(),
         Value::Number(n) => n.as_f64().map_or_else(|| n.to_string(), |f| format!("{f}")),
+        Value::Array(items) if items.len() > 4 => format!("{} values", items.len()),
         Value::Array(items) => {
             let parts: Vec<String> = items
                 .iter()

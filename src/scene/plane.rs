@@ -39,6 +39,11 @@ pub struct DrawingPlane {
     pub sketch: SketchParams,
     /// Seed of the 3D extension's random choices.
     pub seed: u64,
+    /// Pen pressure (0–1) at each point of `points`, for strokes drawn with a pen; empty for
+    /// the mouse, touch and imported strokes. Kept with the stroke (for future brushes); the
+    /// shape does not depend on it yet.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub pressure: Vec<f32>,
 }
 
 impl Default for DrawingPlane {
@@ -52,6 +57,7 @@ impl Default for DrawingPlane {
             closed: true,
             sketch: SketchParams::default(),
             seed: 1,
+            pressure: Vec::new(),
         }
     }
 }
@@ -117,6 +123,7 @@ impl DrawingPlane {
             closed: kind == StrokeKind::Outline,
             sketch: SketchParams::default(),
             seed,
+            pressure: Vec::new(),
         };
         let local: Vec<Vec2> = world_points.iter().map(|&p| plane.to_plane(p)).collect();
         let centre = if local.is_empty() {
@@ -144,6 +151,12 @@ impl DrawingPlane {
         }
         if let Some(r) = super::unit_rotation(self.rotation) {
             self.rotation = r;
+        }
+        if !self.pressure.is_empty() && self.pressure.len() != self.points.len() {
+            self.pressure.clear(); // does not match its stroke: dropped (and reported)
+        }
+        for v in &mut self.pressure {
+            *v = if v.is_nan() { 0.5 } else { v.clamp(0.0, 1.0) };
         }
         self.sketch.sanitize();
         Ok(())

@@ -36,8 +36,9 @@ pub fn read_path(path: &str) -> Loaded {
         .map_err(|e| format!("{path}: {e}"))
 }
 
-/// Pointer samples beyond egui's events: none natively, where every cursor move is an event.
-pub fn take_pointer_samples() -> Option<Vec<egui::Pos2>> {
+/// Pointer samples beyond egui's events: none natively, where every cursor move is an event
+/// (egui's native events carry no pen pressure).
+pub fn take_pointer_samples() -> Option<Vec<(egui::Pos2, Option<f32>)>> {
     None
 }
 

@@ -23,7 +23,7 @@ const MAX_BYTES: f64 = MAX_FILE_BYTES as f64;
 
 thread_local! {
     static INBOX: RefCell<Vec<Loaded>> = const { RefCell::new(Vec::new()) };
-    static SAMPLES: RefCell<Vec<egui::Pos2>> = const { RefCell::new(Vec::new()) };
+    static SAMPLES: RefCell<Vec<(egui::Pos2, Option<f32>)>> = const { RefCell::new(Vec::new()) };
     static REPAINT: RefCell<Option<egui::Context>> = const { RefCell::new(None) };
 }
 
@@ -111,11 +111,13 @@ fn install_pointer_samples(ctx: &egui::Context) {
             };
             let rect = canvas.get_bounding_client_rect();
             let zoom = ctx.zoom_factor();
-            let at = |m: &web_sys::MouseEvent| {
-                egui::pos2(
+            // Position in points, and the pen's pressure (a mouse reports a constant 0.5).
+            let at = |m: &web_sys::PointerEvent| {
+                let pos = egui::pos2(
                     (m.client_x() as f32 - rect.left() as f32) / zoom,
                     (m.client_y() as f32 - rect.top() as f32) / zoom,
-                )
+                );
+                (pos, (m.pointer_type() == "pen").then(|| m.pressure()))
             };
             let coalesced = e.get_coalesced_events();
             SAMPLES.with(|s| {
@@ -124,7 +126,7 @@ fn install_pointer_samples(ctx: &egui::Context) {
                     s.push(at(&e));
                 }
                 for c in coalesced.iter() {
-                    if let Ok(m) = c.dyn_into::<web_sys::MouseEvent>() {
+                    if let Ok(m) = c.dyn_into::<web_sys::PointerEvent>() {
                         s.push(at(&m));
                     }
                 }
@@ -139,8 +141,9 @@ fn install_pointer_samples(ctx: &egui::Context) {
 }
 
 /// Pointer positions (in points) since the last call, every sample the browser saw while the
-/// primary pointer was down; `None` where egui's own events already carry every sample.
-pub fn take_pointer_samples() -> Option<Vec<egui::Pos2>> {
+/// primary pointer was down, each with the pen's pressure when a pen drew it; `None` where
+/// egui's own events already carry every sample.
+pub fn take_pointer_samples() -> Option<Vec<(egui::Pos2, Option<f32>)>> {
     Some(SAMPLES.with(|s| std::mem::take(&mut *s.borrow_mut())))
 }
 

@@ -50,6 +50,8 @@ pub struct SketchTool {
     pub tool: Tool,
     /// Screen points of the stroke being drawn.
     pub stroke: Vec<Pos2>,
+    /// Pen pressure at each point of `stroke`, where the platform reports one.
+    pressure: Vec<Option<f32>>,
     /// Show every plane's grid, not only the selected one's.
     pub show_all_planes: bool,
     /// Hide strokes and grids (H), to look at the cloud alone.
@@ -160,6 +162,23 @@ fn project(camera: &OrbitCamera, rect: Rect, p: Vec3) -> Option<Pos2> {
     camera
         .project(p, rect.aspect_ratio())
         .map(|n| screen(rect, n))
+}
+
+/// A stroke's pen pressure, one value per point, when a pen drew it (any sample has a
+/// pressure); points without one (the press itself, samples from egui's events) take the
+/// nearest earlier value, or the first one known. Empty for the mouse and touch.
+fn pen_pressure(samples: &[Option<f32>]) -> Vec<f32> {
+    let Some(first) = samples.iter().flatten().next().copied() else {
+        return Vec::new();
+    };
+    let mut last = first;
+    samples
+        .iter()
+        .map(|p| {
+            last = p.unwrap_or(last);
+            last
+        })
+        .collect()
 }
 
 /// Deletes the selected plane; returns what was done.
@@ -289,7 +308,7 @@ impl SketchTool {
                 i.events
                     .iter()
                     .filter_map(|e| match e {
-                        egui::Event::PointerMoved(p) => Some(*p),
+                        egui::Event::PointerMoved(p) => Some((*p, None)),
                         _ => None,
                     })
                     .collect()
@@ -297,19 +316,22 @@ impl SketchTool {
         });
         if response.drag_started_by(egui::PointerButton::Primary) {
             self.stroke.clear();
+            self.pressure.clear();
             // Start where the button went down, not where the drag was recognised.
             if let Some(p) = ui
                 .input(|i| i.pointer.press_origin())
                 .or(response.interact_pointer_pos())
             {
                 self.stroke.push(p);
+                self.pressure.push(None);
             }
             self.drawing = true;
         }
         if self.drawing {
-            for p in samples {
+            for (p, pressure) in samples {
                 if self.stroke.last() != Some(&p) && self.stroke.len() < MAX_PLANE_POINTS {
                     self.stroke.push(p);
+                    self.pressure.push(pressure);
                 }
             }
         }
@@ -323,6 +345,7 @@ impl SketchTool {
         if response.drag_stopped_by(egui::PointerButton::Primary) {
             self.drawing = false;
             let mut stroke = std::mem::take(&mut self.stroke);
+            let pressure = pen_pressure(&std::mem::take(&mut self.pressure));
             // A stroke that leaves the view (over the side panel, off the window) is clipped
             // to the view's edge, and the user is told.
             let outside = stroke.iter().filter(|p| !rect.contains(**p)).count();
@@ -332,7 +355,7 @@ impl SketchTool {
             let clipped = (outside > 0).then(|| {
                 format!("{outside} of its points were outside the view and were moved to its edge")
             });
-            self.finish_stroke(now, rect, &stroke, clipped, tc);
+            self.finish_stroke(now, rect, (&stroke, &pressure), clipped, tc);
         }
         true
     }
@@ -344,7 +367,7 @@ impl SketchTool {
         &mut self,
         now: f64,
         rect: Rect,
-        stroke: &[Pos2],
+        (stroke, pressure): (&[Pos2], &[f32]),
         clipped: Option<String>,
         tc: &mut ToolContext<'_>,
     ) {
@@ -372,20 +395,23 @@ impl SketchTool {
             .unwrap_or(0.05);
         let anchor = field.raycast(&first_ray, step).unwrap_or(camera.target);
         let normal = -camera.forward();
-        let world: Vec<Vec3> = stroke
+        // Each point with its pressure (when the pen gave one), so both stay paired.
+        let (world, pressure): (Vec<Vec3>, Vec<Option<f32>>) = stroke
             .iter()
-            .filter_map(|&p| {
+            .enumerate()
+            .filter_map(|(i, &p)| {
                 let ray = camera.ray(ndc(rect, p), aspect);
-                ray.hit_plane(anchor, normal).map(|t| ray.at(t))
+                let at = ray.hit_plane(anchor, normal).map(|t| ray.at(t))?;
+                Some((at, pressure.get(i).copied()))
             })
-            .collect();
+            .unzip();
         let count = scene.planes.iter().filter(|p| p.kind == kind).count() + 1;
         let name = match kind {
             StrokeKind::Outline => format!("Outline {count}"),
             StrokeKind::Cut => format!("Cut {count}"),
         };
         let seed = hash64(scene.seed ^ ((scene.planes.len() as u64) << 32) ^ world.len() as u64);
-        let plane = DrawingPlane::facing(
+        let mut plane = DrawingPlane::facing(
             name,
             kind,
             anchor,
@@ -394,6 +420,10 @@ impl SketchTool {
             &world,
             seed,
         );
+        plane.pressure = pressure.into_iter().flatten().collect();
+        if plane.pressure.len() != plane.points.len() {
+            plane.pressure.clear();
+        }
         let mut warnings = match &*tc.derived.shape_of(&plane) {
             Shape::Unusable(e) => {
                 tc.notices.error(now, format!("Stroke not used: {e}"));
@@ -679,6 +709,18 @@ fn draw_grid(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn pen_pressure_fills_the_points_without_one() {
+        assert!(
+            pen_pressure(&[None, None]).is_empty(),
+            "a mouse stroke has none"
+        );
+        assert_eq!(
+            pen_pressure(&[None, Some(0.2), None, Some(0.8)]),
+            [0.2, 0.2, 0.2, 0.8]
+        );
+    }
 
     fn axis_angle(q: Quat) -> (Vec3, f32) {
         let (axis, angle) = q.to_axis_angle();

@@ -4,7 +4,7 @@
 // Screenshots: web/test-results/screenshots/sketch-*.png.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { serve, launch, openApp, waitForBody, waitForFullQuality, state, screenshot, countDiffering, until } from './harness.mjs';
+import { serve, launch, openApp, waitForBody, waitForFullQuality, state, screenshot, countDiffering, until, withApp } from './harness.mjs';
 
 let server;
 before(async () => { server = await serve(); });
@@ -217,26 +217,30 @@ test('touch: one finger sketches, two fingers orbit', { timeout: 240_000 }, asyn
   }
 });
 
+/** In the open app: focus the view, pick the Sketch tool; returns the view's size. */
+async function startSketching(page) {
+  const [vw, vh] = (await state(page)).view.viewport;
+  await page.mouse.click(vw * 0.05, vh * 0.95);
+  await page.keyboard.press('d');
+  await until(page, (s) => s.view.tool === 'sketch', 'sketch tool');
+  return [vw, vh];
+}
+
+/** A closed circle of 41 screen points. */
+const loop = (x, y, r) => Array.from({ length: 41 }, (_, i) => {
+  const a = (i / 40) * 2 * Math.PI;
+  return [x + r * Math.cos(a), y + r * Math.sin(a)];
+});
+
 test('a stroke that starts over the cloud lands on a plane through its surface', { timeout: 240_000 }, async () => {
-  const { browser, close } = await launch({ webgpu: true });
-  try {
-    const { page, errors } = await openApp(browser, server.url, '');
-    await waitForBody(page, 'data-ready', (v) => v === 'true');
-    let s = await state(page);
-    const [vw, vh] = s.view.viewport;
-    await page.mouse.click(vw * 0.05, vh * 0.95);
-    await page.keyboard.press('d');
-    await until(page, (s) => s.view.tool === 'sketch', 'sketch tool');
-    const loop = (x, y, r) => Array.from({ length: 41 }, (_, i) => {
-      const a = (i / 40) * 2 * Math.PI;
-      return [x + r * Math.cos(a), y + r * Math.sin(a)];
-    });
+  await withApp({ base: server.url, webgpu: true }, async (page) => {
+    const [vw, vh] = await startSketching(page);
     // Starts at the view's centre, over the default cumulus; then one over the empty sky.
     const over = loop(vw * 0.5, vh * 0.5, vh * 0.08).map(([x, y]) => [x - vh * 0.08, y]);
     await stroke(page, [[vw * 0.5, vh * 0.5], ...over.slice(1)]);
     await until(page, (s) => s.scene.planes.length === 1, 'the plane over the cloud');
     await stroke(page, loop(vw * 0.12, vh * 0.12, vh * 0.06));
-    s = await until(page, (s) => s.scene.planes.length === 2, 'the plane over the sky');
+    const s = await until(page, (s) => s.scene.planes.length === 2, 'the plane over the sky');
     const t = s.scene.camera.target;
     // Depth of each plane along its normal (toward the camera), from the orbit target.
     const depth = (p) => {
@@ -248,8 +252,33 @@ test('a stroke that starts over the cloud lands on a plane through its surface',
     const [onCloud, onSky] = s.scene.planes.map(depth);
     assert.ok(Math.abs(onSky) < 1e-3, `a stroke over the sky lies on the target's plane: ${onSky}`);
     assert.ok(onCloud > 0.5, `a stroke over the cloud lies on its surface, in front of the target: ${onCloud}`);
-    assert.deepEqual(errors, []);
-  } finally {
-    await close();
-  }
+  });
+});
+
+test('a pen stroke stores its pressure per point; a mouse stroke stores none', { timeout: 240_000 }, async () => {
+  await withApp({ base: server.url, webgpu: true, query: '?preset=empty' }, async (page) => {
+    const [vw, vh] = await startSketching(page);
+    // A pen through the DevTools protocol (real input events, pointerType "pen"), pressure
+    // rising from 0.2 to 0.9 around a circle, sent without waiting for frames.
+    const cdp = await page.context().newCDPSession(page);
+    const n = 60;
+    const at = (i) => {
+      const a = (i / n) * 2 * Math.PI;
+      return { x: vw * 0.35 + vh * 0.15 * Math.cos(a), y: vh * 0.5 + vh * 0.15 * Math.sin(a), force: 0.2 + (0.7 * i) / n };
+    };
+    const pen = { pointerType: 'pen', button: 'left', buttons: 1 };
+    await cdp.send('Input.dispatchMouseEvent', { type: 'mouseMoved', ...at(0), pointerType: 'pen', buttons: 0 });
+    await cdp.send('Input.dispatchMouseEvent', { type: 'mousePressed', ...at(0), ...pen, clickCount: 1 });
+    for (let i = 1; i <= n; i++) await cdp.send('Input.dispatchMouseEvent', { type: 'mouseMoved', ...at(i), ...pen });
+    await cdp.send('Input.dispatchMouseEvent', { type: 'mouseReleased', ...at(n), ...pen, buttons: 0, clickCount: 1 });
+    let s = await until(page, (s) => s.scene.planes.length === 1, 'the pen stroke');
+    const { points, pressure } = s.scene.planes[0];
+    assert.ok(Array.isArray(pressure) && pressure.length === points.length, `${pressure?.length} pressures for ${points.length} points`);
+    assert.ok(points.length >= 0.9 * n, `${points.length} of ${n} samples`);
+    assert.ok(Math.min(...pressure) < 0.3 && Math.max(...pressure) > 0.8, `pressure ${Math.min(...pressure)}–${Math.max(...pressure)}`);
+    // The mouse: no pressure stored.
+    await stroke(page, loop(vw * 0.7, vh * 0.5, vh * 0.1));
+    s = await until(page, (s) => s.scene.planes.length === 2, 'the mouse stroke');
+    assert.equal(s.scene.planes[1].pressure, undefined);
+  });
 });
