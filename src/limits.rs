@@ -30,8 +30,13 @@ pub const MAX_CROSSING_TESTS: u64 = 4_000_000;
 pub const MAX_RENDER_SIDE: u32 = 8192;
 /// Largest image side decoded at all (guide images).
 pub const MAX_DECODE_SIDE: u32 = 16_384;
-/// Largest guide image side kept (larger images are scaled down before upload).
-pub const MAX_GUIDE_SIDE: u32 = 2048;
+/// Largest reference-image file the document embeds (base64 in the JSON); a larger file is
+/// shown but the document keeps only its name (load it again after reopening).
+pub const MAX_EMBEDDED_IMAGE_BYTES: usize = 4 << 20;
+/// Largest reference-image texture side (larger pictures are scaled down, with a smooth filter,
+/// before upload): about the height it fills in a 1920×1080 view, so it is never shrunk much
+/// on screen, where a texture without mipmaps would alias.
+pub const MAX_GUIDE_SIDE: u32 = 1024;
 /// Most undo steps kept.
 pub const MAX_UNDO: usize = 200;
 

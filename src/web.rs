@@ -4,7 +4,9 @@
 //!
 //! Test contract: `<body>` carries `data-ready` (first full-quality image shown),
 //! `data-backend` (`webgpu` | `webgl2`), `data-adapter` and `data-quality`
-//! (e.g. `full 640x480x128`); `window.cloudsketch.state()` returns the document and view.
+//! (e.g. `full 640x480x128`); `window.cloudsketch.state()` returns the document and view;
+//! `window.cloudsketch.set("/reference/in_front=true")` makes one undoable edit by JSON
+//! Pointer, as the CLI's `--set` does.
 
 use std::cell::RefCell;
 
@@ -16,6 +18,7 @@ use crate::ui::{CloudApp, Host, PageStatus, StartOptions};
 
 thread_local! {
     static STATE: RefCell<String> = const { RefCell::new(String::new()) };
+    static EDITS: RefCell<Vec<String>> = const { RefCell::new(Vec::new()) };
 }
 
 /// Starts the app in the page's `#cloudsketch_canvas`.
@@ -106,15 +109,24 @@ fn install_state_accessor() {
     let state = Closure::<dyn Fn() -> JsValue>::new(|| {
         STATE.with(|s| js_sys::JSON::parse(&s.borrow()).unwrap_or(JsValue::NULL))
     });
+    let set = Closure::<dyn Fn(String)>::new(|assignment: String| {
+        EDITS.with(|e| e.borrow_mut().push(assignment));
+    });
     let api = js_sys::Object::new();
     let _ = js_sys::Reflect::set(&api, &"state".into(), state.as_ref());
+    let _ = js_sys::Reflect::set(&api, &"set".into(), set.as_ref());
     let _ = js_sys::Reflect::set(&window, &"cloudsketch".into(), &api);
     state.forget(); // lives as long as the page
+    set.forget();
 }
 
 struct WebHost;
 
 impl Host for WebHost {
+    fn take_edits(&mut self) -> Vec<String> {
+        EDITS.with(|e| std::mem::take(&mut *e.borrow_mut()))
+    }
+
     fn publish(&mut self, status: &PageStatus) {
         STATE.with(|s| s.replace(status.state.clone()));
         let Some(body) = web_sys::window()

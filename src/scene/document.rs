@@ -38,6 +38,8 @@ pub struct Revisions {
     pub render: u64,
     /// The camera.
     pub camera: u64,
+    /// The reference image.
+    pub reference: u64,
 }
 
 impl Revisions {
@@ -47,6 +49,7 @@ impl Revisions {
             .max(self.light)
             .max(self.render)
             .max(self.camera)
+            .max(self.reference)
     }
 }
 
@@ -57,11 +60,12 @@ struct Changed {
     light: bool,
     render: bool,
     camera: bool,
+    reference: bool,
 }
 
 impl Changed {
     fn any(&self) -> bool {
-        self.geometry || self.light || self.render || self.camera
+        self.geometry || self.light || self.render || self.camera || self.reference
     }
 }
 
@@ -81,6 +85,7 @@ fn diff(a: &Scene, b: &Scene) -> Changed {
         light: a.light != b.light,
         render: a.render != b.render,
         camera: a.camera != b.camera,
+        reference: a.reference != b.reference,
     }
 }
 
@@ -119,6 +124,7 @@ impl Document {
                 light: n,
                 render: n,
                 camera: n,
+                reference: n,
             },
         }
     }
@@ -144,6 +150,7 @@ impl Document {
             (changed.light, &mut r.light),
             (changed.render, &mut r.render),
             (changed.camera, &mut r.camera),
+            (changed.reference, &mut r.reference),
         ] {
             if flag {
                 *rev = n;
@@ -172,6 +179,7 @@ impl Document {
                 changed.geometry = *i <= s.planes.len() && s.planes.len() < MAX_PLANES;
             }
             Edit::RemovePlane(i) => changed.geometry = *i < s.planes.len(),
+            Edit::SetReference(r) => changed.reference = r.as_ref() != s.reference.as_deref(),
             Edit::Replace(new) => changed = diff(s, new),
         }
         if !changed.any() {
@@ -189,6 +197,7 @@ impl Document {
             Edit::RemovePlane(i) => {
                 s.planes.remove(i);
             }
+            Edit::SetReference(r) => s.reference = r.map(Arc::new),
             Edit::Replace(new) => *s = *new,
         }
         let merge = merge_key.is_some() && merge_key == self.last_key;
@@ -434,5 +443,39 @@ mod tests {
         }
         assert_eq!(doc.undo_len(), MAX_UNDO);
         assert_eq!(doc.distinct_planes_held(), MAX_PLANES + 50);
+    }
+}
+
+#[cfg(test)]
+mod reference_tests {
+    use super::*;
+    use crate::scene::ReferenceImage;
+
+    #[test]
+    fn reference_edits_undo_and_bump_only_their_revision() {
+        let mut doc = Document::new(Scene::default());
+        let before = doc.revisions();
+        let image = ReferenceImage::facing(
+            "a.png".into(),
+            vec![1, 2, 3],
+            [4, 3],
+            &doc.scene().camera,
+            0.8,
+        );
+        assert!(doc.apply(Edit::SetReference(Some(image.clone())), None));
+        let mut faded = image.clone();
+        faded.opacity = 0.2;
+        assert!(doc.apply(Edit::SetReference(Some(faded)), Some("reference")));
+        let after = doc.revisions();
+        assert_ne!(after.reference, before.reference);
+        assert_eq!(
+            (after.geometry, after.light, after.render, after.camera),
+            (before.geometry, before.light, before.render, before.camera),
+            "a reference edit re-derives nothing"
+        );
+        assert_eq!(doc.undo(), Some("reference image"));
+        assert_eq!(doc.scene().reference.as_deref(), Some(&image));
+        doc.undo();
+        assert!(doc.scene().reference.is_none());
     }
 }

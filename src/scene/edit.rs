@@ -5,7 +5,7 @@
 
 use std::sync::Arc;
 
-use super::{DrawingPlane, Ellipsoid, Lighting, RenderSettings, Scene};
+use super::{DrawingPlane, Ellipsoid, Lighting, ReferenceImage, RenderSettings, Scene};
 
 /// One change to the document.
 #[derive(Clone, Debug, PartialEq)]
@@ -24,6 +24,8 @@ pub enum Edit {
     InsertPlane(usize, DrawingPlane),
     /// Remove drawing plane `index`.
     RemovePlane(usize),
+    /// Set, change or remove the reference image.
+    SetReference(Option<ReferenceImage>),
     /// Replace the whole document (new, open, preset).
     Replace(Box<Scene>),
 }
@@ -39,6 +41,7 @@ impl Edit {
             Edit::SetPlane(..) => "drawing plane",
             Edit::InsertPlane(..) => "new drawing plane",
             Edit::RemovePlane(_) => "deleted drawing plane",
+            Edit::SetReference(_) => "reference image",
             Edit::Replace(_) => "new scene",
         }
     }

@@ -8,6 +8,7 @@ mod document;
 mod edit;
 mod plane;
 mod pointer;
+mod reference;
 
 pub use crate::limits::{MAX_ELLIPSOIDS, MAX_PLANE_POINTS, MAX_PLANES};
 pub use camera::{OrbitCamera, Ray, StandardView};
@@ -15,6 +16,7 @@ pub use document::{Document, Revisions};
 pub use edit::Edit;
 pub use plane::{DrawingPlane, StrokeKind, centre_of};
 pub use pointer::{SetError, set_by_pointer};
+pub use reference::ReferenceImage;
 
 use std::sync::Arc;
 
@@ -66,6 +68,9 @@ pub struct Scene {
     pub ellipsoids: Vec<Arc<Ellipsoid>>,
     /// Drawing planes, each holding one sketched stroke (outline or cut).
     pub planes: Vec<Arc<DrawingPlane>>,
+    /// The picture to trace, placed in the scene.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reference: Option<Arc<ReferenceImage>>,
 }
 
 impl Default for Scene {
@@ -131,6 +136,7 @@ impl Scene {
             render: RenderSettings::default(),
             ellipsoids,
             planes: Vec::new(),
+            reference: None,
         }
     }
 
@@ -228,6 +234,9 @@ impl Scene {
             Arc::make_mut(plane)
                 .validate(i)
                 .map_err(SceneError::Invalid)?;
+        }
+        if let Some(r) = &mut self.reference {
+            Arc::make_mut(r).validate().map_err(SceneError::Invalid)?;
         }
         self.camera.sanitize();
         self.light.sanitize();
@@ -400,6 +409,7 @@ fn describe_repairs(path: &str, before: &Value, after: &Value, out: &mut Vec<Str
     };
     let show = |v: &Value| match v {
         Value::Null => "not a number".to_owned(),
+        Value::String(text) if text.len() > 60 => format!("{} characters of data", text.len()),
         Value::Number(n) => n.as_f64().map_or_else(|| n.to_string(), |f| format!("{f}")),
         Value::Array(items) if items.len() > 4 => format!("{} values", items.len()),
         Value::Array(items) => {
@@ -533,6 +543,42 @@ mod tests {
             err.to_string().contains("plane 0 has a non-finite value"),
             "{err}"
         );
+    }
+
+    #[test]
+    fn the_reference_image_is_saved_with_the_document_within_the_cap() {
+        let camera = OrbitCamera::default();
+        let bytes: Vec<u8> = (0..5000u32).map(|i| (i * 7 % 251) as u8).collect();
+        let mut scene = Scene::default();
+        let image =
+            ReferenceImage::facing("photo.png".into(), bytes.clone(), [40, 30], &camera, 0.8);
+        // Facing the view: its normal points at the camera, centred on the focus point.
+        let normal = image.rotation * Vec3::Z;
+        assert!(normal.abs_diff_eq(-camera.forward(), 1e-5));
+        assert!(image.at([0.5, 0.5]).abs_diff_eq(camera.target, 1e-5));
+        scene.reference = Some(Arc::new(image));
+        let (back, repairs) = Scene::from_json(&scene.to_json()).unwrap();
+        assert!(repairs.is_empty(), "{repairs:?}");
+        assert_eq!(back, scene);
+        assert_eq!(*back.reference.unwrap().data, bytes);
+        // Too large to embed: shown, but the document keeps its name only.
+        let big = vec![0u8; limits::MAX_EMBEDDED_IMAGE_BYTES + 1];
+        let image = ReferenceImage::facing("huge.jpg".into(), big, [40, 30], &camera, 0.8);
+        assert!(!image.embedded());
+        // A document holding more than the cap (written by hand) is repaired, with a word.
+        let mut text: Value = serde_json::from_str(&scene.to_json()).unwrap();
+        text["reference"]["data"] =
+            Value::String("A".repeat((limits::MAX_EMBEDDED_IMAGE_BYTES + 3) / 3 * 4 + 4));
+        let (s, repairs) = Scene::from_value(text).unwrap();
+        assert!(!s.reference.unwrap().embedded());
+        assert!(
+            repairs
+                .iter()
+                .any(|r| r.starts_with("/reference/data:") && r.contains("characters of data")),
+            "{repairs:?}"
+        );
+        let err = Scene::from_json(r#"{"reference": {"data": "not base64!"}}"#).unwrap_err();
+        assert!(err.to_string().contains("base64"), "{err}");
     }
 
     #[test]

@@ -9,7 +9,7 @@ use super::sketch_tool::{SketchTool, ToolContext};
 use super::viewport::{Viewport, ViewportContext};
 use crate::derive::Derived;
 use crate::render::viewport::{BackendInfo, install};
-use crate::scene::{Document, Scene};
+use crate::scene::{Document, Edit, Scene};
 
 /// What the page (or any embedder) is told after each frame.
 #[derive(Clone, Debug, PartialEq)]
@@ -30,6 +30,12 @@ pub struct PageStatus {
 pub trait Host {
     /// Called after a frame when anything in the status changed.
     fn publish(&mut self, status: &PageStatus);
+
+    /// Edits asked for by the host since the last frame, as `--set` assignments
+    /// (`/reference/in_front=true`): each becomes one undoable edit, as if made in the panel.
+    fn take_edits(&mut self) -> Vec<String> {
+        Vec::new()
+    }
 }
 
 /// How the app starts.
@@ -224,12 +230,28 @@ impl CloudApp {
             &mut self.selection,
             &mut self.notices,
         );
-        self.guide.ui(ui);
+        self.guide.ui(ui, &mut self.doc, &mut self.notices);
         RENDER.ui(ui, &mut self.doc);
         LIGHT.ui(ui, &mut self.doc);
         p.scene.ui(ui, &mut self.doc);
         p.view.ui(ui, &self.viewport.stats, &mut self.doc);
         self.selection.retain_valid(self.doc.scene());
+    }
+
+    /// Applies the host's edits (see [`Host::take_edits`]); a bad one is a notice.
+    fn host_edits(&mut self, ctx: &egui::Context) {
+        let Some(host) = self.host.as_mut() else {
+            return;
+        };
+        let now = ctx.input(|i| i.time);
+        for assignment in host.take_edits() {
+            match crate::scene::set_by_pointer(self.doc.scene(), &assignment) {
+                Ok((scene, _)) => {
+                    self.doc.apply(Edit::Replace(Box::new(scene)), None);
+                }
+                Err(e) => self.notices.error(now, e.to_string()),
+            }
+        }
     }
 
     fn publish(&mut self) {
@@ -245,7 +267,12 @@ impl CloudApp {
         // The document is serialised again only when a revision changed.
         let revision = self.doc.revisions().any();
         if self.published.as_ref().is_none_or(|(r, _)| *r != revision) {
-            let json = serde_json::to_string(self.doc.scene()).unwrap_or_default();
+            // Without the reference image's bytes (up to megabytes, for every change).
+            let mut scene = self.doc.scene().clone();
+            if let Some(r) = &mut scene.reference {
+                std::sync::Arc::make_mut(r).data = Default::default();
+            }
+            let json = serde_json::to_string(&scene).unwrap_or_default();
             self.published = Some((revision, json));
         }
         let scene_json = self
@@ -268,8 +295,9 @@ impl CloudApp {
             "guides_hidden": self.tool.hide_guides,
             "skeleton_shown": self.tool.show_skeleton,
             "panel_open": self.panel_open,
-            "guide_image": self.guide.image.as_ref().map(|g| serde_json::json!({
-                "name": g.name, "size": g.size, "opacity": self.guide.opacity, "visible": self.guide.visible,
+            "guide_image": self.doc.scene().reference.as_deref().map(|g| serde_json::json!({
+                "name": g.name, "size": g.size, "opacity": g.opacity, "visible": g.visible,
+                "in_front": g.in_front, "embedded": g.embedded(),
             })),
             "guide_error": self.guide.error,
             "notice": self.notices.latest.as_ref().map(|n| serde_json::json!({"text": n.text, "error": n.error})),
@@ -328,7 +356,8 @@ impl eframe::App for CloudApp {
         self.cpu_seconds = frame.info().cpu_usage;
         let ctx = ui.ctx().clone();
         self.shortcuts(&ctx);
-        self.guide.input(&ctx);
+        self.guide.input(&ctx, &mut self.doc, &mut self.notices);
+        self.host_edits(&ctx);
         // Fixed width: growing values never shift the buttons under the pointer.
         let mut open = self.panel_open;
         egui::Panel::right("controls")
@@ -362,7 +391,7 @@ impl eframe::App for CloudApp {
                         notices: &mut self.notices,
                     },
                     tool: &mut self.tool,
-                    guide: &self.guide,
+                    guide: &mut self.guide,
                 },
             )
         });

@@ -1,50 +1,32 @@
-//! The guide image (Wither et al. Fig 1): a picture loaded from a file picker, drag & drop or
-//! a path, shown as a semi-transparent underlay behind the cloud to sketch over. It is part of
-//! the view, not of the document (like a tracing sheet), so it never enters undo or links.
+//! The reference image's view (the paper's guide image, placed as Blender's reference images
+//! are): loading a picture from the file picker, drag & drop or a path into the document as a
+//! [`ReferenceImage`] facing the view, its texture, drawing it in the scene under or over the
+//! cloud, and its group in the side panel. The picture itself lives in the document.
 
 use egui::{Color32, Rect, Ui};
 
+use super::notice::Notices;
 use super::platform as files;
+use crate::scene::{Document, Edit, OrbitCamera, ReferenceImage};
 
 /// A file's name and bytes, or why it could not be read.
 pub type Loaded = Result<(String, Vec<u8>), String>;
 
-use crate::limits::{MAX_DECODE_SIDE, MAX_GUIDE_SIDE};
+use crate::limits::{MAX_DECODE_SIDE, MAX_EMBEDDED_IMAGE_BYTES, MAX_GUIDE_SIDE};
 
-/// A loaded guide image.
-pub struct GuideImage {
-    /// File name.
-    pub name: String,
-    /// Size in pixels (after any scaling down).
-    pub size: [u32; 2],
-    /// The egui texture.
-    pub texture: egui::TextureHandle,
-}
+/// Share of the view's height a new reference image fills.
+const FILL: f32 = 0.8;
 
-/// Guide image state.
+/// The reference image's texture and the panel's state.
+#[derive(Default)]
 pub struct Guide {
-    /// The image, once loaded.
-    pub image: Option<GuideImage>,
-    /// Opacity of the underlay.
-    pub opacity: f32,
-    /// Shown or hidden.
-    pub visible: bool,
+    /// The texture of the document's picture, keyed by its bytes' allocation (`None` when they
+    /// could not be decoded or are not embedded).
+    texture: Option<(usize, Option<egui::TextureHandle>)>,
     /// Path typed in the panel (desktop).
     pub path: String,
     /// Last loading error.
     pub error: Option<String>,
-}
-
-impl Default for Guide {
-    fn default() -> Self {
-        Self {
-            image: None,
-            opacity: 0.5,
-            visible: true,
-            path: String::new(),
-            error: None,
-        }
-    }
 }
 
 /// Decodes PNG or JPEG bytes into RGBA, refusing huge images and scaling big ones down.
@@ -78,77 +60,121 @@ pub fn decode(bytes: &[u8]) -> Result<egui::ColorImage, String> {
 }
 
 impl Guide {
-    /// Takes dropped and picked files; an image becomes the guide.
-    pub fn input(&mut self, ctx: &egui::Context) {
+    /// Takes dropped and picked files; an image becomes the document's reference image.
+    pub fn input(&mut self, ctx: &egui::Context, doc: &mut Document, notices: &mut Notices) {
         let dropped = ctx.input_mut(|i| std::mem::take(&mut i.raw.dropped_files));
         let mut loaded: Vec<Loaded> = dropped
             .into_iter()
             .filter_map(|f| files::read_dropped(f, ctx))
             .collect();
         loaded.extend(files::take_loaded());
+        let now = ctx.input(|i| i.time);
         for item in loaded {
-            self.load(ctx, item);
+            self.load(ctx, doc, notices, now, item);
         }
     }
 
-    fn load(&mut self, ctx: &egui::Context, item: Loaded) {
-        let result = item.and_then(|(name, bytes)| {
-            decode(&bytes)
-                .map(|img| (name, img))
-                .map_err(|e| e.to_string())
-        });
-        match result {
-            Ok((name, img)) => {
-                let size = [img.size[0] as u32, img.size[1] as u32];
-                let texture = ctx.load_texture("guide image", img, egui::TextureOptions::LINEAR);
-                self.image = Some(GuideImage {
-                    name,
-                    size,
-                    texture,
-                });
-                self.visible = true;
-                self.error = None;
-            }
+    fn load(
+        &mut self,
+        ctx: &egui::Context,
+        doc: &mut Document,
+        notices: &mut Notices,
+        now: f64,
+        item: Loaded,
+    ) {
+        let decoded = item.and_then(|(name, bytes)| decode(&bytes).map(|img| (name, bytes, img)));
+        let (name, bytes, img) = match decoded {
+            Ok(v) => v,
             Err(e) => {
-                log::warn!("guide image: {e}");
+                log::warn!("reference image: {e}");
                 self.error = Some(e);
+                return;
             }
-        }
-    }
-
-    /// Paints the guide under the cloud, fitted into the viewport and centred.
-    pub fn paint(&self, painter: &egui::Painter, rect: Rect) {
-        let Some(image) = self.image.as_ref().filter(|_| self.visible) else {
-            return;
         };
-        let [w, h] = image.size.map(|v| v.max(1) as f32);
-        let scale = (rect.width() / w).min(rect.height() / h);
-        let fitted = Rect::from_center_size(rect.center(), egui::vec2(w * scale, h * scale));
-        let alpha = (self.opacity.clamp(0.0, 1.0) * 255.0).round() as u8;
-        painter.image(
-            image.texture.id(),
-            fitted,
-            Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0)),
-            Color32::from_white_alpha(alpha),
+        self.error = None;
+        let embedded = bytes.len() <= MAX_EMBEDDED_IMAGE_BYTES;
+        let size = [img.size[0] as u32, img.size[1] as u32];
+        let image = ReferenceImage::facing(name.clone(), bytes, size, &doc.scene().camera, FILL);
+        let key = std::sync::Arc::as_ptr(&image.data) as usize;
+        doc.apply(Edit::SetReference(Some(image)), None);
+        self.texture = Some((key, Some(upload(ctx, img))));
+        notices.note(
+            now,
+            if embedded {
+                format!("{name} placed facing the view (Ctrl+Z undoes)")
+            } else {
+                format!(
+                    "{name} placed facing the view; larger than {} MiB, so the document keeps only its name",
+                    MAX_EMBEDDED_IMAGE_BYTES >> 20
+                )
+            },
         );
     }
 
-    /// The Guide image group of the side panel.
-    pub fn ui(&mut self, ui: &mut Ui) {
-        egui::CollapsingHeader::new("Guide image")
+    /// The texture of `image`, decoded once per picture.
+    fn texture(&mut self, ctx: &egui::Context, image: &ReferenceImage) -> Option<egui::TextureId> {
+        let key = std::sync::Arc::as_ptr(&image.data) as usize;
+        if self.texture.as_ref().is_none_or(|(k, _)| *k != key) {
+            let handle = if image.embedded() {
+                match decode(&image.data) {
+                    Ok(img) => Some(upload(ctx, img)),
+                    Err(e) => {
+                        self.error = Some(format!("{}: {e}", image.name));
+                        None
+                    }
+                }
+            } else {
+                None
+            };
+            self.texture = Some((key, handle));
+        }
+        self.texture.as_ref()?.1.as_ref().map(|t| t.id())
+    }
+
+    /// Draws the document's reference image where it stands in the scene, if it is shown and
+    /// belongs to this layer (`in_front`: over the cloud, else under it).
+    pub fn paint(&mut self, painter: &egui::Painter, rect: Rect, doc: &Document, in_front: bool) {
+        let scene = doc.scene();
+        let Some(image) = scene
+            .reference
+            .as_deref()
+            .filter(|r| r.visible && r.in_front == in_front)
+        else {
+            return;
+        };
+        let Some(texture) = self.texture(painter.ctx(), image) else {
+            return;
+        };
+        let alpha = (image.opacity.clamp(0.0, 1.0) * 255.0).round() as u8;
+        painter.add(mesh(
+            &scene.camera,
+            rect,
+            image,
+            texture,
+            Color32::from_white_alpha(alpha),
+        ));
+    }
+
+    /// The Reference image group of the side panel.
+    pub fn ui(&mut self, ui: &mut Ui, doc: &mut Document, notices: &mut Notices) {
+        egui::CollapsingHeader::new("Reference image")
             .default_open(false)
             .show(ui, |ui| {
+                let now = ui.input(|i| i.time);
                 ui.horizontal(|ui| {
                     if files::HAS_PICKER
                         && ui
                             .button("Load…")
-                            .on_hover_text("or drop a PNG/JPEG on the view")
+                            .on_hover_text("A PNG or JPEG to trace (or drop one on the view): it is placed in the scene, facing the view")
                             .clicked()
                     {
                         files::open_picker();
                     }
-                    if self.image.is_some() && ui.button("Remove").clicked() {
-                        self.image = None;
+                    if doc.scene().reference.is_some()
+                        && ui.button("Remove").clicked()
+                        && doc.apply(Edit::SetReference(None), None)
+                    {
+                        notices.note(now, "Removed the reference image (Ctrl+Z undoes)");
                     }
                 });
                 if !files::HAS_PICKER {
@@ -157,23 +183,90 @@ impl Guide {
                             .on_hover_text("path of a PNG or JPEG; or drop one on the view");
                         if ui.button("Load").clicked() {
                             let item = files::read_path(self.path.trim());
-                            self.load(ui.ctx(), item);
+                            self.load(ui.ctx(), doc, notices, now, item);
                         }
                     });
                 }
-                if let Some(image) = &self.image {
-                    ui.label(format!(
-                        "{} ({}×{})",
-                        image.name, image.size[0], image.size[1]
-                    ));
-                    ui.checkbox(&mut self.visible, "show");
-                    ui.add(egui::Slider::new(&mut self.opacity, 0.0..=1.0).text("opacity"));
+                if let Some(current) = doc.scene().reference.as_deref() {
+                    let mut image = current.clone();
+                    ui.label(format!("{} ({}×{})", image.name, image.size[0], image.size[1]));
+                    if !image.embedded() {
+                        ui.label(
+                            egui::RichText::new("not in the document (too large): load it again after reopening")
+                                .small()
+                                .color(ui.visuals().warn_fg_color),
+                        );
+                    }
+                    ui.horizontal(|ui| {
+                        ui.checkbox(&mut image.visible, "show");
+                        ui.checkbox(&mut image.in_front, "over the cloud")
+                            .on_hover_text("Draw the picture in front of the cloud, to trace a photo's outline");
+                    });
+                    ui.add(egui::Slider::new(&mut image.opacity, 0.0..=1.0).text("opacity"));
+                    if ui
+                        .button("Face the view")
+                        .on_hover_text("Turn the picture to face the current view, through its focus point")
+                        .clicked()
+                    {
+                        image.face(&doc.scene().camera, FILL);
+                    }
+                    if image != *current {
+                        doc.apply(Edit::SetReference(Some(image)), Some("reference"));
+                    }
                 } else {
-                    ui.label("Drop a PNG or JPEG on the view to sketch over it.");
+                    ui.label("Drop a PNG or JPEG on the view to trace over it.");
                 }
                 if let Some(e) = &self.error {
                     ui.colored_label(Color32::LIGHT_RED, e);
                 }
             });
     }
+}
+
+/// A decoded picture as a smoothly filtered texture.
+fn upload(ctx: &egui::Context, img: egui::ColorImage) -> egui::TextureHandle {
+    ctx.load_texture("reference image", img, egui::TextureOptions::LINEAR)
+}
+
+/// The picture as a grid of small quads projected through the camera, so it keeps its place
+/// and perspective in the scene (a single quad's texture would shear across its diagonal).
+fn mesh(
+    camera: &OrbitCamera,
+    rect: Rect,
+    image: &ReferenceImage,
+    texture: egui::TextureId,
+    tint: Color32,
+) -> egui::Mesh {
+    const N: u32 = 16;
+    let mut mesh = egui::Mesh::with_texture(texture);
+    let mut index = vec![None; ((N + 1) * (N + 1)) as usize];
+    for j in 0..=N {
+        for i in 0..=N {
+            let uv = [i as f32 / N as f32, j as f32 / N as f32];
+            if let Some(ndc) = camera.project(image.at(uv), rect.aspect_ratio()) {
+                let pos = egui::pos2(
+                    rect.left() + (ndc.x + 1.0) * 0.5 * rect.width(),
+                    rect.top() + (1.0 - ndc.y) * 0.5 * rect.height(),
+                );
+                index[(j * (N + 1) + i) as usize] = Some(mesh.vertices.len() as u32);
+                mesh.vertices.push(egui::epaint::Vertex {
+                    pos,
+                    uv: egui::pos2(uv[0], uv[1]),
+                    color: tint,
+                });
+            }
+        }
+    }
+    let at = |i: u32, j: u32| index[(j * (N + 1) + i) as usize];
+    for j in 0..N {
+        for i in 0..N {
+            if let (Some(a), Some(b), Some(c), Some(d)) =
+                (at(i, j), at(i + 1, j), at(i, j + 1), at(i + 1, j + 1))
+            {
+                mesh.add_triangle(a, b, d);
+                mesh.add_triangle(a, d, c);
+            }
+        }
+    }
+    mesh
 }

@@ -34,8 +34,8 @@ pub struct ViewportContext<'a> {
     pub cx: ToolContext<'a>,
     /// The sketch tools.
     pub tool: &'a mut SketchTool,
-    /// The guide image.
-    pub guide: &'a Guide,
+    /// The reference image's view.
+    pub guide: &'a mut Guide,
 }
 
 impl Viewport {
@@ -92,7 +92,7 @@ impl Viewport {
         // fill of its own, one full-screen pass less on CPU adapters.
         let painter = ui.painter_at(rect);
         let scene = cx.doc.scene();
-        guide.paint(&painter, rect);
+        guide.paint(&painter, rect, cx.doc, false);
 
         let ppp = ui.ctx().pixels_per_point();
         let px = [
@@ -159,6 +159,7 @@ impl Viewport {
         if plan.repaint {
             ui.ctx().request_repaint();
         }
+        guide.paint(&ui.painter_at(rect), rect, cx.doc, true);
         self.status_line(ui, rect, cx.doc, cx.notices, now);
         tool.overlay(ui, rect, cx.doc, cx.derived, cx.selection);
     }
@@ -281,7 +282,9 @@ impl PixelCrop {
 fn view_key(doc: &Document, px: [u32; 2], crop: Option<[u32; 4]>) -> u64 {
     use std::hash::{Hash, Hasher};
     let mut h = std::collections::hash_map::DefaultHasher::new();
-    doc.revisions().hash(&mut h);
+    // What the volume image shows: the reference image is drawn apart, every frame.
+    let r = doc.revisions();
+    (r.geometry, r.light, r.render, r.camera).hash(&mut h);
     px.hash(&mut h);
     crop.hash(&mut h);
     h.finish()
