@@ -202,7 +202,7 @@ pub const SIMPLIFY: Param = Param::linear(
 /// Sketch: branches adding less than this fraction of the outline's area are pruned.
 pub const PRUNE: Param = Param::linear(
     "prune branches",
-    "Ignore bumps of the outline smaller than this share of its area",
+    "Bumps of the outline smaller than this share of its area get no limb of their own: raise it for a simpler cloud",
     0.0,
     0.5,
     0.02,

@@ -111,6 +111,7 @@ fn install_state_accessor() {
     });
     let set = Closure::<dyn Fn(String)>::new(|assignment: String| {
         EDITS.with(|e| e.borrow_mut().push(assignment));
+        crate::ui::wake();
     });
     let api = js_sys::Object::new();
     let _ = js_sys::Reflect::set(&api, &"state".into(), state.as_ref());

@@ -27,5 +27,6 @@ mod viewport;
 mod widgets;
 
 pub use app::{CloudApp, Host, PageStatus, StartOptions};
+pub use platform::wake;
 pub use selection::Selection;
 pub use sketch_tool::Tool;

@@ -42,6 +42,9 @@ pub fn take_pointer_samples() -> Option<Vec<(egui::Pos2, Option<f32>)>> {
     None
 }
 
+/// Asks for a frame (natively every outside input is an egui event already: nothing to do).
+pub fn wake() {}
+
 /// Nothing to install natively (dropped files arrive through egui).
 pub fn install(_ctx: &egui::Context) {}
 

@@ -29,6 +29,11 @@ thread_local! {
 
 fn deliver(loaded: Loaded) {
     INBOX.with(|i| i.borrow_mut().push(loaded));
+    wake();
+}
+
+/// Asks for a frame: something arrived from outside egui's events (a file, a page edit).
+pub fn wake() {
     REPAINT.with(|c| {
         if let Some(ctx) = c.borrow().as_ref() {
             ctx.request_repaint();

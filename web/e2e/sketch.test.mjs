@@ -4,7 +4,7 @@
 // Screenshots: web/test-results/screenshots/sketch-*.png.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { serve, launch, openApp, waitForBody, waitForFullQuality, state, screenshot, countDiffering, until, withApp } from './harness.mjs';
+import { serve, launch, openApp, waitForBody, waitForFullQuality, state, screenshot, countDiffering, countChanged, until, withApp, recordTiming } from './harness.mjs';
 
 let server;
 before(async () => { server = await serve(); });
@@ -282,3 +282,35 @@ test('a pen stroke stores its pressure per point; a mouse stroke stores none', {
     assert.equal(s.scene.planes[1].pressure, undefined);
   });
 });
+
+for (const backend of ['webgpu', 'webgl2']) {
+  test(`sketching, and the deflate slider changing the image (${backend})`, { timeout: 240_000 }, async () => {
+    await withApp({ base: server.url, webgpu: backend === 'webgpu', query: '?preset=empty', viewport: { width: 1280, height: 800 } }, async (page) => {
+      const [vw, vh] = await startSketching(page);
+      // A fat body with a thin arm: deflating thins the body toward the arm's width.
+      const cx = vw * 0.4, cy = vh * 0.5, r = vh * 0.2;
+      const pts = [];
+      for (let i = 0; i <= 40; i++) {
+        const a = (i / 40) * 2 * Math.PI;
+        pts.push([cx + r * Math.cos(a), cy + r * Math.sin(a)]);
+        if (i === 0) pts.push([cx + r * 2.2, cy - 6], [cx + r * 2.2, cy + 6], [cx + r * 0.99, cy + 8]);
+      }
+      await stroke(page, pts);
+      const t0 = Date.now();
+      await until(page, (s) => s.scene.planes.length === 1, 'the outline');
+      await page.keyboard.press('h');
+      await until(page, (s) => s.view.guides_hidden, 'guides hidden');
+      const { seconds } = await waitForFullQuality(page);
+      const strokeToFull = (Date.now() - t0) / 1000;
+      const before = await screenshot(page, `sketch-deflate-0-${backend}`);
+      const box = { x: Math.round(cx - r * 1.2), y: Math.round(cy - r * 1.2), w: Math.round(r * 2.4), h: Math.round(r * 2.4) };
+      await page.evaluate(() => window.cloudsketch.set('/planes/0/sketch/inflate=1'));
+      await until(page, (s) => s.scene.planes[0].sketch.inflate === 1, 'deflated');
+      await waitForFullQuality(page);
+      const after = await screenshot(page, `sketch-deflate-1-${backend}`);
+      const changed = countChanged(before, after, box);
+      assert.ok(changed > 0.1 * box.w * box.h, `deflating changed ${changed} of ${box.w * box.h} px of the body`);
+      recordTiming({ test: 'stroke-to-full', backend, viewport: [vw, vh], strokeToFullSeconds: strokeToFull, lastWaitSeconds: seconds });
+    });
+  });
+}

@@ -41,12 +41,12 @@ impl SketchPanel {
                         (
                             Tool::Move,
                             "⬌ Move",
-                            "G: drag moves the selected drawing plane",
+                            "G: drag moves the selected drawing plane across the view (Shift: toward or away)",
                         ),
                         (
                             Tool::Rotate,
                             "⟳ Rotate",
-                            "R: drag turns the selected drawing plane",
+                            "R: drag turns the selected drawing plane; X, Y or Z locks the axis, Ctrl snaps to 15°",
                         ),
                     ] {
                         ui.selectable_value(&mut tool.tool, t, label)
