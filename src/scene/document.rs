@@ -457,7 +457,7 @@ mod reference_tests {
         let before = doc.revisions();
         let image = ReferenceImage::facing(
             "a.png".into(),
-            vec![1, 2, 3],
+            Arc::new(vec![1, 2, 3]),
             [4, 3],
             &doc.scene().camera,
             0.8,

@@ -550,8 +550,13 @@ mod tests {
         let camera = OrbitCamera::default();
         let bytes: Vec<u8> = (0..5000u32).map(|i| (i * 7 % 251) as u8).collect();
         let mut scene = Scene::default();
-        let image =
-            ReferenceImage::facing("photo.png".into(), bytes.clone(), [40, 30], &camera, 0.8);
+        let image = ReferenceImage::facing(
+            "photo.png".into(),
+            Arc::new(bytes.clone()),
+            [40, 30],
+            &camera,
+            0.8,
+        );
         // Facing the view: its normal points at the camera, centred on the focus point.
         let normal = image.rotation * Vec3::Z;
         assert!(normal.abs_diff_eq(-camera.forward(), 1e-5));
@@ -563,7 +568,8 @@ mod tests {
         assert_eq!(*back.reference.unwrap().data, bytes);
         // Too large to embed: shown, but the document keeps its name only.
         let big = vec![0u8; limits::MAX_EMBEDDED_IMAGE_BYTES + 1];
-        let image = ReferenceImage::facing("huge.jpg".into(), big, [40, 30], &camera, 0.8);
+        let image =
+            ReferenceImage::facing("huge.jpg".into(), Arc::new(big), [40, 30], &camera, 0.8);
         assert!(!image.embedded());
         // A document holding more than the cap (written by hand) is repaired, with a word.
         let mut text: Value = serde_json::from_str(&scene.to_json()).unwrap();

@@ -57,18 +57,18 @@ impl ReferenceImage {
     /// `fill` of the view's height there. `data` is embedded when it is within the cap.
     pub fn facing(
         name: String,
-        data: Vec<u8>,
+        data: Arc<Vec<u8>>,
         size: [u32; 2],
         camera: &OrbitCamera,
         fill: f32,
     ) -> Self {
         let mut image = Self {
             name,
-            data: Arc::new(if data.len() <= MAX_EMBEDDED_IMAGE_BYTES {
+            data: if data.len() <= MAX_EMBEDDED_IMAGE_BYTES {
                 data
             } else {
-                Vec::new()
-            }),
+                Arc::default()
+            },
             size: size.map(|v| v.max(1)),
             ..Default::default()
         };

@@ -12,7 +12,10 @@ use crate::scene::{Document, Edit, OrbitCamera, ReferenceImage};
 /// A file's name and bytes, or why it could not be read.
 pub type Loaded = Result<(String, Vec<u8>), String>;
 
-use crate::limits::{MAX_DECODE_SIDE, MAX_EMBEDDED_IMAGE_BYTES, MAX_GUIDE_SIDE};
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use crate::limits::MAX_EMBEDDED_IMAGE_BYTES;
 
 /// Share of the view's height a new reference image fills.
 const FILL: f32 = 0.8;
@@ -20,47 +23,22 @@ const FILL: f32 = 0.8;
 /// The reference image's texture and the panel's state.
 #[derive(Default)]
 pub struct Guide {
-    /// The texture of the document's picture, keyed by its bytes' allocation (`None` when they
-    /// could not be decoded or are not embedded).
-    texture: Option<(usize, Option<egui::TextureHandle>)>,
+    /// The texture of the document's picture, keyed by its bytes' allocation (`None` while it
+    /// is being decoded, or when it could not be decoded or is not embedded).
+    texture: Option<(u64, Option<egui::TextureHandle>)>,
+    /// Files being decoded (the browser decodes asynchronously), by ticket.
+    pending: HashMap<u64, (String, Arc<Vec<u8>>)>,
+    /// The last ticket given.
+    tickets: u64,
     /// Path typed in the panel (desktop).
     pub path: String,
     /// Last loading error.
     pub error: Option<String>,
 }
 
-/// Decodes PNG or JPEG bytes into RGBA, refusing huge images and scaling big ones down.
-pub fn decode(bytes: &[u8]) -> Result<egui::ColorImage, String> {
-    let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes))
-        .with_guessed_format()
-        .map_err(|e| format!("cannot read the image: {e}"))?;
-    let mut limits = image::Limits::default();
-    limits.max_image_width = Some(MAX_DECODE_SIDE);
-    limits.max_image_height = Some(MAX_DECODE_SIDE);
-    limits.max_alloc = Some(512 << 20);
-    reader.limits(limits);
-    if reader.format().is_none() {
-        return Err("not a PNG or JPEG image".into());
-    }
-    let mut img = reader
-        .decode()
-        .map_err(|e| format!("cannot decode the image: {e}"))?;
-    if img.width().max(img.height()) > MAX_GUIDE_SIDE {
-        img = img.resize(
-            MAX_GUIDE_SIDE,
-            MAX_GUIDE_SIDE,
-            image::imageops::FilterType::Triangle,
-        );
-    }
-    let rgba = img.to_rgba8();
-    Ok(egui::ColorImage::from_rgba_unmultiplied(
-        [rgba.width() as usize, rgba.height() as usize],
-        rgba.as_raw(),
-    ))
-}
-
 impl Guide {
-    /// Takes dropped and picked files; an image becomes the document's reference image.
+    /// Takes dropped and picked files (an image becomes the document's reference image once
+    /// decoded) and finished decodes.
     pub fn input(&mut self, ctx: &egui::Context, doc: &mut Document, notices: &mut Notices) {
         let dropped = ctx.input_mut(|i| std::mem::take(&mut i.raw.dropped_files));
         let mut loaded: Vec<Loaded> = dropped
@@ -68,24 +46,61 @@ impl Guide {
             .filter_map(|f| files::read_dropped(f, ctx))
             .collect();
         loaded.extend(files::take_loaded());
-        let now = ctx.input(|i| i.time);
         for item in loaded {
-            self.load(ctx, doc, notices, now, item);
+            self.load(item);
+        }
+        let now = ctx.input(|i| i.time);
+        for (key, result) in files::take_decoded() {
+            if let Some((name, bytes)) = self.pending.remove(&key) {
+                self.place(ctx, doc, notices, now, name, bytes, result);
+            } else if self.texture.as_ref().is_some_and(|(k, _)| *k == key) {
+                // The document's picture, decoded for its texture.
+                let handle = match result {
+                    Ok(img) => Some(upload(ctx, img)),
+                    Err(e) => {
+                        self.error = Some(e);
+                        None
+                    }
+                };
+                self.texture = Some((key, handle));
+            }
         }
     }
 
-    fn load(
+    /// Starts decoding a loaded file (it replaces the picture only if it decodes).
+    fn load(&mut self, item: Loaded) {
+        match item {
+            Ok((name, bytes)) => {
+                // Tickets have the top bit set, so they never equal a picture's address.
+                self.tickets += 1;
+                let ticket = (1 << 63) | self.tickets;
+                let bytes = Arc::new(bytes);
+                self.pending.insert(ticket, (name, bytes.clone()));
+                files::decode_image(ticket, bytes);
+            }
+            Err(e) => {
+                log::warn!("reference image: {e}");
+                self.error = Some(e);
+            }
+        }
+    }
+
+    /// A decoded file becomes the document's picture, facing the view.
+    #[allow(clippy::too_many_arguments)]
+    fn place(
         &mut self,
         ctx: &egui::Context,
         doc: &mut Document,
         notices: &mut Notices,
         now: f64,
-        item: Loaded,
+        name: String,
+        bytes: Arc<Vec<u8>>,
+        decoded: Result<egui::ColorImage, String>,
     ) {
-        let decoded = item.and_then(|(name, bytes)| decode(&bytes).map(|img| (name, bytes, img)));
-        let (name, bytes, img) = match decoded {
-            Ok(v) => v,
+        let img = match decoded {
+            Ok(img) => img,
             Err(e) => {
+                let e = format!("{name}: {e}");
                 log::warn!("reference image: {e}");
                 self.error = Some(e);
                 return;
@@ -95,7 +110,7 @@ impl Guide {
         let embedded = bytes.len() <= MAX_EMBEDDED_IMAGE_BYTES;
         let size = [img.size[0] as u32, img.size[1] as u32];
         let image = ReferenceImage::facing(name.clone(), bytes, size, &doc.scene().camera, FILL);
-        let key = std::sync::Arc::as_ptr(&image.data) as usize;
+        let key = Arc::as_ptr(&image.data) as u64;
         doc.apply(Edit::SetReference(Some(image)), None);
         self.texture = Some((key, Some(upload(ctx, img))));
         notices.note(
@@ -111,22 +126,14 @@ impl Guide {
         );
     }
 
-    /// The texture of `image`, decoded once per picture.
-    fn texture(&mut self, ctx: &egui::Context, image: &ReferenceImage) -> Option<egui::TextureId> {
-        let key = std::sync::Arc::as_ptr(&image.data) as usize;
+    /// The texture of `image`, once decoded (decoding starts on the first call per picture).
+    fn texture(&mut self, image: &ReferenceImage) -> Option<egui::TextureId> {
+        let key = Arc::as_ptr(&image.data) as u64;
         if self.texture.as_ref().is_none_or(|(k, _)| *k != key) {
-            let handle = if image.embedded() {
-                match decode(&image.data) {
-                    Ok(img) => Some(upload(ctx, img)),
-                    Err(e) => {
-                        self.error = Some(format!("{}: {e}", image.name));
-                        None
-                    }
-                }
-            } else {
-                None
-            };
-            self.texture = Some((key, handle));
+            self.texture = Some((key, None));
+            if image.embedded() {
+                files::decode_image(key, image.data.clone());
+            }
         }
         self.texture.as_ref()?.1.as_ref().map(|t| t.id())
     }
@@ -142,7 +149,7 @@ impl Guide {
         else {
             return;
         };
-        let Some(texture) = self.texture(painter.ctx(), image) else {
+        let Some(texture) = self.texture(image) else {
             return;
         };
         let alpha = (image.opacity.clamp(0.0, 1.0) * 255.0).round() as u8;
@@ -182,8 +189,7 @@ impl Guide {
                         ui.text_edit_singleline(&mut self.path)
                             .on_hover_text("path of a PNG or JPEG; or drop one on the view");
                         if ui.button("Load").clicked() {
-                            let item = files::read_path(self.path.trim());
-                            self.load(ui.ctx(), doc, notices, now, item);
+                            self.load(files::read_path(self.path.trim()));
                         }
                     });
                 }

@@ -55,3 +55,53 @@ pub fn open_picker() {}
 pub fn take_loaded() -> Vec<Loaded> {
     Vec::new()
 }
+
+thread_local! {
+    static DECODED: std::cell::RefCell<Vec<(u64, Decoded)>> = const { std::cell::RefCell::new(Vec::new()) };
+}
+
+/// A decoded picture, or why it could not be decoded.
+pub type Decoded = Result<egui::ColorImage, String>;
+
+/// Decodes a PNG or JPEG (here at once, with the `image` crate); the result arrives through
+/// [`take_decoded`] under `key`.
+pub fn decode_image(key: u64, bytes: std::sync::Arc<Vec<u8>>) {
+    let result = decode(&bytes);
+    DECODED.with(|d| d.borrow_mut().push((key, result)));
+}
+
+/// Pictures decoded since the last call.
+pub fn take_decoded() -> Vec<(u64, Decoded)> {
+    DECODED.with(|d| std::mem::take(&mut *d.borrow_mut()))
+}
+
+/// Decodes PNG or JPEG bytes into RGBA, refusing huge images and scaling big ones down.
+fn decode(bytes: &[u8]) -> Decoded {
+    use crate::limits::{MAX_DECODE_SIDE, MAX_GUIDE_SIDE};
+    let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes))
+        .with_guessed_format()
+        .map_err(|e| format!("cannot read the image: {e}"))?;
+    let mut limits = image::Limits::default();
+    limits.max_image_width = Some(MAX_DECODE_SIDE);
+    limits.max_image_height = Some(MAX_DECODE_SIDE);
+    limits.max_alloc = Some(512 << 20);
+    reader.limits(limits);
+    if reader.format().is_none() {
+        return Err("not a PNG or JPEG image".into());
+    }
+    let mut img = reader
+        .decode()
+        .map_err(|e| format!("cannot decode the image: {e}"))?;
+    if img.width().max(img.height()) > MAX_GUIDE_SIDE {
+        img = img.resize(
+            MAX_GUIDE_SIDE,
+            MAX_GUIDE_SIDE,
+            image::imageops::FilterType::Triangle,
+        );
+    }
+    let rgba = img.to_rgba8();
+    Ok(egui::ColorImage::from_rgba_unmultiplied(
+        [rgba.width() as usize, rgba.height() as usize],
+        rgba.as_raw(),
+    ))
+}

@@ -183,3 +183,80 @@ pub fn open_picker() {
 pub fn take_loaded() -> Vec<Loaded> {
     INBOX.with(|i| std::mem::take(&mut *i.borrow_mut()))
 }
+
+thread_local! {
+    static DECODED: RefCell<Vec<(u64, Decoded)>> = const { RefCell::new(Vec::new()) };
+}
+
+/// A decoded picture, or why it could not be decoded.
+pub type Decoded = Result<egui::ColorImage, String>;
+
+/// Decodes a PNG or JPEG with the browser's own decoder (no image codecs in the page's wasm):
+/// asynchronously; the result arrives through [`take_decoded`] under `key`.
+pub fn decode_image(key: u64, bytes: std::sync::Arc<Vec<u8>>) {
+    wasm_bindgen_futures::spawn_local(async move {
+        let result = browser_decode(&bytes).await;
+        DECODED.with(|d| d.borrow_mut().push((key, result)));
+        wake();
+    });
+}
+
+/// Pictures decoded since the last call.
+pub fn take_decoded() -> Vec<(u64, Decoded)> {
+    DECODED.with(|d| std::mem::take(&mut *d.borrow_mut()))
+}
+
+/// `createImageBitmap` on the bytes, drawn (scaled down to the texture cap) into an
+/// `OffscreenCanvas` and read back as RGBA.
+async fn browser_decode(bytes: &[u8]) -> Decoded {
+    use crate::limits::{MAX_DECODE_SIDE, MAX_GUIDE_SIDE};
+    let fail = |what: &str, e: JsValue| format!("{what}: {}", js_error(&e));
+    let window = web_sys::window().ok_or("no window")?;
+    let parts = js_sys::Array::of1(&js_sys::Uint8Array::from(bytes));
+    let blob = web_sys::Blob::new_with_u8_array_sequence(&parts)
+        .map_err(|e| fail("cannot read the image", e))?;
+    let promise = window
+        .create_image_bitmap_with_blob(&blob)
+        .map_err(|e| fail("cannot decode the image", e))?;
+    let bitmap: web_sys::ImageBitmap = wasm_bindgen_futures::JsFuture::from(promise)
+        .await
+        .map_err(|_| "not a PNG or JPEG image the browser can decode".to_string())?
+        .dyn_into()
+        .map_err(|e| fail("cannot decode the image", e))?;
+    let (w, h) = (bitmap.width(), bitmap.height());
+    if w == 0 || h == 0 || w.max(h) > MAX_DECODE_SIDE {
+        bitmap.close();
+        return Err(format!(
+            "the image is {w}×{h}: at most {MAX_DECODE_SIDE} px a side"
+        ));
+    }
+    let scale = (MAX_GUIDE_SIDE as f64 / w.max(h) as f64).min(1.0);
+    let (tw, th) = (
+        ((w as f64 * scale).round() as u32).max(1),
+        ((h as f64 * scale).round() as u32).max(1),
+    );
+    let canvas = web_sys::OffscreenCanvas::new(tw, th).map_err(|e| fail("no canvas", e))?;
+    let context: web_sys::OffscreenCanvasRenderingContext2d = canvas
+        .get_context("2d")
+        .map_err(|e| fail("no 2D context", e))?
+        .ok_or("no 2D context")?
+        .dyn_into()
+        .map_err(|e| fail("no 2D context", e.into()))?;
+    context
+        .draw_image_with_image_bitmap_and_dw_and_dh(&bitmap, 0.0, 0.0, tw as f64, th as f64)
+        .map_err(|e| fail("cannot draw the image", e))?;
+    bitmap.close();
+    let data = context
+        .get_image_data(0.0, 0.0, tw as f64, th as f64)
+        .map_err(|e| fail("cannot read the image's pixels", e))?;
+    Ok(egui::ColorImage::from_rgba_unmultiplied(
+        [tw as usize, th as usize],
+        &data.data(),
+    ))
+}
+
+fn js_error(e: &JsValue) -> String {
+    e.dyn_ref::<js_sys::Error>()
+        .map(|e| String::from(e.message()))
+        .unwrap_or_else(|| format!("{e:?}"))
+}
