@@ -115,10 +115,12 @@ for (const backend of ['webgpu', 'webgl2']) {
 // timings.json; the assertion is only that refinement finishes (no fixed time limit here).
 for (const backend of ['webgpu', 'webgl2']) {
   test(`refinement at 1280×800 and 1920×1080 (${backend})`, { timeout: 420_000 }, async () => {
-    const { browser, close } = await launch({ webgpu: backend === 'webgpu' });
-    try {
-      const record = { test: 'refine', backend };
-      for (const viewport of [{ width: 1280, height: 800 }, { width: 1920, height: 1080 }]) {
+    const record = { test: 'refine', backend };
+    // A fresh browser per size, as a user opens the page: on SwiftShader's WebGPU a second
+    // page in the same browser refined 1920×1080 in 15 s instead of 4 s.
+    for (const viewport of [{ width: 1280, height: 800 }, { width: 1920, height: 1080 }]) {
+      const { browser, close } = await launch({ webgpu: backend === 'webgpu' });
+      try {
         const { page, errors } = await openApp(browser, server.url, '', viewport);
         await waitForBody(page, 'data-ready', (v) => v === 'true');
         const [vw, vh] = (await state(page)).view.viewport;
@@ -136,12 +138,11 @@ for (const backend of ['webgpu', 'webgl2']) {
           orbit_s: orbit.seconds, orbit_quality: orbit.quality, stroke_s: stroke.seconds, stroke_quality: stroke.quality,
         };
         assert.deepEqual(errors, []);
-        await page.close();
+      } finally {
+        await close();
       }
-      recordTiming(record);
-      console.log(JSON.stringify(record));
-    } finally {
-      await close();
     }
+    recordTiming(record);
+    console.log(JSON.stringify(record));
   });
 }
