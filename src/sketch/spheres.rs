@@ -14,9 +14,10 @@ pub use crate::limits::MAX_SPHERES;
 /// well below 1, so neighbours overlap deeply and the body never splits.
 const SPACING: f64 = 0.4;
 
-/// Largest turn of a branch copy about the trunk (70°): copies fan out over the dome of the
-/// trunk on the branch's side, so a cloud seen from the side is rounded, not cross-shaped.
-const MAX_COPY_ANGLE: f64 = 70.0 * std::f64::consts::PI / 180.0;
+/// How far (in the radius of the branch's root sphere) a copy may slide along its trunk from
+/// the original: enough to stagger copies, little enough that a thin feature's copy still
+/// projects inside its own outline.
+const COPY_SLIDE: f64 = 0.5;
 
 /// A sphere primitive.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -325,6 +326,104 @@ pub fn trunk(skeleton: &Skeleton) -> Vec<DVec2> {
 }
 
 /// Nearest point on a polyline and the polyline's unit direction there.
+/// The trunks (Wither et al. §3.2): the body branches joined into chains, split wherever three
+/// or more body branches meet. A skeleton without body branches has one trunk, its longest
+/// path ([`trunk`]).
+pub fn trunks(skeleton: &Skeleton) -> Vec<Vec<DVec2>> {
+    let body: Vec<&super::skeleton::Branch> = skeleton
+        .branches
+        .iter()
+        .filter(|b| b.kind == BranchKind::Body && b.nodes.len() >= 2)
+        .collect();
+    if body.is_empty() {
+        return vec![trunk(skeleton)];
+    }
+    let mut incident = std::collections::HashMap::<usize, Vec<usize>>::new();
+    for (i, b) in body.iter().enumerate() {
+        for end in [b.nodes[0], b.nodes[b.nodes.len() - 1]] {
+            incident.entry(end).or_default().push(i);
+        }
+    }
+    let mut used = vec![false; body.len()];
+    let mut out = Vec::new();
+    for start in 0..body.len() {
+        if used[start] {
+            continue;
+        }
+        used[start] = true;
+        let mut chain: std::collections::VecDeque<usize> =
+            body[start].nodes.iter().copied().collect();
+        // Grow the chain at each end through nodes where exactly two body branches meet.
+        for forward in [true, false] {
+            loop {
+                let end = if forward {
+                    chain[chain.len() - 1]
+                } else {
+                    chain[0]
+                };
+                let next = match incident.get(&end).map(Vec::as_slice) {
+                    Some(&[a, b]) => [a, b].into_iter().find(|&i| !used[i]),
+                    _ => None,
+                };
+                let Some(next) = next else { break };
+                used[next] = true;
+                let mut nodes = body[next].nodes.clone();
+                if nodes[0] != end {
+                    nodes.reverse();
+                }
+                for &n in &nodes[1..] {
+                    if forward {
+                        chain.push_back(n);
+                    } else {
+                        chain.push_front(n);
+                    }
+                }
+            }
+        }
+        out.push(chain.into_iter().map(|n| skeleton.nodes[n].pos).collect());
+    }
+    out
+}
+
+/// The point at arclength `s` along a polyline (clamped to its ends) and the unit direction
+/// there.
+fn point_at(polyline: &[DVec2], s: f64) -> (DVec2, DVec2) {
+    let mut left = s.max(0.0);
+    let mut last = (polyline[0], DVec2::X);
+    for w in polyline.windows(2) {
+        let len = w[0].distance(w[1]);
+        if len <= 0.0 {
+            continue;
+        }
+        let dir = (w[1] - w[0]) / len;
+        if left <= len {
+            return (w[0] + dir * left, dir);
+        }
+        left -= len;
+        last = (w[1], dir);
+    }
+    last
+}
+
+/// Arclength along a polyline of its point nearest to `q`.
+fn arclength_of(polyline: &[DVec2], q: DVec2) -> f64 {
+    let (mut best, mut at, mut run) = (f64::INFINITY, 0.0, 0.0);
+    for w in polyline.windows(2) {
+        let ab = w[1] - w[0];
+        let len = ab.length();
+        if len <= 0.0 {
+            continue;
+        }
+        let t = ((q - w[0]).dot(ab) / (len * len)).clamp(0.0, 1.0);
+        let d = (w[0] + ab * t).distance_squared(q);
+        if d < best {
+            (best, at) = (d, run + t * len);
+        }
+        run += len;
+    }
+    at
+}
+
 fn nearest_on(polyline: &[DVec2], q: DVec2) -> (DVec2, DVec2) {
     if polyline.len() < 2 {
         return (polyline.first().copied().unwrap_or(q), DVec2::X);
@@ -347,11 +446,13 @@ fn nearest_on(polyline: &[DVec2], q: DVec2) -> (DVec2, DVec2) {
     (best.1, best.2)
 }
 
-/// Automatic 3D extension: each terminal branch is copied `copies` times and rotated about
-/// the trunk (axis: the trunk's direction at the point nearest the branch's root), spread
-/// evenly toward and away from the viewer over the half of the trunk it grows from; originals
-/// get a small jitter out of their plane. Every moved sphere is fitted so its projection to
-/// the drawing plane stays inside the outline, which keeps the silhouette from the drawing view.
+/// The automatic 3D extension (Wither et al. §3.2): each terminal branch gets `copies` copies
+/// placed around its trunk — the nearest of [`trunks`] to the branch's root — like branches
+/// around a tree: spread evenly over the half-turn on the side the branch grows from (−90° to
+/// 90° out of the drawing plane, toward and away from the viewer, with seeded variation), each
+/// slid a little along the trunk and scaled to the trunk's local radius there. The original
+/// keeps its place but for a small jitter out of the plane, so the outline seen from the
+/// drawing view is unchanged; every copy is trimmed to stay inside it.
 pub fn extend(
     outline: &Outline,
     skeleton: &Skeleton,
@@ -359,7 +460,7 @@ pub fn extend(
     seed: u64,
     copies: usize,
 ) -> Vec<Sphere> {
-    let axis_line = trunk(skeleton);
+    let trunks = trunks(skeleton);
     let mut rng = SplitMix::new(seed ^ 0xC10D_5CE7);
     let mut out: Vec<Sphere> = Vec::with_capacity(spheres.len() * (copies + 1));
     let budget_copies = if spheres.len() * (copies + 1) > MAX_SPHERES {
@@ -367,6 +468,7 @@ pub fn extend(
     } else {
         copies
     };
+    let p = &outline.boundary;
 
     for (b, branch) in skeleton.branches.iter().enumerate() {
         let mut members: Vec<Sphere> = spheres.iter().filter(|s| s.branch == b).copied().collect();
@@ -392,46 +494,71 @@ pub fn extend(
             }
             continue;
         }
-        if branch.kind == BranchKind::Body || axis_line.len() < 2 {
+        let root = skeleton.nodes[branch.nodes[0]].pos;
+        let trunk = trunks.iter().filter(|t| t.len() >= 2).min_by(|a, b| {
+            let d = |t: &Vec<DVec2>| nearest_on(t, root).0.distance_squared(root);
+            d(a).total_cmp(&d(b))
+        });
+        let Some(trunk) = trunk.filter(|_| branch.kind == BranchKind::Terminal) else {
             out.extend(members);
             continue;
-        }
+        };
         members.sort_by(|a, b| a.along.total_cmp(&b.along));
-        let root = skeleton.nodes[branch.nodes[0]].pos;
-        let (pivot, dir) = nearest_on(&axis_line, root);
-        let axis = dir.extend(0.0);
-        let pivot = pivot.extend(0.0);
-        let rotated = |angle: f64| -> Vec<Sphere> {
+        let at = arclength_of(trunk, root);
+        let (pivot, _) = point_at(trunk, at);
+        let radius_at = |q: DVec2| p.distance(q).max(1e-9);
+        let r0 = radius_at(pivot);
+        // The trunk's direction around the pivot, over a stretch as long as its radius (the
+        // chordal axis zig-zags from node to node).
+        let (behind, _) = point_at(trunk, at - r0);
+        let (ahead, _) = point_at(trunk, at + r0);
+        let axis = (ahead - behind)
+            .try_normalize()
+            .unwrap_or(DVec2::X)
+            .extend(0.0);
+        // A copy at `angle` out of the plane about the trunk, its root slid by `slide` along
+        // it and scaled to the trunk's radius there.
+        let place = |angle: f64, slide: f64| -> Vec<Sphere> {
+            let (to, _) = point_at(trunk, at + slide);
+            let scale = (radius_at(to) / r0).clamp(0.5, 1.5);
             let q = DQuat::from_axis_angle(axis, angle);
             members
                 .iter()
                 .map(|s| Sphere {
-                    center: pivot + q * (s.center - pivot),
+                    center: to.extend(0.0) + q * ((s.center - pivot.extend(0.0)) * scale),
+                    radius: s.radius * scale,
+                    max_radius: s.max_radius * scale,
                     ..*s
                 })
                 .collect()
         };
-        // Original: a small jitter rotation out of the plane.
+        // The original: a small jitter out of the plane.
         let jitter = (rng.next_f64() - 0.5) * 0.5;
-        out.extend(fit_branch(outline, rotated(jitter)));
-        // Copies spread evenly over the half of the trunk's surface the branch grows from,
-        // toward and away from the viewer (a bump on top stays on top, never under the base),
-        // with a little seeded variation.
-        let pairs = budget_copies.div_ceil(2);
-        for k in 0..budget_copies {
-            let step = (k / 2 + 1) as f64 / pairs as f64;
-            let side = if k % 2 == 0 { 1.0 } else { -1.0 };
-            let angle = side * (step * MAX_COPY_ANGLE + (rng.next_f64() - 0.5) * 0.3);
-            out.extend(fit_branch(outline, rotated(angle)));
+        out.extend(fit_branch(outline, place(jitter, 0.0)));
+        // Copies in the other slots of `copies + 1` even slots over the half-turn (the one
+        // nearest the drawing plane is the original's), with seeded variation.
+        let m = budget_copies + 1;
+        let slot = |j: usize| {
+            -std::f64::consts::FRAC_PI_2 + std::f64::consts::PI * (j as f64 + 0.5) / m as f64
+        };
+        let original = (0..m)
+            .min_by(|&a, &b| {
+                slot(a)
+                    .abs()
+                    .total_cmp(&slot(b).abs())
+                    .then((rng.next_f64() < 0.5).cmp(&true))
+            })
+            .unwrap_or(0);
+        for j in (0..m).filter(|&j| j != original) {
+            let vary = (rng.next_f64() - 0.5) * (std::f64::consts::PI / m as f64) * 0.4;
+            let slide = (rng.next_f64() * 2.0 - 1.0) * COPY_SLIDE * members[0].radius;
+            out.extend(fit_branch(outline, place(slot(j) + vary, slide)));
         }
     }
     thicken(outline, &mut out);
     out
 }
 
-/// Where the branches gave too little depth (a shape with few features), spheres still in the
-/// drawing plane get two copies pushed toward and away from the viewer: the projection, hence
-/// the silhouette, is unchanged, and each copy overlaps its original.
 fn thicken(outline: &Outline, spheres: &mut Vec<Sphere>) {
     let (lo, hi) = outline
         .points

@@ -632,9 +632,9 @@ fn the_cloud_is_thick_along_the_planes_normal() {
     // outlines whose pruned skeleton is a single path.
     use crate::field::{Blob, Field};
     for (name, shape) in [
-        // Not yet the five-point star: its centre is 0.40 × its height thick (median), at the
-        // bound, until the branch copies follow the trunk (issue: sketch, second pass).
         ("cumulus", cumulus()),
+        ("star", star(5, 5.0, 2.0)),
+        ("sheep", sheep()),
         ("rectangle (one path)", rect(12.0, 3.0, 40)),
         (
             "ellipse (one path)",
@@ -694,4 +694,52 @@ fn the_cloud_is_thick_along_the_planes_normal() {
             spread(&s)
         );
     }
+}
+
+/// Three bumpy arms from a small centre: body branches along each arm (between the bumps'
+/// junctions) meeting at the centre.
+fn tripod() -> Vec<[f64; 2]> {
+    (0..720)
+        .map(|i| i as f64 / 720.0 * TAU)
+        .map(|a| {
+            let arm = (1.5 * a).cos().abs().powi(6);
+            let r = 1.5 + 5.0 * arm + 0.7 * (21.0 * a).sin().max(0.0).powi(2) * arm.sqrt();
+            [r * a.cos(), r * a.sin()]
+        })
+        .collect()
+}
+
+#[test]
+fn several_trunks_where_body_branches_meet_and_copies_follow_them() {
+    // Pruned lightly, so the bumps along the arms keep their branches: each arm's skeleton is
+    // then a body branch, and the three meet at the centre.
+    let params = SketchParams {
+        prune: 0.001,
+        ..Default::default()
+    };
+    let s = interpret(
+        &tripod(),
+        true,
+        &SketchParams {
+            extend: false,
+            ..params.clone()
+        },
+        1,
+    )
+    .unwrap();
+    let trunks = spheres::trunks(&s.skeleton);
+    assert_eq!(trunks.len(), 3, "{:?}", s.skeleton.branches);
+    // Copies are placed around each bump's own trunk, so they stay inside the outline's
+    // projection and are kept (a copy about a far-off axis would be trimmed away).
+    let with = interpret(&tripod(), true, &params, 1).unwrap();
+    let originals = s.spheres.iter().filter(|q| q.terminal).count();
+    let copies = with
+        .spheres
+        .iter()
+        .filter(|q| q.terminal && q.center.z.abs() > 1e-6)
+        .count();
+    assert!(
+        copies as f64 >= 0.6 * originals as f64 * 2.0,
+        "{copies} copy spheres for {originals} originals"
+    );
 }
