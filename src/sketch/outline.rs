@@ -247,7 +247,7 @@ pub fn clean(raw: &[[f64; 2]], closed: bool, simplify: f64) -> Result<Outline, S
     let mut simple = douglas_peucker_closed(&points, tolerance.max(eps * 10.0));
     let asked = tolerance;
     while simple.len() > MAX_OUTLINE_POINTS {
-        tolerance = (tolerance * 1.5).max(size * 1e-4);
+        tolerance = (tolerance * 1.5).max(size * 5e-4);
         simple = douglas_peucker_closed(&points, tolerance);
     }
     if tolerance > asked {

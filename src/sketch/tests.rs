@@ -743,3 +743,41 @@ fn several_trunks_where_body_branches_meet_and_copies_follow_them() {
         "{copies} copy spheres for {originals} originals"
     );
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 2, .. ProptestConfig::default() })]
+
+    /// Strokes at the point cap and past it — long random walks that cross themselves again
+    /// and again, and dense spirals — finish within every budget: thinned to the cap, at most
+    /// 320 corners, the repair within its crossing tests, at most MAX_SPHERES spheres (the 3D
+    /// extension included), or a clear refusal.
+    #[test]
+    fn strokes_at_the_caps_stay_within_their_budgets(seed: u64, spiral: bool, over in 0usize..3000) {
+        let n = outline::MAX_STROKE_POINTS + over;
+        let mut rng = crate::seeded::SplitMix::new(seed);
+        let mut at = DVec2::ZERO;
+        let pts: Vec<[f64; 2]> = (0..n)
+            .map(|i| {
+                if spiral {
+                    let a = i as f64 * 0.05;
+                    [a.cos() * (1.0 + 0.002 * i as f64), a.sin() * (1.0 + 0.002 * i as f64)]
+                } else {
+                    at += DVec2::new(rng.next_f64() - 0.5, rng.next_f64() - 0.5);
+                    [at.x, at.y]
+                }
+            })
+            .collect();
+        match outline::clean(&pts, true, 0.0) {
+            Ok(o) => {
+                prop_assert!(o.points.len() <= 2 * outline::MAX_OUTLINE_POINTS);
+                if over > 0 {
+                    prop_assert!(o.warnings.iter().any(|w| w.contains("thinned")));
+                }
+            }
+            Err(e) => prop_assert!(matches!(e, SketchError::NoArea | SketchError::TooTangled), "{e}"),
+        }
+        if let Ok(s) = interpret(&pts, true, &SketchParams::default(), seed) {
+            prop_assert!(!s.spheres.is_empty() && s.spheres.len() <= spheres::MAX_SPHERES);
+        }
+    }
+}
