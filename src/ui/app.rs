@@ -233,7 +233,7 @@ impl CloudApp {
         self.guide.ui(ui, &mut self.doc, &mut self.notices);
         RENDER.ui(ui, &mut self.doc);
         LIGHT.ui(ui, &mut self.doc);
-        p.scene.ui(ui, &mut self.doc);
+        p.scene.ui(ui, &mut self.doc, &mut self.selection);
         p.view.ui(ui, &self.viewport.stats, &mut self.doc);
         self.selection.retain_valid(self.doc.scene());
     }
@@ -292,6 +292,7 @@ impl CloudApp {
             "redo": self.doc.redo_len(),
             "tool": self.tool.tool.name(),
             "selected_plane": self.selection.plane(),
+            "selected_ellipsoid": self.selection.ellipsoid(),
             "guides_hidden": self.tool.hide_guides,
             "skeleton_shown": self.tool.show_skeleton,
             "panel_open": self.panel_open,

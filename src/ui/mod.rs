@@ -4,7 +4,8 @@
 //!
 //! - `app`: [`CloudApp`], the frame loop, shortcuts and the page status;
 //! - `viewport`: the 3D view (progressive quality, camera input, status line);
-//! - `sketch_tool`: the Sketch, Cut, Move and Rotate tools and their overlay;
+//! - `sketch_tool`: the Sketch, Cut, Ellipsoid, Move and Rotate tools and their overlay;
+//! - `ellipsoids`: adding, picking, moving, duplicating and deleting ellipsoids;
 //! - `guide`: the guide image;
 //! - `panels`: one struct per side-panel group, each with its own `ui()`;
 //! - `selection`, `notice`, `widgets`: small shared pieces;
@@ -12,6 +13,7 @@
 
 mod app;
 mod camera_input;
+mod ellipsoids;
 mod guide;
 mod notice;
 mod panels;

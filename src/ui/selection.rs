@@ -1,5 +1,5 @@
-//! What the user has selected: drawing planes now, ellipsoids next (one type for both, so
-//! tools, the panel and the page state agree).
+//! What the user has selected: drawing planes and ellipsoids (one type for both, so tools, the
+//! panel and the page state agree).
 
 use crate::scene::Scene;
 
@@ -8,6 +8,8 @@ use crate::scene::Scene;
 pub enum Item {
     /// Drawing plane by index.
     Plane(usize),
+    /// Ellipsoid by index.
+    Ellipsoid(usize),
 }
 
 impl Item {
@@ -15,6 +17,15 @@ impl Item {
     pub fn plane(&self) -> Option<usize> {
         match self {
             Item::Plane(p) => Some(*p),
+            Item::Ellipsoid(_) => None,
+        }
+    }
+
+    /// The ellipsoid index, if this is an ellipsoid.
+    pub fn ellipsoid(&self) -> Option<usize> {
+        match self {
+            Item::Ellipsoid(e) => Some(*e),
+            Item::Plane(_) => None,
         }
     }
 }
@@ -41,6 +52,11 @@ impl Selection {
         self.items.iter().rev().find_map(Item::plane)
     }
 
+    /// The active ellipsoid, if one is selected.
+    pub fn ellipsoid(&self) -> Option<usize> {
+        self.items.iter().rev().find_map(Item::ellipsoid)
+    }
+
     /// Selects plane `index` alone, or nothing for `None`.
     pub fn set_plane(&mut self, index: Option<usize>) {
         match index {
@@ -58,6 +74,7 @@ impl Selection {
     pub fn retain_valid(&mut self, scene: &Scene) {
         self.items.retain(|i| match i {
             Item::Plane(p) => *p < scene.planes.len(),
+            Item::Ellipsoid(e) => *e < scene.ellipsoids.len(),
         });
     }
 }

@@ -5,6 +5,7 @@
 use egui::{Color32, Pos2, Rect, Response, Stroke, Ui};
 use glam::{Quat, Vec2, Vec3};
 
+use super::ellipsoids;
 use super::notice::Notices;
 use super::selection::{Item, Selection};
 use crate::derive::{Derived, Shape};
@@ -24,9 +25,13 @@ pub enum Tool {
     Sketch,
     /// Drag draws a cut line (flat base).
     Cut,
-    /// Drag moves the selected drawing plane parallel to the view (Shift: toward or away).
+    /// A click adds an ellipsoid where it lands (a drag orbits).
+    Ellipsoid,
+    /// Drag moves the selected drawing plane or ellipsoid parallel to the view (Shift: toward
+    /// or away).
     Move,
-    /// Drag turns the selected drawing plane (sideways: about the vertical; up/down: tilt).
+    /// Drag turns the selected drawing plane or ellipsoid (sideways: about the vertical;
+    /// up/down: tilt).
     Rotate,
 }
 
@@ -37,6 +42,7 @@ impl Tool {
             Tool::Navigate => "navigate",
             Tool::Sketch => "sketch",
             Tool::Cut => "cut",
+            Tool::Ellipsoid => "ellipsoid",
             Tool::Move => "move",
             Tool::Rotate => "rotate",
         }
@@ -231,6 +237,7 @@ impl SketchTool {
                 i.consume_key(Modifiers::NONE, Key::V),
                 i.consume_key(Modifiers::NONE, Key::D),
                 i.consume_key(Modifiers::NONE, Key::C),
+                i.consume_key(Modifiers::NONE, Key::E),
                 i.consume_key(Modifiers::NONE, Key::G),
                 i.consume_key(Modifiers::NONE, Key::R),
                 i.consume_key(Modifiers::NONE, Key::H),
@@ -239,7 +246,7 @@ impl SketchTool {
                 i.consume_key(Modifiers::NONE, Key::Delete),
             ]
         });
-        let [dup, v, d, c, g, r, h, k, esc, del] = keys;
+        let [dup, v, d, c, e, g, r, h, k, esc, del] = keys;
         if self.tool == Tool::Rotate {
             for (key, axis) in [(Key::X, Axis::X), (Key::Y, Axis::Y), (Key::Z, Axis::Z)] {
                 if ctx.input_mut(|i| i.consume_key(Modifiers::NONE, key)) {
@@ -252,6 +259,7 @@ impl SketchTool {
             (v, Tool::Navigate),
             (d, Tool::Sketch),
             (c, Tool::Cut),
+            (e, Tool::Ellipsoid),
             (g, Tool::Move),
             (r, Tool::Rotate),
         ] {
@@ -272,10 +280,16 @@ impl SketchTool {
             self.stroke.clear();
             self.drawing = false;
         }
-        if dup && let Some(m) = duplicate_selected(tc.doc, tc.selection) {
+        if dup
+            && let Some(m) = ellipsoids::duplicate_selected(tc.doc, tc.selection)
+                .or_else(|| duplicate_selected(tc.doc, tc.selection))
+        {
             tc.notices.note(now, m);
         }
-        if del && let Some(m) = delete_selected(tc.doc, tc.selection) {
+        if del
+            && let Some(m) = ellipsoids::delete_selected(tc.doc, tc.selection)
+                .or_else(|| delete_selected(tc.doc, tc.selection))
+        {
             tc.notices.note(now, m);
         }
     }
@@ -288,10 +302,25 @@ impl SketchTool {
             && response.clicked()
             && let Some(p) = response.interact_pointer_pos()
         {
-            tc.selection.set_plane(plane_at(tc.doc, rect, p));
+            // A drawing plane whose stroke is under the click, else the ellipsoid that shapes
+            // the cloud there.
+            match plane_at(tc.doc, rect, p) {
+                Some(i) => tc.selection.set(Item::Plane(i)),
+                None => match ellipsoids::pick(tc.doc, tc.derived, rect, p) {
+                    Some(i) => tc.selection.set(Item::Ellipsoid(i)),
+                    None => tc.selection.clear(),
+                },
+            }
+        }
+        if self.tool == Tool::Ellipsoid
+            && response.clicked()
+            && let Some(p) = response.interact_pointer_pos()
+            && let Some(m) = ellipsoids::add_at(tc.doc, tc.derived, tc.selection, rect, p)
+        {
+            tc.notices.note(ui.input(|i| i.time), m);
         }
         match self.tool {
-            Tool::Navigate => return false,
+            Tool::Navigate | Tool::Ellipsoid => return false,
             Tool::Move | Tool::Rotate => return self.manipulate(view, tc),
             Tool::Sketch | Tool::Cut => {}
         }
@@ -450,12 +479,17 @@ impl SketchTool {
     /// Without a selection the drag orbits as in Navigate.
     fn manipulate(&mut self, view: &ViewInput<'_>, tc: &mut ToolContext<'_>) -> bool {
         let (ui, response, rect) = (view.ui, view.response, view.rect);
-        let Some(i) = tc
+        let scene = tc.doc.scene();
+        // The selected plane, else the selected ellipsoid: its place and its turn.
+        let plane = tc.selection.plane().filter(|&i| i < scene.planes.len());
+        let ellipsoid = tc
             .selection
-            .plane()
-            .filter(|&i| i < tc.doc.scene().planes.len())
-        else {
-            return false;
+            .ellipsoid()
+            .filter(|&i| i < scene.ellipsoids.len());
+        let (mut origin, mut rotation) = match (plane, ellipsoid) {
+            (Some(i), _) => (scene.planes[i].origin, scene.planes[i].rotation),
+            (None, Some(i)) => (scene.ellipsoids[i].center, scene.ellipsoids[i].rotation),
+            (None, None) => return false,
         };
         if ui.input(|i| i.modifiers.alt || i.multi_touch().is_some()) {
             return true;
@@ -468,17 +502,16 @@ impl SketchTool {
         if delta == egui::Vec2::ZERO {
             return true;
         }
-        let camera = &tc.doc.scene().camera;
-        let mut plane = (*tc.doc.scene().planes[i]).clone();
+        let camera = &scene.camera;
         if response.drag_started() || self.turning.is_none() {
-            self.turning = Some((plane.rotation, Vec2::ZERO));
+            self.turning = Some((rotation, Vec2::ZERO));
         }
         match self.tool {
             Tool::Move => {
-                let depth = (plane.origin - camera.eye()).dot(camera.forward()).max(0.1);
+                let depth = (origin - camera.eye()).dot(camera.forward()).max(0.1);
                 let per_px = camera.world_per_px(depth, rect.height());
                 let shift = ui.input(|i| i.modifiers.shift);
-                plane.origin += if shift {
+                origin += if shift {
                     camera.forward() * (delta.y * per_px)
                 } else {
                     camera.right() * (delta.x * per_px) - camera.up() * (delta.y * per_px)
@@ -486,14 +519,26 @@ impl SketchTool {
             }
             _ => {
                 // The turn is taken from the whole drag, so snapping sees the total angle.
-                let (start, drag) = self.turning.get_or_insert((plane.rotation, Vec2::ZERO));
+                let (start, drag) = self.turning.get_or_insert((rotation, Vec2::ZERO));
                 *drag += Vec2::new(delta.x, delta.y);
                 let snap = ui.input(|i| i.modifiers.ctrl || i.modifiers.command);
                 let turn = drag_turn(*drag, self.axis_lock, snap, camera.right());
-                plane.rotation = (turn * *start).normalize();
+                rotation = (turn * *start).normalize();
             }
         }
-        tc.doc.apply(Edit::SetPlane(i, plane), Some("plane-drag"));
+        match (plane, ellipsoid) {
+            (Some(i), _) => {
+                let mut p = (*scene.planes[i]).clone();
+                (p.origin, p.rotation) = (origin, rotation);
+                tc.doc.apply(Edit::SetPlane(i, p), Some("plane-drag"));
+            }
+            (None, Some(i)) => {
+                let mut e = (*scene.ellipsoids[i]).clone();
+                (e.center, e.rotation) = (origin, rotation);
+                ellipsoids::set(tc.doc, i, e, Some("ellipsoid-drag"));
+            }
+            (None, None) => {}
+        }
         true
     }
 
@@ -510,6 +555,11 @@ impl SketchTool {
         let painter = ui.painter_at(rect);
         let scene = doc.scene();
         let camera = &scene.camera;
+        if !self.hide_guides
+            && let Some(e) = selection.ellipsoid().and_then(|i| scene.ellipsoids.get(i))
+        {
+            draw_ellipsoid(&painter, camera, rect, e);
+        }
         if self.show_skeleton
             && !self.hide_guides
             && let Some(plane) = selection.plane().and_then(|i| scene.planes.get(i))
@@ -563,9 +613,14 @@ impl SketchTool {
         }
         let rotate_hint;
         let hint = match self.tool {
-            Tool::Move | Tool::Rotate if selection.plane().is_none() => {
-                Some("Click a drawing plane (or pick one in the list) to move or rotate it")
+            Tool::Move | Tool::Rotate
+                if selection.plane().is_none() && selection.ellipsoid().is_none() =>
+            {
+                Some(
+                    "Click a drawing plane or the cloud (or pick one in the lists) to move or turn it",
+                )
             }
+            Tool::Ellipsoid => Some("Click to add an ellipsoid there (a drag orbits)"),
             Tool::Rotate => {
                 rotate_hint = match self.axis_lock {
                     Some(a) => format!(
@@ -627,6 +682,29 @@ fn plane_at(doc: &Document, rect: Rect, p: Pos2) -> Option<usize> {
         }
     }
     best.map(|(_, i)| i)
+}
+
+/// The selected ellipsoid's indicator: its three principal ellipses.
+fn draw_ellipsoid(
+    painter: &egui::Painter,
+    camera: &OrbitCamera,
+    rect: Rect,
+    e: &crate::scene::Ellipsoid,
+) {
+    const N: usize = 48;
+    let color = Color32::from_rgb(255, 170, 60);
+    for (a, b) in [(Vec3::X, Vec3::Y), (Vec3::Y, Vec3::Z), (Vec3::Z, Vec3::X)] {
+        let pts: Vec<Pos2> = (0..=N)
+            .filter_map(|k| {
+                let t = k as f32 / N as f32 * std::f32::consts::TAU;
+                let local = (a * t.cos() + b * t.sin()) * e.radii;
+                project(camera, rect, e.center + e.rotation * local)
+            })
+            .collect();
+        if pts.len() > 2 {
+            painter.add(egui::Shape::line(pts, Stroke::new(1.5, color)));
+        }
+    }
 }
 
 /// Wither et al.'s Figure 4 for one plane: its spheres as circles (the 3D extension's copies

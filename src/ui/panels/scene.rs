@@ -1,8 +1,11 @@
-//! The Scene group: new scenes from presets.
+//! The Scene group: new scenes from presets, what the scene holds, and its ellipsoids (a list
+//! to select from, and the selected one's centre, radii and strength).
 
 use egui::Ui;
 
 use crate::scene::{Document, Edit, Preset, Scene, StrokeKind};
+use crate::ui::ellipsoids;
+use crate::ui::selection::{Item, Selection};
 
 /// The Scene group.
 #[derive(Default)]
@@ -10,7 +13,7 @@ pub struct ScenePanel;
 
 impl ScenePanel {
     /// Draws the group.
-    pub fn ui(&mut self, ui: &mut Ui, doc: &mut Document) {
+    pub fn ui(&mut self, ui: &mut Ui, doc: &mut Document, selection: &mut Selection) {
         egui::CollapsingHeader::new("Scene")
             .default_open(true)
             .show(ui, |ui| {
@@ -27,7 +30,68 @@ impl ScenePanel {
                     }
                 });
                 ui.label(contents(doc.scene()));
+                ellipsoid_list(ui, doc, selection);
             });
+    }
+}
+
+/// The ellipsoids as a list to select from, and the selected one's numbers.
+fn ellipsoid_list(ui: &mut Ui, doc: &mut Document, selection: &mut Selection) {
+    let count = doc.scene().ellipsoids.len();
+    if count == 0 {
+        return;
+    }
+    let mut clicked = None;
+    egui::ScrollArea::vertical()
+        .id_salt("ellipsoids")
+        .max_height(90.0)
+        .show(ui, |ui| {
+            ui.horizontal_wrapped(|ui| {
+                for i in 0..count {
+                    let selected = selection.contains(Item::Ellipsoid(i));
+                    if ui
+                        .selectable_label(selected, format!("E{}", i + 1))
+                        .clicked()
+                    {
+                        clicked = Some((i, selected));
+                    }
+                }
+            });
+        });
+    if let Some((i, was)) = clicked {
+        if was {
+            selection.clear();
+        } else {
+            selection.set(Item::Ellipsoid(i));
+        }
+    }
+    let Some(i) = selection.ellipsoid().filter(|&i| i < count) else {
+        return;
+    };
+    let mut e = (*doc.scene().ellipsoids[i]).clone();
+    ui.label(egui::RichText::new(format!("Ellipsoid {}", i + 1)).strong());
+    for (label, v, speed) in [
+        ("centre", &mut e.center, 0.05),
+        ("radii", &mut e.radii, 0.02),
+    ] {
+        ui.horizontal(|ui| {
+            ui.label(label);
+            for (axis, c) in ["x", "y", "z"].iter().zip(v.as_mut()) {
+                ui.add_sized(
+                    [62.0, 18.0],
+                    egui::DragValue::new(c)
+                        .speed(speed)
+                        .fixed_decimals(2)
+                        .prefix(format!("{axis} ")),
+                );
+            }
+        });
+    }
+    e.radii = e.radii.max(glam::Vec3::splat(0.01));
+    ui.add(egui::Slider::new(&mut e.strength, -2.0..=2.0).text("strength"))
+        .on_hover_text("How much it adds to the cloud; below zero it carves the cloud away");
+    if e != *doc.scene().ellipsoids[i] {
+        ellipsoids::set(doc, i, e, Some("ellipsoid"));
     }
 }
 

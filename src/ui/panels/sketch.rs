@@ -39,14 +39,19 @@ impl SketchPanel {
                             "C: drag draws a line; the cloud below it is removed",
                         ),
                         (
+                            Tool::Ellipsoid,
+                            "Ellipsoid",
+                            "E: a click adds an ellipsoid where it lands on the cloud (or at the focus point); a drag orbits",
+                        ),
+                        (
                             Tool::Move,
                             "⬌ Move",
-                            "G: drag moves the selected drawing plane across the view (Shift: toward or away)",
+                            "G: drag moves the selected drawing plane or ellipsoid across the view (Shift: toward or away)",
                         ),
                         (
                             Tool::Rotate,
                             "⟳ Rotate",
-                            "R: drag turns the selected drawing plane; X, Y or Z locks the axis, Ctrl snaps to 15°",
+                            "R: drag turns the selected drawing plane or ellipsoid; X, Y or Z locks the axis, Ctrl snaps to 15°",
                         ),
                     ] {
                         ui.selectable_value(&mut tool.tool, t, label)
