@@ -33,6 +33,8 @@ pub enum Tool {
     /// Drag turns the selected drawing plane or ellipsoid (sideways: about the vertical;
     /// up/down: tilt).
     Rotate,
+    /// Drag scales the selected ellipsoid (right or up grows it).
+    Scale,
 }
 
 impl Tool {
@@ -45,6 +47,7 @@ impl Tool {
             Tool::Ellipsoid => "ellipsoid",
             Tool::Move => "move",
             Tool::Rotate => "rotate",
+            Tool::Scale => "scale",
         }
     }
 }
@@ -68,11 +71,20 @@ pub struct SketchTool {
     drawing: bool,
     /// The world axis Rotate turns about (X, Y or Z), or free.
     pub axis_lock: Option<Axis>,
-    /// The Rotate drag under way: the plane's rotation at its start and the drag so far.
-    turning: Option<(Quat, Vec2)>,
+    /// The Move/Rotate/Scale drag under way: what it started from and the drag so far.
+    gesture: Option<Gesture>,
 }
 
-/// A world axis the Rotate tool can be locked to.
+/// A Rotate or Scale drag: the selected item's turn and radii when it began, and the drag in
+/// pixels so far (turns and scales are taken from the whole drag, so snapping sees the total).
+#[derive(Clone, Copy, Debug)]
+struct Gesture {
+    rotation: Quat,
+    radii: Vec3,
+    drag: Vec2,
+}
+
+/// A world axis the Rotate tool can be locked to (for Scale: the ellipsoid's own axis).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Axis {
     /// World X (right in the front view).
@@ -106,6 +118,22 @@ impl Axis {
 const TURN_PER_PX: f32 = 0.2 * std::f32::consts::PI / 180.0;
 /// The step Ctrl snaps turns to.
 const SNAP_STEP: f32 = 15.0 * std::f32::consts::PI / 180.0;
+
+/// Scale per pixel of drag: a 140 px drag doubles.
+const SCALE_PER_PX: f32 = std::f32::consts::LN_2 / 140.0;
+
+/// The factor per axis a Scale drag of `drag` pixels gives: right or up grows, left or down
+/// shrinks; locked, only that axis changes; `snap` rounds the factor to tenths.
+pub fn drag_scale(drag: Vec2, lock: Option<Axis>, snap: bool) -> Vec3 {
+    let mut f = ((drag.x - drag.y) * SCALE_PER_PX).exp();
+    if snap {
+        f = ((f * 10.0).round() / 10.0).max(0.1);
+    }
+    match lock {
+        Some(axis) => Vec3::ONE + axis.vector() * (f - 1.0),
+        None => Vec3::splat(f),
+    }
+}
 
 /// The turn a Rotate drag of `drag` pixels (screen x right, y down) gives. Locked to an axis,
 /// a drag right or up turns positively about it; free, sideways turns about the vertical and
@@ -223,8 +251,8 @@ pub fn duplicate_selected(doc: &mut Document, selection: &mut Selection) -> Opti
 }
 
 impl SketchTool {
-    /// Tool shortcuts: V navigate, D draw, C cut, G move, R rotate (then X, Y or Z locks the
-    /// axis, the same key again frees it), H hides guides, K shows the skeleton and spheres, Esc cancels a stroke (or clears the
+    /// Tool shortcuts: V navigate, D draw, C cut, E ellipsoid, G move, R rotate, S scale (then
+    /// X, Y or Z locks the axis, the same key again frees it), H hides guides, K shows the skeleton and spheres, Esc cancels a stroke (or clears the
     /// selection), Delete removes the selected plane, Ctrl+D duplicates it.
     pub fn shortcuts(&mut self, ctx: &egui::Context, tc: &mut ToolContext<'_>) {
         if ctx.egui_wants_keyboard_input() {
@@ -240,14 +268,15 @@ impl SketchTool {
                 i.consume_key(Modifiers::NONE, Key::E),
                 i.consume_key(Modifiers::NONE, Key::G),
                 i.consume_key(Modifiers::NONE, Key::R),
+                i.consume_key(Modifiers::NONE, Key::S),
                 i.consume_key(Modifiers::NONE, Key::H),
                 i.consume_key(Modifiers::NONE, Key::K),
                 i.consume_key(Modifiers::NONE, Key::Escape),
                 i.consume_key(Modifiers::NONE, Key::Delete),
             ]
         });
-        let [dup, v, d, c, e, g, r, h, k, esc, del] = keys;
-        if self.tool == Tool::Rotate {
+        let [dup, v, d, c, e, g, r, sc, h, k, esc, del] = keys;
+        if matches!(self.tool, Tool::Rotate | Tool::Scale) {
             for (key, axis) in [(Key::X, Axis::X), (Key::Y, Axis::Y), (Key::Z, Axis::Z)] {
                 if ctx.input_mut(|i| i.consume_key(Modifiers::NONE, key)) {
                     self.axis_lock = (self.axis_lock != Some(axis)).then_some(axis);
@@ -262,6 +291,7 @@ impl SketchTool {
             (e, Tool::Ellipsoid),
             (g, Tool::Move),
             (r, Tool::Rotate),
+            (sc, Tool::Scale),
         ] {
             if pressed {
                 self.tool = tool;
@@ -298,8 +328,10 @@ impl SketchTool {
     /// must not orbit with it). In Navigate, a click selects the drawing plane under the pointer.
     pub fn input(&mut self, view: &ViewInput<'_>, tc: &mut ToolContext<'_>) -> bool {
         let (ui, response, rect) = (view.ui, view.response, view.rect);
-        if matches!(self.tool, Tool::Navigate | Tool::Move | Tool::Rotate)
-            && response.clicked()
+        if matches!(
+            self.tool,
+            Tool::Navigate | Tool::Move | Tool::Rotate | Tool::Scale
+        ) && response.clicked()
             && let Some(p) = response.interact_pointer_pos()
         {
             // A drawing plane whose stroke is under the click, else the ellipsoid that shapes
@@ -321,7 +353,7 @@ impl SketchTool {
         }
         match self.tool {
             Tool::Navigate | Tool::Ellipsoid => return false,
-            Tool::Move | Tool::Rotate => return self.manipulate(view, tc),
+            Tool::Move | Tool::Rotate | Tool::Scale => return self.manipulate(view, tc),
             Tool::Sketch | Tool::Cut => {}
         }
         let (alt, multi) = ui.input(|i| (i.modifiers.alt, i.multi_touch().is_some()));
@@ -486,16 +518,21 @@ impl SketchTool {
             .selection
             .ellipsoid()
             .filter(|&i| i < scene.ellipsoids.len());
-        let (mut origin, mut rotation) = match (plane, ellipsoid) {
-            (Some(i), _) => (scene.planes[i].origin, scene.planes[i].rotation),
-            (None, Some(i)) => (scene.ellipsoids[i].center, scene.ellipsoids[i].rotation),
+        let (mut origin, mut rotation, mut radii) = match (plane, ellipsoid) {
+            // Scale reshapes ellipsoids; with a plane selected a drag orbits.
+            (Some(_), _) if self.tool == Tool::Scale => return false,
+            (Some(i), _) => (scene.planes[i].origin, scene.planes[i].rotation, Vec3::ONE),
+            (None, Some(i)) => {
+                let e = &scene.ellipsoids[i];
+                (e.center, e.rotation, e.radii)
+            }
             (None, None) => return false,
         };
         if ui.input(|i| i.modifiers.alt || i.multi_touch().is_some()) {
             return true;
         }
         if !response.dragged_by(egui::PointerButton::Primary) {
-            self.turning = None;
+            self.gesture = None;
             return true;
         }
         let delta = response.drag_delta();
@@ -503,9 +540,18 @@ impl SketchTool {
             return true;
         }
         let camera = &scene.camera;
-        if response.drag_started() || self.turning.is_none() {
-            self.turning = Some((rotation, Vec2::ZERO));
+        if response.drag_started() || self.gesture.is_none() {
+            self.gesture = Some(Gesture {
+                rotation,
+                radii,
+                drag: Vec2::ZERO,
+            });
         }
+        let Some(gesture) = self.gesture.as_mut() else {
+            return true;
+        };
+        gesture.drag += Vec2::new(delta.x, delta.y);
+        let snap = ui.input(|i| i.modifiers.ctrl || i.modifiers.command);
         match self.tool {
             Tool::Move => {
                 let depth = (origin - camera.eye()).dot(camera.forward()).max(0.1);
@@ -517,13 +563,13 @@ impl SketchTool {
                     camera.right() * (delta.x * per_px) - camera.up() * (delta.y * per_px)
                 };
             }
+            Tool::Scale => {
+                radii = (gesture.radii * drag_scale(gesture.drag, self.axis_lock, snap))
+                    .clamp(Vec3::splat(0.01), Vec3::splat(1e4));
+            }
             _ => {
-                // The turn is taken from the whole drag, so snapping sees the total angle.
-                let (start, drag) = self.turning.get_or_insert((rotation, Vec2::ZERO));
-                *drag += Vec2::new(delta.x, delta.y);
-                let snap = ui.input(|i| i.modifiers.ctrl || i.modifiers.command);
-                let turn = drag_turn(*drag, self.axis_lock, snap, camera.right());
-                rotation = (turn * *start).normalize();
+                let turn = drag_turn(gesture.drag, self.axis_lock, snap, camera.right());
+                rotation = (turn * gesture.rotation).normalize();
             }
         }
         match (plane, ellipsoid) {
@@ -534,7 +580,7 @@ impl SketchTool {
             }
             (None, Some(i)) => {
                 let mut e = (*scene.ellipsoids[i]).clone();
-                (e.center, e.rotation) = (origin, rotation);
+                (e.center, e.rotation, e.radii) = (origin, rotation, radii);
                 ellipsoids::set(tc.doc, i, e, Some("ellipsoid-drag"));
             }
             (None, None) => {}
@@ -621,6 +667,12 @@ impl SketchTool {
                 )
             }
             Tool::Ellipsoid => Some("Click to add an ellipsoid there (a drag orbits)"),
+            Tool::Scale if selection.ellipsoid().is_none() => {
+                Some("Scale works on ellipsoids: click the cloud (or pick one in the list)")
+            }
+            Tool::Scale => {
+                Some("Drag right or up to grow · X/Y/Z scale one axis · Ctrl snaps to tenths")
+            }
             Tool::Rotate => {
                 rotate_hint = match self.axis_lock {
                     Some(a) => format!(
@@ -787,6 +839,16 @@ fn draw_grid(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_scale_drag_grows_rightward_per_axis_and_snaps() {
+        let grow = drag_scale(Vec2::new(140.0, 0.0), None, false);
+        assert!(grow.abs_diff_eq(Vec3::splat(2.0), 1e-4), "{grow}");
+        let shrink = drag_scale(Vec2::new(0.0, 140.0), None, false);
+        assert!(shrink.abs_diff_eq(Vec3::splat(0.5), 1e-4), "{shrink}");
+        let y = drag_scale(Vec2::new(100.0, 0.0), Some(Axis::Y), true);
+        assert_eq!(y, Vec3::new(1.0, 1.6, 1.0));
+    }
 
     #[test]
     fn pen_pressure_fills_the_points_without_one() {

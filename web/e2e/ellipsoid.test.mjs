@@ -1,6 +1,6 @@
 // Ellipsoids in the browser: the Ellipsoid tool adds one where a click lands; the Move tool
-// drags it (the cloud follows, the camera stays); Ctrl+Z undoes the drag as one step; Delete
-// removes it. Screenshots: test-results/screenshots/ellipsoid-*.png.
+// drags it (the cloud follows, the camera stays); Ctrl+Z undoes the drag as one step; the
+// Scale tool grows it; Delete removes it. Screenshots: test-results/screenshots/ellipsoid-*.png.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { serve, state, screenshot, countDiffering, until, withApp, waitForFullQuality } from './harness.mjs';
@@ -25,7 +25,7 @@ function cloud(img, [vw, vh], bg) {
 }
 
 for (const backend of ['webgpu', 'webgl2']) {
-  test(`add an ellipsoid with its tool, move it, undo, delete (${backend})`, { timeout: 240_000 }, async () => {
+  test(`add an ellipsoid with its tool, move it, undo, scale it, delete (${backend})`, { timeout: 240_000 }, async () => {
     await withApp({ base: server.url, webgpu: backend === 'webgpu', query: '?preset=empty', viewport: { width: 1280, height: 800 } }, async (page) => {
       let s = await state(page);
       const view = s.view.viewport;
@@ -63,6 +63,20 @@ for (const backend of ['webgpu', 'webgl2']) {
 
       await page.keyboard.press('Control+z');
       s = await until(page, (s) => Math.abs(s.scene.ellipsoids[0].center[0] - x0) < 1e-4, 'the move undone');
+      // Scale: a drag right grows it, and the cloud with it.
+      const r0 = s.scene.ellipsoids[0].radii[0];
+      await page.keyboard.press('s');
+      await until(page, (s) => s.view.tool === 'scale', 'scale tool');
+      await waitForFullQuality(page);
+      const before = cloud(await screenshot(page, `ellipsoid-3-before-scale-${backend}`), view, bg);
+      await page.mouse.move(vw * 0.4, vh * 0.5);
+      await page.mouse.down();
+      for (let i = 1; i <= 10; i++) await page.mouse.move(vw * 0.4 + i * 10, vh * 0.5);
+      await page.mouse.up();
+      s = await until(page, (s) => s.scene.ellipsoids[0].radii[0] > 1.3 * r0, 'the ellipsoid grew');
+      await waitForFullQuality(page);
+      const grown = cloud(await screenshot(page, `ellipsoid-4-scaled-${backend}`), view, bg);
+      assert.ok(grown.n > 1.5 * before.n, `the cloud grew: ${before.n} → ${grown.n} px`);
       await page.keyboard.press('Delete');
       s = await until(page, (s) => s.scene.ellipsoids.length === 0, 'deleted');
       assert.match(s.view.notice.text, /Deleted Ellipsoid 1/);

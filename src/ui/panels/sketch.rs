@@ -49,6 +49,11 @@ impl SketchPanel {
                             "G: drag moves the selected drawing plane or ellipsoid across the view (Shift: toward or away)",
                         ),
                         (
+                            Tool::Scale,
+                            "Scale",
+                            "S: drag right or up grows the selected ellipsoid; X, Y or Z scales one axis, Ctrl snaps to tenths",
+                        ),
+                        (
                             Tool::Rotate,
                             "⟳ Rotate",
                             "R: drag turns the selected drawing plane or ellipsoid; X, Y or Z locks the axis, Ctrl snaps to 15°",
