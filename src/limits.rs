@@ -1,8 +1,8 @@
 //! Every cap and every parameter range, defined once (pure). Validation of documents, the CLI and the
 //! UI's sliders all read these, so opening a scene never clamps a value the panel could set, and
-//! every way a file comes in (open, drop, CLI, guide image) has the same size limit.
+//! every way a file comes in (open, drop, CLI, reference image) has the same size limit.
 
-/// Largest file read from any source: scene documents, stroke files, guide images.
+/// Largest file read from any source: scene documents, stroke files, reference images.
 pub const MAX_FILE_BYTES: u64 = 64 << 20;
 /// Most ellipsoids a document may hold.
 pub const MAX_ELLIPSOIDS: usize = 4096;
@@ -28,7 +28,7 @@ pub const MIN_LOADED_GRID: u32 = 32;
 pub const MAX_CROSSING_TESTS: u64 = 4_000_000;
 /// Largest image side rendered offscreen.
 pub const MAX_RENDER_SIDE: u32 = 8192;
-/// Largest image side decoded at all (guide images).
+/// Largest image side decoded at all (reference images).
 pub const MAX_DECODE_SIDE: u32 = 16_384;
 /// Largest reference-image file the document embeds (base64 in the JSON); a larger file is
 /// shown but the document keeps only its name (load it again after reopening).

@@ -1,5 +1,5 @@
 //! Everything wasm-only: start-up in the page, URL options, the page's test contract and the
-//! on-page error box. Gated as a whole module (with `ui/files_web.rs`, the browser's file
+//! on-page error box. Gated as a whole module (with `ui/platform_web.rs`, the browser's file
 //! reading), so wasm-only code stays out of the rest of the crate.
 //!
 //! Test contract: `<body>` carries `data-ready` (first full-quality image shown),

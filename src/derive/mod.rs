@@ -109,8 +109,8 @@ pub fn check_cost(scene: &mut Scene) -> Result<Option<String>, String> {
     if work <= MAX_BAKE_WORK {
         return Ok(None);
     }
-    let fits = resolution_within(&field, wanted, MAX_BAKE_WORK);
-    if fits < MIN_LOADED_GRID.min(wanted) || bake_work(&field, fits) > MAX_BAKE_WORK {
+    let (fits, fitted_work) = resolution_within(&field, wanted, MAX_BAKE_WORK);
+    if fits < MIN_LOADED_GRID.min(wanted) || fitted_work > MAX_BAKE_WORK {
         return Err(format!(
             "this scene would take {:.0} million field evaluations to build (at most {:.0} \
              million), even on a {MIN_LOADED_GRID}³ grid: it has too many or too large \
@@ -185,8 +185,8 @@ impl Derived {
                 self.generation += 1;
                 self.work.bakes += 1;
                 // An edit that would bake for seconds bakes a coarser grid instead.
-                let resolution = resolution_within(&field, gkey.resolution, MAX_BAKE_WORK);
-                self.work.bake_work += bake_work(&field, resolution);
+                let (resolution, work) = resolution_within(&field, gkey.resolution, MAX_BAKE_WORK);
+                self.work.bake_work += work;
                 let v = Versioned {
                     generation: self.generation,
                     data: Arc::new(bake(&field, resolution)),

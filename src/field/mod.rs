@@ -193,6 +193,13 @@ impl Field {
             .map(|(lo, hi)| ((lo + hi) * 0.5, (hi - lo).length() * 0.5))
     }
 
+    /// Where a click's ray meets the cloud: [`Field::raycast`] in steps of 1/200 of the
+    /// field's bounding radius (fine enough for picking and placing, and bounded).
+    pub fn surface_under(&self, ray: &crate::scene::Ray) -> Option<Vec3> {
+        let (_, radius) = self.bounding_sphere()?;
+        self.raycast(ray, radius / 200.0)
+    }
+
     /// First point where a ray enters the visible surface, marching in steps of `step`.
     pub fn raycast(&self, ray: &crate::scene::Ray, step: f32) -> Option<Vec3> {
         let (lo, hi) = self.bounds()?;

@@ -126,13 +126,15 @@ pub fn bake_work(field: &Field, resolution: u32) -> u64 {
 }
 
 /// The largest resolution up to `wanted` whose [`bake_work`] fits `budget` (the grid's floor
-/// when none does).
-pub fn resolution_within(field: &Field, wanted: u32, budget: u64) -> u32 {
+/// when none does), with its work.
+pub fn resolution_within(field: &Field, wanted: u32, budget: u64) -> (u32, u64) {
     let mut res = wanted.clamp(MIN_SIDE, MAX_RESOLUTION);
-    while res > MIN_SIDE && bake_work(field, res) > budget {
+    let mut work = bake_work(field, res);
+    while res > MIN_SIDE && work > budget {
         res = (res * 4 / 5).max(MIN_SIDE);
+        work = bake_work(field, res);
     }
-    res
+    (res, work)
 }
 
 /// Samples `field` on a grid over its bounds, `resolution` texels along the longest side.

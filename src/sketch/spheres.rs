@@ -541,14 +541,12 @@ pub fn extend(
         let slot = |j: usize| {
             -std::f64::consts::FRAC_PI_2 + std::f64::consts::PI * (j as f64 + 0.5) / m as f64
         };
-        let original = (0..m)
-            .min_by(|&a, &b| {
-                slot(a)
-                    .abs()
-                    .total_cmp(&slot(b).abs())
-                    .then((rng.next_f64() < 0.5).cmp(&true))
-            })
-            .unwrap_or(0);
+        // The middle slot; with an even count, one of the two middle ones, seeded.
+        let original = if m % 2 == 1 || rng.next_f64() < 0.5 {
+            m / 2
+        } else {
+            m / 2 - 1
+        };
         for j in (0..m).filter(|&j| j != original) {
             let vary = (rng.next_f64() - 0.5) * (std::f64::consts::PI / m as f64) * 0.4;
             let slide = (rng.next_f64() * 2.0 - 1.0) * COPY_SLIDE * members[0].radius;

@@ -5,24 +5,16 @@
 use std::sync::Arc;
 
 use egui::{Pos2, Rect};
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 
 use super::selection::{Item, Selection};
+use super::sketch_tool::ray_at;
 use crate::derive::Derived;
 use crate::field::Blob;
-use crate::scene::{Document, Edit, Ellipsoid, MAX_ELLIPSOIDS, OrbitCamera, Ray};
+use crate::scene::{Document, Edit, Ellipsoid, MAX_ELLIPSOIDS};
 
 /// Share of the view's height a new ellipsoid's vertical radius takes.
 const NEW_SIZE: f32 = 0.12;
-
-/// The camera ray through screen point `p` of the view `rect`.
-pub fn ray_at(camera: &OrbitCamera, rect: Rect, p: Pos2) -> Ray {
-    let ndc = Vec2::new(
-        (p.x - rect.left()) / rect.width() * 2.0 - 1.0,
-        1.0 - (p.y - rect.top()) / rect.height() * 2.0,
-    );
-    camera.ray(ndc, rect.aspect_ratio())
-}
 
 /// Where a click at `p` lands: the cloud's surface under it, or the plane through the focus
 /// point facing the view.

@@ -6,7 +6,7 @@
 //! - `viewport`: the 3D view (progressive quality, camera input, status line);
 //! - `sketch_tool`: the Sketch, Cut, Ellipsoid, Move and Rotate tools and their overlay;
 //! - `ellipsoids`: adding, picking, moving, duplicating and deleting ellipsoids;
-//! - `guide`: the guide image;
+//! - `guide`: the reference image (loading, texture, drawing, its panel group);
 //! - `panels`: one struct per side-panel group, each with its own `ui()`;
 //! - `selection`, `notice`, `widgets`: small shared pieces;
 //! - `platform_native` / `platform_web`: the one platform seam (chosen by `cfg` on the module).

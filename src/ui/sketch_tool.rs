@@ -114,6 +114,17 @@ impl Axis {
     }
 }
 
+/// Each tool's key (Blender's where it has one).
+const TOOL_KEYS: [(egui::Key, Tool); 7] = [
+    (egui::Key::V, Tool::Navigate),
+    (egui::Key::D, Tool::Sketch),
+    (egui::Key::C, Tool::Cut),
+    (egui::Key::E, Tool::Ellipsoid),
+    (egui::Key::G, Tool::Move),
+    (egui::Key::R, Tool::Rotate),
+    (egui::Key::S, Tool::Scale),
+];
+
 /// Turn per pixel of drag: about 1° per 5 px (a 150 px drag turns 30°), as the gizmos will.
 const TURN_PER_PX: f32 = 0.2 * std::f32::consts::PI / 180.0;
 /// The step Ctrl snaps turns to.
@@ -176,6 +187,11 @@ pub struct ToolContext<'a> {
     pub selection: &'a mut Selection,
     /// Where messages go.
     pub notices: &'a mut Notices,
+}
+
+/// The camera ray through screen point `p` of the view `rect`.
+pub fn ray_at(camera: &OrbitCamera, rect: Rect, p: Pos2) -> crate::scene::Ray {
+    camera.ray(ndc(rect, p), rect.aspect_ratio())
 }
 
 fn ndc(rect: Rect, p: Pos2) -> Vec2 {
@@ -253,29 +269,21 @@ pub fn duplicate_selected(doc: &mut Document, selection: &mut Selection) -> Opti
 impl SketchTool {
     /// Tool shortcuts: V navigate, D draw, C cut, E ellipsoid, G move, R rotate, S scale (then
     /// X, Y or Z locks the axis, the same key again frees it), H hides guides, K shows the skeleton and spheres, Esc cancels a stroke (or clears the
-    /// selection), Delete removes the selected plane, Ctrl+D duplicates it.
+    /// selection), Delete removes the selected ellipsoid or plane, Ctrl+D duplicates it.
     pub fn shortcuts(&mut self, ctx: &egui::Context, tc: &mut ToolContext<'_>) {
         if ctx.egui_wants_keyboard_input() {
             return;
         }
         use egui::{Key, Modifiers};
-        let keys = ctx.input_mut(|i| {
-            [
-                i.consume_key(Modifiers::COMMAND, Key::D),
-                i.consume_key(Modifiers::NONE, Key::V),
-                i.consume_key(Modifiers::NONE, Key::D),
-                i.consume_key(Modifiers::NONE, Key::C),
-                i.consume_key(Modifiers::NONE, Key::E),
-                i.consume_key(Modifiers::NONE, Key::G),
-                i.consume_key(Modifiers::NONE, Key::R),
-                i.consume_key(Modifiers::NONE, Key::S),
-                i.consume_key(Modifiers::NONE, Key::H),
-                i.consume_key(Modifiers::NONE, Key::K),
-                i.consume_key(Modifiers::NONE, Key::Escape),
-                i.consume_key(Modifiers::NONE, Key::Delete),
-            ]
-        });
-        let [dup, v, d, c, e, g, r, sc, h, k, esc, del] = keys;
+        // Ctrl+D first, so the plain D below does not take it.
+        let dup = ctx.input_mut(|i| i.consume_key(Modifiers::COMMAND, Key::D));
+        for (key, tool) in TOOL_KEYS {
+            if ctx.input_mut(|i| i.consume_key(Modifiers::NONE, key)) {
+                self.tool = tool;
+            }
+        }
+        let [h, k, esc, del] = [Key::H, Key::K, Key::Escape, Key::Delete]
+            .map(|key| ctx.input_mut(|i| i.consume_key(Modifiers::NONE, key)));
         if matches!(self.tool, Tool::Rotate | Tool::Scale) {
             for (key, axis) in [(Key::X, Axis::X), (Key::Y, Axis::Y), (Key::Z, Axis::Z)] {
                 if ctx.input_mut(|i| i.consume_key(Modifiers::NONE, key)) {
@@ -284,19 +292,6 @@ impl SketchTool {
             }
         }
         let now = ctx.input(|i| i.time);
-        for (pressed, tool) in [
-            (v, Tool::Navigate),
-            (d, Tool::Sketch),
-            (c, Tool::Cut),
-            (e, Tool::Ellipsoid),
-            (g, Tool::Move),
-            (r, Tool::Rotate),
-            (sc, Tool::Scale),
-        ] {
-            if pressed {
-                self.tool = tool;
-            }
-        }
         if h {
             self.hide_guides = !self.hide_guides;
         }
@@ -450,11 +445,7 @@ impl SketchTool {
         let Some(&first) = stroke.first() else { return };
         let first_ray = camera.ray(ndc(rect, first), aspect);
         let field = tc.derived.field(scene, Some(tc.doc.revisions().geometry));
-        let step = field
-            .bounding_sphere()
-            .map(|(_, r)| r / 200.0)
-            .unwrap_or(0.05);
-        let anchor = field.raycast(&first_ray, step).unwrap_or(camera.target);
+        let anchor = field.surface_under(&first_ray).unwrap_or(camera.target);
         let normal = -camera.forward();
         // Each point with its pressure (when the pen gave one), so both stay paired.
         let (world, pressure): (Vec<Vec3>, Vec<Option<f32>>) = stroke

@@ -28,7 +28,7 @@ pub struct Viewport {
 }
 
 /// Everything the viewport works on this frame: what the tools work on, the tools, the
-/// guide image.
+/// reference image.
 pub struct ViewportContext<'a> {
     /// Document, derivation cache, selection and messages.
     pub cx: ToolContext<'a>,
