@@ -252,6 +252,96 @@ fn eleventh_stroke() -> Vec<BenchResult> {
     ]
 }
 
+/// A bank of `n` ellipsoids (seeded), 24 × 5 × 24 world units, as a modeller using thousands of
+/// primitives builds one.
+pub fn ellipsoid_bank(n: usize) -> Scene {
+    use crate::scene::Ellipsoid;
+    let mut rng = crate::seeded::SplitMix::new(n as u64);
+    let mut u = || rng.next_f64() as f32;
+    let mut scene = Scene::preset(Preset::Empty);
+    scene.ellipsoids = (0..n)
+        .map(|_| {
+            let center = glam::Vec3::new(u() * 24.0 - 12.0, u() * 5.0, u() * 24.0 - 12.0);
+            let radii = glam::Vec3::new(0.5 + u(), 0.3 + u() * 0.5, 0.5 + u());
+            Arc::new(Ellipsoid {
+                rotation: glam::Quat::from_rotation_y(u() * 6.0),
+                ..Ellipsoid::new(center, radii)
+            })
+        })
+        .collect();
+    scene
+}
+
+/// The field's density volume for 100 and 2,000 ellipsoids: a full rebuild, and one primitive
+/// moved (the partial update), each against brute force (every primitive at every texel); the
+/// light sweep that follows a geometry change is reported apart.
+fn field_at_scale() -> Vec<BenchResult> {
+    let mut out = Vec::new();
+    for n in [100, 2_000] {
+        let mut doc = Document::new(ellipsoid_bank(n));
+        let res = doc.scene().render.field_resolution;
+        let full = time_median(5, &mut || {
+            std::hint::black_box(Derived::default().density(doc.scene(), doc.revisions()));
+        });
+        let mut derived = Derived::default();
+        derived.density(doc.scene(), doc.revisions());
+        let mut step = 0usize;
+        let moved = time_median(15, &mut || {
+            step += 1;
+            let mut es = doc.scene().ellipsoids.clone();
+            let i = (step * 7919) % es.len();
+            let mut e = (*es[i]).clone();
+            e.center.x += if step % 2 == 0 { 0.4 } else { -0.4 };
+            es[i] = Arc::new(e);
+            doc.apply(Edit::SetEllipsoids(es), None);
+            std::hint::black_box(derived.density(doc.scene(), doc.revisions()));
+        });
+        let field = crate::derive::field_of(doc.scene());
+        let brute = time_median(1, &mut || {
+            std::hint::black_box(crate::field::bake_brute_force(&field, res));
+        });
+        let volume = derived.density(doc.scene(), doc.revisions()).data;
+        let params = crate::derive::LightParams {
+            sun_dir: doc.scene().light.sun_direction(),
+            extinction: doc.scene().render.opacity,
+            softness: doc.scene().render.softness,
+        };
+        let light = time_median(5, &mut || {
+            std::hint::black_box(crate::derive::sweep(&volume, &params));
+        });
+        let brute_name = format!("field_brute_force_{n}_ellipsoids");
+        out.push(result(
+            &format!("field_full_rebuild_{n}_ellipsoids"),
+            full * 1e3,
+            "ms",
+            &brute_name,
+            brute * 1e3,
+        ));
+        out.push(result(
+            &format!("field_one_of_{n}_ellipsoids_moved"),
+            moved * 1e3,
+            "ms",
+            &brute_name,
+            brute * 1e3,
+        ));
+        out.push(result(
+            &format!("field_one_of_{n}_moved_vs_rebuild"),
+            moved * 1e3,
+            "ms",
+            &format!("field_full_rebuild_{n}_ellipsoids"),
+            full * 1e3,
+        ));
+        out.push(result(
+            &format!("light_sweep_after_a_move_{n}_ellipsoids"),
+            light * 1e3,
+            "ms",
+            &format!("field_one_of_{n}_ellipsoids_moved"),
+            moved * 1e3,
+        ));
+    }
+    out
+}
+
 /// Documents at the caps built to be slow (every primitive reaches every texel of the grid):
 /// what a crafted file or link could hold.
 pub fn worst_documents() -> Vec<(&'static str, Scene)> {
@@ -302,8 +392,8 @@ fn worst_documents_bench() -> Vec<BenchResult> {
         .collect()
 }
 
-/// Runs the suite and prints it.
-pub fn run(json: bool) -> Result<(), String> {
+/// Runs the suite (or only the groups named in `only`, comma-separated) and prints it.
+pub fn run(json: bool, only: Option<&str>) -> Result<(), String> {
     let mut offscreen = Offscreen::new().map_err(|e| e.to_string())?;
     let machine = format!(
         "{} cores, {} {}; adapter {}",
@@ -314,11 +404,26 @@ pub fn run(json: bool) -> Result<(), String> {
         std::env::consts::ARCH,
         offscreen.adapter_name()
     );
-    let mut results = vec![sketch_pipeline()?];
-    results.extend(light_tick());
-    results.extend(eleventh_stroke());
-    results.extend(worst_documents_bench());
-    results.push(render_frame(&mut offscreen)?);
+    let wanted = |group: &str| only.is_none_or(|o| o.split(',').any(|g| g.trim() == group));
+    let mut results = Vec::new();
+    if wanted("sketch") {
+        results.push(sketch_pipeline()?);
+    }
+    if wanted("light") {
+        results.extend(light_tick());
+    }
+    if wanted("stroke") {
+        results.extend(eleventh_stroke());
+    }
+    if wanted("worst") {
+        results.extend(worst_documents_bench());
+    }
+    if wanted("field") {
+        results.extend(field_at_scale());
+    }
+    if wanted("render") {
+        results.push(render_frame(&mut offscreen)?);
+    }
     let report = BenchReport { machine, results };
     if json {
         println!(

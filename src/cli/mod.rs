@@ -79,6 +79,9 @@ enum Command {
         /// Print one JSON object instead of a table.
         #[arg(long)]
         json: bool,
+        /// Run only these groups, comma-separated: sketch, light, stroke, worst, field, render.
+        #[arg(long)]
+        only: Option<String>,
     },
 }
 
@@ -113,7 +116,7 @@ pub fn main() -> ExitCode {
             !no_extend,
             seed,
         ),
-        Some(Command::Bench { json }) => crate::bench::run(json),
+        Some(Command::Bench { json, only }) => crate::bench::run(json, only.as_deref()),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

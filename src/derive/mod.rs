@@ -12,7 +12,7 @@ pub use light::{LightParams, LightVolume, sweep};
 pub use planes::{PlaneCache, Shape};
 
 use crate::field::{
-    Blob, Clip, DensityVolume, Field, MAX_PRIMITIVES, bake, bake_work, resolution_within,
+    Baker, Blob, Clip, DensityVolume, Field, MAX_PRIMITIVES, bake_work, resolution_within,
 };
 use crate::limits::{MAX_BAKE_WORK, MIN_LOADED_GRID};
 use crate::scene::{DrawingPlane, Revisions, Scene};
@@ -55,8 +55,11 @@ pub struct Work {
     pub bakes: u64,
     /// Light sweeps.
     pub sweeps: u64,
-    /// Kernel evaluations and clip tests of all bakes ([`bake_work`]).
+    /// Kernel evaluations and clip tests of all bakes ([`bake_work`] for a full one; a
+    /// partial update counts what it re-evaluated).
     pub bake_work: u64,
+    /// Texels re-evaluated by all bakes (a partial update copies the others).
+    pub baked_texels: u64,
 }
 
 /// The planes' drawing-plane placement applied to their shapes: the field of a document.
@@ -150,6 +153,7 @@ pub struct Derived {
     planes: PlaneCache,
     field: Option<(u64, Arc<Field>)>,
     density: Option<(GeometryKey, Versioned<DensityVolume>)>,
+    baker: Baker,
     light: Option<(LightKey, Versioned<LightVolume>)>,
     generation: u64,
     work: Work,
@@ -172,29 +176,37 @@ impl Derived {
         field
     }
 
-    /// The volumes of `scene` whose parts are at `revisions`; derives only what changed.
-    pub fn update(&mut self, scene: &Scene, revisions: Revisions) -> Volumes {
+    /// The density volume of `scene`'s geometry at `revisions` (the geometry alone, without
+    /// its light); re-evaluates only what changed since the last call.
+    pub fn density(&mut self, scene: &Scene, revisions: Revisions) -> Versioned<DensityVolume> {
         let gkey = GeometryKey {
             geometry: revisions.geometry,
             resolution: scene.render.field_resolution,
         };
-        let density = match &self.density {
+        match &self.density {
             Some((k, v)) if *k == gkey => v.clone(),
             _ => {
                 let field = self.field(scene, Some(revisions.geometry));
                 self.generation += 1;
                 self.work.bakes += 1;
-                // An edit that would bake for seconds bakes a coarser grid instead.
-                let (resolution, work) = resolution_within(&field, gkey.resolution, MAX_BAKE_WORK);
-                self.work.bake_work += work;
+                // Only what the edit changed is re-evaluated; an edit that would bake for
+                // seconds bakes a coarser grid instead.
+                let baked = self.baker.update(&field, gkey.resolution, MAX_BAKE_WORK);
+                self.work.bake_work += baked.work;
+                self.work.baked_texels += baked.texels;
                 let v = Versioned {
                     generation: self.generation,
-                    data: Arc::new(bake(&field, resolution)),
+                    data: baked.volume,
                 };
                 self.density = Some((gkey, v.clone()));
                 v
             }
-        };
+        }
+    }
+
+    /// The volumes of `scene` whose parts are at `revisions`; derives only what changed.
+    pub fn update(&mut self, scene: &Scene, revisions: Revisions) -> Volumes {
+        let density = self.density(scene, revisions);
         let lkey = LightKey {
             density: density.generation,
             params: LightParams {

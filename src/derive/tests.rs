@@ -180,11 +180,27 @@ fn cached_volumes_equal_a_fresh_derivation() {
     l.sun_elevation_deg = 70.0;
     doc.apply(Edit::SetLight(l), None);
     let cached = derived.update(doc.scene(), doc.revisions());
-    let fresh = Derived::default().update(doc.scene(), doc.revisions());
-    assert_eq!(*cached.density.data, *fresh.density.data);
-    assert_eq!(*cached.light.data, *fresh.light.data);
-    let brute = bake(&field_of(doc.scene()), doc.scene().render.field_resolution);
-    assert_eq!(*cached.density.data, brute);
+    // The cached grid may keep its texel size (hysteresis), so compare values, not grids:
+    // every texel is the fresh field at its centre, and the light is that density's.
+    let field = field_of(doc.scene());
+    let v = &cached.density.data;
+    for z in 0..v.dims.z {
+        for y in 0..v.dims.y {
+            for x in 0..v.dims.x {
+                let want = field.value(v.center(x, y, z));
+                let got = v.value(x, y, z);
+                // (Texel centres found from the box differ from the lattice's by float rounding.)
+                assert!((got - want).abs() < 1e-4, "({x},{y},{z}): {got} vs {want}");
+            }
+        }
+    }
+    let params = LightParams {
+        sun_dir: doc.scene().light.sun_direction(),
+        extinction: doc.scene().render.opacity,
+        softness: doc.scene().render.softness,
+    };
+    assert_eq!(*cached.light.data, sweep(v, &params));
+    assert!(derived.work().baked_texels > 0);
 }
 
 #[test]

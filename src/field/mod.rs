@@ -9,7 +9,10 @@
 
 mod volume;
 
-pub use volume::{DensityVolume, MAX_RESOLUTION, bake, bake_work, density, resolution_within};
+pub use volume::{
+    Baked, Baker, DensityVolume, MAX_RESOLUTION, bake, bake_brute_force, bake_work, density,
+    resolution_within,
+};
 
 use glam::{Mat3, Vec2, Vec3};
 

@@ -1,14 +1,25 @@
 //! The neutral density volume: a field (or, later, a simulation) sampled on a capped regular
 //! grid. The renderer uploads it as a 3D texture (WebGL2 has no storage buffers or compute),
 //! the light sweep reads it, and exporters will write it.
+//!
+//! Texels are cubes of side `h` on a lattice anchored at the world origin (texel centres at
+//! `(n + ½)·h`), so two grids of one texel size share their texels wherever they overlap: an
+//! update copies what it can from the last volume and re-evaluates only the bricks (8³ texels)
+//! that an edited primitive reaches ([`Baker`]).
 
-use glam::{UVec3, Vec3};
+use std::collections::HashMap;
+use std::hash::{Hash, Hasher};
+use std::sync::Arc;
 
-use super::{Field, ISO};
+use glam::{I64Vec3, UVec3, Vec3};
+
+use super::{Blob, Field, ISO, SUPPORT};
 
 pub use crate::limits::MAX_GRID_RESOLUTION as MAX_RESOLUTION;
 /// Fewest texels along one side.
 const MIN_SIDE: u32 = 4;
+/// Side of a brick, the unit of partial updates (texels).
+const BRICK: u32 = 8;
 
 /// Field values on a regular grid over a box.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -49,6 +60,11 @@ impl DensityVolume {
         self.values[self.index(x, y, z)]
     }
 
+    /// World position of texel (x, y, z)'s centre.
+    pub fn center(&self, x: u32, y: u32, z: u32) -> Vec3 {
+        self.min + (UVec3::new(x, y, z).as_vec3() + 0.5) * self.texel_size()
+    }
+
     /// The texel holding world point `p`, if inside the grid.
     pub fn texel_at(&self, p: Vec3) -> Option<UVec3> {
         let t = (p - self.min) / self.size;
@@ -64,30 +80,57 @@ pub fn density(field: f32, softness: f32) -> f32 {
     t * t * (3.0 - 2.0 * t)
 }
 
-/// The grid `bake` samples a field on: its box and texel counts.
-#[derive(Clone, Copy)]
-struct Grid {
-    lo: Vec3,
-    size: Vec3,
+/// A box of texels on the lattice of texel size `h`: texel `i` of the box is lattice cell
+/// `origin + i`, centred at `(origin + i + ½)·h`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Grid {
+    /// Lattice index of the first texel.
+    origin: I64Vec3,
+    /// Texels per axis.
     dims: UVec3,
-    /// Texel size.
-    h: Vec3,
+    /// Texel side (world units).
+    h: f32,
 }
 
 impl Grid {
-    fn of(field: &Field, resolution: u32) -> Option<Self> {
+    /// The texel side that puts `resolution` texels along the longest side of `field`'s box.
+    fn texel_for(field: &Field, resolution: u32) -> Option<f32> {
         let (lo, hi) = field.bounds()?;
-        let size = (hi - lo).max(Vec3::splat(1e-3));
-        let res = resolution.clamp(MIN_SIDE, MAX_RESOLUTION) as f32;
-        let dims = (size / size.max_element() * res)
-            .ceil()
-            .as_uvec3()
-            .max(UVec3::splat(MIN_SIDE));
-        Some(Self {
-            lo,
-            size,
-            dims,
-            h: size / dims.as_vec3(),
+        let extent = (hi - lo).max_element().max(1e-3);
+        // One texel of slack: the lattice's floor and ceiling add at most one.
+        let res = resolution.clamp(MIN_SIDE, MAX_RESOLUTION);
+        Some(extent / (res - 1) as f32)
+    }
+
+    /// The grid of texel side `h` over `field`'s box, if that stays within the cap per side.
+    fn over(field: &Field, h: f32) -> Option<Self> {
+        let (lo, hi) = field.bounds()?;
+        let h64 = h as f64;
+        let first = (lo.as_dvec3() / h64).floor().as_i64vec3();
+        let end = (hi.as_dvec3() / h64).ceil().as_i64vec3();
+        let dims = (end - first).max(I64Vec3::splat(MIN_SIDE as i64));
+        (dims.max_element() <= MAX_RESOLUTION as i64).then(|| Self {
+            origin: first,
+            dims: dims.as_uvec3(),
+            h,
+        })
+    }
+
+    /// The grid with `resolution` texels along the longest side of `field`'s box.
+    pub fn of(field: &Field, resolution: u32) -> Option<Self> {
+        let h = Self::texel_for(field, resolution)?;
+        // Rounding can push a side one past the cap: widen the texel a hair.
+        Self::over(field, h).or_else(|| Self::over(field, h * 1.02))
+    }
+
+    /// World coordinates of the texel centres along each axis. They depend on the lattice
+    /// index alone, so a texel has the same centre (to the bit) in every grid that holds it.
+    fn centers(&self) -> [Vec<f32>; 3] {
+        let h = self.h as f64;
+        [0, 1, 2].map(|a| {
+            (0..self.dims[a] as i64)
+                .map(|i| (((self.origin[a] + i) as f64 + 0.5) * h) as f32)
+                .collect()
         })
     }
 
@@ -95,34 +138,178 @@ impl Grid {
         self.dims.as_u64vec3().element_product()
     }
 
-    /// The texels a primitive's influence reaches (inclusive), clamped to the grid, if any.
-    fn texel_box(&self, blob: &super::Blob) -> Option<(UVec3, UVec3)> {
-        let reach = blob.extent * super::SUPPORT;
-        let a = ((blob.center - reach - self.lo) / self.h - 0.5)
-            .floor()
-            .max(Vec3::ZERO)
+    fn min(&self) -> Vec3 {
+        (self.origin.as_dvec3() * self.h as f64).as_vec3()
+    }
+
+    /// The texels a world box reaches (inclusive), clamped to the grid, if any.
+    fn texels_of(&self, lo: Vec3, hi: Vec3) -> Option<(UVec3, UVec3)> {
+        let h = self.h as f64;
+        let o = self.origin.as_dvec3();
+        let a = ((lo.as_dvec3() / h - o - 0.5).floor())
+            .max(glam::DVec3::ZERO)
             .as_uvec3();
-        let b = ((blob.center + reach - self.lo) / self.h - 0.5)
-            .ceil()
-            .as_ivec3()
-            .min(self.dims.as_ivec3() - 1);
+        let b = ((hi.as_dvec3() / h - o - 0.5).ceil())
+            .as_i64vec3()
+            .min(self.dims.as_i64vec3() - 1);
         (b.min_element() >= 0 && a.cmple(b.as_uvec3()).all()).then(|| (a, b.as_uvec3()))
+    }
+
+    /// The texels a primitive's influence reaches (inclusive), clamped to the grid, if any.
+    fn texel_box(&self, blob: &Blob) -> Option<(UVec3, UVec3)> {
+        let reach = blob.extent * SUPPORT;
+        self.texels_of(blob.center - reach, blob.center + reach)
+    }
+
+    fn bricks(&self) -> UVec3 {
+        (self.dims + BRICK - 1) / BRICK
     }
 }
 
-/// The work [`bake`] does for `field` at `resolution`: kernel evaluations (each primitive over
-/// the texels its influence reaches) plus clip tests (each cut over every texel, at most).
-/// Cheap to compute (one box per primitive), so callers check it before baking.
-pub fn bake_work(field: &Field, resolution: u32) -> u64 {
-    let Some(grid) = Grid::of(field, resolution) else {
-        return 0;
+/// The bricks of a grid that an update re-evaluates, as runs of texels along x per brick row.
+struct Dirty {
+    bricks: UVec3,
+    /// Per brick row (`by + bricks.y · bz`): merged texel ranges along x.
+    runs: Vec<Vec<std::ops::Range<u32>>>,
+}
+
+impl Dirty {
+    /// Every texel of `grid`.
+    fn all(grid: &Grid) -> Self {
+        let bricks = grid.bricks();
+        Self {
+            bricks,
+            runs: vec![vec![0..grid.dims.x]; (bricks.y * bricks.z) as usize],
+        }
+    }
+
+    /// The bricks flagged in `mask` (x fastest, then y, then z).
+    fn of_mask(grid: &Grid, mask: &[bool]) -> Self {
+        let bricks = grid.bricks();
+        let runs = (0..(bricks.y * bricks.z) as usize)
+            .map(|row| {
+                let flags = &mask[row * bricks.x as usize..][..bricks.x as usize];
+                let mut runs: Vec<std::ops::Range<u32>> = Vec::new();
+                for (bx, _) in flags.iter().enumerate().filter(|(_, f)| **f) {
+                    let (a, b) = (bx as u32 * BRICK, ((bx as u32 + 1) * BRICK).min(grid.dims.x));
+                    match runs.last_mut() {
+                        Some(r) if r.end == a => r.end = b,
+                        _ => runs.push(a..b),
+                    }
+                }
+                runs
+            })
+            .collect();
+        Self { bricks, runs }
+    }
+
+    /// The dirty parts of the texel rows of box `(a, b)` (inclusive): (index of the row's
+    /// first texel, x range).
+    fn rows(
+        &self,
+        dims: UVec3,
+        (a, b): (UVec3, UVec3),
+    ) -> impl Iterator<Item = (usize, std::ops::Range<usize>)> + '_ {
+        let (nx, ny) = (dims.x as usize, dims.y as usize);
+        (a.z..=b.z).flat_map(move |k| {
+            (a.y..=b.y).flat_map(move |j| {
+                let brick_row = (j / BRICK + self.bricks.y * (k / BRICK)) as usize;
+                let row = (k as usize * ny + j as usize) * nx;
+                self.runs[brick_row].iter().filter_map(move |r| {
+                    let (lo, hi) = (r.start.max(a.x), r.end.min(b.x + 1));
+                    (lo < hi).then(|| (row, lo as usize..hi as usize))
+                })
+            })
+        })
+    }
+}
+
+/// Evaluates `field` at the dirty texels of `values` (laid out on `grid`): clears them, sums the
+/// primitives, adds each group's maximum and applies the clips. Every texel is computed by the
+/// same operations in the same order whichever bricks are dirty, so a partial update equals a
+/// full bake bit for bit. Returns the kernel evaluations and clip tests done.
+fn evaluate(field: &Field, grid: &Grid, dirty: &Dirty, values: &mut [f32]) -> u64 {
+    let dims = grid.dims;
+    let (nx, ny) = (dims.x as usize, dims.y as usize);
+    let [xs, ys, zs] = grid.centers();
+    let center = |i: usize, j: usize, k: usize| Vec3::new(xs[i], ys[j], zs[k]);
+    let whole = (UVec3::ZERO, dims - 1);
+    for (row, xs) in dirty.rows(dims, whole) {
+        values[row + xs.start..row + xs.end].fill(0.0);
+    }
+    let mut work = 0u64;
+    let mut splat = |blob: &Blob, out: &mut [f32], combine: fn(f32, f32) -> f32| {
+        let Some(bx) = grid.texel_box(blob) else { return };
+        for (row, xs) in dirty.rows(dims, bx) {
+            let (j, k) = ((row / nx) % ny, row / (nx * ny));
+            work += xs.len() as u64;
+            for i in xs {
+                let v = &mut out[row + i];
+                *v = combine(*v, blob.value(center(i, j, k)));
+            }
+        }
     };
+    for blob in &field.blobs {
+        splat(blob, values, |a, b| a + b);
+    }
+    if !field.groups.is_empty() {
+        // One scratch grid; each group clears and adds back only the box it reaches.
+        let mut group_values = vec![0f32; values.len()];
+        for group in &field.groups {
+            let Some(bx) = group
+                .iter()
+                .filter_map(|b| grid.texel_box(b))
+                .reduce(|(a, b), (c, d)| (a.min(c), b.max(d)))
+            else {
+                continue;
+            };
+            for (row, xs) in dirty.rows(dims, bx) {
+                group_values[row + xs.start..row + xs.end].fill(0.0);
+            }
+            for blob in group {
+                splat(blob, &mut group_values, f32::max);
+            }
+            for (row, xs) in dirty.rows(dims, bx) {
+                let span = row + xs.start..row + xs.end;
+                for (v, g) in values[span.clone()].iter_mut().zip(&group_values[span]) {
+                    *v += g;
+                }
+            }
+        }
+    }
+    if !field.clips.is_empty() {
+        for (row, xs) in dirty.rows(dims, whole) {
+            let (j, k) = ((row / nx) % ny, row / (nx * ny));
+            for i in xs {
+                let v = &mut values[row + i];
+                // Empty texels need no clip test.
+                if *v != 0.0 {
+                    work += field.clips.len() as u64;
+                    if field.clips.iter().any(|c| c.removes(center(i, j, k))) {
+                        *v = 0.0;
+                    }
+                }
+            }
+        }
+    }
+    work
+}
+
+/// The work a full bake of `field` on `grid` does: kernel evaluations (each primitive over the
+/// texels its influence reaches) plus clip tests (each cut over every texel, at most).
+fn work_on(field: &Field, grid: &Grid) -> u64 {
     let kernel: u64 = field
         .all_blobs()
         .filter_map(|b| grid.texel_box(b))
         .map(|(a, b)| (b - a + UVec3::ONE).as_u64vec3().element_product())
         .sum();
     kernel + field.clips.len() as u64 * grid.texels()
+}
+
+/// The work [`bake`] does for `field` at `resolution` (see `work_on`). Cheap to compute (one
+/// box per primitive), so callers check it before baking.
+pub fn bake_work(field: &Field, resolution: u32) -> u64 {
+    Grid::of(field, resolution).map_or(0, |grid| work_on(field, &grid))
 }
 
 /// The largest resolution up to `wanted` whose [`bake_work`] fits `budget` (the grid's floor
@@ -137,92 +324,253 @@ pub fn resolution_within(field: &Field, wanted: u32, budget: u64) -> (u32, u64) 
     (res, work)
 }
 
+fn volume_of(grid: &Grid, values: Vec<f32>) -> DensityVolume {
+    DensityVolume {
+        dims: grid.dims,
+        min: grid.min(),
+        size: grid.dims.as_vec3() * grid.h,
+        values,
+    }
+}
+
 /// Samples `field` on a grid over its bounds, `resolution` texels along the longest side.
 pub fn bake(field: &Field, resolution: u32) -> DensityVolume {
     let Some(grid) = Grid::of(field, resolution) else {
         return DensityVolume::default();
     };
-    let Grid { lo, size, dims, h } = grid;
-    let (nx, ny, nz) = (dims.x as usize, dims.y as usize, dims.z as usize);
-    let mut values = vec![0f32; nx * ny * nz];
-    let center_of =
-        |i: usize, j: usize, k: usize| lo + (Vec3::new(i as f32, j as f32, k as f32) + 0.5) * h;
-    let texel_box = |blob: &super::Blob| grid.texel_box(blob);
-    // Every texel row of a box: (row start index, x range).
-    let rows = move |(a, b): (UVec3, UVec3)| {
-        (a.z..=b.z).flat_map(move |k| {
-            (a.y..=b.y).map(move |j| {
-                (
-                    (k as usize * ny + j as usize) * nx,
-                    a.x as usize..=b.x as usize,
-                )
-            })
-        })
+    bake_on(field, &grid)
+}
+
+/// Samples `field` at every texel of `grid`.
+fn bake_on(field: &Field, grid: &Grid) -> DensityVolume {
+    let mut values = vec![0f32; grid.texels() as usize];
+    evaluate(field, grid, &Dirty::all(grid), &mut values);
+    volume_of(grid, values)
+}
+
+/// Every primitive evaluated at every texel of `resolution`'s grid, with no box culling: the
+/// reference the culled and partial bakes are tested and benchmarked against.
+pub fn bake_brute_force(field: &Field, resolution: u32) -> DensityVolume {
+    let Some(grid) = Grid::of(field, resolution) else {
+        return DensityVolume::default();
     };
-    // Accumulate each primitive over the texels of its influence box only.
-    let splat = |blob: &super::Blob, out: &mut [f32], combine: fn(f32, f32) -> f32| {
-        let Some(bx) = texel_box(blob) else { return };
-        for (row, xs) in rows(bx) {
-            let (j, k) = ((row / nx) % ny, row / (nx * ny));
-            for i in xs {
-                let v = &mut out[row + i];
-                *v = combine(*v, blob.value(center_of(i, j, k)));
+    let mut values = Vec::with_capacity(grid.texels() as usize);
+    let [xs, ys, zs] = grid.centers();
+    for &z in &zs {
+        for &y in &ys {
+            for &x in &xs {
+                values.push(field.value(Vec3::new(x, y, z)));
             }
         }
-    };
-    for blob in &field.blobs {
-        splat(blob, &mut values, |a, b| a + b);
     }
-    if !field.groups.is_empty() {
-        // One scratch grid; each group clears and adds back only the box it reaches.
-        let mut group_values = vec![0f32; values.len()];
-        for group in &field.groups {
-            let Some(bx) = group
-                .iter()
-                .filter_map(texel_box)
-                .reduce(|(a, b), (c, d)| (a.min(c), b.max(d)))
-            else {
-                continue;
+    volume_of(&grid, values)
+}
+
+/// Bit pattern of a primitive, for finding the ones an edit changed.
+fn blob_key(b: &Blob) -> [u32; 16] {
+    let mut k = [0u32; 16];
+    let floats = b.center.to_array().into_iter().chain(b.to_unit.to_cols_array());
+    let floats = floats.chain([b.strength]).chain(b.extent.to_array());
+    for (slot, f) in k.iter_mut().zip(floats) {
+        *slot = f.to_bits();
+    }
+    k
+}
+
+fn group_key(group: &[Blob]) -> u64 {
+    let mut hasher = std::hash::DefaultHasher::new();
+    for b in group {
+        blob_key(b).hash(&mut hasher);
+    }
+    hasher.finish()
+}
+
+/// World boxes reached by the primitives (and sphere groups) of `old` and `new` that are not in
+/// both, or `None` when everything must be re-evaluated (the cuts changed).
+fn changed_boxes(old: &Field, new: &Field) -> Option<Vec<(Vec3, Vec3)>> {
+    if old.clips != new.clips {
+        return None;
+    }
+    let reach = |b: &Blob| (b.center - b.extent * SUPPORT, b.center + b.extent * SUPPORT);
+    let mut boxes = Vec::new();
+    // Present in one field and not the other: counts that do not cancel.
+    let mut count: HashMap<[u32; 16], i32> = HashMap::new();
+    if old.blobs != new.blobs {
+        for b in &old.blobs {
+            *count.entry(blob_key(b)).or_default() += 1;
+        }
+        for b in &new.blobs {
+            *count.entry(blob_key(b)).or_default() -= 1;
+        }
+        let changed = |b: &&Blob| count[&blob_key(b)] != 0;
+        boxes.extend(old.blobs.iter().chain(&new.blobs).filter(changed).map(reach));
+    }
+    if old.groups != new.groups {
+        let mut count: HashMap<u64, i32> = HashMap::new();
+        for g in &old.groups {
+            *count.entry(group_key(g)).or_default() += 1;
+        }
+        for g in &new.groups {
+            *count.entry(group_key(g)).or_default() -= 1;
+        }
+        for g in old.groups.iter().chain(&new.groups) {
+            if count[&group_key(g)] != 0 {
+                boxes.extend(g.iter().map(reach).reduce(|(a, b), (c, d)| (a.min(c), b.max(d))));
+            }
+        }
+    }
+    Some(boxes)
+}
+
+/// The last bake a [`Baker`] made.
+struct LastBake {
+    field: Arc<Field>,
+    grid: Grid,
+    /// The resolution asked for.
+    resolution: u32,
+    /// The field's longest extent when the texel size was chosen.
+    extent: f32,
+    volume: Arc<DensityVolume>,
+}
+
+/// What one [`Baker::update`] produced.
+pub struct Baked {
+    /// The field sampled on the grid.
+    pub volume: Arc<DensityVolume>,
+    /// Kernel evaluations and clip tests done.
+    pub work: u64,
+    /// Texels re-evaluated (the rest were copied from the last volume).
+    pub texels: u64,
+}
+
+/// Bakes a field after each edit, re-evaluating only what changed.
+///
+/// The texel size follows the cloud's extent with hysteresis: it is kept until the extent
+/// differs by more than 2× from the one it was chosen for (or the grid would pass the caps), so
+/// a small cloud gets texels of its size while partial updates stay valid when a stroke grows
+/// the box. On a kept texel size the new grid is the field's box on the same lattice: texels
+/// the old grid had are copied unless a changed primitive reaches their brick (its old place or
+/// its new one), and only the other bricks are evaluated. The result equals [`bake`] on the same
+/// grid bit for bit (the grid alone may differ from a fresh bake's, by the hysteresis).
+#[derive(Default)]
+pub struct Baker {
+    last: Option<LastBake>,
+}
+
+impl Baker {
+    /// Bakes `field` with about `resolution` texels along its longest side, within `budget`
+    /// kernel evaluations for a full bake (coarser otherwise).
+    pub fn update(&mut self, field: &Arc<Field>, resolution: u32, budget: u64) -> Baked {
+        let Some((lo, hi)) = field.bounds() else {
+            self.last = None;
+            return Baked {
+                volume: Arc::new(DensityVolume::default()),
+                work: 0,
+                texels: 0,
             };
-            for (row, xs) in rows(bx) {
-                group_values[row + xs.start()..=row + xs.end()].fill(0.0);
+        };
+        let extent = (hi - lo).max_element().max(1e-3);
+        let kept = self.last.as_ref().and_then(|last| {
+            let ratio = extent / last.extent;
+            let grid = (last.resolution == resolution && (0.5..=2.0).contains(&ratio))
+                .then(|| Grid::over(field, last.grid.h))??;
+            (work_on(field, &grid) <= budget).then_some((grid, last.extent))
+        });
+        let (grid, chosen_for) = match kept {
+            Some(k) => k,
+            None => {
+                let (res, _) = resolution_within(field, resolution, budget);
+                let grid = Grid::of(field, res).expect("a field with bounds has a grid");
+                (grid, extent)
             }
-            for blob in group {
-                splat(blob, &mut group_values, f32::max);
-            }
-            for (row, xs) in rows(bx) {
-                let span = row + xs.start()..=row + xs.end();
-                for (v, g) in values[span.clone()].iter_mut().zip(&group_values[span]) {
-                    *v += g;
-                }
-            }
+        };
+        let mut values = vec![0f32; grid.texels() as usize];
+        let dirty = self
+            .last
+            .as_ref()
+            .filter(|last| last.grid.h == grid.h)
+            .and_then(|last| {
+                let boxes = changed_boxes(&last.field, field)?;
+                Some(copy_unchanged(&grid, last, &boxes, &mut values))
+            })
+            .unwrap_or_else(|| Dirty::all(&grid));
+        let texels = dirty
+            .rows(grid.dims, (UVec3::ZERO, grid.dims - 1))
+            .map(|(_, xs)| xs.len() as u64)
+            .sum();
+        let work = evaluate(field, &grid, &dirty, &mut values);
+        let volume = Arc::new(volume_of(&grid, values));
+        self.last = Some(LastBake {
+            field: field.clone(),
+            grid,
+            resolution,
+            extent: chosen_for,
+            volume: volume.clone(),
+        });
+        Baked {
+            volume,
+            work,
+            texels,
         }
     }
-    if !field.clips.is_empty() {
-        for k in 0..nz {
-            for j in 0..ny {
-                for i in 0..nx {
-                    let v = &mut values[(k * ny + j) * nx + i];
-                    // Empty texels need no clip test.
-                    if *v != 0.0 && field.clips.iter().any(|c| c.removes(center_of(i, j, k))) {
-                        *v = 0.0;
+}
+
+/// Copies into `values` (on `grid`) every texel `last` holds, and returns the bricks to
+/// re-evaluate: those not wholly inside the last grid and those the changed `boxes` reach.
+fn copy_unchanged(grid: &Grid, last: &LastBake, boxes: &[(Vec3, Vec3)], values: &mut [f32]) -> Dirty {
+    let bricks = grid.bricks();
+    let brick_index = |b: UVec3| (b.x + bricks.x * (b.y + bricks.y * b.z)) as usize;
+    let mut mask = vec![false; (bricks.x * bricks.y * bricks.z) as usize];
+    // The overlap of the two grids, in the new grid's texels.
+    let offset = last.grid.origin - grid.origin;
+    let from = offset.max(I64Vec3::ZERO);
+    let to = (offset + last.grid.dims.as_i64vec3()).min(grid.dims.as_i64vec3());
+    if from.cmplt(to).all() {
+        let (from, to) = (from.as_uvec3(), to.as_uvec3());
+        let (nx, ny) = (grid.dims.x as usize, grid.dims.y as usize);
+        let (ox, oy) = (last.grid.dims.x as usize, last.grid.dims.y as usize);
+        let old = &last.volume.values;
+        for k in from.z..to.z {
+            for j in from.y..to.y {
+                let (ok, oj) = ((k as i64 - offset.z) as usize, (j as i64 - offset.y) as usize);
+                let oi = (from.x as i64 - offset.x) as usize;
+                let len = (to.x - from.x) as usize;
+                let dst = (k as usize * ny + j as usize) * nx + from.x as usize;
+                let src = (ok * oy + oj) * ox + oi;
+                values[dst..dst + len].copy_from_slice(&old[src..src + len]);
+            }
+        }
+        // Bricks the copy does not fill wholly.
+        for bz in 0..bricks.z {
+            for by in 0..bricks.y {
+                for bx in 0..bricks.x {
+                    let a = UVec3::new(bx, by, bz) * BRICK;
+                    let b = (a + BRICK).min(grid.dims);
+                    if !(a.cmpge(from).all() && b.cmple(to).all()) {
+                        mask[brick_index(UVec3::new(bx, by, bz))] = true;
                     }
                 }
             }
         }
+    } else {
+        mask.fill(true);
     }
-
-    DensityVolume {
-        dims,
-        min: lo,
-        size,
-        values,
+    for (a, b) in boxes.iter().filter_map(|&(lo, hi)| grid.texels_of(lo, hi)) {
+        for bz in a.z / BRICK..=b.z / BRICK {
+            for by in a.y / BRICK..=b.y / BRICK {
+                for bx in a.x / BRICK..=b.x / BRICK {
+                    mask[brick_index(UVec3::new(bx, by, bz))] = true;
+                }
+            }
+        }
     }
+    Dirty::of_mask(grid, &mask)
 }
 
 #[cfg(test)]
 mod tests {
     use super::super::Blob;
+    use std::sync::Arc;
     use super::*;
 
     #[test]
@@ -294,4 +642,223 @@ mod tests {
         assert_eq!(density(0.0, 0.1), 0.0);
         assert_eq!(density(1.0, 0.1), 1.0);
     }
+
+    /// A scatter of `n` ellipsoid-like blobs (seeded), the kind of field the bench uses.
+    fn scatter(n: usize, seed: u64) -> Vec<Blob> {
+        let mut rng = crate::seeded::SplitMix::new(seed);
+        (0..n)
+            .map(|_| {
+                let c = Vec3::new((rng.next_f64() as f32) * 10.0, (rng.next_f64() as f32) * 3.0, (rng.next_f64() as f32) * 10.0);
+                Blob::sphere(c, 0.3 + (rng.next_f64() as f32) * 0.5)
+            })
+            .collect()
+    }
+
+    /// Fails with the number of differing texels (volumes are too large to print).
+    fn assert_same(got: &DensityVolume, want: &DensityVolume, what: &str) {
+        assert_eq!((got.dims, got.min, got.size), (want.dims, want.min, want.size), "{what}");
+        let diff = got.values.iter().zip(&want.values).filter(|(a, b)| a != b).count();
+        assert_eq!(diff, 0, "{what}: {diff} of {} texels differ", got.values.len());
+    }
+
+    fn full_on_same_grid(baker: &Baker, field: &Field) -> DensityVolume {
+        bake_on(field, &baker.last.as_ref().unwrap().grid)
+    }
+
+    #[test]
+    fn partial_updates_equal_a_full_bake_on_the_same_grid() {
+        let mut blobs = scatter(200, 7);
+        let group: Vec<Blob> = (0..8)
+            .map(|i| Blob::sphere(Vec3::new(i as f32 * 0.5, 1.0, 0.0), 0.6))
+            .collect();
+        let clip = super::super::Clip {
+            origin: Vec3::ZERO,
+            right: Vec3::X,
+            up: Vec3::Y,
+            line: vec![glam::Vec2::new(-20.0, -1.5), glam::Vec2::new(20.0, -1.5)],
+        };
+        let mut field = Field {
+            blobs: blobs.clone(),
+            groups: vec![group.clone()],
+            clips: vec![clip],
+        };
+        let mut baker = Baker::default();
+        let first = baker.update(&Arc::new(field.clone()), 64, u64::MAX);
+        let total = first.volume.values.len() as u64;
+        assert_eq!(first.texels, total, "the first bake evaluates everything");
+        let mut rng = crate::seeded::SplitMix::new(3);
+        for step in 0..24 {
+            let i = (rng.next_u64() % blobs.len() as u64) as usize;
+            match step % 6 {
+                0 => blobs[i].center += Vec3::new(0.7, -0.3, 0.2),
+                1 => blobs[i] = Blob::sphere(blobs[i].center, 1.1),
+                2 => blobs.push(Blob::sphere(Vec3::new((rng.next_f64() as f32) * 9.0, 0.5, -1.0), 0.5)),
+                3 => {
+                    blobs.remove(i);
+                }
+                4 => field.groups[0][3].center.y += 0.4,
+                // Past the box: the grid grows on the same lattice.
+                _ => blobs[i].center.x = 11.0 + step as f32 * 0.1,
+            }
+            field.blobs = blobs.clone();
+            let arc = Arc::new(field.clone());
+            let baked = baker.update(&arc, 64, u64::MAX);
+            let want = full_on_same_grid(&baker, &field);
+            assert_same(&baked.volume, &want, &format!("step {step}"));
+            assert!(
+                baked.texels < want.values.len() as u64 / 2,
+                "step {step}: {} of {} texels re-evaluated",
+                baked.texels,
+                want.values.len()
+            );
+        }
+        // And the grid agrees with the field itself (every primitive at every texel).
+        let v = baker.last.as_ref().unwrap().volume.clone();
+        for z in 0..v.dims.z {
+            for y in 0..v.dims.y {
+                for x in 0..v.dims.x {
+                    let want = field.value(v.center(x, y, z));
+                    assert!((v.value(x, y, z) - want).abs() < 1.0 / 255.0, "({x},{y},{z})");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_changed_cut_re_evaluates_everything() {
+        let mut field = Field::of_blobs(scatter(50, 1));
+        let mut baker = Baker::default();
+        baker.update(&Arc::new(field.clone()), 32, u64::MAX);
+        field.clips.push(super::super::Clip {
+            origin: Vec3::ZERO,
+            right: Vec3::X,
+            up: Vec3::Y,
+            line: vec![glam::Vec2::new(-20.0, 0.0), glam::Vec2::new(20.0, 0.0)],
+        });
+        let baked = baker.update(&Arc::new(field.clone()), 32, u64::MAX);
+        assert_eq!(baked.texels, baked.volume.values.len() as u64);
+        assert_same(&baked.volume, &full_on_same_grid(&baker, &field), "cut");
+    }
+
+    #[test]
+    fn the_texel_size_follows_the_extent_with_hysteresis() {
+        let at = |r: f32| Field::of_blobs(vec![Blob::sphere(Vec3::ZERO, r)]);
+        let mut baker = Baker::default();
+        let h = |b: &Baker| b.last.as_ref().unwrap().grid.h;
+        baker.update(&Arc::new(at(1.0)), 32, u64::MAX);
+        let h0 = h(&baker);
+        // 1.8× larger, then back to 0.6×: the texel is kept (the grid has more or fewer texels).
+        let grown = baker.update(&Arc::new(at(1.8)), 32, u64::MAX);
+        assert_eq!(h(&baker), h0);
+        assert!(grown.volume.dims.x > 50);
+        baker.update(&Arc::new(at(0.6)), 32, u64::MAX);
+        assert_eq!(h(&baker), h0);
+        // Past 2× of the extent it was chosen for: a texel sized for the new cloud.
+        let small = baker.update(&Arc::new(at(0.4)), 32, u64::MAX);
+        assert!(h(&baker) < h0 * 0.5);
+        assert!(small.volume.dims.x <= 32);
+        // Past the cap per side, even within 2×: coarser at once.
+        let mut baker = Baker::default();
+        baker.update(&Arc::new(at(1.0)), 100, u64::MAX);
+        let big = baker.update(&Arc::new(at(1.9)), 100, u64::MAX);
+        assert!(big.volume.dims.max_element() <= MAX_RESOLUTION);
+        // Another resolution asked: fresh texels.
+        let fine = baker.update(&Arc::new(at(1.9)), 120, u64::MAX);
+        assert!(fine.volume.dims.x > 110);
+    }
+
+    #[test]
+    fn edits_change_the_field_where_expected_and_nowhere_else() {
+        use crate::scene::Ellipsoid;
+        let base: Vec<Ellipsoid> = (0..6)
+            .map(|i| Ellipsoid::new(Vec3::new(i as f32 * 3.0, 0.0, 0.0), Vec3::new(1.2, 0.8, 1.0)))
+            .collect();
+        let field_of = |es: &[Ellipsoid]| Field::of_blobs(es.iter().map(Blob::ellipsoid).collect());
+        let mut baker = Baker::default();
+        let before = baker.update(&Arc::new(field_of(&base)), 64, u64::MAX).volume;
+        let reach = |e: &Ellipsoid| {
+            let b = Blob::ellipsoid(e);
+            (b.center - b.extent * SUPPORT, b.center + b.extent * SUPPORT)
+        };
+        let inside = |p: Vec3, (lo, hi): (Vec3, Vec3)| p.cmpge(lo).all() && p.cmple(hi).all();
+        let mut moved = base.clone();
+        moved[2].center.y += 0.8;
+        let mut scaled = base.clone();
+        scaled[4].radii *= 1.3;
+        let mut turned = base.clone();
+        turned[1].rotation = glam::Quat::from_rotation_z(0.9);
+        let mut removed = base.clone();
+        removed.remove(3);
+        let mut added = base.clone();
+        added.push(Ellipsoid::new(Vec3::new(7.5, 1.0, 0.0), Vec3::splat(0.7)));
+        let cases: [(&str, &[Ellipsoid], Vec<(Vec3, Vec3)>); 5] = [
+            ("move", &moved, vec![reach(&base[2]), reach(&moved[2])]),
+            ("scale", &scaled, vec![reach(&base[4]), reach(&scaled[4])]),
+            ("rotate", &turned, vec![reach(&base[1]), reach(&turned[1])]),
+            ("delete", &removed, vec![reach(&base[3])]),
+            ("add", &added, vec![reach(&added[6])]),
+        ];
+        for (name, scene, regions) in cases {
+            let mut baker = Baker::default();
+            baker.update(&Arc::new(field_of(&base)), 64, u64::MAX);
+            let after = baker.update(&Arc::new(field_of(scene)), 64, u64::MAX).volume;
+            assert_eq!(after.texel_size(), before.texel_size(), "{name}: the same lattice");
+            // Texels both grids hold (same lattice: the same centres).
+            let (mut changed, mut outside) = (0, 0);
+            for z in 0..after.dims.z {
+                for y in 0..after.dims.y {
+                    for x in 0..after.dims.x {
+                        let p = after.center(x, y, z);
+                        let Some(t) = before.texel_at(p) else { continue };
+                        if after.value(x, y, z) != before.value(t.x, t.y, t.z) {
+                            changed += 1;
+                            if !regions.iter().any(|r| inside(p, *r)) {
+                                outside += 1;
+                            }
+                        }
+                    }
+                }
+            }
+            assert!(changed > 100, "{name}: {changed} texels changed");
+            assert_eq!(outside, 0, "{name}: changes outside the edited primitive's reach");
+        }
+    }
+
+    #[test]
+    fn strength_zero_adds_nothing_and_negative_strength_carves() {
+        use crate::scene::Ellipsoid;
+        let body = Ellipsoid::new(Vec3::ZERO, Vec3::new(3.0, 2.0, 2.0));
+        let mut ghost = Ellipsoid::new(Vec3::new(2.0, 0.0, 0.0), Vec3::splat(1.5));
+        ghost.strength = 0.0;
+        let alone = Field::of_blobs(vec![Blob::ellipsoid(&body)]);
+        let with = Field::of_blobs(vec![Blob::ellipsoid(&body), Blob::ellipsoid(&ghost)]);
+        assert_eq!(bake(&alone, 48), bake(&with, 48));
+        let mut carver = ghost.clone();
+        carver.strength = -1.0;
+        let carved = Field::of_blobs(vec![Blob::ellipsoid(&body), Blob::ellipsoid(&carver)]);
+        let (a, c) = (bake(&alone, 48), bake(&carved, 48));
+        let inside = |v: &DensityVolume| v.values.iter().filter(|&&x| x >= ISO).count();
+        assert!(inside(&c) < inside(&a) * 9 / 10, "{} vs {}", inside(&c), inside(&a));
+        assert!(!carved.inside(Vec3::new(2.0, 0.0, 0.0)));
+        assert!(alone.inside(Vec3::new(2.0, 0.0, 0.0)));
+    }
+
+    #[test]
+    fn the_culled_bake_equals_brute_force() {
+        let f = Field {
+            blobs: scatter(60, 11),
+            groups: vec![scatter(20, 12), scatter(15, 13)],
+            clips: vec![],
+        };
+        let (culled, brute) = (bake(&f, 40), bake_brute_force(&f, 40));
+        assert_eq!(culled.dims, brute.dims);
+        let worst = culled
+            .values
+            .iter()
+            .zip(&brute.values)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f32::max);
+        assert!(worst < 1e-5, "{worst}");
+    }
+
 }
