@@ -68,6 +68,7 @@ fn assemble(scene: &Scene, shapes: &[Arc<Shape>]) -> Field {
         blobs: scene
             .ellipsoids
             .iter()
+            .filter(|e| !e.hidden)
             .map(|e| Blob::ellipsoid(e))
             .collect(),
         groups: Vec::new(),
@@ -76,6 +77,9 @@ fn assemble(scene: &Scene, shapes: &[Arc<Shape>]) -> Field {
     field.blobs.truncate(MAX_PRIMITIVES);
     let mut budget = MAX_PRIMITIVES.saturating_sub(field.blobs.len());
     for (plane, shape) in scene.planes.iter().zip(shapes) {
+        if plane.hidden {
+            continue;
+        }
         match &**shape {
             Shape::Outline { spheres, .. } => {
                 let group: Vec<Blob> = spheres

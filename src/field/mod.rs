@@ -266,7 +266,7 @@ mod tests {
             center: Vec3::new(0.5, 1.0, -2.0),
             radii: Vec3::new(3.0, 1.0, 2.0),
             rotation: Quat::from_rotation_y(0.7) * Quat::from_rotation_x(0.3),
-            strength: 1.0,
+            ..Default::default()
         };
         let b = Blob::ellipsoid(&e);
         for (axis, r) in [(Vec3::X, 3.0), (Vec3::Y, 1.0), (Vec3::Z, 2.0)] {

@@ -232,6 +232,20 @@ impl Document {
         self.last_key = None;
     }
 
+    /// Takes back the merge run `key` under way (a drag cancelled with Esc): the document
+    /// returns to where the run began and no undo or redo step remains of it. Returns whether
+    /// there was such a run.
+    pub fn revert_merge(&mut self, key: &'static str) -> bool {
+        if self.last_key != Some(key) {
+            return false;
+        }
+        let Some(step) = self.undo.pop_back() else {
+            return false;
+        };
+        self.restore(step);
+        true
+    }
+
     /// Steps back; the camera stays where the user put it. Returns what was undone, or `None`
     /// when there is nothing to undo.
     pub fn undo(&mut self) -> Option<&'static str> {
@@ -322,6 +336,23 @@ mod tests {
         assert!(doc.redo().is_some());
         assert_eq!(doc.scene().render.slices, 64);
         assert!(doc.redo().is_none());
+    }
+
+    #[test]
+    fn a_cancelled_drag_leaves_no_step_and_no_change() {
+        let mut doc = Document::new(Scene::default());
+        let before = doc.scene().clone();
+        let undo = doc.undo_len();
+        let mut l = doc.scene().light.clone();
+        for az in [10.0, 20.0, 30.0] {
+            l.sun_azimuth_deg = az;
+            doc.apply(Edit::SetLight(l.clone()), Some("drag"));
+        }
+        assert!(!doc.revert_merge("other"), "only the run under way");
+        assert!(doc.revert_merge("drag"));
+        assert_eq!(*doc.scene(), before);
+        assert_eq!((doc.undo_len(), doc.redo_len()), (undo, 0));
+        assert!(!doc.revert_merge("drag"), "once");
     }
 
     #[test]

@@ -257,6 +257,9 @@ pub struct Ellipsoid {
     pub rotation: Quat,
     /// Field weight; 1 is a plain primitive.
     pub strength: f32,
+    /// Hidden: kept in the document, left out of the cloud.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub hidden: bool,
 }
 
 impl Default for Ellipsoid {
@@ -273,6 +276,7 @@ impl Ellipsoid {
             radii,
             rotation: Quat::IDENTITY,
             strength: 1.0,
+            hidden: false,
         }
     }
 }

@@ -44,6 +44,9 @@ pub struct DrawingPlane {
     /// shape does not depend on it yet.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub pressure: Vec<f32>,
+    /// Hidden: kept in the document, left out of the cloud (its stroke is drawn faintly).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub hidden: bool,
 }
 
 impl Default for DrawingPlane {
@@ -58,6 +61,7 @@ impl Default for DrawingPlane {
             sketch: SketchParams::default(),
             seed: 1,
             pressure: Vec::new(),
+            hidden: false,
         }
     }
 }
@@ -123,7 +127,7 @@ impl DrawingPlane {
             closed: kind == StrokeKind::Outline,
             sketch: SketchParams::default(),
             seed,
-            pressure: Vec::new(),
+            ..Default::default()
         };
         let local: Vec<Vec2> = world_points.iter().map(|&p| plane.to_plane(p)).collect();
         let centre = if local.is_empty() {

@@ -5,7 +5,7 @@ use super::guide::Guide;
 use super::notice::Notices;
 use super::panels::{LIGHT, RENDER, ScenePanel, SketchPanel, ViewPanel, ViewStats};
 use super::selection::Selection;
-use super::sketch_tool::{SketchTool, ToolContext};
+use super::sketch_tool::{Axis, SketchTool, ToolContext};
 use super::viewport::{Viewport, ViewportContext};
 use crate::derive::Derived;
 use crate::render::viewport::{BackendInfo, install};
@@ -214,7 +214,7 @@ impl CloudApp {
             }
             if ui
                 .button("Frame")
-                .on_hover_text("F: frame the cloud")
+                .on_hover_text("F: frame the selection (the whole cloud when nothing is selected)")
                 .clicked()
             {
                 self.viewport.frame_request = true;
@@ -293,6 +293,16 @@ impl CloudApp {
             "tool": self.tool.tool.name(),
             "selected_plane": self.selection.plane(),
             "selected_ellipsoid": self.selection.ellipsoid(),
+            "gizmo": self.tool.gizmo(&self.doc, &self.selection, self.viewport.rect).map(|g| {
+                let at = |p: Option<egui::Pos2>| p.map(|p| [p.x, p.y]);
+                serde_json::json!({
+                    "center": [g.center.x, g.center.y],
+                    "x": at(g.handle_end(Axis::X)),
+                    "y": at(g.handle_end(Axis::Y)),
+                    "z": at(g.handle_end(Axis::Z)),
+                })
+            }),
+            "axis_lock": self.tool.axis_lock.map(|a| a.name()),
             "guides_hidden": self.tool.hide_guides,
             "skeleton_shown": self.tool.show_skeleton,
             "panel_open": self.panel_open,

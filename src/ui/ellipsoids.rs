@@ -81,7 +81,7 @@ pub fn pick(doc: &Document, derived: &mut Derived, rect: Rect, p: Pos2) -> Optio
 pub fn most_at(ellipsoids: &[Arc<Ellipsoid>], at: Vec3) -> Option<usize> {
     ellipsoids
         .iter()
-        .map(|e| Blob::ellipsoid(e).value(at))
+        .map(|e| if e.hidden { 0.0 } else { Blob::ellipsoid(e).value(at) })
         .enumerate()
         .filter(|&(_, v)| v > 0.0)
         .max_by(|a, b| a.1.total_cmp(&b.1))

@@ -6,6 +6,7 @@
 //! - `viewport`: the 3D view (progressive quality, camera input, status line);
 //! - `sketch_tool`: the Sketch, Cut, Ellipsoid, Move and Rotate tools and their overlay;
 //! - `ellipsoids`: adding, picking, moving, duplicating and deleting ellipsoids;
+//! - `gizmo`: the on-canvas Move, Rotate and Scale handles and their drag maths;
 //! - `guide`: the reference image (loading, texture, drawing, its panel group);
 //! - `panels`: one struct per side-panel group, each with its own `ui()`;
 //! - `selection`, `notice`, `widgets`: small shared pieces;
@@ -14,6 +15,7 @@
 mod app;
 mod camera_input;
 mod ellipsoids;
+mod gizmo;
 mod guide;
 mod notice;
 mod panels;

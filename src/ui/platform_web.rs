@@ -87,6 +87,30 @@ fn input() -> Option<web_sys::HtmlInputElement> {
 /// Every position of the primary pointer while a button is held, coalesced samples
 /// included: the browser hands the page one move per frame, and a frame on a CPU adapter can
 /// take 150 ms, so a stroke drawn from the per-frame moves alone loses its shape.
+/// Keeps the browser from acting on the app's own Ctrl/Cmd shortcuts that eframe lets through:
+/// Ctrl+D (duplicate) would open the bookmark dialog. Text fields keep every key.
+fn keep_browser_shortcuts() {
+    let Some(document) = web_sys::window().and_then(|w| w.document()) else {
+        return;
+    };
+    let on_key = Closure::<dyn FnMut(web_sys::KeyboardEvent)>::new(|e: web_sys::KeyboardEvent| {
+        let typing = e
+            .target()
+            .and_then(|t| t.dyn_into::<web_sys::HtmlInputElement>().ok())
+            .is_some();
+        if !typing && (e.ctrl_key() || e.meta_key()) && e.key().eq_ignore_ascii_case("d") {
+            e.prevent_default();
+        }
+    });
+    // In the capture phase: eframe stops the event's propagation at the canvas.
+    let _ = document.add_event_listener_with_callback_and_bool(
+        "keydown",
+        on_key.as_ref().unchecked_ref(),
+        true,
+    );
+    on_key.forget(); // lives as long as the page
+}
+
 fn install_pointer_samples(ctx: &egui::Context) {
     let Some(document) = web_sys::window().and_then(|w| w.document()) else {
         return;
@@ -157,6 +181,7 @@ pub fn take_pointer_samples() -> Option<Vec<(egui::Pos2, Option<f32>)>> {
 pub fn install(ctx: &egui::Context) {
     REPAINT.with(|c| *c.borrow_mut() = Some(ctx.clone()));
     install_pointer_samples(ctx);
+    keep_browser_shortcuts();
     let Some(el) = input() else {
         log::warn!("the page has no #guide_input: the Load… button will do nothing");
         return;

@@ -6,6 +6,7 @@ use egui::{Color32, Pos2, Rect, Response, Stroke, Ui};
 use glam::{Quat, Vec2, Vec3};
 
 use super::ellipsoids;
+use super::gizmo::{Gizmo, Handle, ring_turn};
 use super::notice::Notices;
 use super::selection::{Item, Selection};
 use crate::derive::{Derived, Shape};
@@ -75,13 +76,22 @@ pub struct SketchTool {
     gesture: Option<Gesture>,
 }
 
-/// A Rotate or Scale drag: the selected item's turn and radii when it began, and the drag in
-/// pixels so far (turns and scales are taken from the whole drag, so snapping sees the total).
-#[derive(Clone, Copy, Debug)]
+/// A Move, Rotate or Scale drag: the selected item's place, turn and radii when it began, the
+/// gizmo as it was laid out then and the handle the press took, and the drag so far (the
+/// transform is taken from the whole drag, so snapping sees the total).
+#[derive(Clone, Debug)]
 struct Gesture {
+    origin: Vec3,
     rotation: Quat,
     radii: Vec3,
     drag: Vec2,
+    gizmo: Option<Gizmo>,
+    handle: Option<Handle>,
+    /// Turn so far about a ring's axis, and the pointer when it was last measured.
+    angle: f32,
+    last: Pos2,
+    /// Esc or a right-click took the drag back: nothing more happens until release.
+    cancelled: bool,
 }
 
 /// A world axis the Rotate tool can be locked to (for Scale: the ellipsoid's own axis).
@@ -96,7 +106,8 @@ pub enum Axis {
 }
 
 impl Axis {
-    fn vector(self) -> Vec3 {
+    /// The world unit vector.
+    pub fn vector(self) -> Vec3 {
         match self {
             Axis::X => Vec3::X,
             Axis::Y => Vec3::Y,
@@ -208,7 +219,8 @@ fn screen(rect: Rect, ndc: Vec2) -> Pos2 {
     )
 }
 
-fn project(camera: &OrbitCamera, rect: Rect, p: Vec3) -> Option<Pos2> {
+/// Where world point `p` appears in the view `rect`, if in front of the camera.
+pub fn project(camera: &OrbitCamera, rect: Rect, p: Vec3) -> Option<Pos2> {
     camera
         .project(p, rect.aspect_ratio())
         .map(|n| screen(rect, n))
@@ -268,15 +280,19 @@ pub fn duplicate_selected(doc: &mut Document, selection: &mut Selection) -> Opti
 
 impl SketchTool {
     /// Tool shortcuts: V navigate, D draw, C cut, E ellipsoid, G move, R rotate, S scale (then
-    /// X, Y or Z locks the axis, the same key again frees it), H hides guides, K shows the skeleton and spheres, Esc cancels a stroke (or clears the
-    /// selection), Delete removes the selected ellipsoid or plane, Ctrl+D duplicates it.
+    /// X, Y or Z locks the axis, the same key again frees it), H hides guides, Shift+H hides the
+    /// selected item (Alt+H shows all), K shows the skeleton and spheres, Esc cancels a drag or
+    /// a stroke (or clears the selection), Delete removes the selected ellipsoid or plane,
+    /// Ctrl+D duplicates it.
     pub fn shortcuts(&mut self, ctx: &egui::Context, tc: &mut ToolContext<'_>) {
         if ctx.egui_wants_keyboard_input() {
             return;
         }
         use egui::{Key, Modifiers};
-        // Ctrl+D first, so the plain D below does not take it.
+        // Ctrl+D, Shift+H and Alt+H first, so the plain D and H below do not take them.
         let dup = ctx.input_mut(|i| i.consume_key(Modifiers::COMMAND, Key::D));
+        let hide = ctx.input_mut(|i| i.consume_key(Modifiers::SHIFT, Key::H));
+        let reveal = ctx.input_mut(|i| i.consume_key(Modifiers::ALT, Key::H));
         for (key, tool) in TOOL_KEYS {
             if ctx.input_mut(|i| i.consume_key(Modifiers::NONE, key)) {
                 self.tool = tool;
@@ -284,7 +300,7 @@ impl SketchTool {
         }
         let [h, k, esc, del] = [Key::H, Key::K, Key::Escape, Key::Delete]
             .map(|key| ctx.input_mut(|i| i.consume_key(Modifiers::NONE, key)));
-        if matches!(self.tool, Tool::Rotate | Tool::Scale) {
+        if matches!(self.tool, Tool::Move | Tool::Rotate | Tool::Scale) {
             for (key, axis) in [(Key::X, Axis::X), (Key::Y, Axis::Y), (Key::Z, Axis::Z)] {
                 if ctx.input_mut(|i| i.consume_key(Modifiers::NONE, key)) {
                     self.axis_lock = (self.axis_lock != Some(axis)).then_some(axis);
@@ -298,12 +314,20 @@ impl SketchTool {
         if k {
             self.show_skeleton = !self.show_skeleton;
         }
-        if esc {
+        if esc && self.cancel_gesture(tc.doc) {
+            tc.notices.note(now, "Cancelled: back where the drag began");
+        } else if esc {
             if self.stroke.is_empty() {
                 tc.selection.clear();
             }
             self.stroke.clear();
             self.drawing = false;
+        }
+        if hide && let Some(m) = super::selection::toggle_hidden(tc.doc, tc.selection) {
+            tc.notices.note(now, format!("{m} (Shift+H again shows it, Alt+H shows all)"));
+        }
+        if reveal && let Some(m) = super::selection::show_all(tc.doc) {
+            tc.notices.note(now, m);
         }
         if dup
             && let Some(m) = ellipsoids::duplicate_selected(tc.doc, tc.selection)
@@ -498,26 +522,53 @@ impl SketchTool {
         }
     }
 
-    /// Move and Rotate: a primary drag transforms the selected plane (one undo step per drag).
-    /// Without a selection the drag orbits as in Navigate.
+    /// Takes back the Move/Rotate/Scale drag under way (Esc, right-click); returns whether
+    /// there was one.
+    fn cancel_gesture(&mut self, doc: &mut Document) -> bool {
+        let Some(g) = self.gesture.as_mut().filter(|g| !g.cancelled) else {
+            return false;
+        };
+        g.cancelled = true;
+        if !doc.revert_merge("plane-drag") {
+            doc.revert_merge("ellipsoid-drag");
+        }
+        true
+    }
+
+    /// The selected plane or ellipsoid a Move/Rotate/Scale acts on: which, and its place, turn
+    /// and radii (a plane's are ones).
+    fn target(&self, doc: &Document, selection: &Selection) -> Option<(Item, Vec3, Quat, Vec3)> {
+        let scene = doc.scene();
+        if let Some(i) = selection.plane().filter(|&i| i < scene.planes.len()) {
+            // Scale reshapes ellipsoids; with a plane selected a drag orbits.
+            if self.tool == Tool::Scale {
+                return None;
+            }
+            let p = &scene.planes[i];
+            return Some((Item::Plane(i), p.origin, p.rotation, Vec3::ONE));
+        }
+        let i = selection.ellipsoid().filter(|&i| i < scene.ellipsoids.len())?;
+        let e = &scene.ellipsoids[i];
+        Some((Item::Ellipsoid(i), e.center, e.rotation, e.radii))
+    }
+
+    /// The gizmo of the current tool on the selected item, as drawn this frame.
+    pub fn gizmo(&self, doc: &Document, selection: &Selection, rect: Rect) -> Option<Gizmo> {
+        if self.hide_guides {
+            return None;
+        }
+        let (_, origin, rotation, _) = self.target(doc, selection)?;
+        Gizmo::layout(self.tool, &doc.scene().camera, rect, origin, rotation)
+    }
+
+    /// Move, Rotate and Scale: a primary drag transforms the selected plane or ellipsoid (one
+    /// undo step per drag). A press on a gizmo handle constrains the drag to its axis (or ring);
+    /// elsewhere X/Y/Z locks do. Esc or a right-click cancels. Without a selection the drag
+    /// orbits as in Navigate.
     fn manipulate(&mut self, view: &ViewInput<'_>, tc: &mut ToolContext<'_>) -> bool {
         let (ui, response, rect) = (view.ui, view.response, view.rect);
-        let scene = tc.doc.scene();
-        // The selected plane, else the selected ellipsoid: its place and its turn.
-        let plane = tc.selection.plane().filter(|&i| i < scene.planes.len());
-        let ellipsoid = tc
-            .selection
-            .ellipsoid()
-            .filter(|&i| i < scene.ellipsoids.len());
-        let (mut origin, mut rotation, mut radii) = match (plane, ellipsoid) {
-            // Scale reshapes ellipsoids; with a plane selected a drag orbits.
-            (Some(_), _) if self.tool == Tool::Scale => return false,
-            (Some(i), _) => (scene.planes[i].origin, scene.planes[i].rotation, Vec3::ONE),
-            (None, Some(i)) => {
-                let e = &scene.ellipsoids[i];
-                (e.center, e.rotation, e.radii)
-            }
-            (None, None) => return false,
+        let Some((item, origin, rotation, radii)) = self.target(tc.doc, tc.selection) else {
+            return false;
         };
         if ui.input(|i| i.modifiers.alt || i.multi_touch().is_some()) {
             return true;
@@ -526,55 +577,102 @@ impl SketchTool {
             self.gesture = None;
             return true;
         }
-        let delta = response.drag_delta();
-        if delta == egui::Vec2::ZERO {
-            return true;
-        }
-        let camera = &scene.camera;
+        let camera = tc.doc.scene().camera.clone();
         if response.drag_started() || self.gesture.is_none() {
+            let press = ui
+                .input(|i| i.pointer.press_origin())
+                .or(response.interact_pointer_pos())
+                .unwrap_or(rect.center());
+            let gizmo = Gizmo::layout(self.tool, &camera, rect, origin, rotation);
             self.gesture = Some(Gesture {
+                origin,
                 rotation,
                 radii,
                 drag: Vec2::ZERO,
+                handle: gizmo.as_ref().and_then(|g| g.hit(press)),
+                gizmo,
+                angle: 0.0,
+                last: press,
+                cancelled: false,
             });
         }
-        let Some(gesture) = self.gesture.as_mut() else {
+        if ui.input(|i| i.pointer.button_pressed(egui::PointerButton::Secondary))
+            && self.cancel_gesture(tc.doc)
+        {
+            let now = ui.input(|i| i.time);
+            tc.notices.note(now, "Cancelled: back where the drag began");
+        }
+        let lock = self.axis_lock;
+        let Some(g) = self.gesture.as_mut().filter(|g| !g.cancelled) else {
             return true;
         };
-        gesture.drag += Vec2::new(delta.x, delta.y);
-        let snap = ui.input(|i| i.modifiers.ctrl || i.modifiers.command);
-        match self.tool {
-            Tool::Move => {
-                let depth = (origin - camera.eye()).dot(camera.forward()).max(0.1);
-                let per_px = camera.world_per_px(depth, rect.height());
-                let shift = ui.input(|i| i.modifiers.shift);
-                origin += if shift {
-                    camera.forward() * (delta.y * per_px)
-                } else {
-                    camera.right() * (delta.x * per_px) - camera.up() * (delta.y * per_px)
-                };
-            }
-            Tool::Scale => {
-                radii = (gesture.radii * drag_scale(gesture.drag, self.axis_lock, snap))
-                    .clamp(Vec3::splat(0.01), Vec3::splat(1e4));
-            }
-            _ => {
-                let turn = drag_turn(gesture.drag, self.axis_lock, snap, camera.right());
-                rotation = (turn * gesture.rotation).normalize();
-            }
+        let delta = response.drag_delta();
+        let pointer = response.interact_pointer_pos().unwrap_or(g.last);
+        if delta == egui::Vec2::ZERO && pointer == g.last {
+            return true;
         }
-        match (plane, ellipsoid) {
-            (Some(i), _) => {
+        g.drag += Vec2::new(delta.x, delta.y);
+        let snap = ui.input(|i| i.modifiers.ctrl || i.modifiers.command);
+        let handle_axis = match g.handle {
+            Some(Handle::Axis(a)) => Some(a),
+            _ => None,
+        };
+        let (mut origin, mut rotation, mut radii) = (g.origin, g.rotation, g.radii);
+        match self.tool {
+            Tool::Move => match (handle_axis.or(lock), &g.gizmo) {
+                (Some(axis), Some(gizmo)) => {
+                    origin += gizmo.along(axis, g.drag).map_or(Vec3::ZERO, |(_, w)| w);
+                }
+                _ => {
+                    let depth = (g.origin - camera.eye()).dot(camera.forward()).max(0.1);
+                    let per_px = camera.world_per_px(depth, rect.height());
+                    origin += if ui.input(|i| i.modifiers.shift) {
+                        camera.forward() * (g.drag.y * per_px)
+                    } else {
+                        camera.right() * (g.drag.x * per_px) - camera.up() * (g.drag.y * per_px)
+                    };
+                }
+            },
+            Tool::Scale => {
+                let factor = match (handle_axis, &g.gizmo) {
+                    (Some(axis), Some(gizmo)) => {
+                        let px = gizmo.along(axis, g.drag).map_or(0.0, |(px, _)| px);
+                        drag_scale(Vec2::new(px, 0.0), Some(axis), snap)
+                    }
+                    _ => drag_scale(g.drag, lock, snap),
+                };
+                radii = (g.radii * factor).clamp(Vec3::splat(0.01), Vec3::splat(1e4));
+            }
+            _ => match (handle_axis, &g.gizmo) {
+                (Some(axis), Some(gizmo)) => {
+                    let toward_viewer = -axis.vector().dot(camera.forward());
+                    g.angle += ring_turn(gizmo.center, g.last, pointer, toward_viewer);
+                    let angle = if snap {
+                        (g.angle / SNAP_STEP).round() * SNAP_STEP
+                    } else {
+                        g.angle
+                    };
+                    rotation = (Quat::from_axis_angle(axis.vector(), angle) * g.rotation).normalize();
+                }
+                _ => {
+                    let turn = drag_turn(g.drag, lock, snap, camera.right());
+                    rotation = (turn * g.rotation).normalize();
+                }
+            },
+        }
+        g.last = pointer;
+        let scene = tc.doc.scene();
+        match item {
+            Item::Plane(i) => {
                 let mut p = (*scene.planes[i]).clone();
                 (p.origin, p.rotation) = (origin, rotation);
                 tc.doc.apply(Edit::SetPlane(i, p), Some("plane-drag"));
             }
-            (None, Some(i)) => {
+            Item::Ellipsoid(i) => {
                 let mut e = (*scene.ellipsoids[i]).clone();
                 (e.center, e.rotation, e.radii) = (origin, rotation, radii);
                 ellipsoids::set(tc.doc, i, e, Some("ellipsoid-drag"));
             }
-            (None, None) => {}
         }
         true
     }
@@ -592,10 +690,24 @@ impl SketchTool {
         let painter = ui.painter_at(rect);
         let scene = doc.scene();
         let camera = &scene.camera;
-        if !self.hide_guides
-            && let Some(e) = selection.ellipsoid().and_then(|i| scene.ellipsoids.get(i))
-        {
-            draw_ellipsoid(&painter, camera, rect, e);
+        if !self.hide_guides {
+            // Every ellipsoid's indicator while a modelling tool is out (noise can hide a
+            // primitive), the selected one bright.
+            let all = matches!(
+                self.tool,
+                Tool::Ellipsoid | Tool::Move | Tool::Rotate | Tool::Scale
+            );
+            for (i, e) in scene.ellipsoids.iter().enumerate() {
+                let selected = selection.contains(Item::Ellipsoid(i));
+                if selected || all || self.show_all_planes {
+                    draw_ellipsoid(&painter, camera, rect, e, selected);
+                }
+            }
+        }
+        if let Some(gizmo) = self.gizmo(doc, selection, rect) {
+            let active = self.gesture.as_ref().filter(|g| !g.cancelled).and_then(|g| g.handle);
+            let hovered = ui.input(|i| i.pointer.hover_pos()).and_then(|p| gizmo.hit(p));
+            gizmo.draw(&painter, active, hovered);
         }
         if self.show_skeleton
             && !self.hide_guides
@@ -618,6 +730,7 @@ impl SketchTool {
                 draw_grid(&painter, camera, rect, plane, selected);
             }
             let color = match (plane.kind, selected) {
+                _ if plane.hidden && !selected => Color32::from_white_alpha(30),
                 (StrokeKind::Cut, _) => Color32::from_rgb(255, 150, 60),
                 (_, true) => Color32::from_rgb(255, 90, 90),
                 _ => Color32::from_white_alpha(70),
@@ -648,7 +761,15 @@ impl SketchTool {
                 Stroke::new(2.0, color),
             ));
         }
-        let rotate_hint;
+        let lock_hint;
+        let lock = |free: &'static str| match self.axis_lock {
+            Some(a) => format!(
+                "Locked to {} (X/Y/Z: another axis, {} again: free) · Ctrl snaps · Esc or right-click cancels",
+                a.name(),
+                a.name()
+            ),
+            None => free.to_owned(),
+        };
         let hint = match self.tool {
             Tool::Move | Tool::Rotate
                 if selection.plane().is_none() && selection.ellipsoid().is_none() =>
@@ -661,19 +782,23 @@ impl SketchTool {
             Tool::Scale if selection.ellipsoid().is_none() => {
                 Some("Scale works on ellipsoids: click the cloud (or pick one in the list)")
             }
+            Tool::Move => {
+                lock_hint = lock(
+                    "Drag an arrow to move along it, elsewhere to move in the view (Shift: toward you) · X/Y/Z lock · Esc cancels",
+                );
+                Some(lock_hint.as_str())
+            }
             Tool::Scale => {
-                Some("Drag right or up to grow · X/Y/Z scale one axis · Ctrl snaps to tenths")
+                lock_hint = lock(
+                    "Drag a box to scale one axis, elsewhere right or up to grow · Ctrl snaps to tenths · Esc cancels",
+                );
+                Some(lock_hint.as_str())
             }
             Tool::Rotate => {
-                rotate_hint = match self.axis_lock {
-                    Some(a) => format!(
-                        "Turning about {} (X/Y/Z: another axis, {} again: free) · Ctrl snaps to 15°",
-                        a.name(),
-                        a.name()
-                    ),
-                    None => "Drag to turn · X/Y/Z lock an axis · Ctrl snaps to 15°".to_owned(),
-                };
-                Some(rotate_hint.as_str())
+                lock_hint = lock(
+                    "Drag a ring to turn about its axis, elsewhere to turn freely · Ctrl snaps to 15° · Esc cancels",
+                );
+                Some(lock_hint.as_str())
             }
             Tool::Sketch if scene.planes.is_empty() && self.stroke.is_empty() => {
                 Some("Drag to draw a cloud's outline")
@@ -727,15 +852,21 @@ fn plane_at(doc: &Document, rect: Rect, p: Pos2) -> Option<usize> {
     best.map(|(_, i)| i)
 }
 
-/// The selected ellipsoid's indicator: its three principal ellipses.
+/// An ellipsoid's indicator: its three principal ellipses (bright when selected, faint when
+/// not, dashed-faint when hidden).
 fn draw_ellipsoid(
     painter: &egui::Painter,
     camera: &OrbitCamera,
     rect: Rect,
     e: &crate::scene::Ellipsoid,
+    selected: bool,
 ) {
     const N: usize = 48;
-    let color = Color32::from_rgb(255, 170, 60);
+    let color = match (selected, e.hidden) {
+        (true, _) => Color32::from_rgb(255, 170, 60),
+        (false, false) => Color32::from_rgba_unmultiplied(255, 200, 120, 70),
+        (false, true) => Color32::from_white_alpha(35),
+    };
     for (a, b) in [(Vec3::X, Vec3::Y), (Vec3::Y, Vec3::Z), (Vec3::Z, Vec3::X)] {
         let pts: Vec<Pos2> = (0..=N)
             .filter_map(|k| {
@@ -745,7 +876,10 @@ fn draw_ellipsoid(
             })
             .collect();
         if pts.len() > 2 {
-            painter.add(egui::Shape::line(pts, Stroke::new(1.5, color)));
+            painter.add(egui::Shape::line(
+                pts,
+                Stroke::new(if selected { 1.5 } else { 1.0 }, color),
+            ));
         }
     }
 }

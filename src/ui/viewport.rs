@@ -6,6 +6,7 @@ use egui::{Color32, Sense};
 use super::guide::Guide;
 use super::notice::Notices;
 use super::panels::ViewStats;
+use super::selection::Selection;
 use super::sketch_tool::{SketchTool, ToolContext, ViewInput};
 use crate::derive::Derived;
 use crate::render::SliceJob;
@@ -21,7 +22,8 @@ pub struct Viewport {
     pub stats: ViewStats,
     /// The first full-quality image has been shown.
     pub ready: bool,
-    /// Set by panels and F; applied once the viewport's size is known.
+    /// Set by panels and F (frame the selection, else the cloud); applied once the viewport's
+    /// size is known.
     pub frame_request: bool,
     /// Where the view was drawn last frame (in points).
     pub rect: egui::Rect,
@@ -50,17 +52,28 @@ impl Viewport {
         }
     }
 
-    /// Frames the cloud (F).
-    fn frame_cloud(&mut self, doc: &mut Document, derived: &mut Derived, aspect: f32) {
-        let volumes = derived.update(doc.scene(), doc.revisions());
-        if volumes.density.data.is_empty() {
-            return;
+    /// Frames the selection (F), or the whole cloud when nothing is selected.
+    fn frame(
+        &mut self,
+        doc: &mut Document,
+        derived: &mut Derived,
+        selection: &Selection,
+        aspect: f32,
+    ) {
+        let target = selection.bounds(doc.scene()).or_else(|| {
+            let volumes = derived.update(doc.scene(), doc.revisions());
+            let density = &volumes.density.data;
+            // The grid box is padded around the visible cloud: frame a little tighter.
+            (!density.is_empty()).then(|| {
+                let (center, radius) = density.bounding_sphere();
+                (center, radius * 0.8)
+            })
+        });
+        if let Some((center, radius)) = target {
+            let mut camera = doc.scene().camera.clone();
+            camera.frame(center, radius, aspect);
+            doc.set_camera(camera);
         }
-        let (center, radius) = volumes.density.data.bounding_sphere();
-        // The grid box is padded around the visible cloud; frame a little tighter than its sphere.
-        let mut camera = doc.scene().camera.clone();
-        camera.frame(center, radius * 0.8, aspect);
-        doc.set_camera(camera);
     }
 
     /// Draws the viewport into the rest of `ui`.
@@ -75,7 +88,7 @@ impl Viewport {
         } = vc;
         if self.frame_request {
             self.frame_request = false;
-            self.frame_cloud(cx.doc, cx.derived, rect.aspect_ratio());
+            self.frame(cx.doc, cx.derived, cx.selection, rect.aspect_ratio());
         }
         let input = ViewInput {
             ui,

@@ -11,10 +11,11 @@ after(async () => { await server?.close(); });
 
 const toBytes = (rgb) => rgb.map((v) => Math.round(v * 255));
 
-/** Horizontal centroid and count of the pixels that differ from the sky. */
+/** Horizontal centroid and count of the pixels that differ from the sky (between the notice
+ * and hint lines at the top and the status line at the bottom). */
 function cloud(img, [vw, vh], bg) {
   let n = 0, sx = 0;
-  for (let y = 0; y < vh; y++) {
+  for (let y = 60; y < vh - 30; y++) {
     for (let x = 0; x < vw; x++) {
       const i = 4 * (y * img.width + x);
       const d = Math.abs(img.data[i] - bg[0]) + Math.abs(img.data[i + 1] - bg[1]) + Math.abs(img.data[i + 2] - bg[2]);
@@ -80,6 +81,97 @@ for (const backend of ['webgpu', 'webgl2']) {
       await page.keyboard.press('Delete');
       s = await until(page, (s) => s.scene.ellipsoids.length === 0, 'deleted');
       assert.match(s.view.notice.text, /Deleted Ellipsoid 1/);
+    });
+  });
+}
+
+// The gizmo: a drag on the X arrow moves the ellipsoid along x only, however the pointer
+// wanders; G then X does the same from anywhere; Esc in the middle of a drag takes it back;
+// Shift+H hides the ellipsoid (the cloud goes), Alt+H shows it; F frames it; Ctrl+D is kept
+// from the browser (its bookmark dialog).
+for (const backend of ['webgpu', 'webgl2']) {
+  test(`gizmo arrows, axis lock, Esc, hide and frame (${backend})`, { timeout: 240_000 }, async () => {
+    await withApp({ base: server.url, webgpu: backend === 'webgpu', query: '?preset=empty', viewport: { width: 1280, height: 800 } }, async (page) => {
+      let s = await state(page);
+      const view = s.view.viewport;
+      const [vw, vh] = view;
+      const bg = toBytes(s.scene.light.background);
+      await page.mouse.click(vw * 0.05, vh * 0.95);
+      await page.keyboard.press('e');
+      await page.mouse.click(vw * 0.4, vh * 0.5);
+      s = await until(page, (s) => s.scene.ellipsoids.length === 1, 'an ellipsoid');
+      await page.keyboard.press('g');
+      s = await until(page, (s) => s.view.gizmo?.x, 'the move gizmo with an x arrow');
+      const camera = JSON.stringify(s.scene.camera);
+      const c0 = s.scene.ellipsoids[0].center;
+      const { center, x: xEnd } = s.view.gizmo;
+      await screenshot(page, `gizmo-1-move-${backend}`);
+
+      // Along the X arrow, with the pointer wandering up and down by 60 px: pointer events at
+      // input rate, not one per frame.
+      const grab = [center[0] + 0.7 * (xEnd[0] - center[0]), center[1] + 0.7 * (xEnd[1] - center[1])];
+      await page.mouse.move(grab[0], grab[1]);
+      await page.mouse.down();
+      for (let i = 1; i <= 20; i++) await page.mouse.move(grab[0] + i * 8, grab[1] + (i % 2 ? -60 : 60) * (i / 20));
+      await page.mouse.up();
+      s = await until(page, (s) => s.scene.ellipsoids[0].center[0] > c0[0] + 0.3, 'moved along x');
+      let c1 = s.scene.ellipsoids[0].center;
+      assert.ok(Math.abs(c1[1] - c0[1]) < 1e-4 && Math.abs(c1[2] - c0[2]) < 1e-4, `along x only: ${c0} → ${c1}`);
+      assert.equal(JSON.stringify(s.scene.camera), camera, 'the camera stayed');
+
+      // A free drag (from the empty sky) would move up too; with X locked it moves along x only.
+      await page.keyboard.press('x');
+      await until(page, (s) => s.view.axis_lock === 'X', 'x locked');
+      await page.mouse.move(vw * 0.2, vh * 0.8);
+      await page.mouse.down();
+      for (let i = 1; i <= 15; i++) await page.mouse.move(vw * 0.2 + i * 6, vh * 0.8 - i * 10);
+      await page.mouse.up();
+      s = await until(page, (s) => s.scene.ellipsoids[0].center[0] > c1[0] + 0.2, 'moved along x (locked)');
+      const c2 = s.scene.ellipsoids[0].center;
+      assert.ok(Math.abs(c2[1] - c1[1]) < 1e-4 && Math.abs(c2[2] - c1[2]) < 1e-4, `locked to x: ${c1} → ${c2}`);
+      await page.keyboard.press('x');
+      await until(page, (s) => s.view.axis_lock === null, 'free again');
+
+      // Esc in the middle of a drag: back where it began, no undo step.
+      const undo = s.view.undo;
+      await page.mouse.move(vw * 0.2, vh * 0.8);
+      await page.mouse.down();
+      for (let i = 1; i <= 10; i++) await page.mouse.move(vw * 0.2 + i * 10, vh * 0.8 - i * 10);
+      await until(page, (s) => s.scene.ellipsoids[0].center[1] > c2[1] + 0.2, 'dragging');
+      await page.keyboard.press('Escape');
+      s = await until(page, (s) => /Cancelled/.test(s.view.notice?.text ?? ''), 'cancelled');
+      for (let i = 1; i <= 5; i++) await page.mouse.move(vw * 0.4 + i * 10, vh * 0.6);
+      await page.mouse.up();
+      s = await state(page);
+      assert.deepEqual(s.scene.ellipsoids[0].center, c2, 'back where the drag began');
+      assert.equal(s.view.undo, undo, 'no undo step');
+      assert.equal(s.view.selected_ellipsoid, 0, 'still selected');
+
+      // Shift+H hides it (the sky is empty), Alt+H shows it again.
+      await page.keyboard.press('h'); // guides off, to see the cloud alone
+      await waitForFullQuality(page);
+      const shown = cloud(await screenshot(page, `gizmo-2-shown-${backend}`), view, bg);
+      await page.keyboard.down('Shift'); await page.keyboard.press('h'); await page.keyboard.up('Shift');
+      s = await until(page, (s) => s.scene.ellipsoids[0].hidden === true, 'hidden');
+      await waitForFullQuality(page);
+      const hidden = cloud(await screenshot(page, `gizmo-3-hidden-${backend}`), view, bg);
+      assert.ok(shown.n > 5000 && hidden.n < 0.02 * shown.n, `hidden: ${shown.n} → ${hidden.n} px`);
+      await page.keyboard.down('Alt'); await page.keyboard.press('h'); await page.keyboard.up('Alt');
+      s = await until(page, (s) => !s.scene.ellipsoids[0].hidden, 'shown again');
+      await page.keyboard.press('h');
+
+      // F frames the selection: the camera turns to the ellipsoid.
+      await page.keyboard.press('f');
+      s = await until(page, (s) => Math.hypot(...s.scene.camera.target.map((t, i) => t - c2[i])) < 1e-3, 'framed on the ellipsoid');
+
+      // Ctrl+D duplicates, and the browser's own Ctrl+D (bookmark) is prevented.
+      const prevented = await page.evaluate(() => {
+        const e = new KeyboardEvent('keydown', { key: 'd', code: 'KeyD', ctrlKey: true, bubbles: true, cancelable: true });
+        document.getElementById('cloudsketch_canvas').dispatchEvent(e);
+        return e.defaultPrevented;
+      });
+      assert.ok(prevented, 'Ctrl+D kept from the browser');
+      await until(page, (s) => s.scene.ellipsoids.length === 2, 'duplicated');
     });
   });
 }

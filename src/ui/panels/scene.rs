@@ -49,8 +49,13 @@ fn ellipsoid_list(ui: &mut Ui, doc: &mut Document, selection: &mut Selection) {
             ui.horizontal_wrapped(|ui| {
                 for i in 0..count {
                     let selected = selection.contains(Item::Ellipsoid(i));
+                    let mut label = egui::RichText::new(format!("E{}", i + 1));
+                    if doc.scene().ellipsoids[i].hidden {
+                        label = label.weak().italics();
+                    }
                     if ui
-                        .selectable_label(selected, format!("E{}", i + 1))
+                        .selectable_label(selected, label)
+                        .on_hover_text("Click to select; italic ones are hidden (Shift+H)")
                         .clicked()
                     {
                         clicked = Some((i, selected));
@@ -90,6 +95,8 @@ fn ellipsoid_list(ui: &mut Ui, doc: &mut Document, selection: &mut Selection) {
     e.radii = e.radii.max(glam::Vec3::splat(0.01));
     ui.add(egui::Slider::new(&mut e.strength, -2.0..=2.0).text("strength"))
         .on_hover_text("How much it adds to the cloud; below zero it carves the cloud away");
+    ui.checkbox(&mut e.hidden, "hidden")
+        .on_hover_text("Shift+H: leave it out of the cloud, kept in the scene (Alt+H shows all)");
     if e != *doc.scene().ellipsoids[i] {
         ellipsoids::set(doc, i, e, Some("ellipsoid"));
     }

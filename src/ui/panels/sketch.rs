@@ -89,6 +89,12 @@ impl SketchPanel {
                                     .color(ui.visuals().warn_fg_color),
                             )
                             .on_hover_text(format!("This stroke adds nothing to the cloud: {e}")),
+                        _ if plane.hidden => ui
+                            .selectable_label(
+                                selected,
+                                egui::RichText::new(format!("{} (hidden)", plane.name)).weak(),
+                            )
+                            .on_hover_text("Hidden: left out of the cloud (Shift+H shows it)"),
                         _ => ui.selectable_label(selected, plane.name.as_str()),
                     };
                     if response.clicked() {
@@ -178,6 +184,8 @@ fn plane_controls(ui: &mut Ui, doc: &mut Document, i: usize) {
             }
         }
     });
+    ui.checkbox(&mut plane.hidden, "hidden")
+        .on_hover_text("Shift+H: leave it out of the cloud, kept in the scene (Alt+H shows all)");
     if (yaw, pitch, roll) != before {
         plane.rotation = Quat::from_euler(EulerRot::YXZ, yaw, pitch, roll);
     }
