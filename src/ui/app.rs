@@ -293,6 +293,8 @@ impl CloudApp {
             "tool": self.tool.tool.name(),
             "selected_plane": self.selection.plane(),
             "selected_ellipsoid": self.selection.ellipsoid(),
+            "selected_planes": self.selection.items().iter().filter_map(|i| i.plane()).collect::<Vec<_>>(),
+            "selected_ellipsoids": self.selection.items().iter().filter_map(|i| i.ellipsoid()).collect::<Vec<_>>(),
             "gizmo": self.tool.gizmo(&self.doc, &self.selection, self.viewport.rect).map(|g| {
                 let at = |p: Option<egui::Pos2>| p.map(|p| [p.x, p.y]);
                 serde_json::json!({

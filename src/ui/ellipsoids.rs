@@ -1,6 +1,6 @@
 //! Ellipsoids in the view (Schpok et al. §3): adding one where the user clicks, picking the one
-//! that shapes the cloud under the pointer, moving, duplicating and deleting the selected one.
-//! Every change is one undoable edit of the document's ellipsoid list.
+//! that shapes the cloud under the pointer, setting one. Every change is one undoable edit of
+//! the document's ellipsoid list (duplicate and delete act on the selection: `selection`).
 
 use std::sync::Arc;
 
@@ -98,41 +98,6 @@ pub fn set(doc: &mut Document, i: usize, e: Ellipsoid, merge: Option<&'static st
     doc.apply(Edit::SetEllipsoids(list), merge)
 }
 
-/// Deletes the selected ellipsoid; returns what was done.
-pub fn delete_selected(doc: &mut Document, selection: &mut Selection) -> Option<String> {
-    let i = selection.ellipsoid()?;
-    let mut list = doc.scene().ellipsoids.clone();
-    if i >= list.len() {
-        return None;
-    }
-    list.remove(i);
-    doc.apply(Edit::SetEllipsoids(list), None).then(|| {
-        selection.clear();
-        format!("Deleted Ellipsoid {} (Ctrl+Z undoes)", i + 1)
-    })
-}
-
-/// Duplicates the selected ellipsoid beside the original (to the view's right by its radius);
-/// returns what was done.
-pub fn duplicate_selected(doc: &mut Document, selection: &mut Selection) -> Option<String> {
-    let i = selection.ellipsoid()?;
-    let scene = doc.scene();
-    if scene.ellipsoids.len() >= MAX_ELLIPSOIDS {
-        return Some(format!(
-            "at most {MAX_ELLIPSOIDS} ellipsoids: delete one first"
-        ));
-    }
-    let mut copy = (**scene.ellipsoids.get(i)?).clone();
-    copy.center += scene.camera.right() * copy.radii.x;
-    let mut list = scene.ellipsoids.clone();
-    list.push(Arc::new(copy));
-    let index = list.len() - 1;
-    doc.apply(Edit::SetEllipsoids(list), None).then(|| {
-        selection.set(Item::Ellipsoid(index));
-        format!("Added Ellipsoid {} (a copy)", index + 1)
-    })
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -186,18 +151,4 @@ mod tests {
         assert_eq!(most_at(&list, Vec3::new(9.0, 0.0, 0.0)), None);
     }
 
-    #[test]
-    fn duplicate_and_delete_are_single_undoable_edits() {
-        let mut doc = Document::new(Scene::default());
-        let mut selection = Selection::default();
-        let n = doc.scene().ellipsoids.len();
-        selection.set(Item::Ellipsoid(1));
-        duplicate_selected(&mut doc, &mut selection).unwrap();
-        assert_eq!(doc.scene().ellipsoids.len(), n + 1);
-        assert_eq!(selection.ellipsoid(), Some(n));
-        delete_selected(&mut doc, &mut selection).unwrap();
-        assert_eq!(doc.scene().ellipsoids.len(), n);
-        doc.undo();
-        assert_eq!(doc.scene().ellipsoids.len(), n + 1);
-    }
 }

@@ -7,6 +7,7 @@
 //! - `sketch_tool`: the Sketch, Cut, Ellipsoid, Move and Rotate tools and their overlay;
 //! - `ellipsoids`: adding, picking, moving, duplicating and deleting ellipsoids;
 //! - `gizmo`: the on-canvas Move, Rotate and Scale handles and their drag maths;
+//! - `picking`: what a click or a dragged box selects;
 //! - `guide`: the reference image (loading, texture, drawing, its panel group);
 //! - `panels`: one struct per side-panel group, each with its own `ui()`;
 //! - `selection`, `notice`, `widgets`: small shared pieces;
@@ -19,6 +20,7 @@ mod gizmo;
 mod guide;
 mod notice;
 mod panels;
+mod picking;
 #[cfg(not(target_arch = "wasm32"))]
 #[path = "platform_native.rs"]
 mod platform;

@@ -8,13 +8,13 @@ use glam::{Quat, Vec2, Vec3};
 use super::ellipsoids;
 use super::gizmo::{Gizmo, Handle, ring_turn};
 use super::notice::Notices;
+use super::picking;
 use super::selection::{Item, Selection};
 use crate::derive::{Derived, Shape};
 use crate::scene::{
     Document, DrawingPlane, Edit, MAX_PLANE_POINTS, MAX_PLANES, OrbitCamera, StrokeKind,
 };
 use crate::seeded::hash64;
-use crate::sketch::outline;
 
 /// What a primary drag in the viewport does.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -74,13 +74,22 @@ pub struct SketchTool {
     pub axis_lock: Option<Axis>,
     /// The Move/Rotate/Scale drag under way: what it started from and the drag so far.
     gesture: Option<Gesture>,
+    /// B was pressed: the next drag draws a selection box.
+    box_armed: bool,
+    /// The selection box being dragged: where it began and where the pointer is.
+    area: Option<(Pos2, Pos2)>,
 }
 
-/// A Move, Rotate or Scale drag: the selected item's place, turn and radii when it began, the
-/// gizmo as it was laid out then and the handle the press took, and the drag so far (the
-/// transform is taken from the whole drag, so snapping sees the total).
+/// Where a selected item was when a drag began: its place, turn and radii (a plane's are ones).
+type Start = (Item, Vec3, Quat, Vec3);
+
+/// A Move, Rotate or Scale drag: the active item's place, turn and radii when it began (and
+/// every selected item's, which follow it), the gizmo as it was laid out then and the handle the
+/// press took, and the drag so far (the transform is taken from the whole drag, so snapping
+/// sees the total).
 #[derive(Clone, Debug)]
 struct Gesture {
+    starts: Vec<Start>,
     origin: Vec3,
     rotation: Quat,
     radii: Vec3,
@@ -243,41 +252,6 @@ fn pen_pressure(samples: &[Option<f32>]) -> Vec<f32> {
         .collect()
 }
 
-/// Deletes the selected plane; returns what was done.
-pub fn delete_selected(doc: &mut Document, selection: &mut Selection) -> Option<String> {
-    let i = selection.plane()?;
-    let name = doc.scene().planes.get(i)?.name.clone();
-    doc.apply(Edit::RemovePlane(i), None).then(|| {
-        selection.clear();
-        format!("Deleted {name} (Ctrl+Z undoes)")
-    })
-}
-
-/// Duplicates the selected plane behind the original; returns what was done.
-pub fn duplicate_selected(doc: &mut Document, selection: &mut Selection) -> Option<String> {
-    let i = selection.plane()?;
-    let planes = &doc.scene().planes;
-    if planes.len() >= MAX_PLANES {
-        return Some(format!(
-            "at most {MAX_PLANES} drawing planes: delete one first"
-        ));
-    }
-    let mut copy = (**planes.get(i)?).clone();
-    let (lo, hi) = copy
-        .points
-        .iter()
-        .fold((f32::MAX, f32::MIN), |(a, b), p| (a.min(p.x), b.max(p.x)));
-    // Behind the original by a third of its width, so the copy thickens the cloud.
-    copy.origin -= copy.normal() * ((hi - lo).max(0.1) / 3.0);
-    copy.name = format!("{} copy", copy.name);
-    copy.seed = hash64(copy.seed);
-    let name = copy.name.clone();
-    doc.apply(Edit::InsertPlane(i + 1, copy), None).then(|| {
-        selection.set(Item::Plane(i + 1));
-        format!("Added {name}")
-    })
-}
-
 impl SketchTool {
     /// Tool shortcuts: V navigate, D draw, C cut, E ellipsoid, G move, R rotate, S scale (then
     /// X, Y or Z locks the axis, the same key again frees it), H hides guides, Shift+H hides the
@@ -298,8 +272,11 @@ impl SketchTool {
                 self.tool = tool;
             }
         }
-        let [h, k, esc, del] = [Key::H, Key::K, Key::Escape, Key::Delete]
+        let [h, k, esc, del, b] = [Key::H, Key::K, Key::Escape, Key::Delete, Key::B]
             .map(|key| ctx.input_mut(|i| i.consume_key(Modifiers::NONE, key)));
+        if b {
+            self.box_armed = true;
+        }
         if matches!(self.tool, Tool::Move | Tool::Rotate | Tool::Scale) {
             for (key, axis) in [(Key::X, Axis::X), (Key::Y, Axis::Y), (Key::Z, Axis::Z)] {
                 if ctx.input_mut(|i| i.consume_key(Modifiers::NONE, key)) {
@@ -314,7 +291,9 @@ impl SketchTool {
         if k {
             self.show_skeleton = !self.show_skeleton;
         }
-        if esc && self.cancel_gesture(tc.doc) {
+        if esc && (self.box_armed || self.area.is_some()) {
+            (self.box_armed, self.area) = (false, None);
+        } else if esc && self.cancel_gesture(tc.doc) {
             tc.notices.note(now, "Cancelled: back where the drag began");
         } else if esc {
             if self.stroke.is_empty() {
@@ -329,16 +308,10 @@ impl SketchTool {
         if reveal && let Some(m) = super::selection::show_all(tc.doc) {
             tc.notices.note(now, m);
         }
-        if dup
-            && let Some(m) = ellipsoids::duplicate_selected(tc.doc, tc.selection)
-                .or_else(|| duplicate_selected(tc.doc, tc.selection))
-        {
+        if dup && let Some(m) = super::selection::duplicate(tc.doc, tc.selection) {
             tc.notices.note(now, m);
         }
-        if del
-            && let Some(m) = ellipsoids::delete_selected(tc.doc, tc.selection)
-                .or_else(|| delete_selected(tc.doc, tc.selection))
-        {
+        if del && let Some(m) = super::selection::delete(tc.doc, tc.selection) {
             tc.notices.note(now, m);
         }
     }
@@ -353,15 +326,19 @@ impl SketchTool {
         ) && response.clicked()
             && let Some(p) = response.interact_pointer_pos()
         {
-            // A drawing plane whose stroke is under the click, else the ellipsoid that shapes
-            // the cloud there.
-            match plane_at(tc.doc, rect, p) {
-                Some(i) => tc.selection.set(Item::Plane(i)),
-                None => match ellipsoids::pick(tc.doc, tc.derived, rect, p) {
-                    Some(i) => tc.selection.set(Item::Ellipsoid(i)),
-                    None => tc.selection.clear(),
-                },
+            // A drawing plane whose stroke is under the click, an ellipsoid whose indicator it
+            // touches, else the ellipsoid that shapes the cloud there; Shift adds or removes.
+            let shift = ui.input(|i| i.modifiers.shift);
+            let indicators = self.indicators_shown();
+            match picking::item_at(tc.doc, tc.derived, rect, p, indicators) {
+                Some(item) if shift => tc.selection.toggle(item),
+                Some(item) => tc.selection.set(item),
+                None if shift => {}
+                None => tc.selection.clear(),
             }
+        }
+        if self.select_box(view, tc) {
+            return true;
         }
         if self.tool == Tool::Ellipsoid
             && response.clicked()
@@ -522,6 +499,48 @@ impl SketchTool {
         }
     }
 
+    /// Whether every ellipsoid's indicator is drawn (and can be clicked).
+    fn indicators_shown(&self) -> bool {
+        !self.hide_guides
+            && (self.show_all_planes
+                || matches!(
+                    self.tool,
+                    Tool::Ellipsoid | Tool::Move | Tool::Rotate | Tool::Scale
+                ))
+    }
+
+    /// Box selection: after B, or with Move, Rotate or Scale and nothing selected, a drag draws
+    /// a box and selects every plane and ellipsoid whose centre it holds (Shift adds to the
+    /// selection). Returns whether the drag is a box (so the camera stays).
+    fn select_box(&mut self, view: &ViewInput<'_>, tc: &mut ToolContext<'_>) -> bool {
+        let (ui, response, rect) = (view.ui, view.response, view.rect);
+        if response.drag_started_by(egui::PointerButton::Primary) {
+            let empty = matches!(self.tool, Tool::Move | Tool::Rotate | Tool::Scale)
+                && self.target(tc.doc, tc.selection).is_none();
+            if self.box_armed || empty {
+                let from = ui
+                    .input(|i| i.pointer.press_origin())
+                    .or(response.interact_pointer_pos());
+                self.area = from.map(|p| (p, p));
+            }
+        }
+        let Some((from, _)) = self.area else {
+            return false;
+        };
+        let to = response.interact_pointer_pos().map_or(from, |p| rect.clamp(p));
+        self.area = Some((from, to));
+        if !response.dragged_by(egui::PointerButton::Primary) {
+            let shift = ui.input(|i| i.modifiers.shift);
+            let items = picking::items_in(tc.doc, rect, Rect::from_two_pos(from, to));
+            let now = ui.input(|i| i.time);
+            tc.notices.note(now, format!("Selected {} item{}", items.len(), if items.len() == 1 { "" } else { "s" }));
+            tc.selection.select_all(items, shift);
+            self.area = None;
+            self.box_armed = false;
+        }
+        true
+    }
+
     /// Takes back the Move/Rotate/Scale drag under way (Esc, right-click); returns whether
     /// there was one.
     fn cancel_gesture(&mut self, doc: &mut Document) -> bool {
@@ -529,27 +548,18 @@ impl SketchTool {
             return false;
         };
         g.cancelled = true;
-        if !doc.revert_merge("plane-drag") {
-            doc.revert_merge("ellipsoid-drag");
-        }
+        doc.revert_merge("drag");
         true
     }
 
-    /// The selected plane or ellipsoid a Move/Rotate/Scale acts on: which, and its place, turn
-    /// and radii (a plane's are ones).
-    fn target(&self, doc: &Document, selection: &Selection) -> Option<(Item, Vec3, Quat, Vec3)> {
-        let scene = doc.scene();
-        if let Some(i) = selection.plane().filter(|&i| i < scene.planes.len()) {
-            // Scale reshapes ellipsoids; with a plane selected a drag orbits.
-            if self.tool == Tool::Scale {
-                return None;
-            }
-            let p = &scene.planes[i];
-            return Some((Item::Plane(i), p.origin, p.rotation, Vec3::ONE));
-        }
-        let i = selection.ellipsoid().filter(|&i| i < scene.ellipsoids.len())?;
-        let e = &scene.ellipsoids[i];
-        Some((Item::Ellipsoid(i), e.center, e.rotation, e.radii))
+    /// The item a Move/Rotate/Scale drag places its gizmo on, and where it is.
+    fn target(&self, doc: &Document, selection: &Selection) -> Option<Start> {
+        // The active item; Scale reshapes ellipsoids only, so it takes the last one selected.
+        let item = match self.tool {
+            Tool::Scale => selection.ellipsoid().map(Item::Ellipsoid),
+            _ => selection.active(),
+        }?;
+        start_of(doc, item)
     }
 
     /// The gizmo of the current tool on the selected item, as drawn this frame.
@@ -567,7 +577,7 @@ impl SketchTool {
     /// orbits as in Navigate.
     fn manipulate(&mut self, view: &ViewInput<'_>, tc: &mut ToolContext<'_>) -> bool {
         let (ui, response, rect) = (view.ui, view.response, view.rect);
-        let Some((item, origin, rotation, radii)) = self.target(tc.doc, tc.selection) else {
+        let Some((_, origin, rotation, radii)) = self.target(tc.doc, tc.selection) else {
             return false;
         };
         if ui.input(|i| i.modifiers.alt || i.multi_touch().is_some()) {
@@ -584,12 +594,21 @@ impl SketchTool {
                 .or(response.interact_pointer_pos())
                 .unwrap_or(rect.center());
             let gizmo = Gizmo::layout(self.tool, &camera, rect, origin, rotation);
+            let starts = (tc.selection.items().iter())
+                .filter(|i| self.tool != Tool::Scale || i.ellipsoid().is_some())
+                .filter_map(|&i| start_of(tc.doc, i))
+                .collect();
             self.gesture = Some(Gesture {
+                starts,
                 origin,
                 rotation,
                 radii,
                 drag: Vec2::ZERO,
-                handle: gizmo.as_ref().and_then(|g| g.hit(press)),
+                // An axis locked from the keyboard wins over the handle under the press.
+                handle: gizmo
+                    .as_ref()
+                    .filter(|_| self.axis_lock.is_none())
+                    .and_then(|g| g.hit(press)),
                 gizmo,
                 angle: 0.0,
                 last: press,
@@ -661,19 +680,17 @@ impl SketchTool {
             },
         }
         g.last = pointer;
-        let scene = tc.doc.scene();
-        match item {
-            Item::Plane(i) => {
-                let mut p = (*scene.planes[i]).clone();
-                (p.origin, p.rotation) = (origin, rotation);
-                tc.doc.apply(Edit::SetPlane(i, p), Some("plane-drag"));
-            }
-            Item::Ellipsoid(i) => {
-                let mut e = (*scene.ellipsoids[i]).clone();
-                (e.center, e.rotation, e.radii) = (origin, rotation, radii);
-                ellipsoids::set(tc.doc, i, e, Some("ellipsoid-drag"));
-            }
-        }
+        // Every selected item follows the active one: the same shift, the same turn and the
+        // same scale, each about its own centre.
+        let turn = rotation * g.rotation.inverse();
+        let factor = radii / g.radii;
+        let moved: Vec<Start> = (g.starts.iter())
+            .map(|&(i, o, r, rad)| {
+                let rad = (rad * factor).clamp(Vec3::splat(0.01), Vec3::splat(1e4));
+                (i, o + (origin - g.origin), (turn * r).normalize(), rad)
+            })
+            .collect();
+        apply_starts(tc.doc, &moved);
         true
     }
 
@@ -750,6 +767,16 @@ impl SketchTool {
                 ));
             }
         }
+        if let Some((from, to)) = self.area {
+            let area = Rect::from_two_pos(from, to);
+            painter.rect_filled(area, 0.0, Color32::from_white_alpha(18));
+            painter.rect_stroke(
+                area,
+                0.0,
+                Stroke::new(1.0, Color32::from_white_alpha(180)),
+                egui::StrokeKind::Inside,
+            );
+        }
         if self.stroke.len() >= 2 {
             let color = if self.tool == Tool::Cut {
                 Color32::from_rgb(255, 150, 60)
@@ -771,13 +798,12 @@ impl SketchTool {
             None => free.to_owned(),
         };
         let hint = match self.tool {
-            Tool::Move | Tool::Rotate
-                if selection.plane().is_none() && selection.ellipsoid().is_none() =>
-            {
-                Some(
-                    "Click a drawing plane or the cloud (or pick one in the lists) to move or turn it",
-                )
+            _ if self.box_armed || self.area.is_some() => {
+                Some("Drag a box round what to select (Shift adds to the selection) · Esc cancels")
             }
+            Tool::Move | Tool::Rotate if selection.is_empty() => Some(
+                "Click a drawing plane or the cloud (Shift adds), or drag a box round several, to move or turn them",
+            ),
             Tool::Ellipsoid => Some("Click to add an ellipsoid there (a drag orbits)"),
             Tool::Scale if selection.ellipsoid().is_none() => {
                 Some("Scale works on ellipsoids: click the cloud (or pick one in the list)")
@@ -820,36 +846,42 @@ impl SketchTool {
     }
 }
 
-/// The drawing plane whose stroke encloses screen point `p` (outlines by their inside, cuts
-/// within a few pixels of their line), the nearest to the camera when several do.
-fn plane_at(doc: &Document, rect: Rect, p: Pos2) -> Option<usize> {
-    let camera = &doc.scene().camera;
-    let eye = camera.eye();
-    let mut best: Option<(f32, usize)> = None;
-    for (i, plane) in doc.scene().planes.iter().enumerate() {
-        // Screen points in f64, for the sketch core's polygon helpers.
-        let pts: Vec<glam::DVec2> = plane
-            .points
-            .iter()
-            .filter_map(|q| project(camera, rect, plane.to_world(q.extend(0.0))))
-            .map(|q| glam::DVec2::new(q.x as f64, q.y as f64))
-            .collect();
-        if pts.len() < 2 {
-            continue;
-        }
-        let at = glam::DVec2::new(p.x as f64, p.y as f64);
-        let hit = match plane.kind {
-            StrokeKind::Outline => outline::contains(&pts, at),
-            StrokeKind::Cut => pts
-                .windows(2)
-                .any(|w| outline::segment_distance(at, w[0], w[1]) < 6.0),
-        };
-        let depth = plane.origin.distance(eye);
-        if hit && best.is_none_or(|(d, _)| depth < d) {
-            best = Some((depth, i));
+/// Where `item` is now, if the document has it.
+fn start_of(doc: &Document, item: Item) -> Option<Start> {
+    let scene = doc.scene();
+    match item {
+        Item::Plane(i) => scene
+            .planes
+            .get(i)
+            .map(|p| (item, p.origin, p.rotation, Vec3::ONE)),
+        Item::Ellipsoid(i) => scene
+            .ellipsoids
+            .get(i)
+            .map(|e| (item, e.center, e.rotation, e.radii)),
+    }
+}
+
+/// Puts items where a drag took them, folded into the drag's one undo step.
+fn apply_starts(doc: &mut Document, items: &[Start]) {
+    let mut ellipsoids = doc.scene().ellipsoids.clone();
+    for &(item, origin, rotation, radii) in items {
+        match item {
+            Item::Plane(i) => {
+                let Some(p) = doc.scene().planes.get(i) else { continue };
+                let mut p = (**p).clone();
+                (p.origin, p.rotation) = (origin, rotation);
+                doc.apply(Edit::SetPlane(i, p), Some("drag"));
+            }
+            Item::Ellipsoid(i) => {
+                if let Some(slot) = ellipsoids.get_mut(i) {
+                    let mut e = (**slot).clone();
+                    (e.center, e.rotation, e.radii) = (origin, rotation, radii);
+                    *slot = std::sync::Arc::new(e);
+                }
+            }
         }
     }
-    best.map(|(_, i)| i)
+    doc.apply(Edit::SetEllipsoids(ellipsoids), Some("drag"));
 }
 
 /// An ellipsoid's indicator: its three principal ellipses (bright when selected, faint when
@@ -861,20 +893,12 @@ fn draw_ellipsoid(
     e: &crate::scene::Ellipsoid,
     selected: bool,
 ) {
-    const N: usize = 48;
     let color = match (selected, e.hidden) {
         (true, _) => Color32::from_rgb(255, 170, 60),
         (false, false) => Color32::from_rgba_unmultiplied(255, 200, 120, 70),
         (false, true) => Color32::from_white_alpha(35),
     };
-    for (a, b) in [(Vec3::X, Vec3::Y), (Vec3::Y, Vec3::Z), (Vec3::Z, Vec3::X)] {
-        let pts: Vec<Pos2> = (0..=N)
-            .filter_map(|k| {
-                let t = k as f32 / N as f32 * std::f32::consts::TAU;
-                let local = (a * t.cos() + b * t.sin()) * e.radii;
-                project(camera, rect, e.center + e.rotation * local)
-            })
-            .collect();
+    for pts in picking::indicator(camera, rect, e) {
         if pts.len() > 2 {
             painter.add(egui::Shape::line(
                 pts,

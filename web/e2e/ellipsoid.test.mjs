@@ -175,3 +175,55 @@ for (const backend of ['webgpu', 'webgl2']) {
     });
   });
 }
+
+// Several at once: a box dragged with Move and nothing selected selects both ellipsoids; a drag
+// on the X arrow moves both by the same distance; Shift+click takes one out; Ctrl+D duplicates
+// the selection; one Ctrl+Z undoes the whole move.
+for (const backend of ['webgpu', 'webgl2']) {
+  test(`box select, move several, Shift+click (${backend})`, { timeout: 240_000 }, async () => {
+    await withApp({ base: server.url, webgpu: backend === 'webgpu', query: '?preset=empty', viewport: { width: 1280, height: 800 } }, async (page) => {
+      let s = await state(page);
+      const [vw, vh] = s.view.viewport;
+      await page.mouse.click(vw * 0.05, vh * 0.95);
+      await page.keyboard.press('e');
+      await page.mouse.click(vw * 0.3, vh * 0.5);
+      await until(page, (s) => s.scene.ellipsoids.length === 1, 'one');
+      await page.mouse.click(vw * 0.6, vh * 0.5);
+      s = await until(page, (s) => s.scene.ellipsoids.length === 2, 'two');
+      const before = s.scene.ellipsoids.map((e) => e.center);
+      await page.keyboard.press('g');
+      await page.keyboard.press('Escape'); // nothing selected: a drag now draws a box
+      await until(page, (s) => s.view.selected_ellipsoids.length === 0, 'nothing selected');
+      await page.mouse.move(vw * 0.15, vh * 0.3);
+      await page.mouse.down();
+      for (let i = 1; i <= 12; i++) await page.mouse.move(vw * (0.15 + i * 0.05), vh * (0.3 + i * 0.03));
+      await screenshot(page, `select-1-box-${backend}`);
+      await page.mouse.up();
+      s = await until(page, (s) => s.view.selected_ellipsoids.length === 2, 'both in the box');
+      assert.deepEqual(s.scene.ellipsoids.map((e) => e.center), before, 'a box moves nothing');
+      const undo = s.view.undo;
+      const { center, x: xEnd } = s.view.gizmo;
+      const grab = [center[0] + 0.7 * (xEnd[0] - center[0]), center[1] + 0.7 * (xEnd[1] - center[1])];
+      await page.mouse.move(grab[0], grab[1]);
+      await page.mouse.down();
+      for (let i = 1; i <= 12; i++) await page.mouse.move(grab[0] + i * 10, grab[1]);
+      await page.mouse.up();
+      s = await until(page, (s) => s.scene.ellipsoids[1].center[0] > before[1][0] + 0.3, 'moved');
+      const dx = s.scene.ellipsoids.map((e, i) => e.center[0] - before[i][0]);
+      assert.ok(Math.abs(dx[0] - dx[1]) < 1e-4 && dx[0] > 0.3, `both moved alike: ${dx}`);
+      assert.equal(s.view.undo, undo + 1, 'one undo step for both');
+      await screenshot(page, `select-2-moved-${backend}`);
+      await page.keyboard.press('Control+z');
+      s = await until(page, (s) => Math.abs(s.scene.ellipsoids[0].center[0] - before[0][0]) < 1e-4 && Math.abs(s.scene.ellipsoids[1].center[0] - before[1][0]) < 1e-4, 'both back with one undo');
+      // Shift+click on the first one's cloud takes it out of the selection.
+      await page.keyboard.down('Shift');
+      await page.mouse.click(vw * 0.3, vh * 0.5);
+      await page.keyboard.up('Shift');
+      s = await until(page, (s) => s.view.selected_ellipsoids.length === 1, 'one taken out');
+      assert.deepEqual(s.view.selected_ellipsoids, [1]);
+      await page.keyboard.press('Control+d');
+      s = await until(page, (s) => s.scene.ellipsoids.length === 3, 'the selection duplicated');
+      assert.deepEqual(s.view.selected_ellipsoids, [2]);
+    });
+  });
+}

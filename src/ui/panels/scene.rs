@@ -55,7 +55,7 @@ fn ellipsoid_list(ui: &mut Ui, doc: &mut Document, selection: &mut Selection) {
                     }
                     if ui
                         .selectable_label(selected, label)
-                        .on_hover_text("Click to select; italic ones are hidden (Shift+H)")
+                        .on_hover_text("Click to select, Shift+click to add; italic ones are hidden (Shift+H)")
                         .clicked()
                     {
                         clicked = Some((i, selected));
@@ -64,7 +64,9 @@ fn ellipsoid_list(ui: &mut Ui, doc: &mut Document, selection: &mut Selection) {
             });
         });
     if let Some((i, was)) = clicked {
-        if was {
+        if ui.input(|i| i.modifiers.shift) {
+            selection.toggle(Item::Ellipsoid(i));
+        } else if was {
             selection.clear();
         } else {
             selection.set(Item::Ellipsoid(i));

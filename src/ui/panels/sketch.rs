@@ -8,7 +8,8 @@ use crate::limits;
 use crate::scene::{Document, Edit, StrokeKind};
 use crate::ui::notice::Notices;
 use crate::ui::selection::{Item, Selection};
-use crate::ui::sketch_tool::{SketchTool, Tool, delete_selected, duplicate_selected};
+use crate::ui::selection::{delete, duplicate};
+use crate::ui::sketch_tool::{SketchTool, Tool};
 use crate::ui::widgets::param;
 
 /// The Sketch group.
@@ -102,7 +103,11 @@ impl SketchPanel {
                     }
                 }
                 if let Some((i, was)) = clicked {
-                    selection.set_plane((!was).then_some(i));
+                    if ui.input(|i| i.modifiers.shift) {
+                        selection.toggle(Item::Plane(i));
+                    } else {
+                        selection.set_plane((!was).then_some(i));
+                    }
                 }
                 if let Some(i) = selection.plane().filter(|&i| i < doc.scene().planes.len()) {
                     ui.separator();
@@ -122,12 +127,12 @@ impl SketchPanel {
                     ui.horizontal(|ui| {
                         let now = ui.input(|i| i.time);
                         if ui.button("Duplicate").on_hover_text("Ctrl+D").clicked()
-                            && let Some(m) = duplicate_selected(doc, selection)
+                            && let Some(m) = duplicate(doc, selection)
                         {
                             notices.note(now, m);
                         }
                         if ui.button("Delete").on_hover_text("Delete").clicked()
-                            && let Some(m) = delete_selected(doc, selection)
+                            && let Some(m) = delete(doc, selection)
                         {
                             notices.note(now, m);
                         }
