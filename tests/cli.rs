@@ -80,6 +80,56 @@ fn render_writes_a_png_of_the_scene() {
     assert_eq!((info.width, info.height), (96, 64));
 }
 
+/// Renders the default scene at 96×64 with `sets` applied; the image's RGB bytes.
+fn render_with(name: &str, sets: &[&str]) -> Vec<u8> {
+    let png = temp(name);
+    let mut args = vec!["render", "-o", png.to_str().unwrap(), "--size", "96x64"];
+    for s in sets {
+        args.extend(["--set", s]);
+    }
+    args.extend(["--set", "/render/slices=32"]);
+    let out = cloudsketch(&args);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&png).unwrap()));
+    let mut reader = decoder.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    let channels = info.color_type.samples();
+    buf.chunks(channels).flat_map(|p| p[..3].to_vec()).collect()
+}
+
+/// Mean x (pixels) of the pixels that differ from the top-left one (the sky), and their count.
+fn cloud_centroid(rgb: &[u8]) -> (f64, usize) {
+    let sky = &rgb[..3];
+    let (mut sum, mut n) = (0.0, 0);
+    for (i, p) in rgb.chunks(3).enumerate() {
+        let d: i32 = p.iter().zip(sky).map(|(a, b)| (*a as i32 - *b as i32).abs()).sum();
+        if d > 24 {
+            sum += (i % 96) as f64;
+            n += 1;
+        }
+    }
+    (sum / n.max(1) as f64, n)
+}
+
+#[test]
+fn set_moves_and_hides_ellipsoids() {
+    let base = cloud_centroid(&render_with("e-base.png", &[]));
+    // Every ellipsoid but the first hidden, and the first moved right then left: the cloud goes
+    // with it.
+    let hide: Vec<String> = (1..6).map(|i| format!("/ellipsoids/{i}/hidden=true")).collect();
+    let mut sets: Vec<&str> = hide.iter().map(String::as_str).collect();
+    let right = cloud_centroid(&render_with(
+        "e-right.png",
+        &[&sets[..], &["/ellipsoids/0/center=[5,3,0]"]].concat(),
+    ));
+    sets.push("/ellipsoids/0/center=[-5,3,0]");
+    let left = cloud_centroid(&render_with("e-left.png", &sets));
+    assert!(base.1 > 300 && right.1 > 50 && left.1 > 50, "{base:?} {right:?} {left:?}");
+    assert!(right.1 < base.1 && left.1 < base.1, "one ellipsoid covers less than six");
+    assert!(right.0 > left.0 + 25.0, "moved with its centre: {} vs {}", right.0, left.0);
+}
+
 #[test]
 fn bad_input_is_a_clear_error() {
     let png = temp("never.png");

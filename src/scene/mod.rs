@@ -258,7 +258,6 @@ pub struct Ellipsoid {
     /// Field weight; 1 is a plain primitive.
     pub strength: f32,
     /// Hidden: kept in the document, left out of the cloud.
-    #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub hidden: bool,
 }
 

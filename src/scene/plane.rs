@@ -45,7 +45,6 @@ pub struct DrawingPlane {
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub pressure: Vec<f32>,
     /// Hidden: kept in the document, left out of the cloud (its stroke is drawn faintly).
-    #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub hidden: bool,
 }
 

@@ -3,7 +3,13 @@
 // Scale tool grows it; Delete removes it. Screenshots: test-results/screenshots/ellipsoid-*.png.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { serve, state, screenshot, countDiffering, until, withApp, waitForFullQuality } from './harness.mjs';
+import fs from 'node:fs';
+import os from 'node:os';
+import path from 'node:path';
+import { execFileSync } from 'node:child_process';
+import { fileURLToPath } from 'node:url';
+import { PNG } from 'pngjs';
+import { serve, state, screenshot, countChanged, until, withApp, waitForFullQuality, SCREENSHOTS } from './harness.mjs';
 
 let server;
 before(async () => { server = await serve(); });
@@ -41,7 +47,8 @@ for (const backend of ['webgpu', 'webgl2']) {
       assert.match(s.view.notice.text, /Added Ellipsoid 1/);
       await page.keyboard.press('h'); // the indicator off: look at the cloud alone
       await waitForFullQuality(page);
-      const placed = cloud(await screenshot(page, `ellipsoid-1-added-${backend}`), view, bg);
+      const placedImg = await screenshot(page, `ellipsoid-1-added-${backend}`);
+      const placed = cloud(placedImg, view, bg);
       assert.ok(placed.n > 0.01 * vw * vh, `a cloud where the click was: ${placed.n} px`);
       assert.ok(Math.abs(placed.x - vw * 0.4) < vw * 0.05, `centred on the click: ${placed.x}`);
 
@@ -59,11 +66,19 @@ for (const backend of ['webgpu', 'webgl2']) {
       assert.equal(JSON.stringify(s.scene.camera), camera, 'the camera stayed');
       assert.equal(s.view.undo, undo + 1, 'one drag, one undo step');
       await waitForFullQuality(page);
-      const moved = cloud(await screenshot(page, `ellipsoid-2-moved-${backend}`), view, bg);
+      const movedImg = await screenshot(page, `ellipsoid-2-moved-${backend}`);
+      const moved = cloud(movedImg, view, bg);
       assert.ok(moved.x > placed.x + 100, `the cloud followed: ${placed.x} → ${moved.x}`);
 
       await page.keyboard.press('Control+z');
       s = await until(page, (s) => Math.abs(s.scene.ellipsoids[0].center[0] - x0) < 1e-4, 'the move undone');
+      // Undo restores the image, not only the numbers (the moved one differs widely).
+      await waitForFullQuality(page);
+      const undone = await screenshot(page, `ellipsoid-2b-undone-${backend}`);
+      const body = { x: 0, y: 60, w: vw, h: vh - 90 };
+      const back = countChanged(placedImg, undone, body);
+      const away = countChanged(placedImg, movedImg, body);
+      assert.ok(back < 0.02 * away, `after undo the image is as placed: ${back} px differ (${away} when moved)`);
       // Scale: a drag right grows it, and the cloud with it.
       const r0 = s.scene.ellipsoids[0].radii[0];
       await page.keyboard.press('s');
@@ -224,6 +239,53 @@ for (const backend of ['webgpu', 'webgl2']) {
       await page.keyboard.press('Control+d');
       s = await until(page, (s) => s.scene.ellipsoids.length === 3, 'the selection duplicated');
       assert.deepEqual(s.view.selected_ellipsoids, [2]);
+    });
+  });
+}
+
+// One renderer on both sides: the same scene (the default cumulus of six ellipsoids, one of
+// them moved) rendered by the native CLI (lavapipe) and shown in the page covers the same
+// pixels. The native binary is the one `cargo test` built before these tests run.
+const NATIVE = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../../target/debug/cloudsketch');
+
+/** Cloud mask of an RGBA image over `w`×`h` (pixels away from the sky colour `bg`). */
+function mask(img, w, h, bg) {
+  const m = new Uint8Array(w * h);
+  for (let y = 60; y < h - 30; y++) {
+    for (let x = 0; x < w; x++) {
+      const i = 4 * (y * img.width + x);
+      const d = Math.abs(img.data[i] - bg[0]) + Math.abs(img.data[i + 1] - bg[1]) + Math.abs(img.data[i + 2] - bg[2]);
+      m[y * w + x] = d > 24 ? 1 : 0;
+    }
+  }
+  return m;
+}
+
+for (const backend of ['webgpu', 'webgl2']) {
+  test(`a scene with ellipsoids looks the same natively and in the page (${backend})`, { timeout: 240_000 }, async () => {
+    assert.ok(fs.existsSync(NATIVE), `${NATIVE} missing: run cargo test (it builds the CLI) first`);
+    await withApp({ base: server.url, webgpu: backend === 'webgpu', viewport: { width: 1280, height: 800 } }, async (page) => {
+      await page.evaluate(() => window.cloudsketch.set('/ellipsoids/2/center=[4,5,1]'));
+      await until(page, (s) => s.scene.ellipsoids[2].center[1] === 5, 'moved by set()');
+      await page.mouse.click(5, 795);
+      await page.keyboard.press('h');
+      await waitForFullQuality(page);
+      const s = await state(page);
+      const [vw, vh] = s.view.viewport;
+      const bg = toBytes(s.scene.light.background);
+      const shot = await screenshot(page, `parity-page-${backend}`);
+      const dir = fs.mkdtempSync(path.join(os.tmpdir(), 'cloudsketch-parity-'));
+      const scene = path.join(dir, 'scene.json');
+      fs.writeFileSync(scene, JSON.stringify(s.scene));
+      const out = path.join(SCREENSHOTS, `parity-native-${backend}.png`);
+      execFileSync(NATIVE, ['render', scene, '-o', out, '--size', `${vw}x${vh}`], { env: { ...process.env, NODEVICE_SELECT: '1' } });
+      const native = PNG.sync.read(fs.readFileSync(out));
+      const [a, b] = [mask(shot, vw, vh, bg), mask(native, vw, vh, bg)];
+      let both = 0, either = 0;
+      for (let i = 0; i < a.length; i++) { both += a[i] & b[i]; either += a[i] | b[i]; }
+      const iou = both / either;
+      assert.ok(either > 20_000, `a cloud is drawn: ${either} px`);
+      assert.ok(iou > 0.9, `page and native cover the same pixels: IoU ${iou.toFixed(3)}`);
     });
   });
 }

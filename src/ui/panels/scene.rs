@@ -6,6 +6,7 @@ use egui::Ui;
 use crate::scene::{Document, Edit, Preset, Scene, StrokeKind};
 use crate::ui::ellipsoids;
 use crate::ui::selection::{Item, Selection};
+use crate::ui::widgets::{rotation_fields, vec3_fields};
 
 /// The Scene group.
 #[derive(Default)]
@@ -77,23 +78,9 @@ fn ellipsoid_list(ui: &mut Ui, doc: &mut Document, selection: &mut Selection) {
     };
     let mut e = (*doc.scene().ellipsoids[i]).clone();
     ui.label(egui::RichText::new(format!("Ellipsoid {}", i + 1)).strong());
-    for (label, v, speed) in [
-        ("centre", &mut e.center, 0.05),
-        ("radii", &mut e.radii, 0.02),
-    ] {
-        ui.horizontal(|ui| {
-            ui.label(label);
-            for (axis, c) in ["x", "y", "z"].iter().zip(v.as_mut()) {
-                ui.add_sized(
-                    [62.0, 18.0],
-                    egui::DragValue::new(c)
-                        .speed(speed)
-                        .fixed_decimals(2)
-                        .prefix(format!("{axis} ")),
-                );
-            }
-        });
-    }
+    vec3_fields(ui, "centre", &mut e.center, 0.05);
+    vec3_fields(ui, "radii", &mut e.radii, 0.02);
+    rotation_fields(ui, &mut e.rotation);
     e.radii = e.radii.max(glam::Vec3::splat(0.01));
     ui.add(egui::Slider::new(&mut e.strength, -2.0..=2.0).text("strength"))
         .on_hover_text("How much it adds to the cloud; below zero it carves the cloud away");

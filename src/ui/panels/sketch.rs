@@ -1,16 +1,14 @@
 //! The Sketch group: the tools, the drawing-plane list and the selected plane's controls.
 
 use egui::Ui;
-use glam::{EulerRot, Quat};
 
 use crate::derive::{Derived, Shape};
 use crate::limits;
 use crate::scene::{Document, Edit, StrokeKind};
 use crate::ui::notice::Notices;
-use crate::ui::selection::{Item, Selection};
-use crate::ui::selection::{delete, duplicate};
+use crate::ui::selection::{Item, Selection, delete, duplicate};
 use crate::ui::sketch_tool::{SketchTool, Tool};
-use crate::ui::widgets::param;
+use crate::ui::widgets::{param, rotation_fields, vec3_fields};
 
 /// The Sketch group.
 #[derive(Default)]
@@ -156,44 +154,10 @@ fn plane_controls(ui: &mut Ui, doc: &mut Document, i: usize) {
             param(ui, &mut s.copies, &limits::COPIES);
         });
     }
-    ui.horizontal(|ui| {
-        ui.label("move");
-        for (axis, v) in ["x", "y", "z"].iter().zip(plane.origin.as_mut()) {
-            ui.add_sized(
-                [62.0, 18.0],
-                egui::DragValue::new(v)
-                    .speed(0.05)
-                    .fixed_decimals(2)
-                    .prefix(format!("{axis} ")),
-            );
-        }
-    });
-    let (mut yaw, mut pitch, mut roll) = plane.rotation.to_euler(EulerRot::YXZ);
-    let before = (yaw, pitch, roll);
-    ui.horizontal(|ui| {
-        ui.label("rotate");
-        for (label, v) in [("y ", &mut yaw), ("p ", &mut pitch), ("r ", &mut roll)] {
-            let mut deg = v.to_degrees();
-            if ui
-                .add_sized(
-                    [62.0, 18.0],
-                    egui::DragValue::new(&mut deg)
-                        .speed(0.5)
-                        .fixed_decimals(0)
-                        .prefix(label)
-                        .suffix("°"),
-                )
-                .changed()
-            {
-                *v = deg.to_radians();
-            }
-        }
-    });
+    vec3_fields(ui, "move", &mut plane.origin, 0.05);
+    rotation_fields(ui, &mut plane.rotation);
     ui.checkbox(&mut plane.hidden, "hidden")
         .on_hover_text("Shift+H: leave it out of the cloud, kept in the scene (Alt+H shows all)");
-    if (yaw, pitch, roll) != before {
-        plane.rotation = Quat::from_euler(EulerRot::YXZ, yaw, pitch, roll);
-    }
     if plane != *doc.scene().planes[i] {
         doc.apply(Edit::SetPlane(i, plane), Some("plane"));
     }
