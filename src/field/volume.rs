@@ -171,6 +171,9 @@ struct Dirty {
     bricks: UVec3,
     /// Per brick row (`by + bricks.y · bz`): merged texel ranges along x.
     runs: Vec<Vec<std::ops::Range<u32>>>,
+    /// The texel box (inclusive) holding every dirty texel, if any: a primitive whose box
+    /// misses it is skipped without visiting its rows.
+    bounds: Option<(UVec3, UVec3)>,
 }
 
 impl Dirty {
@@ -180,6 +183,7 @@ impl Dirty {
         Self {
             bricks,
             runs: vec![vec![0..grid.dims.x]; (bricks.y * bricks.z) as usize],
+            bounds: Some((UVec3::ZERO, grid.dims - 1)),
         }
     }
 
@@ -200,7 +204,21 @@ impl Dirty {
                 runs
             })
             .collect();
-        Self { bricks, runs }
+        let mut bounds: Option<(UVec3, UVec3)> = None;
+        for (i, _) in mask.iter().enumerate().filter(|(_, f)| **f) {
+            let b = UVec3::new(
+                i as u32 % bricks.x,
+                (i as u32 / bricks.x) % bricks.y,
+                i as u32 / (bricks.x * bricks.y),
+            );
+            let (lo, hi) = (b * BRICK, ((b + 1) * BRICK).min(grid.dims) - 1);
+            bounds = Some(bounds.map_or((lo, hi), |(a, c)| (a.min(lo), c.max(hi))));
+        }
+        Self {
+            bricks,
+            runs,
+            bounds,
+        }
     }
 
     /// The dirty parts of the texel rows of box `(a, b)` (inclusive): (index of the row's
@@ -211,6 +229,13 @@ impl Dirty {
         (a, b): (UVec3, UVec3),
     ) -> impl Iterator<Item = (usize, std::ops::Range<usize>)> + '_ {
         let (nx, ny) = (dims.x as usize, dims.y as usize);
+        // Only the part of the box inside the dirty bounds has dirty rows (none without them).
+        let (a, b) = match self.bounds {
+            Some((lo, hi)) => (a.max(lo), b.min(hi)),
+            None => (UVec3::ONE, UVec3::ZERO),
+        };
+        let empty = a.cmpgt(b).any();
+        let (a, b) = if empty { (UVec3::ONE, UVec3::ZERO) } else { (a, b) };
         (a.z..=b.z).flat_map(move |k| {
             (a.y..=b.y).flat_map(move |j| {
                 let brick_row = (j / BRICK + self.bricks.y * (k / BRICK)) as usize;
@@ -238,7 +263,23 @@ fn evaluate(field: &Field, grid: &Grid, dirty: &Dirty, values: &mut [f32]) -> u6
         values[row + xs.start..row + xs.end].fill(0.0);
     }
     let mut work = 0u64;
+    // The dirty texels' world box (a texel of slack): a primitive that misses it is skipped
+    // before any texel arithmetic.
+    let Some((da, db)) = dirty.bounds else {
+        return 0;
+    };
+    let (wlo, whi) = (
+        grid.min() + (da.as_vec3() - 1.0) * grid.h,
+        grid.min() + (db.as_vec3() + 2.0) * grid.h,
+    );
+    let misses = |b: &Blob| {
+        let r = b.extent * SUPPORT;
+        (b.center + r).cmplt(wlo).any() || (b.center - r).cmpgt(whi).any()
+    };
     let mut splat = |blob: &Blob, out: &mut [f32], combine: fn(f32, f32) -> f32| {
+        if misses(blob) {
+            return;
+        }
         let Some(bx) = grid.texel_box(blob) else { return };
         for (row, xs) in dirty.rows(dims, bx) {
             let (j, k) = ((row / nx) % ny, row / (nx * ny));
@@ -393,9 +434,16 @@ fn changed_boxes(old: &Field, new: &Field) -> Option<Vec<(Vec3, Vec3)>> {
     }
     let reach = |b: &Blob| (b.center - b.extent * SUPPORT, b.center + b.extent * SUPPORT);
     let mut boxes = Vec::new();
-    // Present in one field and not the other: counts that do not cancel.
-    let mut count: HashMap<[u32; 16], i32> = HashMap::new();
-    if old.blobs != new.blobs {
+    if old.blobs.len() == new.blobs.len() {
+        // The same count (a drag, a slider): compare in place.
+        for (a, b) in old.blobs.iter().zip(&new.blobs) {
+            if a != b {
+                boxes.extend([reach(a), reach(b)]);
+            }
+        }
+    } else {
+        // Present in one field and not the other: counts that do not cancel.
+        let mut count: HashMap<[u32; 16], i32> = HashMap::new();
         for b in &old.blobs {
             *count.entry(blob_key(b)).or_default() += 1;
         }
@@ -405,7 +453,14 @@ fn changed_boxes(old: &Field, new: &Field) -> Option<Vec<(Vec3, Vec3)>> {
         let changed = |b: &&Blob| count[&blob_key(b)] != 0;
         boxes.extend(old.blobs.iter().chain(&new.blobs).filter(changed).map(reach));
     }
-    if old.groups != new.groups {
+    let group_box = |g: &Vec<Blob>| g.iter().map(reach).reduce(|(a, b), (c, d)| (a.min(c), b.max(d)));
+    if old.groups.len() == new.groups.len() {
+        for (a, b) in old.groups.iter().zip(&new.groups) {
+            if a != b {
+                boxes.extend(group_box(a).into_iter().chain(group_box(b)));
+            }
+        }
+    } else {
         let mut count: HashMap<u64, i32> = HashMap::new();
         for g in &old.groups {
             *count.entry(group_key(g)).or_default() += 1;
@@ -415,7 +470,7 @@ fn changed_boxes(old: &Field, new: &Field) -> Option<Vec<(Vec3, Vec3)>> {
         }
         for g in old.groups.iter().chain(&new.groups) {
             if count[&group_key(g)] != 0 {
-                boxes.extend(g.iter().map(reach).reduce(|(a, b), (c, d)| (a.min(c), b.max(d))));
+                boxes.extend(group_box(g));
             }
         }
     }
@@ -470,30 +525,32 @@ impl Baker {
             };
         };
         let extent = (hi - lo).max_element().max(1e-3);
-        let kept = self.last.as_ref().and_then(|last| {
+        // On the kept texel size, a partial update when only primitives changed: it copies
+        // what it can and re-evaluates the bricks the changes reach. Its work is checked
+        // against the budget only when those bricks are most of the grid (then it is nearly a
+        // full bake, and primitives reaching everything could make it a long one).
+        let partial = self.last.as_ref().and_then(|last| {
             let ratio = extent / last.extent;
             let grid = (last.resolution == resolution && (0.5..=2.0).contains(&ratio))
                 .then(|| Grid::over(field, last.grid.h))??;
-            (work_on(field, &grid) <= budget).then_some((grid, last.extent))
+            let mut values = vec![0f32; grid.texels() as usize];
+            let dirty = changed_boxes(&last.field, field)
+                .map(|boxes| copy_unchanged(&grid, last, &boxes, &mut values))
+                .unwrap_or_else(|| Dirty::all(&grid));
+            let most = dirty.bounds.is_some_and(|(a, b)| {
+                2 * (b - a + UVec3::ONE).as_u64vec3().element_product() > grid.texels()
+            });
+            (!most || work_on(field, &grid) <= budget).then_some((grid, last.extent, values, dirty))
         });
-        let (grid, chosen_for) = match kept {
-            Some(k) => k,
+        let (grid, chosen_for, mut values, dirty) = match partial {
+            Some(p) => p,
             None => {
                 let (res, _) = resolution_within(field, resolution, budget);
                 let grid = Grid::of(field, res).expect("a field with bounds has a grid");
-                (grid, extent)
+                let values = vec![0f32; grid.texels() as usize];
+                (grid, extent, values, Dirty::all(&grid))
             }
         };
-        let mut values = vec![0f32; grid.texels() as usize];
-        let dirty = self
-            .last
-            .as_ref()
-            .filter(|last| last.grid.h == grid.h)
-            .and_then(|last| {
-                let boxes = changed_boxes(&last.field, field)?;
-                Some(copy_unchanged(&grid, last, &boxes, &mut values))
-            })
-            .unwrap_or_else(|| Dirty::all(&grid));
         let texels = dirty
             .rows(grid.dims, (UVec3::ZERO, grid.dims - 1))
             .map(|(_, xs)| xs.len() as u64)

@@ -286,6 +286,9 @@ impl CloudApp {
             "frame_ms": stats.frame_seconds.map(|s| (s * 1000.0).round()),
             "cpu_ms": self.cpu_seconds.map(|s| (s * 1000.0).round()),
             "refining": stats.refining,
+            "geometry_update": stats.geometry_update.map(|g| serde_json::json!({
+                "count": g.count, "ms": g.ms, "texels": g.texels, "of": g.of,
+            })),
             "backend": backend.backend,
             "adapter": backend.adapter,
             "undo": self.doc.undo_len(),

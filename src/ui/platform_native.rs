@@ -42,6 +42,12 @@ pub fn take_pointer_samples() -> Option<Vec<(egui::Pos2, Option<f32>)>> {
     None
 }
 
+/// Seconds since the first call, for timing work within a frame.
+pub fn now() -> f64 {
+    static START: std::sync::OnceLock<std::time::Instant> = std::sync::OnceLock::new();
+    START.get_or_init(std::time::Instant::now).elapsed().as_secs_f64()
+}
+
 /// Asks for a frame (natively every outside input is an egui event already: nothing to do).
 pub fn wake() {}
 

@@ -32,6 +32,13 @@ fn deliver(loaded: Loaded) {
     wake();
 }
 
+/// Seconds since the page opened (`performance.now()`), for timing work within a frame.
+pub fn now() -> f64 {
+    web_sys::window()
+        .and_then(|w| w.performance())
+        .map_or(0.0, |p| p.now() / 1000.0)
+}
+
 /// Asks for a frame: something arrived from outside egui's events (a file, a page edit).
 pub fn wake() {
     REPAINT.with(|c| {

@@ -680,6 +680,10 @@ impl SketchTool {
             },
         }
         g.last = pointer;
+        if snap && self.tool == Tool::Move {
+            // Ctrl snaps the move to tenths of a world unit.
+            origin = g.origin + ((origin - g.origin) * 10.0).round() / 10.0;
+        }
         // Every selected item follows the active one: the same shift, the same turn and the
         // same scale, each about its own centre.
         let turn = rotation * g.rotation.inverse();

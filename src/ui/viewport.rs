@@ -5,7 +5,7 @@ use egui::{Color32, Sense};
 
 use super::guide::Guide;
 use super::notice::Notices;
-use super::panels::ViewStats;
+use super::panels::{GeometryUpdate, ViewStats};
 use super::selection::Selection;
 use super::sketch_tool::{SketchTool, ToolContext, ViewInput};
 use crate::derive::Derived;
@@ -113,6 +113,19 @@ impl Viewport {
             (rect.height() * ppp).round().max(1.0) as u32,
         ];
         self.stats.viewport_px = px;
+        // The geometry first, timed apart (the light sweep follows in `update`).
+        let (before, t0) = (cx.derived.work(), super::platform::now());
+        let density = cx.derived.density(scene, cx.doc.revisions());
+        let work = cx.derived.work();
+        if work.bakes > before.bakes {
+            let count = self.stats.geometry_update.map_or(0, |g| g.count) + 1;
+            self.stats.geometry_update = Some(GeometryUpdate {
+                count,
+                ms: (super::platform::now() - t0) * 1e3,
+                texels: work.baked_texels - before.baked_texels,
+                of: density.data.values.len() as u64,
+            });
+        }
         let volumes = cx.derived.update(scene, cx.doc.revisions());
         let aspect = rect.aspect_ratio();
         // Draw the volume only over the part of the view its box covers: fewer pixels to

@@ -9,7 +9,7 @@ import path from 'node:path';
 import { execFileSync } from 'node:child_process';
 import { fileURLToPath } from 'node:url';
 import { PNG } from 'pngjs';
-import { serve, state, screenshot, countChanged, until, withApp, waitForFullQuality, SCREENSHOTS } from './harness.mjs';
+import { serve, state, screenshot, countChanged, until, withApp, waitForFullQuality, recordTiming, SCREENSHOTS } from './harness.mjs';
 
 let server;
 before(async () => { server = await serve(); });
@@ -289,3 +289,35 @@ for (const backend of ['webgpu', 'webgl2']) {
     });
   });
 }
+
+// Thousands of primitives in the page: 2,000 ellipsoids, then one moved at a time. Each move
+// re-evaluates only the bricks it reaches (a partial update, checked by its texel count), and
+// its wall time in the wasm build is recorded (test-results/timings.json) beside the native
+// bench's figure; no time is asserted.
+test('one of 2,000 ellipsoids moved updates only what it reaches (webgpu)', { timeout: 240_000 }, async () => {
+  await withApp({ base: server.url, webgpu: true, query: '?preset=empty', viewport: { width: 1280, height: 800 } }, async (page) => {
+    let seed = 2000;
+    const u = () => ((seed = (seed * 1103515245 + 12345) % 2147483648) / 2147483648);
+    const bank = Array.from({ length: 2000 }, () => ({
+      center: [u() * 24 - 12, u() * 5, u() * 24 - 12],
+      radii: [0.5 + u(), 0.3 + u() * 0.5, 0.5 + u()],
+    }));
+    await page.evaluate((json) => window.cloudsketch.set(`/ellipsoids=${json}`), JSON.stringify(bank));
+    let s = await until(page, (s) => s.scene.ellipsoids.length === 2000 && s.view.geometry_update?.of > 0, '2,000 ellipsoids baked', 120_000);
+    const full = s.view.geometry_update;
+    assert.equal(full.texels, full.of, 'the first bake evaluates every texel');
+    const times = [];
+    for (let k = 0; k < 7; k++) {
+      const count = s.view.geometry_update.count;
+      const i = (k * 283) % 2000;
+      const c = bank[i].center;
+      await page.evaluate((p) => window.cloudsketch.set(p), `/ellipsoids/${i}/center=[${c[0] + 0.4},${c[1]},${c[2]}]`);
+      s = await until(page, (s) => s.view.geometry_update.count > count, `move ${k}`);
+      const g = s.view.geometry_update;
+      assert.ok(g.texels < g.of / 4, `a partial update: ${g.texels} of ${g.of} texels`);
+      times.push(g.ms);
+    }
+    times.sort((a, b) => a - b);
+    recordTiming({ test: 'field_one_of_2000_moved', backend: 'webgpu', medianMs: times[3], fullBakeMs: full.ms, texels: full.of });
+  });
+});

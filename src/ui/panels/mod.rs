@@ -11,7 +11,7 @@ pub use light::LIGHT;
 pub use render::RENDER;
 pub use scene::ScenePanel;
 pub use sketch::SketchPanel;
-pub use view::{ViewPanel, ViewStats, view_keys};
+pub use view::{GeometryUpdate, ViewPanel, ViewStats, view_keys};
 
 use egui::Ui;
 

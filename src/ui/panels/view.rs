@@ -51,6 +51,22 @@ pub struct ViewStats {
     pub frame_seconds: Option<f64>,
     /// Viewport size in pixels.
     pub viewport_px: [u32; 2],
+    /// The last geometry update of the density volume: how many there have been, its wall time
+    /// in milliseconds, the texels it re-evaluated and the grid's texels.
+    pub geometry_update: Option<GeometryUpdate>,
+}
+
+/// One geometry update of the density volume, as the viewport timed it.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct GeometryUpdate {
+    /// Updates so far.
+    pub count: u64,
+    /// Wall time of this one (milliseconds).
+    pub ms: f64,
+    /// Texels it re-evaluated (the rest were copied).
+    pub texels: u64,
+    /// Texels of the grid.
+    pub of: u64,
 }
 
 /// The View group.
