@@ -223,6 +223,14 @@ pub const COPIES: Param = Param::linear(
     6.0,
     2.0,
 );
+/// Sketch: width of the smooth blend between an outline's spheres, inside the outline.
+pub const BLEND: Param = Param::linear(
+    "soft blend",
+    "Smooth the creases where the cloud's spheres meet (inside the outline: its silhouette stays as drawn); 0 is the plain union",
+    0.0,
+    1.0,
+    0.4,
+);
 
 #[cfg(test)]
 mod tests {
@@ -247,6 +255,7 @@ mod tests {
             PRUNE,
             INFLATE,
             COPIES,
+            BLEND,
         ] {
             assert!(
                 p.min < p.max && (p.min..=p.max).contains(&p.default),

@@ -12,7 +12,8 @@ pub use light::{LightParams, LightVolume, sweep};
 pub use planes::{PlaneCache, Shape};
 
 use crate::field::{
-    Baker, Blob, Clip, DensityVolume, Field, MAX_PRIMITIVES, bake_work, resolution_within,
+    Baker, Blob, Clip, DensityVolume, Field, Group, MAX_PRIMITIVES, PlacedInside, bake_work,
+    resolution_within,
 };
 use crate::limits::{MAX_BAKE_WORK, MIN_LOADED_GRID};
 use crate::scene::{DrawingPlane, Revisions, Scene};
@@ -81,14 +82,24 @@ fn assemble(scene: &Scene, shapes: &[Arc<Shape>]) -> Field {
             continue;
         }
         match &**shape {
-            Shape::Outline { spheres, .. } => {
-                let group: Vec<Blob> = spheres
+            Shape::Outline {
+                spheres, inside, ..
+            } => {
+                let blobs: Vec<Blob> = spheres
                     .iter()
                     .take(budget)
                     .map(|s| Blob::sphere(plane.to_world(s.center.as_vec3()), s.radius as f32))
                     .collect();
-                budget -= group.len();
-                field.groups.push(group);
+                budget -= blobs.len();
+                field.groups.push(Group {
+                    blobs,
+                    blend: plane.sketch.blend as f32,
+                    inside: inside.clone().map(|map| PlacedInside {
+                        map,
+                        origin: plane.origin,
+                        to_plane: plane.rotation.inverse(),
+                    }),
+                });
             }
             Shape::Cut(line) => field.clips.push(clip(plane, line.clone())),
             Shape::Unusable(_) => {}

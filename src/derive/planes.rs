@@ -8,6 +8,7 @@ use std::sync::Arc;
 
 use glam::Vec2;
 
+use crate::field::InsideMap;
 use crate::scene::{DrawingPlane, StrokeKind};
 use crate::sketch::{SketchError, Sphere};
 
@@ -18,6 +19,8 @@ pub enum Shape {
     Outline {
         /// Spheres in plane coordinates.
         spheres: Vec<Sphere>,
+        /// How deep each plane point lies inside the outline (where the blend may act).
+        inside: Option<Arc<InsideMap>>,
         /// The pruned chordal axis, as segments in plane coordinates (for the overlay).
         skeleton: Vec<[Vec2; 2]>,
         /// Repairs made to the stroke.
@@ -54,6 +57,7 @@ fn interpret(plane: &DrawingPlane) -> Shape {
             match crate::sketch::interpret(&plane.stroke(), plane.closed, &plane.sketch, plane.seed)
             {
                 Ok(sketch) => Shape::Outline {
+                    inside: InsideMap::new(&sketch.outline.points).map(Arc::new),
                     skeleton: sketch
                         .skeleton
                         .segments

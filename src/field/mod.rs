@@ -7,7 +7,10 @@
 //! surface is the iso-level [`ISO`] = 0.5, and w(1/4) = 0.5 exactly, so an isolated primitive of
 //! visible radius r gets R = 2r: its surface lies exactly at r.
 
+mod inside;
 mod volume;
+
+pub use inside::{InsideMap, PlacedInside};
 
 pub use volume::{
     Baked, Baker, DensityVolume, MAX_RESOLUTION, bake, bake_brute_force, bake_work, density,
@@ -129,18 +132,89 @@ fn line_height(line: &[Vec2], x: f32) -> Option<f32> {
     Some(a.y + (b.y - a.y) * t)
 }
 
+/// One sketched outline's spheres. They combine by their maximum (so the outline's dense
+/// spheres give their union, whose silhouette is the drawn outline), softened by a smooth
+/// maximum of the two largest values where the point lies inside the outline as seen along
+/// its plane's normal: creases between spheres fill in, the silhouette does not move.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Group {
+    /// The spheres.
+    pub blobs: Vec<Blob>,
+    /// Width of the smooth maximum (field units; 0 is the plain maximum).
+    pub blend: f32,
+    /// Where the blend may act, and how far inside the outline it reaches full width.
+    pub inside: Option<PlacedInside>,
+}
+
+/// Polynomial smooth maximum of `a ≥ b` of width `k`: `a` where they differ by `k` or more,
+/// up to `a + k/4` where they are equal.
+#[inline]
+pub fn smooth_max(a: f32, b: f32, k: f32) -> f32 {
+    if k <= 0.0 {
+        return a;
+    }
+    let h = (k - (a - b)).max(0.0) / k;
+    a + h * h * k * 0.25
+}
+
+impl Group {
+    /// A group of spheres combined by their plain maximum.
+    pub fn hard(blobs: Vec<Blob>) -> Self {
+        Self {
+            blobs,
+            ..Default::default()
+        }
+    }
+
+    /// The blend width at `p`: full where `p` is deeper inside the outline than 4% of its
+    /// size, none on or outside it.
+    #[inline]
+    pub fn blend_at(&self, p: Vec3) -> f32 {
+        match &self.inside {
+            _ if self.blend <= 0.0 => 0.0,
+            None => self.blend,
+            Some(inside) => {
+                let t = (inside.depth(p) / (0.04 * inside.map.extent)).clamp(0.0, 1.0);
+                self.blend * t * t * (3.0 - 2.0 * t)
+            }
+        }
+    }
+
+    /// The group's value at `p` from its two largest sphere values there. The blend's width
+    /// grows with the value up to the surface level, so it acts around and inside the surface
+    /// and adds nothing where the spheres barely reach (no haze of k/4 around the cloud).
+    #[inline]
+    pub fn combine(&self, first: f32, second: f32, p: Vec3) -> f32 {
+        if first <= 0.0 || self.blend <= 0.0 {
+            return first.max(0.0);
+        }
+        smooth_max(first, second, self.blend_at(p) * (first / ISO).min(1.0))
+    }
+
+    /// The group's value at `p`.
+    pub fn value(&self, p: Vec3) -> f32 {
+        let (a, b) = self.blobs.iter().map(|b| b.value(p)).fold((0.0, 0.0), top_two);
+        self.combine(a, b, p)
+    }
+}
+
+/// Folds a value into the two largest so far.
+#[inline]
+pub fn top_two((first, second): (f32, f32), v: f32) -> (f32, f32) {
+    if v > first { (v, first) } else { (first, second.max(v)) }
+}
+
 /// The whole field: blended primitives minus clips.
 ///
 /// Ellipsoids are summed (Wyvill blending). The spheres of one sketched outline are first
-/// combined by their maximum, so the outline's dense spheres give exactly their union (its
-/// silhouette is the drawn outline); those per-outline fields are then summed like any other
+/// combined into one value ([`Group`]); those per-outline fields are then summed like any other
 /// primitive, so outlines and ellipsoids blend into one cloud.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Field {
     /// Positive primitives, summed.
     pub blobs: Vec<Blob>,
-    /// Sphere groups (one per sketched outline): max within a group, summed across.
-    pub groups: Vec<Vec<Blob>>,
+    /// Sphere groups (one per sketched outline), summed across.
+    pub groups: Vec<Group>,
     /// Hard clips.
     pub clips: Vec<Clip>,
 }
@@ -156,7 +230,9 @@ impl Field {
 
     /// Every primitive, summed ones and grouped ones.
     pub fn all_blobs(&self) -> impl Iterator<Item = &Blob> {
-        self.blobs.iter().chain(self.groups.iter().flatten())
+        self.blobs
+            .iter()
+            .chain(self.groups.iter().flat_map(|g| &g.blobs))
     }
 
     /// Field value at `p`.
@@ -165,11 +241,7 @@ impl Field {
             return 0.0;
         }
         let summed: f32 = self.blobs.iter().map(|b| b.value(p)).sum();
-        let grouped: f32 = self
-            .groups
-            .iter()
-            .map(|g| g.iter().map(|b| b.value(p)).fold(0.0, f32::max))
-            .sum();
+        let grouped: f32 = self.groups.iter().map(|g| g.value(p)).sum();
         summed + grouped
     }
 

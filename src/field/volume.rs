@@ -249,6 +249,27 @@ impl Dirty {
     }
 }
 
+/// Calls `sink` with the index and centre of every dirty texel of box `bx`, counting them.
+#[inline]
+fn splat(
+    dirty: &Dirty,
+    dims: UVec3,
+    [xs_c, ys_c, zs_c]: &[Vec<f32>; 3],
+    bx: (UVec3, UVec3),
+    work: &mut u64,
+    mut sink: impl FnMut(usize, Vec3),
+) {
+    let (nx, ny) = (dims.x as usize, dims.y as usize);
+    for (row, xs) in dirty.rows(dims, bx) {
+        let (j, k) = ((row / nx) % ny, row / (nx * ny));
+        *work += xs.len() as u64;
+        let (y, z) = (ys_c[j], zs_c[k]);
+        for i in xs {
+            sink(row + i, Vec3::new(xs_c[i], y, z));
+        }
+    }
+}
+
 /// Evaluates `field` at the dirty texels of `values` (laid out on `grid`): clears them, sums the
 /// primitives, adds each group's maximum and applies the clips. Every texel is computed by the
 /// same operations in the same order whichever bricks are dirty, so a partial update equals a
@@ -276,28 +297,21 @@ fn evaluate(field: &Field, grid: &Grid, dirty: &Dirty, values: &mut [f32]) -> u6
         let r = b.extent * SUPPORT;
         (b.center + r).cmplt(wlo).any() || (b.center - r).cmpgt(whi).any()
     };
-    let mut splat = |blob: &Blob, out: &mut [f32], combine: fn(f32, f32) -> f32| {
-        if misses(blob) {
-            return;
-        }
-        let Some(bx) = grid.texel_box(blob) else { return };
-        for (row, xs) in dirty.rows(dims, bx) {
-            let (j, k) = ((row / nx) % ny, row / (nx * ny));
-            work += xs.len() as u64;
-            for i in xs {
-                let v = &mut out[row + i];
-                *v = combine(*v, blob.value(center(i, j, k)));
-            }
-        }
-    };
+    let reach = |blob: &Blob| (!misses(blob)).then(|| grid.texel_box(blob)).flatten();
+    let centers = grid.centers();
     for blob in &field.blobs {
-        splat(blob, values, |a, b| a + b);
+        if let Some(bx) = reach(blob) {
+            splat(dirty, dims, &centers, bx, &mut work, |at, p| values[at] += blob.value(p));
+        }
     }
     if !field.groups.is_empty() {
-        // One scratch grid; each group clears and adds back only the box it reaches.
-        let mut group_values = vec![0f32; values.len()];
+        // Scratch grids of each group's two largest values; each group clears and adds back
+        // only the box it reaches.
+        let mut first = vec![0f32; values.len()];
+        let mut second = vec![0f32; values.len()];
         for group in &field.groups {
             let Some(bx) = group
+                .blobs
                 .iter()
                 .filter_map(|b| grid.texel_box(b))
                 .reduce(|(a, b), (c, d)| (a.min(c), b.max(d)))
@@ -305,17 +319,20 @@ fn evaluate(field: &Field, grid: &Grid, dirty: &Dirty, values: &mut [f32]) -> u6
                 continue;
             };
             for (row, xs) in dirty.rows(dims, bx) {
-                group_values[row + xs.start..row + xs.end].fill(0.0);
+                first[row + xs.start..row + xs.end].fill(0.0);
+                second[row + xs.start..row + xs.end].fill(0.0);
             }
-            for blob in group {
-                splat(blob, &mut group_values, f32::max);
-            }
-            for (row, xs) in dirty.rows(dims, bx) {
-                let span = row + xs.start..row + xs.end;
-                for (v, g) in values[span.clone()].iter_mut().zip(&group_values[span]) {
-                    *v += g;
+            for blob in &group.blobs {
+                if let Some(bx) = reach(blob) {
+                    splat(dirty, dims, &centers, bx, &mut work, |at, p| {
+                        (first[at], second[at]) =
+                            super::top_two((first[at], second[at]), blob.value(p));
+                    });
                 }
             }
+            splat(dirty, dims, &centers, bx, &mut work, |at, p| {
+                values[at] += group.combine(first[at], second[at], p)
+            });
         }
     }
     if !field.clips.is_empty() {
@@ -418,10 +435,16 @@ fn blob_key(b: &Blob) -> [u32; 16] {
     k
 }
 
-fn group_key(group: &[Blob]) -> u64 {
+fn group_key(group: &super::Group) -> u64 {
     let mut hasher = std::hash::DefaultHasher::new();
-    for b in group {
+    for b in &group.blobs {
         blob_key(b).hash(&mut hasher);
+    }
+    group.blend.to_bits().hash(&mut hasher);
+    if let Some(inside) = &group.inside {
+        for f in inside.origin.to_array().into_iter().chain(inside.to_plane.to_array()) {
+            f.to_bits().hash(&mut hasher);
+        }
     }
     hasher.finish()
 }
@@ -453,7 +476,9 @@ fn changed_boxes(old: &Field, new: &Field) -> Option<Vec<(Vec3, Vec3)>> {
         let changed = |b: &&Blob| count[&blob_key(b)] != 0;
         boxes.extend(old.blobs.iter().chain(&new.blobs).filter(changed).map(reach));
     }
-    let group_box = |g: &Vec<Blob>| g.iter().map(reach).reduce(|(a, b), (c, d)| (a.min(c), b.max(d)));
+    let group_box = |g: &super::Group| {
+        g.blobs.iter().map(reach).reduce(|(a, b), (c, d)| (a.min(c), b.max(d)))
+    };
     if old.groups.len() == new.groups.len() {
         for (a, b) in old.groups.iter().zip(&new.groups) {
             if a != b {
@@ -670,8 +695,13 @@ mod tests {
         let f = Field {
             blobs: vec![Blob::sphere(Vec3::new(0.0, 1.0, 0.0), 1.2)],
             groups: vec![
-                group(Vec3::new(-2.0, 0.0, 0.0)),
-                group(Vec3::new(1.0, -1.0, 0.5)),
+                // One softened everywhere, one a plain maximum.
+                super::super::Group {
+                    blobs: group(Vec3::new(-2.0, 0.0, 0.0)),
+                    blend: 0.15,
+                    inside: None,
+                },
+                super::super::Group::hard(group(Vec3::new(1.0, -1.0, 0.5))),
             ],
             clips: vec![super::super::Clip {
                 origin: Vec3::ZERO,
@@ -736,7 +766,11 @@ mod tests {
         };
         let mut field = Field {
             blobs: blobs.clone(),
-            groups: vec![group.clone()],
+            groups: vec![super::super::Group {
+                blobs: group.clone(),
+                blend: 0.15,
+                inside: None,
+            }],
             clips: vec![clip],
         };
         let mut baker = Baker::default();
@@ -753,7 +787,7 @@ mod tests {
                 3 => {
                     blobs.remove(i);
                 }
-                4 => field.groups[0][3].center.y += 0.4,
+                4 => field.groups[0].blobs[3].center.y += 0.4,
                 // Past the box: the grid grows on the same lattice.
                 _ => blobs[i].center.x = 11.0 + step as f32 * 0.1,
             }
@@ -904,7 +938,14 @@ mod tests {
     fn the_culled_bake_equals_brute_force() {
         let f = Field {
             blobs: scatter(60, 11),
-            groups: vec![scatter(20, 12), scatter(15, 13)],
+            groups: vec![
+                super::super::Group::hard(scatter(20, 12)),
+                super::super::Group {
+                    blobs: scatter(15, 13),
+                    blend: 0.2,
+                    inside: None,
+                },
+            ],
             clips: vec![],
         };
         let (culled, brute) = (bake(&f, 40), bake_brute_force(&f, 40));

@@ -50,6 +50,9 @@ pub struct SketchParams {
     pub extend: bool,
     /// Copies of each terminal branch placed around the trunk by the extension.
     pub copies: u32,
+    /// Width of the smooth maximum between the spheres inside the outline (the field's
+    /// [`crate::field::Group`]; it does not change the spheres).
+    pub blend: f64,
 }
 
 impl Default for SketchParams {
@@ -60,6 +63,7 @@ impl Default for SketchParams {
             inflate: limits::INFLATE.default,
             extend: true,
             copies: limits::COPIES.default as u32,
+            blend: limits::BLEND.default,
         }
     }
 }
@@ -71,6 +75,7 @@ impl SketchParams {
         self.prune = limits::PRUNE.fix(self.prune);
         self.inflate = limits::INFLATE.fix(self.inflate);
         self.copies = limits::COPIES.fix_u32(self.copies);
+        self.blend = limits::BLEND.fix(self.blend);
     }
 }
 

@@ -648,12 +648,12 @@ fn the_cloud_is_thick_along_the_planes_normal() {
         let flat = interpret(&shape, true, &no_extend(), 3).unwrap();
         let h = height(&s);
         let field = Field {
-            groups: vec![
+            groups: vec![crate::field::Group::hard(
                 s.spheres
                     .iter()
                     .map(|q| Blob::sphere(q.center.as_vec3(), q.radius as f32))
                     .collect(),
-            ],
+            )],
             ..Default::default()
         };
         let p = &s.outline.points;

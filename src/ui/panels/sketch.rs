@@ -153,6 +153,7 @@ fn plane_controls(ui: &mut Ui, doc: &mut Document, i: usize) {
         ui.add_enabled_ui(s.extend, |ui| {
             param(ui, &mut s.copies, &limits::COPIES);
         });
+        param(ui, &mut s.blend, &limits::BLEND);
     }
     vec3_fields(ui, "move", &mut plane.origin, 0.05);
     rotation_fields(ui, &mut plane.rotation);
