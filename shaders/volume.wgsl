@@ -30,10 +30,23 @@ fn vs_main(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> 
     return out;
 }
 
-// Sum of noise octaves in [0, 1], each octave a look-up of the periodic noise volume through
-// its own transform.
+// Table 2's filters (Schpok et al. 2003) of one octave's noise t in [0, 1] (signed n = 2t − 1):
+// stratus n, cumulus |n|, wispy 1 − |2n|, veined (1 + |10n|)⁻¹; each in [0, 1].
+fn filtered(t: f32) -> f32 {
+    let n = 2.0 * t - 1.0;
+    switch i32(u.noise.z) {
+        case 1: { return abs(n); }
+        case 2: { return clamp(1.0 - abs(2.0 * n), 0.0, 1.0); }
+        case 3: { return 1.0 / (1.0 + abs(10.0 * n)); }
+        default: { return t; }
+    }
+}
+
+// Sum of filtered noise octaves in [0, 1], each octave a look-up of the periodic noise volume
+// (Perlin in red, Worley in green) through its own transform.
 fn fbm(p: vec3<f32>) -> f32 {
     let octaves = i32(u.noise.y);
+    let worley = u.noise.w > 0.5;
     var amp = 1.0;
     var sum = 0.0;
     var norm = 0.0;
@@ -42,7 +55,8 @@ fn fbm(p: vec3<f32>) -> f32 {
             break;
         }
         let q = (u.octaves[i] * vec4<f32>(p, 1.0)).xyz;
-        sum = sum + amp * textureSampleLevel(noise_tex, repeat_smp, q, 0.0).r;
+        let s = textureSampleLevel(noise_tex, repeat_smp, q, 0.0);
+        sum = sum + amp * filtered(select(s.r, s.g, worley));
         norm = norm + amp;
         amp = amp * u.noise.x;
     }
@@ -71,7 +85,16 @@ fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
     }
     let view_dir = select(u.forward.xyz, normalize(in.world - u.eye.xyz), u.eye.w > 0.5);
     let path = u.slicing.z / max(dot(view_dir, u.forward.xyz), 0.2);
-    let alpha = 1.0 - exp(-u.media.x * density * path);
+    // Sharpness (Table 2): the alpha cut-off is Sharpness × this slice's opacity at full
+    // density, and what is above it is stretched back to that opacity: the faint fringe goes,
+    // the core keeps its opacity, and the edge's ramp steepens.
+    let full = 1.0 - exp(-u.media.x * path);
+    let cut = u.slicing.w * full;
+    let raw = 1.0 - exp(-u.media.x * density * path);
+    let alpha = full * max(raw - cut, 0.0) / max(full - cut, 1e-6);
+    if alpha <= 0.0 {
+        discard;
+    }
     let light = u.sun_color.rgb * sample.g + u.sky_color.rgb;
     return vec4<f32>(light * alpha, alpha);
 }

@@ -19,14 +19,16 @@ struct Volume {
     grid_inv_size: vec4<f32>,
     // Bounding sphere: centre (xyz), radius (w).
     sphere: vec4<f32>,
-    // x: total slices, y: first slice of this draw (0 = farthest), z: slice spacing (world).
+    // x: total slices, y: first slice of this draw (0 = farthest), z: slice spacing (world),
+    // w: Sharpness (the alpha cut-off as a share of the slice's full opacity).
     slicing: vec4<f32>,
     // Linear sun colour × intensity, sky colour × ambient (rgb).
     sun_color: vec4<f32>,
     sky_color: vec4<f32>,
     // x: extinction per world unit, y: iso-level, z: soft-edge half-width, w: noise amount.
     media: vec4<f32>,
-    // x: amplitude gain per octave, y: octaves.
+    // x: amplitude gain per octave, y: octaves, z: Table 2 filter (0 stratus, 1 cumulus,
+    // 2 wispy, 3 veined), w: basis (0 Perlin, 1 Worley).
     noise: vec4<f32>,
     // Per-octave transform of world positions into noise-texture coordinates
     // (scale × rotation × translation; the scale grows by the lacunarity per octave).

@@ -16,6 +16,8 @@ pub const MAX_OUTLINE_POINTS: usize = 320;
 pub const MAX_SPHERES: usize = 3000;
 /// Most primitives in one field (sketches make many spheres; the cap keeps baking bounded).
 pub const MAX_PRIMITIVES: usize = 20_000;
+/// Latest scene time (seconds): a day of playing.
+pub const MAX_TIME: f32 = 86_400.0;
 /// Most texels along one side of the density volume.
 pub const MAX_GRID_RESOLUTION: u32 = 128;
 /// Most work one bake of the density volume may do (kernel evaluations plus clip tests; about
@@ -118,7 +120,31 @@ pub const FIELD_RESOLUTION: Param = Param::linear(
 );
 /// Noise octaves.
 pub const OCTAVES: Param =
-    Param::linear("octaves", "Layers of finer and finer noise", 0.0, 4.0, 3.0);
+    Param::linear("octaves", "Layers of finer and finer noise", 0.0, 8.0, 3.0);
+/// Sharpness: the alpha cut-off as a share of one slice's opacity (Schpok et al., Table 2).
+pub const SHARPNESS: Param = Param::linear(
+    "sharpness",
+    "Cut the faint fringe off the cloud's edges (it does not shrink the cloud when opacity changes)",
+    0.0,
+    0.9,
+    0.0,
+);
+/// Wind: drift of the noise per second of scene time, per horizontal axis (world units).
+pub const WIND: Param = Param::linear(
+    "wind",
+    "How fast the noise drifts while the scene plays (world units per second)",
+    -5.0,
+    5.0,
+    0.0,
+);
+/// Torque: turn of the noise about the vertical per second of scene time (degrees).
+pub const TORQUE: Param = Param::linear(
+    "torque",
+    "How fast the noise turns while the scene plays (degrees per second)",
+    -90.0,
+    90.0,
+    0.0,
+);
 /// Opacity: extinction per world unit of the densest cloud.
 pub const OPACITY: Param = Param::log(
     "opacity",
@@ -256,6 +282,9 @@ mod tests {
             INFLATE,
             COPIES,
             BLEND,
+            SHARPNESS,
+            WIND,
+            TORQUE,
         ] {
             assert!(
                 p.min < p.max && (p.min..=p.max).contains(&p.default),

@@ -151,3 +151,86 @@ fn more_opacity_more_cover() {
         "opacity 6 covers {thick} px, 0.2 covers {thin} px"
     );
 }
+
+/// Pixels whose colour differs by more than 24/255 (summed) between two images.
+fn changed(a: &cloudsketch::render::offscreen::Image, b: &cloudsketch::render::offscreen::Image) -> usize {
+    a.rgba
+        .chunks(4)
+        .zip(b.rgba.chunks(4))
+        .filter(|(p, q)| (0..3).map(|i| (p[i] as i32 - q[i] as i32).abs()).sum::<i32>() > 24)
+        .count()
+}
+
+#[test]
+fn table_2_filters_and_the_worley_basis_each_change_the_media() {
+    // Each filter changes a tenth of the cloud's pixels or more against every other filter,
+    // and so does the other basis (the same document always gives the same image, so any
+    // difference comes from the media).
+    let base = with(&Scene::default(), &["/render/slices=64", "/render/noise_amount=0.6"]);
+    let images: Vec<_> = ["stratus", "cumulus", "wispy", "veined"]
+        .iter()
+        .map(|f| render(&with(&base, &[&format!("/render/noise_filter=\"{f}\"")])))
+        .collect();
+    let cloud = images[0]
+        .rgba
+        .chunks(4)
+        .filter(|p| differs([p[0], p[1], p[2], p[3]], background(&base)))
+        .count();
+    for i in 0..images.len() {
+        for j in i + 1..images.len() {
+            let d = changed(&images[i], &images[j]);
+            assert!(d > cloud / 10, "filters {i} and {j}: {d} of {cloud} cloud px differ");
+        }
+    }
+    let worley = render(&with(&base, &["/render/noise_basis=\"worley\""]));
+    let d = changed(&images[0], &worley);
+    assert!(d > cloud / 10, "Worley vs Perlin: {d} of {cloud} px");
+}
+
+#[test]
+fn sharpness_trims_the_fringe_without_shrinking_the_core() {
+    let base = with(&Scene::default(), &["/render/slices=64"]);
+    let bg = background(&base);
+    // Fringe: pixels off the sky by 7–60 (summed over channels); core: more than 60.
+    let measure = |s: &Scene| {
+        let image = render(s);
+        let mut fringe = 0;
+        let mut core = 0;
+        for p in image.rgba.chunks(4) {
+            let d: i32 = (0..3).map(|i| (p[i] as i32 - bg[i] as i32).abs()).sum();
+            if d > 60 {
+                core += 1;
+            } else if d > 6 {
+                fringe += 1;
+            }
+        }
+        (fringe, core)
+    };
+    let (soft_fringe, soft_core) = measure(&base);
+    let (sharp_fringe, sharp_core) = measure(&with(&base, &["/render/sharpness=0.8"]));
+    assert!(
+        (sharp_fringe as f64) < 0.8 * soft_fringe as f64,
+        "fringe {soft_fringe} → {sharp_fringe} px"
+    );
+    assert!(
+        sharp_core as f64 > 0.85 * soft_core as f64,
+        "core {soft_core} → {sharp_core} px"
+    );
+}
+
+#[test]
+fn wind_moves_the_media_over_scene_time_and_calm_air_does_not() {
+    let base = with(&Scene::default(), &["/render/slices=64", "/render/noise_amount=0.6"]);
+    let at = |s: &Scene, t: f32| {
+        let mut s = s.clone();
+        s.time = t;
+        render(&s)
+    };
+    assert_eq!(at(&base, 0.0), at(&base, 3.0), "no wind, no torque: time changes nothing");
+    let windy = with(&base, &["/render/wind=[1.5,0]"]);
+    let d = changed(&at(&windy, 0.0), &at(&windy, 1.0));
+    assert!(d > 500, "the wind moved the noise: {d} px changed");
+    let turning = with(&base, &["/render/torque=30"]);
+    let d = changed(&at(&turning, 0.0), &at(&turning, 1.0));
+    assert!(d > 500, "the torque turned the noise: {d} px changed");
+}

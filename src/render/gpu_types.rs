@@ -8,7 +8,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Quat, Vec3};
 
 use crate::field::{DensityVolume, ISO};
-use crate::scene::{Lighting, OrbitCamera, RenderSettings};
+use crate::scene::{Lighting, NoiseBasis, NoiseFilter, OrbitCamera, RenderSettings};
 
 /// Noise octaves the slice shader can composite (`MAX_OCTAVES` in volume_common.wgsl).
 pub const MAX_OCTAVES: usize = 8;
@@ -34,7 +34,8 @@ pub struct VolumeUniforms {
     /// Bounding sphere of the volume: centre (xyz), radius (w).
     pub sphere: [f32; 4],
     /// x: total slices, y: index of the first slice of this draw (0 = farthest),
-    /// z: spacing between slices in world units, w: unused.
+    /// z: spacing between slices in world units, w: Sharpness (the alpha cut-off as a share of
+    /// a slice's opacity at full density, Table 2).
     pub slicing: [f32; 4],
     /// Linear sun colour × intensity (rgb).
     pub sun_color: [f32; 4],
@@ -42,7 +43,8 @@ pub struct VolumeUniforms {
     pub sky_color: [f32; 4],
     /// x: extinction per world unit, y: iso-level, z: soft-edge half-width, w: noise amount.
     pub media: [f32; 4],
-    /// x: amplitude gain per octave, y: octaves in use, zw: unused.
+    /// x: amplitude gain per octave, y: octaves in use, z: Table 2 filter (0 stratus,
+    /// 1 cumulus, 2 wispy, 3 veined), w: basis (0 Perlin, 1 Worley).
     pub noise: [f32; 4],
     /// Per-octave transform of world positions into noise-texture coordinates.
     pub octaves: [[[f32; 4]; 4]; MAX_OCTAVES],
@@ -58,6 +60,8 @@ pub struct View {
     pub light: Lighting,
     /// Media and quality.
     pub render: RenderSettings,
+    /// The scene clock (seconds): how far wind and torque have carried the noise.
+    pub time: f32,
     /// Width / height of the whole view.
     pub aspect: f32,
     /// The part of the view this image covers, in normalised device coordinates
@@ -93,14 +97,23 @@ pub fn crop_matrix(crop: [f32; 4]) -> Mat4 {
     ])
 }
 
-/// Transform of octave `i`: world → noise-texture coordinates, scale × rotate × translate with
-/// frequency `base × lacunarity^i`. Octaves are turned against each other so their lattices do
-/// not line up.
-pub fn octave_transform(render: &RenderSettings, i: usize) -> Mat4 {
+/// Transform of octave `i` at scene time `time`: world → noise-texture coordinates, scale ×
+/// rotate × translate with frequency `base × lacunarity^i`. Octaves are turned against each
+/// other so their lattices do not line up. The wind carries the noise along (world units per
+/// second) and the torque turns it about the vertical through the origin, each octave
+/// `1 + i/2` times as fast as the first (finer detail moves faster, as turbulence does).
+pub fn octave_transform(render: &RenderSettings, i: usize, time: f32) -> Mat4 {
     let freq = render.detail.powi(i as i32) / render.noise_scale.max(1e-3);
     let turn = Quat::from_axis_angle(Vec3::new(0.3, 1.0, 0.2).normalize(), i as f32 * 0.9);
     let shift = Vec3::new(0.37, 0.11, 0.73) * i as f32;
-    Mat4::from_translation(shift) * Mat4::from_quat(turn) * Mat4::from_scale(Vec3::splat(freq))
+    let speed = time * (1.0 + 0.5 * i as f32);
+    let [wx, wz] = render.wind;
+    let drift = Mat4::from_rotation_y(-(render.torque * speed).to_radians())
+        * Mat4::from_translation(-Vec3::new(wx, 0.0, wz) * speed);
+    Mat4::from_translation(shift)
+        * Mat4::from_quat(turn)
+        * Mat4::from_scale(Vec3::splat(freq))
+        * drift
 }
 
 impl VolumeUniforms {
@@ -132,6 +145,17 @@ impl VolumeUniforms {
         let sky_color = srgb_to_linear(light.sky_color) * light.ambient;
         let inv_size = Vec3::ONE / volume.size.max(Vec3::splat(1e-6));
         let octaves = r.noise_octaves.min(MAX_OCTAVES as u32);
+        let spacing = 2.0 * radius / total as f32;
+        let filter = match r.noise_filter {
+            NoiseFilter::Stratus => 0.0,
+            NoiseFilter::Cumulus => 1.0,
+            NoiseFilter::Wispy => 2.0,
+            NoiseFilter::Veined => 3.0,
+        };
+        let basis = match r.noise_basis {
+            NoiseBasis::Perlin => 0.0,
+            NoiseBasis::Worley => 1.0,
+        };
         Self {
             view_proj: (crop_matrix(view.crop) * camera.view_projection(view.aspect))
                 .to_cols_array_2d(),
@@ -146,7 +170,12 @@ impl VolumeUniforms {
             grid_min: volume.min.extend(0.0).to_array(),
             grid_inv_size: inv_size.extend(0.0).to_array(),
             sphere: center.extend(radius).to_array(),
-            slicing: [total as f32, first as f32, 2.0 * radius / total as f32, 0.0],
+            slicing: [
+                total as f32,
+                first as f32,
+                spacing,
+                r.sharpness,
+            ],
             sun_color: sun_color.extend(1.0).to_array(),
             sky_color: sky_color.extend(1.0).to_array(),
             media: [
@@ -155,8 +184,8 @@ impl VolumeUniforms {
                 r.softness,
                 if octaves == 0 { 0.0 } else { r.noise_amount },
             ],
-            noise: [0.5, octaves as f32, 0.0, 0.0],
-            octaves: std::array::from_fn(|i| octave_transform(r, i).to_cols_array_2d()),
+            noise: [0.5, octaves as f32, filter, basis],
+            octaves: std::array::from_fn(|i| octave_transform(r, i, view.time).to_cols_array_2d()),
         }
     }
 }
@@ -186,6 +215,7 @@ mod tests {
             camera: scene.camera.clone(),
             light: scene.light.clone(),
             render: scene.render.clone(),
+            time: 0.0,
             aspect: 1.5,
             crop: FULL_VIEW,
         };
@@ -214,11 +244,29 @@ mod tests {
     }
 
     #[test]
+    fn wind_carries_the_noise_and_finer_octaves_move_faster() {
+        let mut r = RenderSettings::default();
+        r.wind = [2.0, 0.0];
+        let p = Vec3::new(1.0, 2.0, 3.0);
+        // After t seconds, the noise seen at p + wind·t·speed is what was at p at time 0.
+        for i in [0, 3] {
+            let speed = 1.0 + 0.5 * i as f32;
+            let before = octave_transform(&r, i, 0.0).transform_point3(p);
+            let moved = p + Vec3::new(2.0, 0.0, 0.0) * 1.5 * speed;
+            let after = octave_transform(&r, i, 1.5).transform_point3(moved);
+            assert!(before.abs_diff_eq(after, 1e-4), "octave {i}: {before} vs {after}");
+        }
+        // Without wind or torque, time changes nothing.
+        let calm = RenderSettings::default();
+        assert_eq!(octave_transform(&calm, 2, 0.0), octave_transform(&calm, 2, 9.0));
+    }
+
+    #[test]
     fn octave_frequency_grows_by_the_lacunarity() {
         let r = RenderSettings::default();
         let p = Vec3::new(1.0, 0.0, 0.0);
         let len = |i| {
-            let m = octave_transform(&r, i);
+            let m = octave_transform(&r, i, 0.0);
             (m.transform_point3(p) - m.transform_point3(Vec3::ZERO)).length()
         };
         assert!((len(0) - 1.0 / r.noise_scale).abs() < 1e-5);

@@ -1,7 +1,9 @@
 //! The periodic noise volume the slice shader samples for its octaves (pure CPU code).
 //!
-//! Gradient (Perlin) noise on a lattice that wraps, so the texture tiles seamlessly with a
-//! repeating sampler; values are rescaled to fill [0, 1]. Deterministic for a given seed.
+//! Two bases on lattices that wrap, so the texture tiles seamlessly with a repeating sampler:
+//! gradient (Perlin) noise in the red channel and cellular (Worley) noise — one minus the
+//! distance to the nearest of one feature point per cell — in the green. Each is rescaled to
+//! fill [0, 1]. Deterministic for a given seed.
 
 /// Texels along each side of the noise volume.
 pub const NOISE_SIZE: u32 = 32;
@@ -50,21 +52,37 @@ fn perlin(seed: u64, p: [f32; 3]) -> f32 {
     sum
 }
 
-/// `NOISE_SIZE³` bytes of tileable noise in [0, 255], x fastest.
-pub fn noise_volume(seed: u64) -> Vec<u8> {
-    let n = NOISE_SIZE;
-    let scale = LATTICE as f32 / n as f32;
-    let mut values = Vec::with_capacity((n * n * n) as usize);
-    for z in 0..n {
-        for y in 0..n {
-            for x in 0..n {
-                values.push(perlin(
-                    seed,
-                    [x as f32 * scale, y as f32 * scale, z as f32 * scale],
-                ));
+/// The feature point of lattice cell `c` (wrapped), in cell units.
+fn feature(seed: u64, c: [i64; 3]) -> [f32; 3] {
+    let l = c.map(|v| v.rem_euclid(LATTICE as i64) as u64);
+    let h = hash64(seed ^ 0xC311 ^ hash64((l[0] << 42) | (l[1] << 21) | l[2]));
+    [0, 21, 42].map(|shift| ((h >> shift) & 0x1F_FFFF) as f32 / 0x1F_FFFF as f32)
+}
+
+/// Tileable cellular noise at a lattice-space point: the distance to the nearest feature point.
+fn worley(seed: u64, p: [f32; 3]) -> f32 {
+    let cell = p.map(|v| v.floor() as i64);
+    let mut best = f32::MAX;
+    for dz in -1..=1 {
+        for dy in -1..=1 {
+            for dx in -1..=1 {
+                let c = [cell[0] + dx, cell[1] + dy, cell[2] + dz];
+                let f = feature(seed, c);
+                let d2: f32 = (0..3)
+                    .map(|i| {
+                        let d = c[i] as f32 + f[i] - p[i];
+                        d * d
+                    })
+                    .sum();
+                best = best.min(d2);
             }
         }
     }
+    best.sqrt()
+}
+
+/// Rescales values to fill [0, 255].
+fn to_bytes(values: &[f32]) -> Vec<u8> {
     let (lo, hi) = values
         .iter()
         .fold((f32::MAX, f32::MIN), |(lo, hi), &v| (lo.min(v), hi.max(v)));
@@ -73,6 +91,22 @@ pub fn noise_volume(seed: u64) -> Vec<u8> {
         .iter()
         .map(|v| ((v - lo) / span * 255.0).round() as u8)
         .collect()
+}
+
+/// `NOISE_SIZE³` texels of tileable noise as `Rg8Unorm` bytes: Perlin in red, Worley in green,
+/// x fastest.
+pub fn noise_volume(seed: u64) -> Vec<u8> {
+    let n = NOISE_SIZE;
+    let scale = LATTICE as f32 / n as f32;
+    let points = (0..n).flat_map(|z| {
+        (0..n).flat_map(move |y| {
+            (0..n).map(move |x| [x as f32 * scale, y as f32 * scale, z as f32 * scale])
+        })
+    });
+    let (gradient, cellular): (Vec<f32>, Vec<f32>) =
+        points.map(|p| (perlin(seed, p), -worley(seed, p))).unzip();
+    let (r, g) = (to_bytes(&gradient), to_bytes(&cellular));
+    r.into_iter().zip(g).flat_map(|(a, b)| [a, b]).collect()
 }
 
 #[cfg(test)]
@@ -84,11 +118,27 @@ mod tests {
         let a = noise_volume(7);
         assert_eq!(a, noise_volume(7));
         assert_ne!(a, noise_volume(8));
-        assert_eq!(a.len(), (NOISE_SIZE * NOISE_SIZE * NOISE_SIZE) as usize);
-        assert_eq!(*a.iter().min().unwrap(), 0);
-        assert_eq!(*a.iter().max().unwrap(), 255);
-        let mean = a.iter().map(|&v| v as f64).sum::<f64>() / a.len() as f64;
-        assert!((mean - 127.5).abs() < 30.0, "{mean}");
+        assert_eq!(a.len(), 2 * (NOISE_SIZE * NOISE_SIZE * NOISE_SIZE) as usize);
+        for channel in 0..2 {
+            let c: Vec<u8> = a.iter().skip(channel).step_by(2).copied().collect();
+            assert_eq!(*c.iter().min().unwrap(), 0);
+            assert_eq!(*c.iter().max().unwrap(), 255);
+            let mean = c.iter().map(|&v| v as f64).sum::<f64>() / c.len() as f64;
+            assert!((mean - 127.5).abs() < 60.0, "channel {channel}: {mean}");
+        }
+        // The two bases are different noises.
+        let same = a.chunks(2).filter(|p| p[0].abs_diff(p[1]) < 8).count();
+        assert!(same < a.len() / 2 / 4, "{same}");
+    }
+
+    #[test]
+    fn worley_is_zero_at_feature_points_and_tiles() {
+        let f = feature(3, [2, 5, 1]);
+        let at = [2.0 + f[0], 5.0 + f[1], 1.0 + f[2]];
+        assert!(worley(3, at) < 1e-5);
+        let q = at.map(|v| v + LATTICE as f32);
+        assert!((worley(3, [0.3, 1.7, 2.2]) - worley(3, [0.3 + 8.0, 1.7, 2.2 - 8.0])).abs() < 1e-5);
+        assert!(worley(3, q) < 1e-4);
     }
 
     #[test]

@@ -196,6 +196,7 @@ impl Offscreen {
                 camera: scene.camera.clone(),
                 light: scene.light.clone(),
                 render: scene.render.clone(),
+                time: scene.time,
                 aspect: width as f32 / height as f32,
                 crop: FULL_VIEW,
             },

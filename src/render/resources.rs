@@ -122,7 +122,7 @@ impl VolumeTextures {
                 queue,
                 "noise",
                 [n, n, n],
-                wgpu::TextureFormat::R8Unorm,
+                wgpu::TextureFormat::Rg8Unorm,
                 &bytes,
             )
         });

@@ -83,7 +83,7 @@ fn diff(a: &Scene, b: &Scene) -> Changed {
             || !same(&a.ellipsoids, &b.ellipsoids)
             || !same(&a.planes, &b.planes),
         light: a.light != b.light,
-        render: a.render != b.render,
+        render: a.render != b.render || a.time != b.time,
         camera: a.camera != b.camera,
         reference: a.reference != b.reference,
     }
@@ -227,6 +227,18 @@ impl Document {
         }
     }
 
+    /// Sets the scene clock (playing, scrubbing). Not an undo step; bumps the render revision.
+    pub fn set_time(&mut self, time: f32) {
+        let time = if time.is_finite() { time.clamp(0.0, crate::limits::MAX_TIME) } else { 0.0 };
+        if time != self.scene.time {
+            self.scene.time = time;
+            self.bump(Changed {
+                render: true,
+                ..Default::default()
+            });
+        }
+    }
+
     /// Ends the current merge run (pointer released), so the next edit is a new step.
     pub fn end_merge(&mut self) {
         self.last_key = None;
@@ -278,6 +290,7 @@ impl Document {
     fn restore(&mut self, step: Step) -> Step {
         let mut scene = step.scene;
         scene.camera = self.scene.camera.clone();
+        scene.time = self.scene.time;
         let changed = diff(&self.scene, &scene);
         self.last_key = None;
         let previous = std::mem::replace(&mut self.scene, scene);

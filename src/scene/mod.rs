@@ -71,6 +71,9 @@ pub struct Scene {
     /// The picture to trace, placed in the scene.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub reference: Option<Arc<ReferenceImage>>,
+    /// The scene clock in seconds: where the media's wind and torque have carried the noise.
+    /// Playing advances it; like the camera it is not an undo step.
+    pub time: f32,
 }
 
 impl Default for Scene {
@@ -137,6 +140,7 @@ impl Scene {
             ellipsoids,
             planes: Vec::new(),
             reference: None,
+            time: 0.0,
         }
     }
 
@@ -241,6 +245,9 @@ impl Scene {
         self.camera.sanitize();
         self.light.sanitize();
         self.render.sanitize();
+        if !self.time.is_finite() || !(0.0..=limits::MAX_TIME).contains(&self.time) {
+            self.time = if self.time.is_finite() { self.time.clamp(0.0, limits::MAX_TIME) } else { 0.0 };
+        }
         Ok(())
     }
 }
@@ -342,7 +349,49 @@ impl Lighting {
     }
 }
 
-/// Render quality and cloud media (the seed of Schpok et al.'s Table 2 controls).
+/// Table 2's noise filters (Schpok et al. 2003), applied to each octave's signed noise n in
+/// [−1, 1]; each gives values in [0, 1].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum NoiseFilter {
+    /// (n + 1) / 2: soft, even variation (the paper's "stratus = noise").
+    #[default]
+    Stratus,
+    /// |n|: billows with creases between them ("cumulus = |noise|").
+    Cumulus,
+    /// 1 − |2n|: thin ridges, wisps ("wispy").
+    Wispy,
+    /// (1 + |10n|)⁻¹: sharp bright veins on a dark body (the table's second cumulus filter).
+    Veined,
+}
+
+impl NoiseFilter {
+    /// Every filter, in the order the panel lists them.
+    pub const ALL: [NoiseFilter; 4] = [Self::Stratus, Self::Cumulus, Self::Wispy, Self::Veined];
+
+    /// Name for the panel.
+    pub fn label(self) -> &'static str {
+        match self {
+            Self::Stratus => "stratus (n)",
+            Self::Cumulus => "cumulus (|n|)",
+            Self::Wispy => "wispy (1 - |2n|)",
+            Self::Veined => "veined (1 / (1 + |10n|))",
+        }
+    }
+}
+
+/// The periodic noise the octaves sample.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum NoiseBasis {
+    /// Gradient noise.
+    #[default]
+    Perlin,
+    /// Cellular noise (one minus the distance to the nearest feature point): round puffs.
+    Worley,
+}
+
+/// Render quality and cloud media (Schpok et al.'s Table 2 controls).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct RenderSettings {
@@ -362,6 +411,17 @@ pub struct RenderSettings {
     pub detail: f32,
     /// Width of the soft edge around the surface, in field units.
     pub softness: f32,
+    /// Table 2's filter applied to each octave.
+    pub noise_filter: NoiseFilter,
+    /// The noise the octaves sample.
+    pub noise_basis: NoiseBasis,
+    /// Sharpness: the alpha cut-off, as a share of one slice's opacity (Table 2), so edges
+    /// sharpen without the cloud shrinking when the opacity changes.
+    pub sharpness: f32,
+    /// Wind: how fast the noise drifts (world units per second of scene time, x and z).
+    pub wind: [f32; 2],
+    /// Torque: how fast the noise turns about the vertical (degrees per second).
+    pub torque: f32,
 }
 
 impl Default for RenderSettings {
@@ -375,6 +435,11 @@ impl Default for RenderSettings {
             noise_octaves: limits::OCTAVES.default as u32,
             detail: limits::DETAIL.default as f32,
             softness: limits::SOFTNESS.default as f32,
+            noise_filter: NoiseFilter::default(),
+            noise_basis: NoiseBasis::default(),
+            sharpness: limits::SHARPNESS.default as f32,
+            wind: [0.0; 2],
+            torque: 0.0,
         }
     }
 }
@@ -389,6 +454,9 @@ impl RenderSettings {
         self.noise_scale = limits::NOISE_SCALE.fix_f32(self.noise_scale);
         self.detail = limits::DETAIL.fix_f32(self.detail);
         self.softness = limits::SOFTNESS.fix_f32(self.softness);
+        self.sharpness = limits::SHARPNESS.fix_f32(self.sharpness);
+        self.wind = self.wind.map(|w| limits::WIND.fix_f32(w));
+        self.torque = limits::TORQUE.fix_f32(self.torque);
     }
 }
 

@@ -3,7 +3,7 @@
 
 use super::guide::Guide;
 use super::notice::Notices;
-use super::panels::{LIGHT, RENDER, ScenePanel, SketchPanel, ViewPanel, ViewStats};
+use super::panels::{ClockPanel, LIGHT, RENDER, ScenePanel, SketchPanel, ViewPanel, ViewStats};
 use super::selection::Selection;
 use super::sketch_tool::{Axis, SketchTool, ToolContext};
 use super::viewport::{Viewport, ViewportContext};
@@ -64,6 +64,7 @@ const PANEL_WIDTH: f32 = 300.0;
 /// The side panel's views.
 #[derive(Default)]
 struct Panels {
+    clock: ClockPanel,
     sketch: SketchPanel,
     scene: ScenePanel,
     view: ViewPanel,
@@ -141,7 +142,8 @@ impl CloudApp {
         self.selection.retain_valid(self.doc.scene());
     }
 
-    /// Undo (Ctrl+Z), redo (Ctrl+Shift+Z, Ctrl+Y), frame (F), then the tools' shortcuts.
+    /// Undo (Ctrl+Z), redo (Ctrl+Shift+Z, Ctrl+Y), frame (F), play (Alt+A), then the tools'
+    /// shortcuts.
     fn shortcuts(&mut self, ctx: &egui::Context) {
         if ctx.egui_wants_keyboard_input() {
             return;
@@ -153,6 +155,10 @@ impl CloudApp {
             let undo = i.consume_key(Modifiers::COMMAND, Key::Z);
             let frame = i.consume_key(Modifiers::NONE, Key::F);
             let panel = i.consume_key(Modifiers::NONE, Key::N);
+            // Alt+A plays and pauses (Blender's shortcut before Space took it over).
+            if i.consume_key(Modifiers::ALT, Key::A) {
+                self.panels.clock.playing = !self.panels.clock.playing;
+            }
             (undo, redo, frame, panel)
         });
         if panel {
@@ -231,6 +237,7 @@ impl CloudApp {
             &mut self.notices,
         );
         self.guide.ui(ui, &mut self.doc, &mut self.notices);
+        p.clock.ui(ui, &mut self.doc);
         RENDER.ui(ui, &mut self.doc);
         LIGHT.ui(ui, &mut self.doc);
         p.scene.ui(ui, &mut self.doc, &mut self.selection);
@@ -308,6 +315,7 @@ impl CloudApp {
                 })
             }),
             "axis_lock": self.tool.axis_lock.map(|a| a.name()),
+            "playing": self.panels.clock.playing,
             "guides_hidden": self.tool.hide_guides,
             "skeleton_shown": self.tool.show_skeleton,
             "panel_open": self.panel_open,
@@ -372,6 +380,9 @@ impl eframe::App for CloudApp {
         self.cpu_seconds = frame.info().cpu_usage;
         let ctx = ui.ctx().clone();
         self.shortcuts(&ctx);
+        if self.panels.clock.tick(&mut self.doc, ctx.input(|i| i.stable_dt)) {
+            ctx.request_repaint();
+        }
         self.guide.input(&ctx, &mut self.doc, &mut self.notices);
         self.host_edits(&ctx);
         // Fixed width: growing values never shift the buttons under the pointer.

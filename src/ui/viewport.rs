@@ -162,6 +162,7 @@ impl Viewport {
                     camera: scene.camera.clone(),
                     light: scene.light.clone(),
                     render: scene.render.clone(),
+                    time: scene.time,
                     aspect,
                     crop: crop.ndc(px),
                 },

@@ -1,12 +1,14 @@
 //! The side panel: one view per collapsible group, each with its own `ui()` that takes only
 //! what it needs (the document, the selection, the tool state), as egui's demo app does.
 
+mod clock;
 mod light;
 mod render;
 mod scene;
 mod sketch;
 mod view;
 
+pub use clock::ClockPanel;
 pub use light::LIGHT;
 pub use render::RENDER;
 pub use scene::ScenePanel;

@@ -4,7 +4,7 @@ use egui::Ui;
 
 use super::PartPanel;
 use crate::limits;
-use crate::scene::{Edit, RenderSettings};
+use crate::scene::{Edit, NoiseBasis, NoiseFilter, RenderSettings};
 use crate::ui::widgets::param;
 
 /// The Render group.
@@ -20,4 +20,33 @@ fn body(ui: &mut Ui, r: &mut RenderSettings) {
     param(ui, &mut r.noise_octaves, &limits::OCTAVES);
     param(ui, &mut r.detail, &limits::DETAIL);
     param(ui, &mut r.field_resolution, &limits::FIELD_RESOLUTION);
+    param(ui, &mut r.sharpness, &limits::SHARPNESS);
+    egui::CollapsingHeader::new("Media: filter, basis, wind")
+        .default_open(false)
+        .show(ui, |ui| {
+            egui::ComboBox::from_label("filter")
+                .selected_text(r.noise_filter.label())
+                .show_ui(ui, |ui| {
+                    for f in NoiseFilter::ALL {
+                        ui.selectable_value(&mut r.noise_filter, f, f.label());
+                    }
+                })
+                .response
+                .on_hover_text("Schpok et al.'s Table 2: how each octave's noise is shaped");
+            ui.horizontal(|ui| {
+                ui.label("noise");
+                ui.selectable_value(&mut r.noise_basis, NoiseBasis::Perlin, "Perlin");
+                ui.selectable_value(&mut r.noise_basis, NoiseBasis::Worley, "Worley (puffs)");
+            });
+            let [wx, wz] = &mut r.wind;
+            ui.horizontal(|ui| {
+                ui.label("wind");
+                param(ui, wx, &limits::WIND);
+            });
+            ui.horizontal(|ui| {
+                ui.label("wind z");
+                param(ui, wz, &limits::WIND);
+            });
+            param(ui, &mut r.torque, &limits::TORQUE);
+        });
 }
