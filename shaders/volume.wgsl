@@ -95,6 +95,7 @@ fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
     if alpha <= 0.0 {
         discard;
     }
-    let light = u.sun_color.rgb * sample.g + u.sky_color.rgb;
+    // Dirtiness scales the optical depth toward the sun: T^d = exp(−d·τ).
+    let light = u.sun_color.rgb * pow(sample.g, u.sun_color.w) + u.sky_color.rgb;
     return vec4<f32>(light * alpha, alpha);
 }

@@ -22,7 +22,7 @@ struct Volume {
     // x: total slices, y: first slice of this draw (0 = farthest), z: slice spacing (world),
     // w: Sharpness (the alpha cut-off as a share of the slice's full opacity).
     slicing: vec4<f32>,
-    // Linear sun colour × intensity, sky colour × ambient (rgb).
+    // Linear sun colour × intensity, sky colour × ambient (rgb); sun_color.w: Dirtiness.
     sun_color: vec4<f32>,
     sky_color: vec4<f32>,
     // x: extinction per world unit, y: iso-level, z: soft-edge half-width, w: noise amount.

@@ -129,6 +129,14 @@ pub const SHARPNESS: Param = Param::linear(
     0.9,
     0.0,
 );
+/// Dirtiness: multiplies the optical depth toward the sun (Schpok et al., Table 2).
+pub const DIRTINESS: Param = Param::linear(
+    "dirtiness",
+    "How fast the cloud darkens away from the sun (1 is physical)",
+    0.0,
+    4.0,
+    1.0,
+);
 /// Wind: drift of the noise per second of scene time, per horizontal axis (world units).
 pub const WIND: Param = Param::linear(
     "wind",
@@ -283,6 +291,7 @@ mod tests {
             COPIES,
             BLEND,
             SHARPNESS,
+            DIRTINESS,
             WIND,
             TORQUE,
         ] {

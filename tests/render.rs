@@ -234,3 +234,48 @@ fn wind_moves_the_media_over_scene_time_and_calm_air_does_not() {
     let d = changed(&at(&turning, 0.0), &at(&turning, 1.0));
     assert!(d > 500, "the torque turned the noise: {d} px changed");
 }
+
+/// Mean luminance of the opaque cloud pixels (far from the sky's colour, so the sky showing
+/// through a thin edge does not count) in each quarter of their screen extent, left to right.
+fn quarter_brightness(image: &cloudsketch::render::offscreen::Image, bg: [u8; 3]) -> [f64; 4] {
+    let opaque = |p: [u8; 4]| (0..3).map(|i| (p[i] as i32 - bg[i] as i32).abs()).sum::<i32>() > 90;
+    let cloud: Vec<(u32, u32)> = (0..image.height)
+        .flat_map(|y| (0..image.width).map(move |x| (x, y)))
+        .filter(|&(x, y)| opaque(image.pixel(x, y)))
+        .collect();
+    let (lo, hi) = cloud
+        .iter()
+        .fold((u32::MAX, 0), |(a, b), &(x, _)| (a.min(x), b.max(x)));
+    let width = (hi - lo + 1) as f64;
+    let mut sum = [0.0; 4];
+    let mut count = [0usize; 4];
+    for &(x, y) in &cloud {
+        let q = (((x - lo) as f64 / width) * 4.0) as usize;
+        sum[q.min(3)] += luminance(image.pixel(x, y));
+        count[q.min(3)] += 1;
+    }
+    std::array::from_fn(|i| sum[i] / count[i].max(1) as f64)
+}
+
+#[test]
+fn dirtiness_makes_the_cloud_darken_faster_away_from_the_sun() {
+    // Sun low on the right. Table 2's Dirtiness sets how fast the cloud darkens with depth:
+    // from a clean cloud (0.25) to the default (1), the brightness a quarter of the cloud in
+    // from the sunlit edge falls further behind the edge's own. (Dirtier still, the edge
+    // quarter darkens too, toward the ambient light alone, so the ratio does not keep falling:
+    // it stays below the clean cloud's.)
+    let scene = with(
+        &Scene::default(),
+        &["/light/sun_azimuth_deg=0", "/light/sun_elevation_deg=5", "/render/slices=64"],
+    );
+    let bg = background(&scene);
+    let falloff = |d: &str| {
+        let q = quarter_brightness(&render(&with(&scene, &[&format!("/render/dirtiness={d}")])), bg);
+        q[2] / q[3]
+    };
+    let (clean, default, dirty) = (falloff("0.25"), falloff("1"), falloff("3"));
+    assert!(
+        clean > default + 0.03 && clean > dirty + 0.01,
+        "inner/edge brightness: clean {clean:.3}, default {default:.3}, dirty {dirty:.3}"
+    );
+}

@@ -37,7 +37,8 @@ pub struct VolumeUniforms {
     /// z: spacing between slices in world units, w: Sharpness (the alpha cut-off as a share of
     /// a slice's opacity at full density, Table 2).
     pub slicing: [f32; 4],
-    /// Linear sun colour × intensity (rgb).
+    /// Linear sun colour × intensity (rgb); w: Dirtiness (the exponent on the transmittance
+    /// toward the sun).
     pub sun_color: [f32; 4],
     /// Linear sky colour × ambient intensity (rgb).
     pub sky_color: [f32; 4],
@@ -176,7 +177,7 @@ impl VolumeUniforms {
                 spacing,
                 r.sharpness,
             ],
-            sun_color: sun_color.extend(1.0).to_array(),
+            sun_color: sun_color.extend(r.dirtiness).to_array(),
             sky_color: sky_color.extend(1.0).to_array(),
             media: [
                 r.opacity,

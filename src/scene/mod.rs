@@ -418,6 +418,10 @@ pub struct RenderSettings {
     /// Sharpness: the alpha cut-off, as a share of one slice's opacity (Table 2), so edges
     /// sharpen without the cloud shrinking when the opacity changes.
     pub sharpness: f32,
+    /// Dirtiness: how fast the cloud darkens away from the sun (Table 2's shadow magnitude; it
+    /// multiplies the optical depth toward the sun, which is already per world unit, so the
+    /// slice count does not change it). 1 is physical.
+    pub dirtiness: f32,
     /// Wind: how fast the noise drifts (world units per second of scene time, x and z).
     pub wind: [f32; 2],
     /// Torque: how fast the noise turns about the vertical (degrees per second).
@@ -438,6 +442,7 @@ impl Default for RenderSettings {
             noise_filter: NoiseFilter::default(),
             noise_basis: NoiseBasis::default(),
             sharpness: limits::SHARPNESS.default as f32,
+            dirtiness: limits::DIRTINESS.default as f32,
             wind: [0.0; 2],
             torque: 0.0,
         }
@@ -455,6 +460,7 @@ impl RenderSettings {
         self.detail = limits::DETAIL.fix_f32(self.detail);
         self.softness = limits::SOFTNESS.fix_f32(self.softness);
         self.sharpness = limits::SHARPNESS.fix_f32(self.sharpness);
+        self.dirtiness = limits::DIRTINESS.fix_f32(self.dirtiness);
         self.wind = self.wind.map(|w| limits::WIND.fix_f32(w));
         self.torque = limits::TORQUE.fix_f32(self.torque);
     }

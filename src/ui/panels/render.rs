@@ -21,6 +21,7 @@ fn body(ui: &mut Ui, r: &mut RenderSettings) {
     param(ui, &mut r.detail, &limits::DETAIL);
     param(ui, &mut r.field_resolution, &limits::FIELD_RESOLUTION);
     param(ui, &mut r.sharpness, &limits::SHARPNESS);
+    param(ui, &mut r.dirtiness, &limits::DIRTINESS);
     egui::CollapsingHeader::new("Media: filter, basis, wind")
         .default_open(false)
         .show(ui, |ui| {
