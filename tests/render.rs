@@ -279,3 +279,39 @@ fn dirtiness_makes_the_cloud_darken_faster_away_from_the_sun() {
         "inner/edge brightness: clean {clean:.3}, default {default:.3}, dirty {dirty:.3}"
     );
 }
+
+/// Screen bounding box (width, height) of the pixels that differ from the sky.
+fn cloud_box(image: &cloudsketch::render::offscreen::Image, bg: [u8; 3]) -> (u32, u32) {
+    let (mut x0, mut y0, mut x1, mut y1) = (u32::MAX, u32::MAX, 0, 0);
+    for y in 0..image.height {
+        for x in 0..image.width {
+            if differs(image.pixel(x, y), bg) {
+                (x0, y0, x1, y1) = (x0.min(x), y0.min(y), x1.max(x), y1.max(y));
+            }
+        }
+    }
+    (x1.saturating_sub(x0) + 1, y1.saturating_sub(y0) + 1)
+}
+
+#[test]
+fn presets_are_each_recognisable() {
+    let names = ["cumulus", "stratus", "cirrus", "cumulonimbus", "sunset"];
+    let scenes: Vec<Scene> = names
+        .iter()
+        .map(|n| with(&Scene::preset(Preset::from_name(n).unwrap()), &["/render/slices=64"]))
+        .collect();
+    let images: Vec<_> = scenes.iter().map(render).collect();
+    // The baseline: the same preset with another seed (other noise) differs this much.
+    for (i, scene) in scenes.iter().enumerate() {
+        let reseeded = render(&with(scene, &["/seed=2"]));
+        let noise = changed(&images[i], &reseeded).max(50);
+        for j in (0..images.len()).filter(|&j| j != i) {
+            let d = changed(&images[i], &images[j]);
+            assert!(d >= 3 * noise, "{} vs {}: {d} px, two seeds of {}: {noise} px", names[i], names[j], names[i]);
+        }
+    }
+    let (w, h) = cloud_box(&images[1], background(&scenes[1]));
+    assert!(w as f64 >= 4.0 * h as f64, "stratus is a layer: {w}×{h} px");
+    let (w, h) = cloud_box(&images[3], background(&scenes[3]));
+    assert!(h > w, "cumulonimbus towers: {w}×{h} px");
+}

@@ -8,6 +8,7 @@ mod document;
 mod edit;
 mod plane;
 mod pointer;
+mod presets;
 mod reference;
 
 pub use crate::limits::{MAX_ELLIPSOIDS, MAX_PLANE_POINTS, MAX_PLANES};
@@ -16,6 +17,7 @@ pub use document::{Document, Revisions};
 pub use edit::Edit;
 pub use plane::{DrawingPlane, StrokeKind, centre_of};
 pub use pointer::{SetError, set_by_pointer};
+pub use presets::Preset;
 pub use reference::ReferenceImage;
 
 use std::sync::Arc;
@@ -82,68 +84,7 @@ impl Default for Scene {
     }
 }
 
-/// Named starting points for `cloudsketch new --preset` and `?preset=` in the page.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Preset {
-    /// A fair-weather cumulus of a few blended ellipsoids (the default).
-    Cumulus,
-    /// Nothing but sky: for sketching from scratch.
-    Empty,
-}
-
-impl Preset {
-    /// All presets with their names.
-    pub const ALL: [(Preset, &'static str); 2] =
-        [(Preset::Cumulus, "cumulus"), (Preset::Empty, "empty")];
-
-    /// Looks a preset up by name.
-    pub fn from_name(name: &str) -> Option<Preset> {
-        Self::ALL
-            .iter()
-            .find(|(_, n)| n.eq_ignore_ascii_case(name))
-            .map(|(p, _)| *p)
-    }
-
-    /// The preset's name.
-    pub fn name(self) -> &'static str {
-        Self::ALL
-            .iter()
-            .find(|(p, _)| *p == self)
-            .map(|(_, n)| *n)
-            .unwrap_or("cumulus")
-    }
-}
-
 impl Scene {
-    /// A new document from a preset.
-    pub fn preset(preset: Preset) -> Self {
-        let ellipsoids = match preset {
-            Preset::Cumulus => vec![
-                Ellipsoid::new(Vec3::new(0.0, 1.6, 0.0), Vec3::new(4.2, 1.5, 3.0)),
-                Ellipsoid::new(Vec3::new(-2.0, 2.7, 0.3), Vec3::new(2.2, 1.9, 2.0)),
-                Ellipsoid::new(Vec3::new(1.4, 3.2, -0.3), Vec3::new(2.5, 2.4, 2.2)),
-                Ellipsoid::new(Vec3::new(0.1, 4.7, 0.1), Vec3::new(1.8, 1.7, 1.7)),
-                Ellipsoid::new(Vec3::new(3.4, 2.3, 0.5), Vec3::new(1.5, 1.3, 1.4)),
-                Ellipsoid::new(Vec3::new(-3.6, 2.0, -0.4), Vec3::new(1.3, 1.1, 1.2)),
-            ]
-            .into_iter()
-            .map(Arc::new)
-            .collect(),
-            Preset::Empty => Vec::new(),
-        };
-        Scene {
-            version: SCENE_VERSION,
-            seed: 1,
-            camera: OrbitCamera::default(),
-            light: Lighting::default(),
-            render: RenderSettings::default(),
-            ellipsoids,
-            planes: Vec::new(),
-            reference: None,
-            time: 0.0,
-        }
-    }
-
     /// Parses a document, upgrading older versions and checking every limit. Returns the scene
     /// and what validation repaired in it, in words (see [`Scene::validate`]): tell the user.
     pub fn from_json(text: &str) -> Result<(Self, Vec<String>), SceneError> {

@@ -3,7 +3,7 @@
 // test-results/screenshots/media-*.png.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { serve, state, screenshot, countChanged, until, withApp, waitForFullQuality } from './harness.mjs';
+import { serve, launch, openApp, waitForBody, state, screenshot, countChanged, until, withApp, waitForFullQuality } from './harness.mjs';
 
 let server;
 before(async () => { server = await serve(); });
@@ -43,5 +43,38 @@ for (const backend of ['webgpu', 'webgl2']) {
       assert.equal(JSON.stringify(s.scene.camera), camera, 'the camera stayed');
       assert.equal(s.view.undo, undo, 'playing is no undo step');
     });
+  });
+}
+
+// Every preset opens from its link (?preset=NAME) with its own framing and media, and each looks
+// unlike every other (pairwise pixel differences; the shapes are measured offscreen).
+for (const backend of ['webgpu', 'webgl2']) {
+  test(`each preset opens from a link and looks its own (${backend})`, { timeout: 300_000 }, async () => {
+    const { browser, close } = await launch({ webgpu: backend === 'webgpu' });
+    try {
+      const shots = {};
+      for (const name of ['cumulus', 'stratus', 'cirrus', 'cumulonimbus', 'sunset']) {
+        const { page, errors } = await openApp(browser, server.url, `?preset=${name}`, { width: 1280, height: 800 });
+        await waitForBody(page, 'data-ready', (v) => v === 'true');
+        await page.mouse.click(5, 795);
+        await waitForFullQuality(page);
+        const s = await state(page);
+        assert.ok(s.scene.ellipsoids.length > 0, `${name}: a cloud`);
+        shots[name] = { img: await screenshot(page, `preset-${name}-${backend}`), view: s.view.viewport };
+        assert.deepEqual(errors, [], `${name}: errors logged`);
+        await page.close();
+      }
+      const names = Object.keys(shots);
+      const [vw, vh] = shots.cumulus.view;
+      const body = { x: 0, y: 60, w: vw, h: vh - 90 };
+      for (let i = 0; i < names.length; i++) {
+        for (let j = i + 1; j < names.length; j++) {
+          const d = countChanged(shots[names[i]].img, shots[names[j]].img, body);
+          assert.ok(d > 0.05 * vw * vh, `${names[i]} vs ${names[j]}: ${d} px differ`);
+        }
+      }
+    } finally {
+      await close();
+    }
   });
 }

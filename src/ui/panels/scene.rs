@@ -18,14 +18,16 @@ impl ScenePanel {
         egui::CollapsingHeader::new("Scene")
             .default_open(true)
             .show(ui, |ui| {
-                ui.horizontal(|ui| {
-                    for (preset, label) in [
-                        (Preset::Cumulus, "New cumulus"),
-                        (Preset::Empty, "New empty"),
-                    ] {
-                        if ui.button(label).clicked() {
-                            let mut scene = Scene::preset(preset);
-                            scene.camera = doc.scene().camera.clone();
+                ui.horizontal_wrapped(|ui| {
+                    ui.label("New:");
+                    for (preset, name) in Preset::ALL {
+                        if ui
+                            .small_button(name)
+                            .on_hover_text(format!("Start again from the {name} preset (Ctrl+Z undoes)"))
+                            .clicked()
+                        {
+                            // A preset brings its own camera, framed for its cloud.
+                            let scene = Scene::preset(preset);
                             doc.apply(Edit::Replace(Box::new(scene)), None);
                         }
                     }

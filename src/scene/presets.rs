@@ -1,0 +1,189 @@
+//! Named starting points (`cloudsketch new --preset NAME`, `?preset=NAME`, the Scene group):
+//! the paper's cloud types (Schpok et al. 2003, Figures 3–7), each a set of ellipsoids with the
+//! media, light and camera that make it recognisable at first sight. Every random choice comes
+//! from a fixed seed, so a preset is the same document everywhere.
+
+use std::sync::Arc;
+
+use glam::{Quat, Vec3};
+
+use super::{
+    Ellipsoid, Lighting, NoiseBasis, NoiseFilter, OrbitCamera, RenderSettings, SCENE_VERSION,
+    Scene,
+};
+use crate::seeded::SplitMix;
+
+/// Named starting points.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Preset {
+    /// A fair-weather cumulus of a few blended ellipsoids (the default).
+    Cumulus,
+    /// A low layer far wider than tall, soft and even.
+    Stratus,
+    /// High, thin streaks of wispy noise drawn out by the wind.
+    Cirrus,
+    /// A towering storm cloud with a flat anvil on top, taller than wide.
+    Cumulonimbus,
+    /// Scattered clouds lit from just above the horizon: pink shadows, darker tops.
+    Sunset,
+    /// Nothing but sky: for sketching from scratch.
+    Empty,
+}
+
+impl Preset {
+    /// All presets with their names.
+    pub const ALL: [(Preset, &'static str); 6] = [
+        (Preset::Cumulus, "cumulus"),
+        (Preset::Stratus, "stratus"),
+        (Preset::Cirrus, "cirrus"),
+        (Preset::Cumulonimbus, "cumulonimbus"),
+        (Preset::Sunset, "sunset"),
+        (Preset::Empty, "empty"),
+    ];
+
+    /// Looks a preset up by name.
+    pub fn from_name(name: &str) -> Option<Preset> {
+        Self::ALL
+            .iter()
+            .find(|(_, n)| n.eq_ignore_ascii_case(name))
+            .map(|(p, _)| *p)
+    }
+
+    /// The preset's name.
+    pub fn name(self) -> &'static str {
+        Self::ALL
+            .iter()
+            .find(|(p, _)| *p == self)
+            .map(|(_, n)| *n)
+            .unwrap_or("cumulus")
+    }
+}
+
+fn cumulus() -> Vec<Ellipsoid> {
+    vec![
+        Ellipsoid::new(Vec3::new(0.0, 1.6, 0.0), Vec3::new(4.2, 1.5, 3.0)),
+        Ellipsoid::new(Vec3::new(-2.0, 2.7, 0.3), Vec3::new(2.2, 1.9, 2.0)),
+        Ellipsoid::new(Vec3::new(1.4, 3.2, -0.3), Vec3::new(2.5, 2.4, 2.2)),
+        Ellipsoid::new(Vec3::new(0.1, 4.7, 0.1), Vec3::new(1.8, 1.7, 1.7)),
+        Ellipsoid::new(Vec3::new(3.4, 2.3, 0.5), Vec3::new(1.5, 1.3, 1.4)),
+        Ellipsoid::new(Vec3::new(-3.6, 2.0, -0.4), Vec3::new(1.3, 1.1, 1.2)),
+    ]
+}
+
+/// `n` flattened puffs scattered over a `w` × `d` area at height `y` (seeded).
+fn layer(n: usize, w: f32, d: f32, y: f32, radii: Vec3, seed: u64) -> Vec<Ellipsoid> {
+    let mut rng = SplitMix::new(seed);
+    let mut u = move || rng.next_f64() as f32;
+    (0..n)
+        .map(|_| {
+            let c = Vec3::new((u() - 0.5) * w, y + (u() - 0.5) * radii.y, (u() - 0.5) * d);
+            let s = 0.7 + 0.6 * u();
+            Ellipsoid {
+                rotation: Quat::from_rotation_y(u() * 3.0),
+                ..Ellipsoid::new(c, radii * s)
+            }
+        })
+        .collect()
+}
+
+fn cumulonimbus() -> Vec<Ellipsoid> {
+    // The tower: rings of puffs rising and bulging out of one another, then the anvil spreading
+    // flat on top, overhanging toward the wind.
+    let mut rng = SplitMix::new(51);
+    let mut u = move || rng.next_f64() as f32;
+    let mut v = Vec::new();
+    for level in 0..7 {
+        let y = 1.5 + level as f32 * 2.0;
+        for k in 0..3 {
+            let a = k as f32 * 2.1 + level as f32 * 0.9;
+            let off = 1.3 + 0.5 * u();
+            let c = Vec3::new(a.cos() * off, y + u(), a.sin() * off * 0.8);
+            let r = 2.0 + 0.8 * u() - level as f32 * 0.08;
+            v.push(Ellipsoid::new(c, Vec3::new(r, r * 0.85, r)));
+        }
+    }
+    v.push(Ellipsoid::new(Vec3::new(1.5, 15.6, 0.0), Vec3::new(6.5, 1.2, 4.0)));
+    v.push(Ellipsoid::new(Vec3::new(-1.0, 15.2, 0.6), Vec3::new(4.5, 1.0, 3.2)));
+    v.push(Ellipsoid::new(Vec3::new(4.5, 15.9, -0.4), Vec3::new(3.0, 0.8, 2.4)));
+    v
+}
+
+impl Scene {
+    /// A new document from a preset.
+    pub fn preset(preset: Preset) -> Self {
+        let mut camera = OrbitCamera::default();
+        let mut light = Lighting::default();
+        let mut render = RenderSettings::default();
+        let ellipsoids = match preset {
+            Preset::Cumulus => cumulus(),
+            Preset::Stratus => {
+                camera.distance = 34.0;
+                camera.pitch_deg = 10.0;
+                render.noise_filter = NoiseFilter::Stratus;
+                render.noise_scale = 5.0;
+                render.noise_amount = 0.3;
+                render.opacity = 1.2;
+                light.sun_elevation_deg = 25.0;
+                light.ambient = 0.6;
+                light.sky_color = [0.62, 0.66, 0.74];
+                light.background = [0.5, 0.58, 0.7];
+                layer(28, 30.0, 10.0, 3.0, Vec3::new(3.2, 0.7, 2.6), 11)
+            }
+            Preset::Cirrus => {
+                camera.target = Vec3::new(0.0, 9.0, 0.0);
+                camera.distance = 30.0;
+                camera.pitch_deg = 18.0;
+                render.noise_filter = NoiseFilter::Wispy;
+                render.noise_scale = 2.0;
+                render.noise_amount = 0.7;
+                render.noise_octaves = 5;
+                render.opacity = 0.8;
+                render.sharpness = 0.3;
+                render.wind = [1.5, 0.0];
+                light.sun_elevation_deg = 55.0;
+                light.background = [0.24, 0.45, 0.78];
+                layer(9, 22.0, 12.0, 9.0, Vec3::new(6.0, 0.35, 0.9), 23)
+            }
+            Preset::Cumulonimbus => {
+                camera.target = Vec3::new(0.5, 8.5, 0.0);
+                camera.distance = 36.0;
+                camera.pitch_deg = 4.0;
+                render.noise_filter = NoiseFilter::Cumulus;
+                render.noise_basis = NoiseBasis::Worley;
+                render.noise_scale = 8.0;
+                render.noise_amount = 0.55;
+                render.dirtiness = 1.6;
+                render.torque = 6.0;
+                light.sun_elevation_deg = 30.0;
+                light.background = [0.36, 0.46, 0.6];
+                cumulonimbus()
+            }
+            Preset::Sunset => {
+                camera.distance = 24.0;
+                camera.pitch_deg = 6.0;
+                render.noise_filter = NoiseFilter::Cumulus;
+                render.noise_amount = 0.4;
+                light.sun_azimuth_deg = 200.0;
+                light.sun_elevation_deg = 3.0;
+                light.sun_color = [1.0, 0.55, 0.32];
+                light.sun_intensity = 2.0;
+                light.sky_color = [0.95, 0.45, 0.6];
+                light.ambient = 0.55;
+                light.background = [0.42, 0.33, 0.5];
+                layer(14, 20.0, 8.0, 3.5, Vec3::new(2.6, 1.3, 2.2), 37)
+            }
+            Preset::Empty => Vec::new(),
+        };
+        Scene {
+            version: SCENE_VERSION,
+            seed: 1,
+            camera,
+            light,
+            render,
+            ellipsoids: ellipsoids.into_iter().map(Arc::new).collect(),
+            planes: Vec::new(),
+            reference: None,
+            time: 0.0,
+        }
+    }
+}
