@@ -1,5 +1,5 @@
 // Slice-based volume rendering (Schpok et al. 2003, §4): view-aligned slices through the
-// cloud's bounding sphere, drawn back to front in one instanced draw and composited with
+// cloud's box (its depth along the view), drawn back to front in one instanced draw and composited with
 // premultiplied "over" blending into a linear RGBA target.
 //
 // Density = blended implicit field (red of the volume texture) perturbed by octaves of
@@ -13,10 +13,11 @@ struct VsOut {
 
 @vertex
 fn vs_main(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> VsOut {
-    // Slice 0 is the farthest; the quad covers the bounding sphere's cross-section.
+    // Slice 0 is the farthest; slices span the grid box's depth along the view (from
+    // grid_min.w toward the eye), and each quad covers the bounding sphere's cross-section.
     let slice = f32(ii) + u.slicing.y;
     let r = u.sphere.w;
-    let d = r - (slice + 0.5) * u.slicing.z;
+    let d = u.grid_min.w - (slice + 0.5) * u.slicing.z;
     let half = sqrt(max(r * r - d * d, 0.0));
     var corners = array<vec2<f32>, 6>(
         vec2<f32>(-1.0, -1.0), vec2<f32>(1.0, -1.0), vec2<f32>(1.0, 1.0),
@@ -88,14 +89,20 @@ fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
     // Sharpness (Table 2): the alpha cut-off is Sharpness × this slice's opacity at full
     // density, and what is above it is stretched back to that opacity: the faint fringe goes,
     // the core keeps its opacity, and the edge's ramp steepens.
-    let full = 1.0 - exp(-u.media.x * path);
-    let cut = u.slicing.w * full;
-    let raw = 1.0 - exp(-u.media.x * density * path);
-    let alpha = full * max(raw - cut, 0.0) / max(full - cut, 1e-6);
+    var alpha = 1.0 - exp(-u.media.x * density * path);
+    if u.slicing.w > 0.0 {
+        let full = 1.0 - exp(-u.media.x * path);
+        let cut = u.slicing.w * full;
+        alpha = full * max(alpha - cut, 0.0) / max(full - cut, 1e-6);
+    }
     if alpha <= 0.0 {
         discard;
     }
     // Dirtiness scales the optical depth toward the sun: T^d = exp(−d·τ).
-    let light = u.sun_color.rgb * pow(sample.g, u.sun_color.w) + u.sky_color.rgb;
+    var sun = sample.g;
+    if u.sun_color.w != 1.0 {
+        sun = pow(sun, u.sun_color.w);
+    }
+    let light = u.sun_color.rgb * sun + u.sky_color.rgb;
     return vec4<f32>(light * alpha, alpha);
 }

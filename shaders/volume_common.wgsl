@@ -14,7 +14,8 @@ struct Volume {
     forward: vec4<f32>,
     right: vec4<f32>,
     up: vec4<f32>,
-    // Density grid: minimum corner and 1 / size (xyz).
+    // Density grid: minimum corner and 1 / size (xyz); grid_min.w: depth of the farthest slice
+    // boundary along the view from the bounding sphere's centre.
     grid_min: vec4<f32>,
     grid_inv_size: vec4<f32>,
     // Bounding sphere: centre (xyz), radius (w).

@@ -315,3 +315,29 @@ fn presets_are_each_recognisable() {
     let (w, h) = cloud_box(&images[3], background(&scenes[3]));
     assert!(h > w, "cumulonimbus towers: {w}×{h} px");
 }
+
+#[test]
+fn quality_changes_smoothness_not_the_cloud() {
+    // Table 2's Quality is the slice count: 64 and 256 slices give the same coverage and mean
+    // brightness within 5% (the extinction is per world unit), for a round cloud and for a flat
+    // layer (whose slices span only its box's depth, not its bounding sphere's).
+    for name in ["cumulus", "stratus"] {
+        let scene = Scene::preset(Preset::from_name(name).unwrap());
+        let bg = background(&scene);
+        let measure = |slices: u32| {
+            let image = render(&with(&scene, &[&format!("/render/slices={slices}")]));
+            let cloud: Vec<[u8; 4]> = image
+                .rgba
+                .chunks(4)
+                .map(|p| [p[0], p[1], p[2], p[3]])
+                .filter(|&p| differs(p, bg))
+                .collect();
+            let mean = cloud.iter().map(|&p| luminance(p)).sum::<f64>() / cloud.len().max(1) as f64;
+            (cloud.len() as f64, mean)
+        };
+        let ((c64, b64), (c256, b256)) = (measure(64), measure(256));
+        assert!(c64 > 500.0, "{name}: a cloud");
+        assert!((c256 / c64 - 1.0).abs() < 0.05, "{name}: coverage {c64} → {c256}");
+        assert!((b256 / b64 - 1.0).abs() < 0.05, "{name}: brightness {b64:.1} → {b256:.1}");
+    }
+}

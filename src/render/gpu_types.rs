@@ -27,7 +27,8 @@ pub struct VolumeUniforms {
     pub right: [f32; 4],
     /// Unit image-plane up (xyz).
     pub up: [f32; 4],
-    /// Density grid minimum corner (xyz).
+    /// Density grid minimum corner (xyz); w: depth of the farthest slice boundary along the
+    /// view direction, from the bounding sphere's centre (slices run from there toward the eye).
     pub grid_min: [f32; 4],
     /// 1 / density grid size (xyz).
     pub grid_inv_size: [f32; 4],
@@ -146,7 +147,11 @@ impl VolumeUniforms {
         let sky_color = srgb_to_linear(light.sky_color) * light.ambient;
         let inv_size = Vec3::ONE / volume.size.max(Vec3::splat(1e-6));
         let octaves = r.noise_octaves.min(MAX_OCTAVES as u32);
-        let spacing = 2.0 * radius / total as f32;
+        // Slices span only the depth the grid's box takes along the view (a flat layer seen
+        // edge-on takes far less than its bounding sphere's diameter), farthest first.
+        let forward = camera.forward();
+        let (near, far) = box_depths(volume, center, forward);
+        let spacing = (far - near).max(1e-6) / total as f32;
         let filter = match r.noise_filter {
             NoiseFilter::Stratus => 0.0,
             NoiseFilter::Cumulus => 1.0,
@@ -168,7 +173,7 @@ impl VolumeUniforms {
             forward: camera.forward().extend(0.0).to_array(),
             right: camera.right().extend(0.0).to_array(),
             up: camera.up().extend(0.0).to_array(),
-            grid_min: volume.min.extend(0.0).to_array(),
+            grid_min: volume.min.extend(far).to_array(),
             grid_inv_size: inv_size.extend(0.0).to_array(),
             sphere: center.extend(radius).to_array(),
             slicing: [
@@ -189,6 +194,17 @@ impl VolumeUniforms {
             octaves: std::array::from_fn(|i| octave_transform(r, i, view.time).to_cols_array_2d()),
         }
     }
+}
+
+/// Nearest and farthest depth of the grid box's corners along `forward`, from `center`.
+pub fn box_depths(volume: &DensityVolume, center: Vec3, forward: Vec3) -> (f32, f32) {
+    (0..8)
+        .map(|i| {
+            let corner = volume.min
+                + volume.size * Vec3::new((i & 1) as f32, ((i >> 1) & 1) as f32, (i >> 2) as f32);
+            (corner - center).dot(forward)
+        })
+        .fold((f32::MAX, f32::MIN), |(a, b), d| (a.min(d), b.max(d)))
 }
 
 /// sRGB-encoded colour → linear.
@@ -223,7 +239,10 @@ mod tests {
         let u = VolumeUniforms::new(&view, &volume, 64, 10);
         let center = Vec3::from_slice(&u.sphere[..3]);
         assert!(center.abs_diff_eq(volume.min + volume.size * 0.5, 1e-4));
-        assert!((u.slicing[2] * 64.0 - 2.0 * u.sphere[3]).abs() < 1e-4);
+        // The slices span the box's depth along the view, inside the bounding sphere.
+        let (near, far) = box_depths(&volume, center, scene.camera.forward());
+        assert!((u.slicing[2] * 64.0 - (far - near)).abs() < 1e-4);
+        assert!(far - near <= 2.0 * u.sphere[3] + 1e-4 && u.grid_min[3] == far);
         assert_eq!(
             Mat4::from_cols_array_2d(&u.view_proj),
             scene.camera.view_projection(1.5)

@@ -103,9 +103,7 @@ mod tests {
     use super::*;
     use crate::scene::{Preset, Scene};
 
-    fn view() -> Rect {
-        Rect::from_min_size(Pos2::ZERO, egui::vec2(1280.0, 800.0))
-    }
+    use crate::ui::test_view as view;
 
     #[test]
     fn a_click_adds_an_ellipsoid_where_it_lands_and_picking_finds_it() {

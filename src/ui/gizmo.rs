@@ -8,6 +8,7 @@
 use egui::{Color32, Pos2, Rect, Stroke};
 use glam::{Quat, Vec2, Vec3};
 
+use super::picking::segment_distance;
 use super::sketch_tool::{Axis, Tool, project};
 use crate::scene::OrbitCamera;
 
@@ -61,13 +62,6 @@ fn color(axis: Axis) -> Color32 {
         Axis::Y => Color32::from_rgb(130, 205, 70),
         Axis::Z => Color32::from_rgb(70, 140, 245),
     }
-}
-
-/// Distance from `p` to segment `ab`.
-fn segment_distance(p: Pos2, a: Pos2, b: Pos2) -> f32 {
-    let ab = b - a;
-    let t = ((p - a).dot(ab) / ab.length_sq().max(1e-6)).clamp(0.0, 1.0);
-    p.distance(a + ab * t)
 }
 
 impl Gizmo {
@@ -242,9 +236,7 @@ mod tests {
     use super::*;
     use crate::scene::Scene;
 
-    fn view() -> Rect {
-        Rect::from_min_size(Pos2::ZERO, egui::vec2(1280.0, 800.0))
-    }
+    use crate::ui::test_view as view;
 
     #[test]
     fn a_drag_along_the_x_arrow_moves_along_x_by_what_the_pointer_covers() {

@@ -33,6 +33,12 @@ mod viewport;
 mod widgets;
 
 pub use app::{CloudApp, Host, PageStatus, StartOptions};
+
+/// The view rectangle the UI's unit tests place things in: 1280×800 points at the origin.
+#[cfg(test)]
+fn test_view() -> egui::Rect {
+    egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(1280.0, 800.0))
+}
 pub use platform::wake;
 pub use selection::Selection;
 pub use sketch_tool::Tool;

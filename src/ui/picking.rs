@@ -29,7 +29,8 @@ pub fn indicator(camera: &OrbitCamera, rect: Rect, e: &Ellipsoid) -> [Vec<Pos2>;
     })
 }
 
-fn segment_distance(p: Pos2, a: Pos2, b: Pos2) -> f32 {
+/// Distance from screen point `p` to segment `ab`.
+pub fn segment_distance(p: Pos2, a: Pos2, b: Pos2) -> f32 {
     let ab = b - a;
     let t = ((p - a).dot(ab) / ab.length_sq().max(1e-6)).clamp(0.0, 1.0);
     p.distance(a + ab * t)
@@ -126,9 +127,7 @@ mod tests {
     use super::*;
     use crate::scene::{Preset, Scene};
 
-    fn view() -> Rect {
-        Rect::from_min_size(Pos2::ZERO, egui::vec2(1280.0, 800.0))
-    }
+    use crate::ui::test_view as view;
 
     #[test]
     fn an_indicator_line_picks_its_ellipsoid_and_a_box_takes_what_it_holds() {

@@ -17,6 +17,21 @@ after(async () => { await server?.close(); });
 
 const toBytes = (rgb) => rgb.map((v) => Math.round(v * 255));
 
+/** Focuses the view, takes the Ellipsoid tool (E) and clicks once at each of `at` (fractions of
+ * the view); resolves to the state once every ellipsoid is in the scene. */
+async function addEllipsoids(page, at) {
+  const [vw, vh] = (await state(page)).view.viewport;
+  await page.mouse.click(vw * 0.05, vh * 0.95);
+  await page.keyboard.press('e');
+  await until(page, (s) => s.view.tool === 'ellipsoid', 'ellipsoid tool');
+  let s;
+  for (const [i, [fx, fy]] of at.entries()) {
+    await page.mouse.click(vw * fx, vh * fy);
+    s = await until(page, (s) => s.scene.ellipsoids.length === i + 1, `ellipsoid ${i + 1}`);
+  }
+  return s;
+}
+
 /** Horizontal centroid and count of the pixels that differ from the sky (between the notice
  * and hint lines at the top and the status line at the bottom). */
 function cloud(img, [vw, vh], bg) {
@@ -38,11 +53,7 @@ for (const backend of ['webgpu', 'webgl2']) {
       const view = s.view.viewport;
       const [vw, vh] = view;
       const bg = toBytes(s.scene.light.background);
-      await page.mouse.click(vw * 0.05, vh * 0.95);
-      await page.keyboard.press('e');
-      await until(page, (s) => s.view.tool === 'ellipsoid', 'ellipsoid tool');
-      await page.mouse.click(vw * 0.4, vh * 0.5);
-      s = await until(page, (s) => s.scene.ellipsoids.length === 1, 'an ellipsoid');
+      s = await addEllipsoids(page, [[0.4, 0.5]]);
       assert.equal(s.view.selected_ellipsoid, 0);
       assert.match(s.view.notice.text, /Added Ellipsoid 1/);
       await page.keyboard.press('h'); // the indicator off: look at the cloud alone
@@ -111,10 +122,7 @@ for (const backend of ['webgpu', 'webgl2']) {
       const view = s.view.viewport;
       const [vw, vh] = view;
       const bg = toBytes(s.scene.light.background);
-      await page.mouse.click(vw * 0.05, vh * 0.95);
-      await page.keyboard.press('e');
-      await page.mouse.click(vw * 0.4, vh * 0.5);
-      s = await until(page, (s) => s.scene.ellipsoids.length === 1, 'an ellipsoid');
+      s = await addEllipsoids(page, [[0.4, 0.5]]);
       await page.keyboard.press('g');
       s = await until(page, (s) => s.view.gizmo?.x, 'the move gizmo with an x arrow');
       const camera = JSON.stringify(s.scene.camera);
@@ -199,12 +207,7 @@ for (const backend of ['webgpu', 'webgl2']) {
     await withApp({ base: server.url, webgpu: backend === 'webgpu', query: '?preset=empty', viewport: { width: 1280, height: 800 } }, async (page) => {
       let s = await state(page);
       const [vw, vh] = s.view.viewport;
-      await page.mouse.click(vw * 0.05, vh * 0.95);
-      await page.keyboard.press('e');
-      await page.mouse.click(vw * 0.3, vh * 0.5);
-      await until(page, (s) => s.scene.ellipsoids.length === 1, 'one');
-      await page.mouse.click(vw * 0.6, vh * 0.5);
-      s = await until(page, (s) => s.scene.ellipsoids.length === 2, 'two');
+      s = await addEllipsoids(page, [[0.3, 0.5], [0.6, 0.5]]);
       const before = s.scene.ellipsoids.map((e) => e.center);
       await page.keyboard.press('g');
       await page.keyboard.press('Escape'); // nothing selected: a drag now draws a box
