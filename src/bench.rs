@@ -85,6 +85,34 @@ fn render_frame(offscreen: &mut Offscreen) -> Result<BenchResult, String> {
     ))
 }
 
+/// Offscreen frames at 1280×720 for other qualities and octave counts (Table 2's Quality and
+/// Detail), each against the plain slice shader at the same slice count.
+fn render_frames_by_quality(offscreen: &mut Offscreen) -> Result<Vec<BenchResult>, String> {
+    const FRAMES: usize = 3;
+    let (w, h) = (1280, 720);
+    let mut out = Vec::new();
+    for (slices, octaves) in [(64, 4), (256, 4), (128, 8)] {
+        let mut scene = Scene::default();
+        scene.render.slices = slices;
+        scene.render.noise_octaves = octaves;
+        let time = |o: &mut Offscreen, plain| {
+            o.time_frames(&scene, w, h, FRAMES, plain)
+                .map(median)
+                .map_err(|e| e.to_string())
+        };
+        let ours = time(offscreen, false)?;
+        let plain = time(offscreen, true)?;
+        out.push(result(
+            &format!("render_frame_1280x720_{slices}_slices_{octaves}_octaves"),
+            ours * 1e3,
+            "ms",
+            &format!("plain_slice_shader_1280x720_{slices}_slices"),
+            plain * 1e3,
+        ));
+    }
+    Ok(out)
+}
+
 /// A 500-point cloud-like outline (flat base, bumpy top) for the sketch benchmark.
 pub fn bench_outline() -> Vec<[f64; 2]> {
     let n = 500;
@@ -423,6 +451,9 @@ pub fn run(json: bool, only: Option<&str>) -> Result<(), String> {
     }
     if wanted("render") {
         results.push(render_frame(&mut offscreen)?);
+    }
+    if wanted("quality") {
+        results.extend(render_frames_by_quality(&mut offscreen)?);
     }
     let report = BenchReport { machine, results };
     if json {

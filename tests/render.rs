@@ -341,3 +341,47 @@ fn quality_changes_smoothness_not_the_cloud() {
         assert!((b256 / b64 - 1.0).abs() < 0.05, "{name}: brightness {b64:.1} → {b256:.1}");
     }
 }
+
+/// High-frequency energy of an image: the mean squared Laplacian of its luminance over the
+/// pixels where the cloud is.
+fn detail_energy(image: &cloudsketch::render::offscreen::Image, bg: [u8; 3]) -> f64 {
+    let l = |x: u32, y: u32| luminance(image.pixel(x, y));
+    let (mut sum, mut n) = (0.0, 0);
+    for y in 1..image.height - 1 {
+        for x in 1..image.width - 1 {
+            if differs(image.pixel(x, y), bg) {
+                let lap = 4.0 * l(x, y) - l(x - 1, y) - l(x + 1, y) - l(x, y - 1) - l(x, y + 1);
+                sum += lap * lap;
+                n += 1;
+            }
+        }
+    }
+    sum / n.max(1) as f64
+}
+
+#[test]
+fn more_detail_more_fine_structure_and_opacity_keeps_the_cloud_in_place() {
+    let scene = with(&Scene::default(), &["/render/slices=64", "/render/noise_octaves=5"]);
+    let bg = background(&scene);
+    // Detail is the lacunarity: a larger step between octaves puts the finer octaves finer.
+    let smooth = detail_energy(&render(&with(&scene, &["/render/detail=1.6"])), bg);
+    let rough = detail_energy(&render(&with(&scene, &["/render/detail=3.2"])), bg);
+    assert!(rough > 1.2 * smooth, "high-frequency energy {smooth:.1} → {rough:.1}");
+    // Opacity covers more but does not move the cloud: its centroid stays within a pixel.
+    let centroid = |s: &Scene| {
+        let image = render(s);
+        let (mut sx, mut sy, mut n) = (0.0, 0.0, 0.0);
+        for y in 0..image.height {
+            for x in 0..image.width {
+                if differs(image.pixel(x, y), bg) {
+                    (sx, sy, n) = (sx + x as f64, sy + y as f64, n + 1.0);
+                }
+            }
+        }
+        (sx / n, sy / n, n)
+    };
+    let (x1, y1, n1) = centroid(&with(&scene, &["/render/opacity=1"]));
+    let (x2, y2, n2) = centroid(&with(&scene, &["/render/opacity=4"]));
+    assert!(n2 > n1, "opacity 4 covers more: {n1} → {n2}");
+    assert!((x2 - x1).hypot(y2 - y1) <= 1.0, "centroid ({x1:.1},{y1:.1}) → ({x2:.1},{y2:.1})");
+}

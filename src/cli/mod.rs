@@ -79,7 +79,8 @@ enum Command {
         /// Print one JSON object instead of a table.
         #[arg(long)]
         json: bool,
-        /// Run only these groups, comma-separated: sketch, light, stroke, worst, field, render.
+        /// Run only these groups, comma-separated: sketch, light, stroke, worst, field, render,
+        /// quality.
         #[arg(long)]
         only: Option<String>,
     },

@@ -11,17 +11,19 @@ use crate::ui::widgets::param;
 pub const RENDER: PartPanel<RenderSettings> =
     PartPanel::new("Render", |s| &s.render, Edit::SetRender, body);
 
+/// Table 2's qualitative controls first (Opacity, Quality, Detail, Dirtiness, Sharpness, cloud
+/// size), the finer settings after, the media's filter, noise and motion in a deeper group.
 fn body(ui: &mut Ui, r: &mut RenderSettings) {
-    param(ui, &mut r.slices, &limits::SLICES);
     param(ui, &mut r.opacity, &limits::OPACITY);
-    param(ui, &mut r.softness, &limits::SOFTNESS);
-    param(ui, &mut r.noise_amount, &limits::NOISE_AMOUNT);
-    param(ui, &mut r.noise_scale, &limits::NOISE_SCALE);
-    param(ui, &mut r.noise_octaves, &limits::OCTAVES);
+    param(ui, &mut r.slices, &limits::SLICES);
     param(ui, &mut r.detail, &limits::DETAIL);
-    param(ui, &mut r.field_resolution, &limits::FIELD_RESOLUTION);
-    param(ui, &mut r.sharpness, &limits::SHARPNESS);
     param(ui, &mut r.dirtiness, &limits::DIRTINESS);
+    param(ui, &mut r.sharpness, &limits::SHARPNESS);
+    param(ui, &mut r.noise_scale, &limits::NOISE_SCALE);
+    param(ui, &mut r.noise_amount, &limits::NOISE_AMOUNT);
+    param(ui, &mut r.softness, &limits::SOFTNESS);
+    param(ui, &mut r.noise_octaves, &limits::OCTAVES);
+    param(ui, &mut r.field_resolution, &limits::FIELD_RESOLUTION);
     egui::CollapsingHeader::new("Media: filter, basis, wind")
         .default_open(false)
         .show(ui, |ui| {
