@@ -13,7 +13,7 @@ use std::cell::RefCell;
 use wasm_bindgen::JsCast as _;
 use wasm_bindgen::prelude::*;
 
-use crate::scene::{Preset, Scene};
+use crate::scene::Scene;
 use crate::ui::{CloudApp, Host, PageStatus, StartOptions};
 
 thread_local! {
@@ -32,10 +32,13 @@ pub fn start() {
         previous(info);
     }));
     install_state_accessor();
+    let (scene, notice) = scene_from_url();
     let options = StartOptions {
-        scene: scene_from_url(),
+        scene,
         host: Some(Box::new(WebHost)),
         initial_cost: 4e-8,
+        notice,
+        autosave: true,
     };
     wasm_bindgen_futures::spawn_local(async move {
         if let Err(message) = run(options).await {
@@ -70,21 +73,14 @@ async fn run(options: StartOptions) -> Result<(), String> {
     Ok(())
 }
 
-/// `?preset=NAME` picks the starting document.
-fn scene_from_url() -> Scene {
+/// The starting document: `?preset=NAME` opens a preset (keeping the last session aside), a
+/// plain visit continues the last session (see [`crate::ui::start_session`]).
+fn scene_from_url() -> (Scene, Option<String>) {
     let search = web_sys::window()
         .and_then(|w| w.location().search().ok())
         .unwrap_or_default();
     let params = web_sys::UrlSearchParams::new_with_str(&search).ok();
-    match params.and_then(|p| p.get("preset")) {
-        Some(name) => Preset::from_name(&name)
-            .map(Scene::preset)
-            .unwrap_or_else(|| {
-                log::warn!("unknown preset {name:?}; opening the default scene");
-                Scene::default()
-            }),
-        None => Scene::default(),
-    }
+    crate::ui::start_session(params.and_then(|p| p.get("preset")).as_deref())
 }
 
 /// Shows a message in the page's error box (and keeps the page usable as a page).

@@ -2,8 +2,9 @@
 
 use crate::ui::{CloudApp, StartOptions};
 
-/// Opens the desktop window on the default scene.
+/// Opens the desktop window on the last session (autosaved), else the default scene.
 pub fn run() -> Result<(), String> {
+    let (scene, notice) = crate::ui::start_session(None);
     let options = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default()
             .with_title("cloudsketch")
@@ -17,7 +18,10 @@ pub fn run() -> Result<(), String> {
             Ok(Box::new(CloudApp::new(
                 cc,
                 StartOptions {
+                    scene,
                     initial_cost: 1e-8,
+                    notice,
+                    autosave: true,
                     ..Default::default()
                 },
             )))

@@ -1,6 +1,7 @@
 //! The application: owns the document, the derivation cache, the viewport and the side
 //! panel's views, runs the frame loop and the global shortcuts, and publishes the page status.
 
+use super::autosave::Autosave;
 use super::guide::Guide;
 use super::notice::Notices;
 use super::panels::{ClockPanel, LIGHT, RENDER, ScenePanel, SketchPanel, ViewPanel, ViewStats};
@@ -46,6 +47,10 @@ pub struct StartOptions {
     pub host: Option<Box<dyn Host>>,
     /// Guessed cost of the volume pass in seconds per pixel·slice, refined by measurement.
     pub initial_cost: f64,
+    /// What to tell the user at start (a restored session, a bad link).
+    pub notice: Option<String>,
+    /// Write the document to the platform's store as it changes (the app; not tests).
+    pub autosave: bool,
 }
 
 impl Default for StartOptions {
@@ -54,6 +59,8 @@ impl Default for StartOptions {
             scene: Scene::default(),
             host: None,
             initial_cost: 2e-8,
+            notice: None,
+            autosave: false,
         }
     }
 }
@@ -88,6 +95,8 @@ pub struct CloudApp {
     cpu_seconds: Option<f32>,
     /// The document's JSON as last published, with the revision it was made at.
     published: Option<(u64, String)>,
+    /// When to write the autosave (`None`: not autosaving).
+    autosave: Option<Autosave>,
 }
 
 impl CloudApp {
@@ -103,8 +112,14 @@ impl CloudApp {
         cc.egui_ctx.set_visuals(egui::Visuals::dark());
         super::widgets::install_fonts(&cc.egui_ctx);
         super::platform::install(&cc.egui_ctx);
+        let doc = Document::new(options.scene);
+        let mut notices = Notices::default();
+        if let Some(text) = options.notice {
+            notices.note(0.0, text);
+        }
         Self {
-            doc: Document::new(options.scene),
+            autosave: options.autosave.then(|| Autosave::new(&doc)),
+            doc,
             derived: Derived::default(),
             viewport: Viewport::new(
                 options.initial_cost,
@@ -115,7 +130,7 @@ impl CloudApp {
             ),
             tool: SketchTool::default(),
             selection: Selection::default(),
-            notices: Notices::default(),
+            notices,
             guide: Guide::default(),
             panels: Panels::default(),
             panel_open: true,
@@ -258,6 +273,22 @@ impl CloudApp {
                 }
                 Err(e) => self.notices.error(now, e.to_string()),
             }
+        }
+    }
+
+    /// Writes the document to the platform's store a second after it last changed.
+    fn autosave(&mut self, ctx: &egui::Context) {
+        let Some(autosave) = self.autosave.as_mut() else {
+            return;
+        };
+        let now = ctx.input(|i| i.time);
+        if let Some(json) = autosave.due(&self.doc, now)
+            && let Some(message) = autosave.written(super::platform::store_autosave(&json))
+        {
+            self.notices.error(now, message);
+        }
+        if let Some(wait) = autosave.pending(now) {
+            ctx.request_repaint_after(std::time::Duration::from_secs_f64(wait + 0.05));
         }
     }
 
@@ -425,6 +456,7 @@ impl eframe::App for CloudApp {
         if !ctx.input(|i| i.pointer.any_down()) {
             self.doc.end_merge();
         }
+        self.autosave(&ctx);
         self.publish();
     }
 }

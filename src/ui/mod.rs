@@ -3,6 +3,8 @@
 //! hands the renderer a per-frame snapshot.
 //!
 //! - `app`: [`CloudApp`], the frame loop, shortcuts and the page status;
+//! - `autosave`: when the document is written to the platform's store, and what a session
+//!   starts with;
 //! - `viewport`: the 3D view (progressive quality, camera input, status line);
 //! - `sketch_tool`: the Sketch, Cut, Ellipsoid, Move and Rotate tools and their overlay;
 //! - `ellipsoids`: adding, picking, moving, duplicating and deleting ellipsoids;
@@ -14,6 +16,7 @@
 //! - `platform_native` / `platform_web`: the one platform seam (chosen by `cfg` on the module).
 
 mod app;
+mod autosave;
 mod camera_input;
 mod ellipsoids;
 mod gizmo;
@@ -33,6 +36,7 @@ mod viewport;
 mod widgets;
 
 pub use app::{CloudApp, Host, PageStatus, StartOptions};
+pub use autosave::start_session;
 
 /// The view rectangle the UI's unit tests place things in: 1280×800 points at the origin.
 #[cfg(test)]

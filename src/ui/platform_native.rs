@@ -42,6 +42,36 @@ pub fn take_pointer_samples() -> Option<Vec<(egui::Pos2, Option<f32>)>> {
     None
 }
 
+/// Where the autosave lives: `$XDG_DATA_HOME/cloudsketch`, else `~/.local/share/cloudsketch`.
+fn autosave_dir() -> Option<std::path::PathBuf> {
+    let base = std::env::var_os("XDG_DATA_HOME")
+        .map(std::path::PathBuf::from)
+        .or_else(|| std::env::var_os("HOME").map(|h| std::path::Path::new(&h).join(".local/share")))?;
+    Some(base.join("cloudsketch"))
+}
+
+/// The last autosaved document, if any.
+pub fn load_autosave() -> Option<String> {
+    let path = autosave_dir()?.join("autosave.json");
+    (std::fs::metadata(&path).ok()?.len() <= MAX_BYTES).then(|| std::fs::read_to_string(path).ok())?
+}
+
+/// Writes the autosave (to a temporary file first, so a crash mid-write keeps the last one).
+pub fn store_autosave(json: &str) -> Result<(), String> {
+    let dir = autosave_dir().ok_or("no home folder to keep it in")?;
+    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let tmp = dir.join("autosave.json.tmp");
+    std::fs::write(&tmp, json).map_err(|e| format!("{}: {e}", tmp.display()))?;
+    std::fs::rename(&tmp, dir.join("autosave.json")).map_err(|e| format!("{}: {e}", dir.display()))
+}
+
+/// Keeps the last autosave aside before a new session writes over it.
+pub fn keep_previous_autosave() {
+    if let Some(dir) = autosave_dir() {
+        let _ = std::fs::copy(dir.join("autosave.json"), dir.join("autosave.previous.json"));
+    }
+}
+
 /// Seconds since the first call, for timing work within a frame.
 pub fn now() -> f64 {
     static START: std::sync::OnceLock<std::time::Instant> = std::sync::OnceLock::new();

@@ -32,6 +32,34 @@ fn deliver(loaded: Loaded) {
     wake();
 }
 
+/// localStorage keys of the autosave and of the session kept aside.
+const AUTOSAVE_KEY: &str = "cloudsketch.autosave";
+const PREVIOUS_KEY: &str = "cloudsketch.autosave.previous";
+
+fn storage() -> Option<web_sys::Storage> {
+    web_sys::window().and_then(|w| w.local_storage().ok().flatten())
+}
+
+/// The last autosaved document, if any.
+pub fn load_autosave() -> Option<String> {
+    storage()?.get_item(AUTOSAVE_KEY).ok().flatten()
+}
+
+/// Writes the autosave (the browser's quota may refuse a large reference image).
+pub fn store_autosave(json: &str) -> Result<(), String> {
+    let storage = storage().ok_or("this browser keeps no local storage for the page")?;
+    storage
+        .set_item(AUTOSAVE_KEY, json)
+        .map_err(|_| "the browser's storage for this page is full".to_owned())
+}
+
+/// Keeps the last autosave aside (under its own key) before a new session writes over it.
+pub fn keep_previous_autosave() {
+    if let (Some(storage), Some(json)) = (storage(), load_autosave()) {
+        let _ = storage.set_item(PREVIOUS_KEY, &json);
+    }
+}
+
 /// Seconds since the page opened (`performance.now()`), for timing work within a frame.
 pub fn now() -> f64 {
     web_sys::window()

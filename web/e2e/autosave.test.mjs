@@ -1,0 +1,47 @@
+// Nothing a user makes is lost on a reload: the scene is written to the page's storage a
+// second after it changes and a plain visit continues it (with a notice); opening a link to a
+// preset never replaces that session silently: it is kept aside under its own key.
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import { serve, launch, openApp, waitForBody, state, until } from './harness.mjs';
+
+let server;
+before(async () => { server = await serve(); });
+after(async () => { await server?.close(); });
+
+const saved = (page, key) => page.evaluate((k) => JSON.parse(localStorage.getItem(k) ?? 'null'), key);
+
+test('a reload continues the session; a link keeps it aside (webgpu)', { timeout: 180_000 }, async () => {
+  const { browser, close } = await launch({ webgpu: true });
+  try {
+    const { page, errors } = await openApp(browser, server.url, '', { width: 1280, height: 800 });
+    await waitForBody(page, 'data-ready', (v) => v === 'true');
+    assert.equal(await saved(page, 'cloudsketch.autosave'), null, 'an untouched session writes nothing');
+    await page.evaluate(() => window.cloudsketch.set('/ellipsoids/0/center=[5,5,5]'));
+    await until(page, (s) => s.scene.ellipsoids[0].center[0] === 5, 'edited');
+    // Written about a second later, without any further input.
+    const t0 = Date.now();
+    await page.waitForFunction(() => {
+      const s = JSON.parse(localStorage.getItem('cloudsketch.autosave') ?? 'null');
+      return s && s.ellipsoids[0].center[0] === 5;
+    }, null, { timeout: 10_000, polling: 50 });
+    const waited = (Date.now() - t0) / 1000;
+    assert.ok(waited < 5, `autosaved after ${waited} s`);
+
+    await page.reload();
+    await waitForBody(page, 'data-ready', (v) => v === 'true');
+    let s = await state(page);
+    assert.deepEqual(s.scene.ellipsoids[0].center, [5, 5, 5], 'the session came back');
+    assert.match(s.view.notice.text, /Restored your last session/);
+
+    await page.goto(`${server.url}?preset=stratus`);
+    await waitForBody(page, 'data-ready', (v) => v === 'true');
+    s = await state(page);
+    assert.ok(s.scene.ellipsoids.length > 20, 'the link opened the stratus preset');
+    const previous = await saved(page, 'cloudsketch.autosave.previous');
+    assert.deepEqual(previous.ellipsoids[0].center, [5, 5, 5], 'the last session is kept aside');
+    assert.deepEqual(errors, []);
+  } finally {
+    await close();
+  }
+});
