@@ -103,7 +103,11 @@ fn cloud_centroid(rgb: &[u8]) -> (f64, usize) {
     let sky = &rgb[..3];
     let (mut sum, mut n) = (0.0, 0);
     for (i, p) in rgb.chunks(3).enumerate() {
-        let d: i32 = p.iter().zip(sky).map(|(a, b)| (*a as i32 - *b as i32).abs()).sum();
+        let d: i32 = p
+            .iter()
+            .zip(sky)
+            .map(|(a, b)| (*a as i32 - *b as i32).abs())
+            .sum();
         if d > 24 {
             sum += (i % 96) as f64;
             n += 1;
@@ -117,7 +121,9 @@ fn set_moves_and_hides_ellipsoids() {
     let base = cloud_centroid(&render_with("e-base.png", &[]));
     // Every ellipsoid but the first hidden, and the first moved right then left: the cloud goes
     // with it.
-    let hide: Vec<String> = (1..6).map(|i| format!("/ellipsoids/{i}/hidden=true")).collect();
+    let hide: Vec<String> = (1..6)
+        .map(|i| format!("/ellipsoids/{i}/hidden=true"))
+        .collect();
     let mut sets: Vec<&str> = hide.iter().map(String::as_str).collect();
     let right = cloud_centroid(&render_with(
         "e-right.png",
@@ -125,9 +131,20 @@ fn set_moves_and_hides_ellipsoids() {
     ));
     sets.push("/ellipsoids/0/center=[-5,3,0]");
     let left = cloud_centroid(&render_with("e-left.png", &sets));
-    assert!(base.1 > 300 && right.1 > 50 && left.1 > 50, "{base:?} {right:?} {left:?}");
-    assert!(right.1 < base.1 && left.1 < base.1, "one ellipsoid covers less than six");
-    assert!(right.0 > left.0 + 25.0, "moved with its centre: {} vs {}", right.0, left.0);
+    assert!(
+        base.1 > 300 && right.1 > 50 && left.1 > 50,
+        "{base:?} {right:?} {left:?}"
+    );
+    assert!(
+        right.1 < base.1 && left.1 < base.1,
+        "one ellipsoid covers less than six"
+    );
+    assert!(
+        right.0 > left.0 + 25.0,
+        "moved with its centre: {} vs {}",
+        right.0,
+        left.0
+    );
 }
 
 #[test]

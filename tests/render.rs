@@ -153,11 +153,19 @@ fn more_opacity_more_cover() {
 }
 
 /// Pixels whose colour differs by more than 24/255 (summed) between two images.
-fn changed(a: &cloudsketch::render::offscreen::Image, b: &cloudsketch::render::offscreen::Image) -> usize {
+fn changed(
+    a: &cloudsketch::render::offscreen::Image,
+    b: &cloudsketch::render::offscreen::Image,
+) -> usize {
     a.rgba
         .chunks(4)
         .zip(b.rgba.chunks(4))
-        .filter(|(p, q)| (0..3).map(|i| (p[i] as i32 - q[i] as i32).abs()).sum::<i32>() > 24)
+        .filter(|(p, q)| {
+            (0..3)
+                .map(|i| (p[i] as i32 - q[i] as i32).abs())
+                .sum::<i32>()
+                > 24
+        })
         .count()
 }
 
@@ -166,7 +174,10 @@ fn table_2_filters_and_the_worley_basis_each_change_the_media() {
     // Each filter changes a tenth of the cloud's pixels or more against every other filter,
     // and so does the other basis (the same document always gives the same image, so any
     // difference comes from the media).
-    let base = with(&Scene::default(), &["/render/slices=64", "/render/noise_amount=0.6"]);
+    let base = with(
+        &Scene::default(),
+        &["/render/slices=64", "/render/noise_amount=0.6"],
+    );
     let images: Vec<_> = ["stratus", "cumulus", "wispy", "veined"]
         .iter()
         .map(|f| render(&with(&base, &[&format!("/render/noise_filter=\"{f}\"")])))
@@ -179,7 +190,10 @@ fn table_2_filters_and_the_worley_basis_each_change_the_media() {
     for i in 0..images.len() {
         for j in i + 1..images.len() {
             let d = changed(&images[i], &images[j]);
-            assert!(d > cloud / 10, "filters {i} and {j}: {d} of {cloud} cloud px differ");
+            assert!(
+                d > cloud / 10,
+                "filters {i} and {j}: {d} of {cloud} cloud px differ"
+            );
         }
     }
     let worley = render(&with(&base, &["/render/noise_basis=\"worley\""]));
@@ -220,13 +234,20 @@ fn sharpness_trims_the_fringe_without_shrinking_the_core() {
 
 #[test]
 fn wind_moves_the_media_over_scene_time_and_calm_air_does_not() {
-    let base = with(&Scene::default(), &["/render/slices=64", "/render/noise_amount=0.6"]);
+    let base = with(
+        &Scene::default(),
+        &["/render/slices=64", "/render/noise_amount=0.6"],
+    );
     let at = |s: &Scene, t: f32| {
         let mut s = s.clone();
         s.time = t;
         render(&s)
     };
-    assert_eq!(at(&base, 0.0), at(&base, 3.0), "no wind, no torque: time changes nothing");
+    assert_eq!(
+        at(&base, 0.0),
+        at(&base, 3.0),
+        "no wind, no torque: time changes nothing"
+    );
     let windy = with(&base, &["/render/wind=[1.5,0]"]);
     let d = changed(&at(&windy, 0.0), &at(&windy, 1.0));
     assert!(d > 500, "the wind moved the noise: {d} px changed");
@@ -238,7 +259,12 @@ fn wind_moves_the_media_over_scene_time_and_calm_air_does_not() {
 /// Mean luminance of the opaque cloud pixels (far from the sky's colour, so the sky showing
 /// through a thin edge does not count) in each quarter of their screen extent, left to right.
 fn quarter_brightness(image: &cloudsketch::render::offscreen::Image, bg: [u8; 3]) -> [f64; 4] {
-    let opaque = |p: [u8; 4]| (0..3).map(|i| (p[i] as i32 - bg[i] as i32).abs()).sum::<i32>() > 90;
+    let opaque = |p: [u8; 4]| {
+        (0..3)
+            .map(|i| (p[i] as i32 - bg[i] as i32).abs())
+            .sum::<i32>()
+            > 90
+    };
     let cloud: Vec<(u32, u32)> = (0..image.height)
         .flat_map(|y| (0..image.width).map(move |x| (x, y)))
         .filter(|&(x, y)| opaque(image.pixel(x, y)))
@@ -266,11 +292,18 @@ fn dirtiness_makes_the_cloud_darken_faster_away_from_the_sun() {
     // it stays below the clean cloud's.)
     let scene = with(
         &Scene::default(),
-        &["/light/sun_azimuth_deg=0", "/light/sun_elevation_deg=5", "/render/slices=64"],
+        &[
+            "/light/sun_azimuth_deg=0",
+            "/light/sun_elevation_deg=5",
+            "/render/slices=64",
+        ],
     );
     let bg = background(&scene);
     let falloff = |d: &str| {
-        let q = quarter_brightness(&render(&with(&scene, &[&format!("/render/dirtiness={d}")])), bg);
+        let q = quarter_brightness(
+            &render(&with(&scene, &[&format!("/render/dirtiness={d}")])),
+            bg,
+        );
         q[2] / q[3]
     };
     let (clean, default, dirty) = (falloff("0.25"), falloff("1"), falloff("3"));
@@ -298,7 +331,12 @@ fn presets_are_each_recognisable() {
     let names = ["cumulus", "stratus", "cirrus", "cumulonimbus", "sunset"];
     let scenes: Vec<Scene> = names
         .iter()
-        .map(|n| with(&Scene::preset(Preset::from_name(n).unwrap()), &["/render/slices=64"]))
+        .map(|n| {
+            with(
+                &Scene::preset(Preset::from_name(n).unwrap()),
+                &["/render/slices=64"],
+            )
+        })
         .collect();
     let images: Vec<_> = scenes.iter().map(render).collect();
     // The baseline: the same preset with another seed (other noise) differs this much.
@@ -307,7 +345,13 @@ fn presets_are_each_recognisable() {
         let noise = changed(&images[i], &reseeded).max(50);
         for j in (0..images.len()).filter(|&j| j != i) {
             let d = changed(&images[i], &images[j]);
-            assert!(d >= 3 * noise, "{} vs {}: {d} px, two seeds of {}: {noise} px", names[i], names[j], names[i]);
+            assert!(
+                d >= 3 * noise,
+                "{} vs {}: {d} px, two seeds of {}: {noise} px",
+                names[i],
+                names[j],
+                names[i]
+            );
         }
     }
     let (w, h) = cloud_box(&images[1], background(&scenes[1]));
@@ -337,8 +381,14 @@ fn quality_changes_smoothness_not_the_cloud() {
         };
         let ((c64, b64), (c256, b256)) = (measure(64), measure(256));
         assert!(c64 > 500.0, "{name}: a cloud");
-        assert!((c256 / c64 - 1.0).abs() < 0.05, "{name}: coverage {c64} → {c256}");
-        assert!((b256 / b64 - 1.0).abs() < 0.05, "{name}: brightness {b64:.1} → {b256:.1}");
+        assert!(
+            (c256 / c64 - 1.0).abs() < 0.05,
+            "{name}: coverage {c64} → {c256}"
+        );
+        assert!(
+            (b256 / b64 - 1.0).abs() < 0.05,
+            "{name}: brightness {b64:.1} → {b256:.1}"
+        );
     }
 }
 
@@ -361,12 +411,18 @@ fn detail_energy(image: &cloudsketch::render::offscreen::Image, bg: [u8; 3]) -> 
 
 #[test]
 fn more_detail_more_fine_structure_and_opacity_keeps_the_cloud_in_place() {
-    let scene = with(&Scene::default(), &["/render/slices=64", "/render/noise_octaves=5"]);
+    let scene = with(
+        &Scene::default(),
+        &["/render/slices=64", "/render/noise_octaves=5"],
+    );
     let bg = background(&scene);
     // Detail is the lacunarity: a larger step between octaves puts the finer octaves finer.
     let smooth = detail_energy(&render(&with(&scene, &["/render/detail=1.6"])), bg);
     let rough = detail_energy(&render(&with(&scene, &["/render/detail=3.2"])), bg);
-    assert!(rough > 1.2 * smooth, "high-frequency energy {smooth:.1} → {rough:.1}");
+    assert!(
+        rough > 1.2 * smooth,
+        "high-frequency energy {smooth:.1} → {rough:.1}"
+    );
     // Opacity covers more but does not move the cloud: its centroid stays within a pixel.
     let centroid = |s: &Scene| {
         let image = render(s);
@@ -383,5 +439,8 @@ fn more_detail_more_fine_structure_and_opacity_keeps_the_cloud_in_place() {
     let (x1, y1, n1) = centroid(&with(&scene, &["/render/opacity=1"]));
     let (x2, y2, n2) = centroid(&with(&scene, &["/render/opacity=4"]));
     assert!(n2 > n1, "opacity 4 covers more: {n1} → {n2}");
-    assert!((x2 - x1).hypot(y2 - y1) <= 1.0, "centroid ({x1:.1},{y1:.1}) → ({x2:.1},{y2:.1})");
+    assert!(
+        (x2 - x1).hypot(y2 - y1) <= 1.0,
+        "centroid ({x1:.1},{y1:.1}) → ({x2:.1},{y2:.1})"
+    );
 }

@@ -284,7 +284,9 @@ fn silhouette_overshoot(outline: &[glam::DVec2], group: &crate::field::Group) ->
             }
             let near = crate::field::Group {
                 blobs: (group.blobs.iter())
-                    .filter(|b| (b.center.truncate().as_dvec2() - q).length() < 2.0 * b.extent.x as f64)
+                    .filter(|b| {
+                        (b.center.truncate().as_dvec2() - q).length() < 2.0 * b.extent.x as f64
+                    })
                     .cloned()
                     .collect(),
                 ..group.clone()
@@ -356,7 +358,10 @@ fn the_soft_blend_fills_creases_and_keeps_the_silhouette_within_a_pixel() {
             ..soft.clone()
         };
         let (pushed, _) = silhouette_overshoot(&s.outline.points, &unlimited);
-        assert!(pushed > 1.5, "{name}: the unlimited blend would push it {pushed:.2} px");
+        assert!(
+            pushed > 1.5,
+            "{name}: the unlimited blend would push it {pushed:.2} px"
+        );
         // Softer: the blended cloud holds more than the plain union (the creases fill in).
         let volume = |g: &Group| {
             let f = Field {
@@ -367,7 +372,12 @@ fn the_soft_blend_fills_creases_and_keeps_the_silhouette_within_a_pixel() {
             v.values.iter().filter(|&&x| x >= crate::field::ISO).count()
         };
         let (hard, softened) = (volume(&Group::hard(blobs)), volume(&soft));
-        eprintln!("{name}: overshoot {overshoot:.2}, unlimited {pushed:.2}, volume {hard} → {softened}");
-        assert!(softened as f64 > hard as f64 * 1.02, "{name}: {hard} → {softened}");
+        eprintln!(
+            "{name}: overshoot {overshoot:.2}, unlimited {pushed:.2}, volume {hard} → {softened}"
+        );
+        assert!(
+            softened as f64 > hard as f64 * 1.02,
+            "{name}: {hard} → {softened}"
+        );
     }
 }

@@ -91,7 +91,8 @@ pub struct PlacedInside {
 impl PlacedInside {
     /// Inside distance of world point `p`'s projection along the plane's normal.
     pub fn depth(&self, p: Vec3) -> f32 {
-        self.map.depth_at((self.to_plane * (p - self.origin)).truncate())
+        self.map
+            .depth_at((self.to_plane * (p - self.origin)).truncate())
     }
 }
 

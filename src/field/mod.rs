@@ -185,7 +185,9 @@ impl Group {
     /// and adds nothing where the spheres barely reach (no haze of k/4 around the cloud).
     #[inline]
     pub fn combine(&self, first: f32, second: f32, p: Vec3) -> f32 {
-        if first <= 0.0 || self.blend <= 0.0 {
+        // Values a blend's width or more apart get no lift: skip the inside look-up (most
+        // texels of a dense group, in the bake's inner loop).
+        if first <= 0.0 || first - second >= self.blend {
             return first.max(0.0);
         }
         smooth_max(first, second, self.blend_at(p) * (first / ISO).min(1.0))
@@ -193,7 +195,11 @@ impl Group {
 
     /// The group's value at `p`.
     pub fn value(&self, p: Vec3) -> f32 {
-        let (a, b) = self.blobs.iter().map(|b| b.value(p)).fold((0.0, 0.0), top_two);
+        let (a, b) = self
+            .blobs
+            .iter()
+            .map(|b| b.value(p))
+            .fold((0.0, 0.0), top_two);
         self.combine(a, b, p)
     }
 }
@@ -201,7 +207,11 @@ impl Group {
 /// Folds a value into the two largest so far.
 #[inline]
 pub fn top_two((first, second): (f32, f32), v: f32) -> (f32, f32) {
-    if v > first { (v, first) } else { (first, second.max(v)) }
+    if v > first {
+        (v, first)
+    } else {
+        (first, second.max(v))
+    }
 }
 
 /// The whole field: blended primitives minus clips.

@@ -195,7 +195,10 @@ impl Dirty {
                 let flags = &mask[row * bricks.x as usize..][..bricks.x as usize];
                 let mut runs: Vec<std::ops::Range<u32>> = Vec::new();
                 for (bx, _) in flags.iter().enumerate().filter(|(_, f)| **f) {
-                    let (a, b) = (bx as u32 * BRICK, ((bx as u32 + 1) * BRICK).min(grid.dims.x));
+                    let (a, b) = (
+                        bx as u32 * BRICK,
+                        ((bx as u32 + 1) * BRICK).min(grid.dims.x),
+                    );
                     match runs.last_mut() {
                         Some(r) if r.end == a => r.end = b,
                         _ => runs.push(a..b),
@@ -235,14 +238,18 @@ impl Dirty {
             None => (UVec3::ONE, UVec3::ZERO),
         };
         let empty = a.cmpgt(b).any();
-        let (a, b) = if empty { (UVec3::ONE, UVec3::ZERO) } else { (a, b) };
+        let (a, b) = if empty {
+            (UVec3::ONE, UVec3::ZERO)
+        } else {
+            (a, b)
+        };
         (a.z..=b.z).flat_map(move |k| {
             (a.y..=b.y).flat_map(move |j| {
                 let brick_row = (j / BRICK + self.bricks.y * (k / BRICK)) as usize;
                 let row = (k as usize * ny + j as usize) * nx;
                 self.runs[brick_row].iter().filter_map(move |r| {
                     let (lo, hi) = (r.start.max(a.x), r.end.min(b.x + 1));
-                    (lo < hi).then(|| (row, lo as usize..hi as usize))
+                    (lo < hi).then_some((row, lo as usize..hi as usize))
                 })
             })
         })
@@ -301,7 +308,9 @@ fn evaluate(field: &Field, grid: &Grid, dirty: &Dirty, values: &mut [f32]) -> u6
     let centers = grid.centers();
     for blob in &field.blobs {
         if let Some(bx) = reach(blob) {
-            splat(dirty, dims, &centers, bx, &mut work, |at, p| values[at] += blob.value(p));
+            splat(dirty, dims, &centers, bx, &mut work, |at, p| {
+                values[at] += blob.value(p)
+            });
         }
     }
     if !field.groups.is_empty() {
@@ -427,7 +436,11 @@ pub fn bake_brute_force(field: &Field, resolution: u32) -> DensityVolume {
 /// Bit pattern of a primitive, for finding the ones an edit changed.
 fn blob_key(b: &Blob) -> [u32; 16] {
     let mut k = [0u32; 16];
-    let floats = b.center.to_array().into_iter().chain(b.to_unit.to_cols_array());
+    let floats = b
+        .center
+        .to_array()
+        .into_iter()
+        .chain(b.to_unit.to_cols_array());
     let floats = floats.chain([b.strength]).chain(b.extent.to_array());
     for (slot, f) in k.iter_mut().zip(floats) {
         *slot = f.to_bits();
@@ -442,7 +455,12 @@ fn group_key(group: &super::Group) -> u64 {
     }
     group.blend.to_bits().hash(&mut hasher);
     if let Some(inside) = &group.inside {
-        for f in inside.origin.to_array().into_iter().chain(inside.to_plane.to_array()) {
+        for f in inside
+            .origin
+            .to_array()
+            .into_iter()
+            .chain(inside.to_plane.to_array())
+        {
             f.to_bits().hash(&mut hasher);
         }
     }
@@ -474,10 +492,19 @@ fn changed_boxes(old: &Field, new: &Field) -> Option<Vec<(Vec3, Vec3)>> {
             *count.entry(blob_key(b)).or_default() -= 1;
         }
         let changed = |b: &&Blob| count[&blob_key(b)] != 0;
-        boxes.extend(old.blobs.iter().chain(&new.blobs).filter(changed).map(reach));
+        boxes.extend(
+            old.blobs
+                .iter()
+                .chain(&new.blobs)
+                .filter(changed)
+                .map(reach),
+        );
     }
     let group_box = |g: &super::Group| {
-        g.blobs.iter().map(reach).reduce(|(a, b), (c, d)| (a.min(c), b.max(d)))
+        g.blobs
+            .iter()
+            .map(reach)
+            .reduce(|(a, b), (c, d)| (a.min(c), b.max(d)))
     };
     if old.groups.len() == new.groups.len() {
         for (a, b) in old.groups.iter().zip(&new.groups) {
@@ -571,7 +598,15 @@ impl Baker {
             Some(p) => p,
             None => {
                 let (res, _) = resolution_within(field, resolution, budget);
-                let grid = Grid::of(field, res).expect("a field with bounds has a grid");
+                let Some(grid) = Grid::of(field, res) else {
+                    // Bounds no grid within the caps can hold (not a validated document).
+                    self.last = None;
+                    return Baked {
+                        volume: Arc::new(DensityVolume::default()),
+                        work: 0,
+                        texels: 0,
+                    };
+                };
                 let values = vec![0f32; grid.texels() as usize];
                 (grid, extent, values, Dirty::all(&grid))
             }
@@ -599,7 +634,12 @@ impl Baker {
 
 /// Copies into `values` (on `grid`) every texel `last` holds, and returns the bricks to
 /// re-evaluate: those not wholly inside the last grid and those the changed `boxes` reach.
-fn copy_unchanged(grid: &Grid, last: &LastBake, boxes: &[(Vec3, Vec3)], values: &mut [f32]) -> Dirty {
+fn copy_unchanged(
+    grid: &Grid,
+    last: &LastBake,
+    boxes: &[(Vec3, Vec3)],
+    values: &mut [f32],
+) -> Dirty {
     let bricks = grid.bricks();
     let brick_index = |b: UVec3| (b.x + bricks.x * (b.y + bricks.y * b.z)) as usize;
     let mut mask = vec![false; (bricks.x * bricks.y * bricks.z) as usize];
@@ -614,7 +654,10 @@ fn copy_unchanged(grid: &Grid, last: &LastBake, boxes: &[(Vec3, Vec3)], values: 
         let old = &last.volume.values;
         for k in from.z..to.z {
             for j in from.y..to.y {
-                let (ok, oj) = ((k as i64 - offset.z) as usize, (j as i64 - offset.y) as usize);
+                let (ok, oj) = (
+                    (k as i64 - offset.z) as usize,
+                    (j as i64 - offset.y) as usize,
+                );
                 let oi = (from.x as i64 - offset.x) as usize;
                 let len = (to.x - from.x) as usize;
                 let dst = (k as usize * ny + j as usize) * nx + from.x as usize;
@@ -652,8 +695,8 @@ fn copy_unchanged(grid: &Grid, last: &LastBake, boxes: &[(Vec3, Vec3)], values: 
 #[cfg(test)]
 mod tests {
     use super::super::Blob;
-    use std::sync::Arc;
     use super::*;
+    use std::sync::Arc;
 
     #[test]
     fn empty_field_bakes_empty_volume() {
@@ -735,7 +778,11 @@ mod tests {
         let mut rng = crate::seeded::SplitMix::new(seed);
         (0..n)
             .map(|_| {
-                let c = Vec3::new((rng.next_f64() as f32) * 10.0, (rng.next_f64() as f32) * 3.0, (rng.next_f64() as f32) * 10.0);
+                let c = Vec3::new(
+                    (rng.next_f64() as f32) * 10.0,
+                    (rng.next_f64() as f32) * 3.0,
+                    (rng.next_f64() as f32) * 10.0,
+                );
                 Blob::sphere(c, 0.3 + (rng.next_f64() as f32) * 0.5)
             })
             .collect()
@@ -743,9 +790,23 @@ mod tests {
 
     /// Fails with the number of differing texels (volumes are too large to print).
     fn assert_same(got: &DensityVolume, want: &DensityVolume, what: &str) {
-        assert_eq!((got.dims, got.min, got.size), (want.dims, want.min, want.size), "{what}");
-        let diff = got.values.iter().zip(&want.values).filter(|(a, b)| a != b).count();
-        assert_eq!(diff, 0, "{what}: {diff} of {} texels differ", got.values.len());
+        assert_eq!(
+            (got.dims, got.min, got.size),
+            (want.dims, want.min, want.size),
+            "{what}"
+        );
+        let diff = got
+            .values
+            .iter()
+            .zip(&want.values)
+            .filter(|(a, b)| a != b)
+            .count();
+        assert_eq!(
+            diff,
+            0,
+            "{what}: {diff} of {} texels differ",
+            got.values.len()
+        );
     }
 
     fn full_on_same_grid(baker: &Baker, field: &Field) -> DensityVolume {
@@ -783,7 +844,10 @@ mod tests {
             match step % 6 {
                 0 => blobs[i].center += Vec3::new(0.7, -0.3, 0.2),
                 1 => blobs[i] = Blob::sphere(blobs[i].center, 1.1),
-                2 => blobs.push(Blob::sphere(Vec3::new((rng.next_f64() as f32) * 9.0, 0.5, -1.0), 0.5)),
+                2 => blobs.push(Blob::sphere(
+                    Vec3::new((rng.next_f64() as f32) * 9.0, 0.5, -1.0),
+                    0.5,
+                )),
                 3 => {
                     blobs.remove(i);
                 }
@@ -809,7 +873,10 @@ mod tests {
             for y in 0..v.dims.y {
                 for x in 0..v.dims.x {
                     let want = field.value(v.center(x, y, z));
-                    assert!((v.value(x, y, z) - want).abs() < 1.0 / 255.0, "({x},{y},{z})");
+                    assert!(
+                        (v.value(x, y, z) - want).abs() < 1.0 / 255.0,
+                        "({x},{y},{z})"
+                    );
                 }
             }
         }
@@ -862,11 +929,18 @@ mod tests {
     fn edits_change_the_field_where_expected_and_nowhere_else() {
         use crate::scene::Ellipsoid;
         let base: Vec<Ellipsoid> = (0..6)
-            .map(|i| Ellipsoid::new(Vec3::new(i as f32 * 3.0, 0.0, 0.0), Vec3::new(1.2, 0.8, 1.0)))
+            .map(|i| {
+                Ellipsoid::new(
+                    Vec3::new(i as f32 * 3.0, 0.0, 0.0),
+                    Vec3::new(1.2, 0.8, 1.0),
+                )
+            })
             .collect();
         let field_of = |es: &[Ellipsoid]| Field::of_blobs(es.iter().map(Blob::ellipsoid).collect());
         let mut baker = Baker::default();
-        let before = baker.update(&Arc::new(field_of(&base)), 64, u64::MAX).volume;
+        let before = baker
+            .update(&Arc::new(field_of(&base)), 64, u64::MAX)
+            .volume;
         let reach = |e: &Ellipsoid| {
             let b = Blob::ellipsoid(e);
             (b.center - b.extent * SUPPORT, b.center + b.extent * SUPPORT)
@@ -892,15 +966,23 @@ mod tests {
         for (name, scene, regions) in cases {
             let mut baker = Baker::default();
             baker.update(&Arc::new(field_of(&base)), 64, u64::MAX);
-            let after = baker.update(&Arc::new(field_of(scene)), 64, u64::MAX).volume;
-            assert_eq!(after.texel_size(), before.texel_size(), "{name}: the same lattice");
+            let after = baker
+                .update(&Arc::new(field_of(scene)), 64, u64::MAX)
+                .volume;
+            assert_eq!(
+                after.texel_size(),
+                before.texel_size(),
+                "{name}: the same lattice"
+            );
             // Texels both grids hold (same lattice: the same centres).
             let (mut changed, mut outside) = (0, 0);
             for z in 0..after.dims.z {
                 for y in 0..after.dims.y {
                     for x in 0..after.dims.x {
                         let p = after.center(x, y, z);
-                        let Some(t) = before.texel_at(p) else { continue };
+                        let Some(t) = before.texel_at(p) else {
+                            continue;
+                        };
                         if after.value(x, y, z) != before.value(t.x, t.y, t.z) {
                             changed += 1;
                             if !regions.iter().any(|r| inside(p, *r)) {
@@ -911,7 +993,10 @@ mod tests {
                 }
             }
             assert!(changed > 100, "{name}: {changed} texels changed");
-            assert_eq!(outside, 0, "{name}: changes outside the edited primitive's reach");
+            assert_eq!(
+                outside, 0,
+                "{name}: changes outside the edited primitive's reach"
+            );
         }
     }
 
@@ -929,7 +1014,12 @@ mod tests {
         let carved = Field::of_blobs(vec![Blob::ellipsoid(&body), Blob::ellipsoid(&carver)]);
         let (a, c) = (bake(&alone, 48), bake(&carved, 48));
         let inside = |v: &DensityVolume| v.values.iter().filter(|&&x| x >= ISO).count();
-        assert!(inside(&c) < inside(&a) * 9 / 10, "{} vs {}", inside(&c), inside(&a));
+        assert!(
+            inside(&c) < inside(&a) * 9 / 10,
+            "{} vs {}",
+            inside(&c),
+            inside(&a)
+        );
         assert!(!carved.inside(Vec3::new(2.0, 0.0, 0.0)));
         assert!(alone.inside(Vec3::new(2.0, 0.0, 0.0)));
     }
@@ -958,5 +1048,4 @@ mod tests {
             .fold(0.0, f32::max);
         assert!(worst < 1e-5, "{worst}");
     }
-
 }

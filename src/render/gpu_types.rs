@@ -176,12 +176,7 @@ impl VolumeUniforms {
             grid_min: volume.min.extend(far).to_array(),
             grid_inv_size: inv_size.extend(0.0).to_array(),
             sphere: center.extend(radius).to_array(),
-            slicing: [
-                total as f32,
-                first as f32,
-                spacing,
-                r.sharpness,
-            ],
+            slicing: [total as f32, first as f32, spacing, r.sharpness],
             sun_color: sun_color.extend(r.dirtiness).to_array(),
             sky_color: sky_color.extend(1.0).to_array(),
             media: [
@@ -274,11 +269,17 @@ mod tests {
             let before = octave_transform(&r, i, 0.0).transform_point3(p);
             let moved = p + Vec3::new(2.0, 0.0, 0.0) * 1.5 * speed;
             let after = octave_transform(&r, i, 1.5).transform_point3(moved);
-            assert!(before.abs_diff_eq(after, 1e-4), "octave {i}: {before} vs {after}");
+            assert!(
+                before.abs_diff_eq(after, 1e-4),
+                "octave {i}: {before} vs {after}"
+            );
         }
         // Without wind or torque, time changes nothing.
         let calm = RenderSettings::default();
-        assert_eq!(octave_transform(&calm, 2, 0.0), octave_transform(&calm, 2, 9.0));
+        assert_eq!(
+            octave_transform(&calm, 2, 0.0),
+            octave_transform(&calm, 2, 9.0)
+        );
     }
 
     #[test]

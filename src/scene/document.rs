@@ -229,7 +229,11 @@ impl Document {
 
     /// Sets the scene clock (playing, scrubbing). Not an undo step; bumps the render revision.
     pub fn set_time(&mut self, time: f32) {
-        let time = if time.is_finite() { time.clamp(0.0, crate::limits::MAX_TIME) } else { 0.0 };
+        let time = if time.is_finite() {
+            time.clamp(0.0, crate::limits::MAX_TIME)
+        } else {
+            0.0
+        };
         if time != self.scene.time {
             self.scene.time = time;
             self.bump(Changed {

@@ -187,7 +187,11 @@ impl Scene {
         self.light.sanitize();
         self.render.sanitize();
         if !self.time.is_finite() || !(0.0..=limits::MAX_TIME).contains(&self.time) {
-            self.time = if self.time.is_finite() { self.time.clamp(0.0, limits::MAX_TIME) } else { 0.0 };
+            self.time = if self.time.is_finite() {
+                self.time.clamp(0.0, limits::MAX_TIME)
+            } else {
+                0.0
+            };
         }
         Ok(())
     }

@@ -8,8 +8,7 @@ use std::sync::Arc;
 use glam::{Quat, Vec3};
 
 use super::{
-    Ellipsoid, Lighting, NoiseBasis, NoiseFilter, OrbitCamera, RenderSettings, SCENE_VERSION,
-    Scene,
+    Ellipsoid, Lighting, NoiseBasis, NoiseFilter, OrbitCamera, RenderSettings, SCENE_VERSION, Scene,
 };
 use crate::seeded::SplitMix;
 
@@ -102,9 +101,18 @@ fn cumulonimbus() -> Vec<Ellipsoid> {
             v.push(Ellipsoid::new(c, Vec3::new(r, r * 0.85, r)));
         }
     }
-    v.push(Ellipsoid::new(Vec3::new(1.5, 15.6, 0.0), Vec3::new(6.5, 1.2, 4.0)));
-    v.push(Ellipsoid::new(Vec3::new(-1.0, 15.2, 0.6), Vec3::new(4.5, 1.0, 3.2)));
-    v.push(Ellipsoid::new(Vec3::new(4.5, 15.9, -0.4), Vec3::new(3.0, 0.8, 2.4)));
+    v.push(Ellipsoid::new(
+        Vec3::new(1.5, 15.6, 0.0),
+        Vec3::new(6.5, 1.2, 4.0),
+    ));
+    v.push(Ellipsoid::new(
+        Vec3::new(-1.0, 15.2, 0.6),
+        Vec3::new(4.5, 1.0, 3.2),
+    ));
+    v.push(Ellipsoid::new(
+        Vec3::new(4.5, 15.9, -0.4),
+        Vec3::new(3.0, 0.8, 2.4),
+    ));
     v
 }
 

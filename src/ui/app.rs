@@ -411,7 +411,11 @@ impl eframe::App for CloudApp {
         self.cpu_seconds = frame.info().cpu_usage;
         let ctx = ui.ctx().clone();
         self.shortcuts(&ctx);
-        if self.panels.clock.tick(&mut self.doc, ctx.input(|i| i.stable_dt)) {
+        if self
+            .panels
+            .clock
+            .tick(&mut self.doc, ctx.input(|i| i.stable_dt))
+        {
             ctx.request_repaint();
         }
         self.guide.input(&ctx, &mut self.doc, &mut self.notices);

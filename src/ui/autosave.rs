@@ -12,10 +12,15 @@ pub const DELAY: f64 = 1.0;
 /// The document a session starts with, from the preset named in its link (if any) and the
 /// last autosave (if any), with what to tell the user, and whether the autosave must be kept
 /// aside before it is written over.
-pub fn starting_scene(preset: Option<&str>, autosave: Option<&str>) -> (Scene, Option<String>, bool) {
+pub fn starting_scene(
+    preset: Option<&str>,
+    autosave: Option<&str>,
+) -> (Scene, Option<String>, bool) {
     match (preset, autosave) {
         (Some(name), saved) => {
-            let scene = Preset::from_name(name).map(Scene::preset).unwrap_or_default();
+            let scene = Preset::from_name(name)
+                .map(Scene::preset)
+                .unwrap_or_default();
             let notice = Preset::from_name(name)
                 .is_none()
                 .then(|| format!("No preset called {name:?}: opened the default scene"));
@@ -29,7 +34,9 @@ pub fn starting_scene(preset: Option<&str>, autosave: Option<&str>) -> (Scene, O
             ),
             Err(e) => (
                 Scene::default(),
-                Some(format!("The last session could not be restored ({e}); it is kept aside")),
+                Some(format!(
+                    "The last session could not be restored ({e}); it is kept aside"
+                )),
                 true,
             ),
         },
@@ -98,7 +105,9 @@ impl Autosave {
             }
             Err(e) if !self.failed => {
                 self.failed = true;
-                Some(format!("Autosave failed: {e} (save the scene to a file to keep it)"))
+                Some(format!(
+                    "Autosave failed: {e} (save the scene to a file to keep it)"
+                ))
             }
             Err(_) => None,
         }
@@ -114,7 +123,10 @@ mod tests {
     fn writes_a_second_after_the_last_change_and_not_before() {
         let mut doc = Document::new(Scene::default());
         let mut autosave = Autosave::new(&doc);
-        assert!(autosave.due(&doc, 0.0).is_none(), "untouched: nothing to write");
+        assert!(
+            autosave.due(&doc, 0.0).is_none(),
+            "untouched: nothing to write"
+        );
         let mut l = doc.scene().light.clone();
         l.ambient = 0.9;
         doc.apply(Edit::SetLight(l), None);
@@ -123,7 +135,13 @@ mod tests {
         let json = autosave.due(&doc, 11.0).expect("a second later");
         assert_eq!(Scene::from_json(&json).unwrap().0, *doc.scene());
         assert!(autosave.due(&doc, 20.0).is_none(), "written once");
-        assert_eq!(autosave.written(Err("quota".into())).as_deref().map(|m| m.starts_with("Autosave failed")), Some(true));
+        assert_eq!(
+            autosave
+                .written(Err("quota".into()))
+                .as_deref()
+                .map(|m| m.starts_with("Autosave failed")),
+            Some(true)
+        );
         assert!(autosave.written(Err("quota".into())).is_none(), "said once");
     }
 

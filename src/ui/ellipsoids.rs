@@ -81,7 +81,13 @@ pub fn pick(doc: &Document, derived: &mut Derived, rect: Rect, p: Pos2) -> Optio
 pub fn most_at(ellipsoids: &[Arc<Ellipsoid>], at: Vec3) -> Option<usize> {
     ellipsoids
         .iter()
-        .map(|e| if e.hidden { 0.0 } else { Blob::ellipsoid(e).value(at) })
+        .map(|e| {
+            if e.hidden {
+                0.0
+            } else {
+                Blob::ellipsoid(e).value(at)
+            }
+        })
         .enumerate()
         .filter(|&(_, v)| v > 0.0)
         .max_by(|a, b| a.1.total_cmp(&b.1))
@@ -148,5 +154,4 @@ mod tests {
         assert_eq!(most_at(&list, Vec3::new(1.3, 0.0, 0.0)), Some(1));
         assert_eq!(most_at(&list, Vec3::new(9.0, 0.0, 0.0)), None);
     }
-
 }

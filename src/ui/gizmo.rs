@@ -144,7 +144,10 @@ impl Gizmo {
                     offer(d, Handle::Axis(a.axis));
                 }
                 _ if self.handle_end(a.axis).is_some() && p.distance(self.center) > CENTER_PX => {
-                    offer(segment_distance(p, self.center, a.end), Handle::Axis(a.axis));
+                    offer(
+                        segment_distance(p, self.center, a.end),
+                        Handle::Axis(a.axis),
+                    );
                 }
                 _ => {}
             }
@@ -198,7 +201,11 @@ impl Gizmo {
                             Stroke::NONE,
                         ));
                     } else {
-                        painter.rect_filled(Rect::from_center_size(end, egui::vec2(9.0, 9.0)), 1.0, c);
+                        painter.rect_filled(
+                            Rect::from_center_size(end, egui::vec2(9.0, 9.0)),
+                            1.0,
+                            c,
+                        );
                     }
                 }
             }
@@ -228,7 +235,11 @@ pub fn ring_turn(center: Pos2, from: Pos2, to: Pos2, axis_toward_viewer: f32) ->
         return 0.0;
     }
     let angle = a.perp_dot(b).atan2(a.dot(b));
-    if axis_toward_viewer >= 0.0 { angle } else { -angle }
+    if axis_toward_viewer >= 0.0 {
+        angle
+    } else {
+        -angle
+    }
 }
 
 #[cfg(test)]
@@ -243,7 +254,9 @@ mod tests {
         let camera = Scene::default().camera;
         let origin = camera.target;
         let g = Gizmo::layout(Tool::Move, &camera, view(), origin, Quat::IDENTITY).unwrap();
-        let end = g.handle_end(Axis::X).expect("x handle offered in the default view");
+        let end = g
+            .handle_end(Axis::X)
+            .expect("x handle offered in the default view");
         // A press on the arrow takes it; one on the centre takes the centre; far away, none.
         let on_arrow = g.center + (end - g.center) * 0.6;
         assert_eq!(g.hit(on_arrow), Some(Handle::Axis(Axis::X)));
@@ -252,7 +265,9 @@ mod tests {
         // Dragging along the arrow by its own length moves by the handle's world length, along
         // x only, whatever the drag's sideways part.
         let d = end - g.center;
-        let (_, moved) = g.along(Axis::X, Vec2::new(d.x, d.y) + Vec2::new(-d.y, d.x) * 0.5).unwrap();
+        let (_, moved) = g
+            .along(Axis::X, Vec2::new(d.x, d.y) + Vec2::new(-d.y, d.x) * 0.5)
+            .unwrap();
         assert!(moved.y.abs() < 1e-6 && moved.z.abs() < 1e-6, "{moved}");
         let tip = project(&camera, view(), origin + moved).unwrap();
         assert!(tip.distance(end) < 0.5, "{tip:?} vs {end:?}");
@@ -261,16 +276,31 @@ mod tests {
     #[test]
     fn rings_turn_the_way_the_pointer_goes_round() {
         let camera = Scene::default().camera;
-        let g = Gizmo::layout(Tool::Rotate, &camera, view(), camera.target, Quat::IDENTITY).unwrap();
+        let g =
+            Gizmo::layout(Tool::Rotate, &camera, view(), camera.target, Quat::IDENTITY).unwrap();
         // The Z ring (facing a front view) is a circle round the centre: a press on it, away
         // from the X and Y rings (seen nearly edge-on), takes it.
         let on_ring = g.center + egui::vec2(1.0, -1.0).normalized() * RING_PX;
         assert_eq!(g.hit(on_ring), Some(Handle::Axis(Axis::Z)));
         // A quarter turn counter-clockwise on screen about an axis toward the viewer is +90°.
         let c = Pos2::new(100.0, 100.0);
-        let t = ring_turn(c, c + egui::vec2(50.0, 0.0), c + egui::vec2(0.0, -50.0), 1.0);
+        let t = ring_turn(
+            c,
+            c + egui::vec2(50.0, 0.0),
+            c + egui::vec2(0.0, -50.0),
+            1.0,
+        );
         assert!((t - std::f32::consts::FRAC_PI_2).abs() < 1e-5, "{t}");
-        assert!((ring_turn(c, c + egui::vec2(50.0, 0.0), c + egui::vec2(0.0, -50.0), -1.0) + t).abs() < 1e-6);
+        assert!(
+            (ring_turn(
+                c,
+                c + egui::vec2(50.0, 0.0),
+                c + egui::vec2(0.0, -50.0),
+                -1.0
+            ) + t)
+                .abs()
+                < 1e-6
+        );
     }
 
     #[test]
@@ -280,8 +310,14 @@ mod tests {
         let g = Gizmo::layout(Tool::Scale, &camera, view(), camera.target, turn).unwrap();
         // Its x axis now points up the screen.
         let end = g.handle_end(Axis::X).unwrap();
-        assert!(end.y < g.center.y - 40.0 && (end.x - g.center.x).abs() < 5.0, "{end:?}");
+        assert!(
+            end.y < g.center.y - 40.0 && (end.x - g.center.x).abs() < 5.0,
+            "{end:?}"
+        );
         let (px, world) = g.along(Axis::X, Vec2::new(0.0, -30.0)).unwrap();
-        assert!(px > 29.0 && world.normalize().abs_diff_eq(Vec3::Y, 1e-4), "{px} {world}");
+        assert!(
+            px > 29.0 && world.normalize().abs_diff_eq(Vec3::Y, 1e-4),
+            "{px} {world}"
+        );
     }
 }

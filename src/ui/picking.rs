@@ -121,7 +121,6 @@ pub fn plane_at(doc: &Document, rect: Rect, p: Pos2) -> Option<usize> {
     best.map(|(_, i)| i)
 }
 
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -143,6 +142,9 @@ mod tests {
         let area = Rect::from_center_size(c, egui::vec2(4.0, 4.0));
         assert_eq!(items_in(&doc, view(), area), vec![Item::Ellipsoid(2)]);
         // The whole view holds every ellipsoid.
-        assert_eq!(items_in(&doc, view(), view()).len(), doc.scene().ellipsoids.len());
+        assert_eq!(
+            items_in(&doc, view(), view()).len(),
+            doc.scene().ellipsoids.len()
+        );
     }
 }

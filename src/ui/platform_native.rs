@@ -46,14 +46,17 @@ pub fn take_pointer_samples() -> Option<Vec<(egui::Pos2, Option<f32>)>> {
 fn autosave_dir() -> Option<std::path::PathBuf> {
     let base = std::env::var_os("XDG_DATA_HOME")
         .map(std::path::PathBuf::from)
-        .or_else(|| std::env::var_os("HOME").map(|h| std::path::Path::new(&h).join(".local/share")))?;
+        .or_else(|| {
+            std::env::var_os("HOME").map(|h| std::path::Path::new(&h).join(".local/share"))
+        })?;
     Some(base.join("cloudsketch"))
 }
 
 /// The last autosaved document, if any.
 pub fn load_autosave() -> Option<String> {
     let path = autosave_dir()?.join("autosave.json");
-    (std::fs::metadata(&path).ok()?.len() <= MAX_BYTES).then(|| std::fs::read_to_string(path).ok())?
+    (std::fs::metadata(&path).ok()?.len() <= MAX_BYTES)
+        .then(|| std::fs::read_to_string(path).ok())?
 }
 
 /// Writes the autosave (to a temporary file first, so a crash mid-write keeps the last one).
@@ -68,14 +71,20 @@ pub fn store_autosave(json: &str) -> Result<(), String> {
 /// Keeps the last autosave aside before a new session writes over it.
 pub fn keep_previous_autosave() {
     if let Some(dir) = autosave_dir() {
-        let _ = std::fs::copy(dir.join("autosave.json"), dir.join("autosave.previous.json"));
+        let _ = std::fs::copy(
+            dir.join("autosave.json"),
+            dir.join("autosave.previous.json"),
+        );
     }
 }
 
 /// Seconds since the first call, for timing work within a frame.
 pub fn now() -> f64 {
     static START: std::sync::OnceLock<std::time::Instant> = std::sync::OnceLock::new();
-    START.get_or_init(std::time::Instant::now).elapsed().as_secs_f64()
+    START
+        .get_or_init(std::time::Instant::now)
+        .elapsed()
+        .as_secs_f64()
 }
 
 /// Asks for a frame (natively every outside input is an egui event already: nothing to do).

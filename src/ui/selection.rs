@@ -119,13 +119,17 @@ impl Selection {
         for item in &self.items {
             match *item {
                 Item::Ellipsoid(e) => {
-                    let Some(e) = scene.ellipsoids.get(e) else { continue };
+                    let Some(e) = scene.ellipsoids.get(e) else {
+                        continue;
+                    };
                     let r = e.radii.max_element();
                     lo = lo.min(e.center - r);
                     hi = hi.max(e.center + r);
                 }
                 Item::Plane(p) => {
-                    let Some(p) = scene.planes.get(p) else { continue };
+                    let Some(p) = scene.planes.get(p) else {
+                        continue;
+                    };
                     for q in &p.points {
                         let w = p.to_world(q.extend(0.0));
                         lo = lo.min(w);
@@ -180,7 +184,10 @@ pub fn delete(doc: &mut Document, selection: &mut Selection) -> Option<String> {
         ([], []) => return None,
         ([p], []) => format!("Deleted {} (Ctrl+Z undoes)", scene.planes[*p].name),
         ([], [e]) => format!("Deleted Ellipsoid {} (Ctrl+Z undoes)", e + 1),
-        _ => format!("Deleted {} items (Ctrl+Z undoes)", planes.len() + ellipsoids.len()),
+        _ => format!(
+            "Deleted {} items (Ctrl+Z undoes)",
+            planes.len() + ellipsoids.len()
+        ),
     };
     let keep = |list: &[usize], i: usize| list.binary_search(&i).is_err();
     let new_planes = (scene.planes.iter().enumerate())
@@ -207,10 +214,14 @@ pub fn duplicate(doc: &mut Document, selection: &mut Selection) -> Option<String
         return None;
     }
     if scene.planes.len() + planes.len() > MAX_PLANES {
-        return Some(format!("at most {MAX_PLANES} drawing planes: delete some first"));
+        return Some(format!(
+            "at most {MAX_PLANES} drawing planes: delete some first"
+        ));
     }
     if scene.ellipsoids.len() + ellipsoids.len() > MAX_ELLIPSOIDS {
-        return Some(format!("at most {MAX_ELLIPSOIDS} ellipsoids: delete some first"));
+        return Some(format!(
+            "at most {MAX_ELLIPSOIDS} ellipsoids: delete some first"
+        ));
     }
     let mut new_planes = scene.planes.clone();
     let mut copies = Vec::new();
@@ -259,7 +270,11 @@ pub fn toggle_hidden(doc: &mut Document, selection: &Selection) -> Option<String
     let mut list = scene.ellipsoids.clone();
     let mut e = (**list.get(i)?).clone();
     e.hidden = !e.hidden;
-    let text = format!("{} Ellipsoid {}", if e.hidden { "Hid" } else { "Showed" }, i + 1);
+    let text = format!(
+        "{} Ellipsoid {}",
+        if e.hidden { "Hid" } else { "Showed" },
+        i + 1
+    );
     list[i] = Arc::new(e);
     doc.apply(Edit::SetEllipsoids(list), None).then_some(text)
 }
@@ -272,34 +287,31 @@ pub fn show_all(doc: &mut Document) -> Option<String> {
     if count == 0 {
         return None;
     }
-    let planes = scene
-        .planes
-        .iter()
-        .map(|p| match p.hidden {
-            true => Arc::new(crate::scene::DrawingPlane {
-                hidden: false,
-                ..(**p).clone()
-            }),
-            false => p.clone(),
-        })
-        .collect();
-    let ellipsoids = scene
-        .ellipsoids
-        .iter()
-        .map(|e| match e.hidden {
-            true => Arc::new(crate::scene::Ellipsoid {
-                hidden: false,
-                ..(**e).clone()
-            }),
-            false => e.clone(),
-        })
-        .collect();
+    // Each hidden item replaced by a shown copy; the others shared as they are.
+    fn shown<T: Clone>(items: &[Arc<T>], hidden: fn(&T) -> bool, show: fn(&mut T)) -> Vec<Arc<T>> {
+        items
+            .iter()
+            .map(|item| match hidden(item) {
+                true => {
+                    let mut copy = (**item).clone();
+                    show(&mut copy);
+                    Arc::new(copy)
+                }
+                false => item.clone(),
+            })
+            .collect()
+    }
+    let planes = shown(&scene.planes, |p| p.hidden, |p| p.hidden = false);
+    let ellipsoids = shown(&scene.ellipsoids, |e| e.hidden, |e| e.hidden = false);
     // Two edits folded into one undo step.
     doc.end_merge();
     doc.apply(Edit::SetPlanes(planes), Some("show-all"));
     doc.apply(Edit::SetEllipsoids(ellipsoids), Some("show-all"));
     doc.end_merge();
-    Some(format!("Showed {count} hidden item{}", if count == 1 { "" } else { "s" }))
+    Some(format!(
+        "Showed {count} hidden item{}",
+        if count == 1 { "" } else { "s" }
+    ))
 }
 
 #[cfg(test)]
@@ -314,17 +326,26 @@ mod tests {
         let n = doc.scene().ellipsoids.len();
         let mut selection = Selection::default();
         selection.set(Item::Ellipsoid(1));
-        assert_eq!(duplicate(&mut doc, &mut selection).unwrap(), format!("Added Ellipsoid {} (a copy)", n + 1));
+        assert_eq!(
+            duplicate(&mut doc, &mut selection).unwrap(),
+            format!("Added Ellipsoid {} (a copy)", n + 1)
+        );
         assert_eq!(selection.items(), &[Item::Ellipsoid(n)]);
         // Three at once, with Shift: one step each way.
         selection.toggle(Item::Ellipsoid(0));
         selection.toggle(Item::Ellipsoid(3));
         let undo = doc.undo_len();
-        assert_eq!(duplicate(&mut doc, &mut selection).unwrap(), "Duplicated 3 items");
+        assert_eq!(
+            duplicate(&mut doc, &mut selection).unwrap(),
+            "Duplicated 3 items"
+        );
         assert_eq!(doc.scene().ellipsoids.len(), n + 4);
         assert_eq!(doc.undo_len(), undo + 1);
         let copies: Vec<_> = selection.items().to_vec();
-        assert_eq!(delete(&mut doc, &mut selection).unwrap(), "Deleted 3 items (Ctrl+Z undoes)");
+        assert_eq!(
+            delete(&mut doc, &mut selection).unwrap(),
+            "Deleted 3 items (Ctrl+Z undoes)"
+        );
         assert_eq!(doc.scene().ellipsoids.len(), n + 1);
         assert!(selection.is_empty());
         doc.undo();
@@ -339,7 +360,11 @@ mod tests {
         for name in ["A", "B"] {
             scene.planes.push(Arc::new(crate::scene::DrawingPlane {
                 name: name.into(),
-                points: vec![glam::Vec2::ZERO, glam::Vec2::new(3.0, 0.0), glam::Vec2::new(0.0, 2.0)],
+                points: vec![
+                    glam::Vec2::ZERO,
+                    glam::Vec2::new(3.0, 0.0),
+                    glam::Vec2::new(0.0, 2.0),
+                ],
                 ..Default::default()
             }));
         }
@@ -351,7 +376,10 @@ mod tests {
         assert_eq!(names, ["A", "A copy", "B", "B copy"]);
         assert_eq!(selection.items(), &[Item::Plane(1), Item::Plane(3)]);
         let behind = doc.scene().planes[1].origin - doc.scene().planes[0].origin;
-        assert!((behind + doc.scene().planes[0].normal()).length() < 1e-5, "{behind}");
+        assert!(
+            (behind + doc.scene().planes[0].normal()).length() < 1e-5,
+            "{behind}"
+        );
     }
 
     #[test]

@@ -303,7 +303,10 @@ impl SketchTool {
             self.drawing = false;
         }
         if hide && let Some(m) = super::selection::toggle_hidden(tc.doc, tc.selection) {
-            tc.notices.note(now, format!("{m} (Shift+H again shows it, Alt+H shows all)"));
+            tc.notices.note(
+                now,
+                format!("{m} (Shift+H again shows it, Alt+H shows all)"),
+            );
         }
         if reveal && let Some(m) = super::selection::show_all(tc.doc) {
             tc.notices.note(now, m);
@@ -527,13 +530,22 @@ impl SketchTool {
         let Some((from, _)) = self.area else {
             return false;
         };
-        let to = response.interact_pointer_pos().map_or(from, |p| rect.clamp(p));
+        let to = response
+            .interact_pointer_pos()
+            .map_or(from, |p| rect.clamp(p));
         self.area = Some((from, to));
         if !response.dragged_by(egui::PointerButton::Primary) {
             let shift = ui.input(|i| i.modifiers.shift);
             let items = picking::items_in(tc.doc, rect, Rect::from_two_pos(from, to));
             let now = ui.input(|i| i.time);
-            tc.notices.note(now, format!("Selected {} item{}", items.len(), if items.len() == 1 { "" } else { "s" }));
+            tc.notices.note(
+                now,
+                format!(
+                    "Selected {} item{}",
+                    items.len(),
+                    if items.len() == 1 { "" } else { "s" }
+                ),
+            );
             tc.selection.select_all(items, shift);
             self.area = None;
             self.box_armed = false;
@@ -671,7 +683,8 @@ impl SketchTool {
                     } else {
                         g.angle
                     };
-                    rotation = (Quat::from_axis_angle(axis.vector(), angle) * g.rotation).normalize();
+                    rotation =
+                        (Quat::from_axis_angle(axis.vector(), angle) * g.rotation).normalize();
                 }
                 _ => {
                     let turn = drag_turn(g.drag, lock, snap, camera.right());
@@ -726,8 +739,14 @@ impl SketchTool {
             }
         }
         if let Some(gizmo) = self.gizmo(doc, selection, rect) {
-            let active = self.gesture.as_ref().filter(|g| !g.cancelled).and_then(|g| g.handle);
-            let hovered = ui.input(|i| i.pointer.hover_pos()).and_then(|p| gizmo.hit(p));
+            let active = self
+                .gesture
+                .as_ref()
+                .filter(|g| !g.cancelled)
+                .and_then(|g| g.handle);
+            let hovered = ui
+                .input(|i| i.pointer.hover_pos())
+                .and_then(|p| gizmo.hit(p));
             gizmo.draw(&painter, active, hovered);
         }
         if self.show_skeleton
@@ -871,7 +890,9 @@ fn apply_starts(doc: &mut Document, items: &[Start]) {
     for &(item, origin, rotation, radii) in items {
         match item {
             Item::Plane(i) => {
-                let Some(p) = doc.scene().planes.get(i) else { continue };
+                let Some(p) = doc.scene().planes.get(i) else {
+                    continue;
+                };
                 let mut p = (**p).clone();
                 (p.origin, p.rotation) = (origin, rotation);
                 doc.apply(Edit::SetPlane(i, p), Some("drag"));

@@ -73,6 +73,53 @@ pub fn srgb_button(ui: &mut Ui, label: &str, color: &mut [f32; 3]) -> bool {
     }
 }
 
+/// Three drag fields (x, y, z) for a vector, on one labelled row.
+pub fn vec3_fields(ui: &mut Ui, label: &str, v: &mut glam::Vec3, speed: f64) {
+    ui.horizontal(|ui| {
+        ui.label(label);
+        for (axis, c) in ["x", "y", "z"].iter().zip(v.as_mut()) {
+            ui.add_sized(
+                [62.0, 18.0],
+                egui::DragValue::new(c)
+                    .speed(speed)
+                    .fixed_decimals(2)
+                    .prefix(format!("{axis} ")),
+            );
+        }
+    });
+}
+
+/// A turn as yaw, pitch and roll in degrees (about y, then x, then z), on one row; the
+/// quaternion is rebuilt only when a field changes, so reading it never alters it.
+pub fn rotation_fields(ui: &mut Ui, rotation: &mut glam::Quat) {
+    use glam::EulerRot;
+    let (mut yaw, mut pitch, mut roll) = rotation.to_euler(EulerRot::YXZ);
+    let mut changed = false;
+    ui.horizontal(|ui| {
+        ui.label("rotate");
+        for (label, v) in [("y ", &mut yaw), ("p ", &mut pitch), ("r ", &mut roll)] {
+            let mut deg = v.to_degrees();
+            if ui
+                .add_sized(
+                    [62.0, 18.0],
+                    egui::DragValue::new(&mut deg)
+                        .speed(0.5)
+                        .fixed_decimals(0)
+                        .prefix(label)
+                        .suffix("°"),
+                )
+                .changed()
+            {
+                *v = deg.to_radians();
+                changed = true;
+            }
+        }
+    });
+    if changed {
+        *rotation = glam::Quat::from_euler(EulerRot::YXZ, yaw, pitch, roll);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -118,52 +165,5 @@ mod tests {
             .filter(|&c| !has(true, &c.to_string()))
             .collect();
         assert!(missing.is_empty(), "no glyph for {missing:?}");
-    }
-}
-
-/// Three drag fields (x, y, z) for a vector, on one labelled row.
-pub fn vec3_fields(ui: &mut Ui, label: &str, v: &mut glam::Vec3, speed: f64) {
-    ui.horizontal(|ui| {
-        ui.label(label);
-        for (axis, c) in ["x", "y", "z"].iter().zip(v.as_mut()) {
-            ui.add_sized(
-                [62.0, 18.0],
-                egui::DragValue::new(c)
-                    .speed(speed)
-                    .fixed_decimals(2)
-                    .prefix(format!("{axis} ")),
-            );
-        }
-    });
-}
-
-/// A turn as yaw, pitch and roll in degrees (about y, then x, then z), on one row; the
-/// quaternion is rebuilt only when a field changes, so reading it never alters it.
-pub fn rotation_fields(ui: &mut Ui, rotation: &mut glam::Quat) {
-    use glam::EulerRot;
-    let (mut yaw, mut pitch, mut roll) = rotation.to_euler(EulerRot::YXZ);
-    let mut changed = false;
-    ui.horizontal(|ui| {
-        ui.label("rotate");
-        for (label, v) in [("y ", &mut yaw), ("p ", &mut pitch), ("r ", &mut roll)] {
-            let mut deg = v.to_degrees();
-            if ui
-                .add_sized(
-                    [62.0, 18.0],
-                    egui::DragValue::new(&mut deg)
-                        .speed(0.5)
-                        .fixed_decimals(0)
-                        .prefix(label)
-                        .suffix("°"),
-                )
-                .changed()
-            {
-                *v = deg.to_radians();
-                changed = true;
-            }
-        }
-    });
-    if changed {
-        *rotation = glam::Quat::from_euler(EulerRot::YXZ, yaw, pitch, roll);
     }
 }

@@ -40,24 +40,40 @@ impl ClockPanel {
             let label = if self.playing { "Pause" } else { "Play" };
             if ui
                 .button(label)
-                .on_hover_text("Alt+A: play the scene (the wind and torque of the media move the noise)")
+                .on_hover_text(
+                    "Alt+A: play the scene (the wind and torque of the media move the noise)",
+                )
                 .clicked()
             {
                 self.playing = !self.playing;
             }
             let mut time = doc.scene().time;
             if ui
-                .add(egui::DragValue::new(&mut time).speed(0.05).suffix(" s").range(0.0..=crate::limits::MAX_TIME))
+                .add(
+                    egui::DragValue::new(&mut time)
+                        .speed(0.05)
+                        .suffix(" s")
+                        .range(0.0..=crate::limits::MAX_TIME),
+                )
                 .on_hover_text("Scene time: drag to scrub")
                 .changed()
             {
                 doc.set_time(time);
             }
-            if ui.small_button("to 0").on_hover_text("Back to 0 s").clicked() {
+            if ui
+                .small_button("to 0")
+                .on_hover_text("Back to 0 s")
+                .clicked()
+            {
                 doc.set_time(0.0);
             }
-            ui.add(egui::DragValue::new(&mut self.speed).speed(0.05).prefix("×").range(0.0..=10.0))
-                .on_hover_text("Speed");
+            ui.add(
+                egui::DragValue::new(&mut self.speed)
+                    .speed(0.05)
+                    .prefix("×")
+                    .range(0.0..=10.0),
+            )
+            .on_hover_text("Speed");
         });
     }
 }
@@ -78,7 +94,11 @@ mod tests {
         for _ in 0..10 {
             clock.tick(&mut doc, 0.1);
         }
-        assert!((doc.scene().time - 2.0).abs() < 1e-5, "{}", doc.scene().time);
+        assert!(
+            (doc.scene().time - 2.0).abs() < 1e-5,
+            "{}",
+            doc.scene().time
+        );
         assert_eq!(doc.undo_len(), 0);
         assert!(doc.revisions().render > render, "the image knows to change");
         // A stalled frame does not jump the clock.

@@ -23,7 +23,9 @@ impl ScenePanel {
                     for (preset, name) in Preset::ALL {
                         if ui
                             .small_button(name)
-                            .on_hover_text(format!("Start again from the {name} preset (Ctrl+Z undoes)"))
+                            .on_hover_text(format!(
+                                "Start again from the {name} preset (Ctrl+Z undoes)"
+                            ))
                             .clicked()
                         {
                             // A preset brings its own camera, framed for its cloud.
@@ -58,7 +60,9 @@ fn ellipsoid_list(ui: &mut Ui, doc: &mut Document, selection: &mut Selection) {
                     }
                     if ui
                         .selectable_label(selected, label)
-                        .on_hover_text("Click to select, Shift+click to add; italic ones are hidden (Shift+H)")
+                        .on_hover_text(
+                            "Click to select, Shift+click to add; italic ones are hidden (Shift+H)",
+                        )
                         .clicked()
                     {
                         clicked = Some((i, selected));
