@@ -8,6 +8,7 @@
 //! - [`field`]: the blended implicit field and the density volume it is sampled into (pure);
 //! - [`derive`]: document → per-plane spheres → field → density and light volumes, cached
 //!   per part (pure);
+//! - [`share`]: share links and scene files, read as untrusted input (pure);
 //! - [`limits`], [`seeded`]: every cap and range, and seeded randomness (pure);
 //! - [`render`]: the only user of wgpu;
 //! - [`ui`]: the eframe app;
@@ -19,6 +20,7 @@ pub mod limits;
 pub mod render;
 pub mod scene;
 pub mod seeded;
+pub mod share;
 pub mod sketch;
 pub mod ui;
 

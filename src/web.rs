@@ -6,15 +6,14 @@
 //! `data-backend` (`webgpu` | `webgl2`), `data-adapter` and `data-quality`
 //! (e.g. `full 640x480x128`); `window.cloudsketch.state()` returns the document and view;
 //! `window.cloudsketch.set("/reference/in_front=true")` makes one undoable edit by JSON
-//! Pointer, as the CLI's `--set` does.
+//! Pointer, as the CLI's `--set` does. The page opens `#s=…` share links and `?preset=NAME`.
 
 use std::cell::RefCell;
 
 use wasm_bindgen::JsCast as _;
 use wasm_bindgen::prelude::*;
 
-use crate::scene::Scene;
-use crate::ui::{CloudApp, Host, PageStatus, StartOptions};
+use crate::ui::{CloudApp, Host, Opening, PageStatus, Start, StartOptions};
 
 thread_local! {
     static STATE: RefCell<String> = const { RefCell::new(String::new()) };
@@ -32,12 +31,13 @@ pub fn start() {
         previous(info);
     }));
     install_state_accessor();
-    let (scene, notice) = scene_from_url();
+    let start = scene_from_url();
     let options = StartOptions {
-        scene,
+        scene: start.scene,
         host: Some(Box::new(WebHost)),
         initial_cost: 4e-8,
-        notice,
+        notice: start.notice,
+        file: start.file,
         autosave: true,
     };
     wasm_bindgen_futures::spawn_local(async move {
@@ -73,14 +73,32 @@ async fn run(options: StartOptions) -> Result<(), String> {
     Ok(())
 }
 
-/// The starting document: `?preset=NAME` opens a preset (keeping the last session aside), a
-/// plain visit continues the last session (see [`crate::ui::start_session`]).
-fn scene_from_url() -> (Scene, Option<String>) {
-    let search = web_sys::window()
-        .and_then(|w| w.location().search().ok())
+/// The starting document: a share link (`#s=…`) or `?preset=NAME` opens that (keeping the
+/// last session aside), a plain visit continues the last session (see
+/// [`crate::ui::start_session`]). The link or preset then leaves the address bar, so a reload
+/// continues the session instead of opening it again.
+fn scene_from_url() -> Start {
+    let location = web_sys::window().map(|w| w.location());
+    let hash = location
+        .as_ref()
+        .and_then(|l| l.hash().ok())
         .unwrap_or_default();
-    let params = web_sys::UrlSearchParams::new_with_str(&search).ok();
-    crate::ui::start_session(params.and_then(|p| p.get("preset")).as_deref())
+    let search = location
+        .as_ref()
+        .and_then(|l| l.search().ok())
+        .unwrap_or_default();
+    let preset = web_sys::UrlSearchParams::new_with_str(&search)
+        .ok()
+        .and_then(|p| p.get("preset"));
+    let start = if hash.starts_with("#s=") {
+        crate::ui::start_session(Opening::Link(&hash))
+    } else if let Some(name) = &preset {
+        crate::ui::start_session(Opening::Preset(name))
+    } else {
+        crate::ui::start_session(Opening::Nothing)
+    };
+    crate::ui::forget_opening_in_url();
+    start
 }
 
 /// Shows a message in the page's error box (and keeps the page usable as a page).

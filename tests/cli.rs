@@ -90,7 +90,12 @@ fn render_with(name: &str, sets: &[&str]) -> Vec<u8> {
     args.extend(["--set", "/render/slices=32"]);
     let out = cloudsketch(&args);
     assert!(out.status.success(), "{}", stderr(&out));
-    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&png).unwrap()));
+    read_rgb(&png)
+}
+
+/// A PNG's pixels as RGB bytes.
+fn read_rgb(png: &std::path::Path) -> Vec<u8> {
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(png).unwrap()));
     let mut reader = decoder.read_info().unwrap();
     let mut buf = vec![0; reader.output_buffer_size().unwrap()];
     let info = reader.next_frame(&mut buf).unwrap();
@@ -390,4 +395,72 @@ fn bench_reports_ratios_as_json() {
         assert!(v > 0.0 && b > 0.0 && ((b / v) - ratio).abs() < 1e-9 * ratio.max(1.0));
     }
     assert_eq!(results.len(), 2, "only the groups asked for");
+}
+
+#[test]
+fn link_makes_a_url_that_decodes_and_renders_and_refuses_a_broken_one() {
+    let scene = temp("for-link.json");
+    let path = scene.to_str().unwrap();
+    assert!(
+        cloudsketch(&["new", "--preset", "stratus", "-o", path])
+            .status
+            .success()
+    );
+    let out = cloudsketch(&["link", path]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let url = String::from_utf8_lossy(&out.stdout).trim().to_owned();
+    assert!(url.starts_with("http://127.0.0.1:8080/#s="), "{url}");
+    assert!(stderr(&out).contains("characters"));
+    let out = cloudsketch(&["link", path, "--base", "https://clouds.example/app/"]);
+    let other = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        other.starts_with("https://clouds.example/app/#s="),
+        "{other}"
+    );
+
+    let back = temp("from-link.json");
+    let out = cloudsketch(&["link", "--decode", &url, "-o", back.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let decoded = cloudsketch::scene::Scene::from_json(&std::fs::read_to_string(&back).unwrap())
+        .unwrap()
+        .0;
+    let original = cloudsketch::scene::Scene::preset(cloudsketch::scene::Preset::Stratus);
+    assert_eq!(decoded.ellipsoids.len(), original.ellipsoids.len());
+    assert_eq!(decoded.render.noise_filter, original.render.noise_filter);
+
+    // `render` takes the link where it takes a file, and draws the same picture.
+    let from_url = temp("from-url.png");
+    let from_file = temp("from-file.png");
+    for (input, png) in [(url.as_str(), &from_url), (path, &from_file)] {
+        let out = cloudsketch(&[
+            "render",
+            input,
+            "-o",
+            png.to_str().unwrap(),
+            "--size",
+            "96x64",
+            "--set",
+            "/render/slices=32",
+        ]);
+        assert!(out.status.success(), "{}", stderr(&out));
+    }
+    let (a, b) = (read_rgb(&from_url), read_rgb(&from_file));
+    let worst = a.iter().zip(&b).map(|(x, y)| x.abs_diff(*y)).max().unwrap();
+    assert!(worst <= 3, "link and file render {worst} apart");
+
+    // A damaged link is an error that says so, and writes nothing.
+    let never = temp("never.json");
+    let cut = &url[..url.len() / 2];
+    let out = cloudsketch(&["link", "--decode", cut, "-o", never.to_str().unwrap()]);
+    assert!(!out.status.success());
+    assert!(stderr(&out).contains("damaged"), "{}", stderr(&out));
+    assert!(!never.exists());
+    let out = cloudsketch(&[
+        "link",
+        "--decode",
+        "https://example.org/",
+        "-o",
+        never.to_str().unwrap(),
+    ]);
+    assert!(stderr(&out).contains("no \"#s=\" part"), "{}", stderr(&out));
 }

@@ -444,3 +444,56 @@ fn more_detail_more_fine_structure_and_opacity_keeps_the_cloud_in_place() {
         "centroid ({x1:.1},{y1:.1}) → ({x2:.1},{y2:.1})"
     );
 }
+
+/// Mean and largest difference of two images' colour channels (0–255).
+fn image_difference(a: &Image, b: &Image) -> (f64, u8) {
+    let (mut sum, mut worst, mut n) = (0.0, 0u8, 0usize);
+    for y in 0..a.height {
+        for x in 0..a.width {
+            let (p, q) = (a.pixel(x, y), b.pixel(x, y));
+            for i in 0..3 {
+                let d = p[i].abs_diff(q[i]);
+                sum += d as f64;
+                worst = worst.max(d);
+                n += 1;
+            }
+        }
+    }
+    (sum / n as f64, worst)
+}
+
+#[test]
+fn a_scene_opened_from_its_link_renders_as_the_scene() {
+    use cloudsketch::share::{decode_link, encode_link, fixture};
+    let through_link = |s: &Scene| {
+        decode_link(&format!("#s={}", encode_link(s).unwrap()))
+            .unwrap()
+            .0
+    };
+    let mut scenes: Vec<(&str, Scene)> = Preset::ALL
+        .iter()
+        .map(|&(p, name)| (name, Scene::preset(p)))
+        .collect();
+    scenes.push(("five hand-drawn strokes", fixture::hand_drawn()));
+    let mut largest = 0.0f64;
+    for (name, scene) in &scenes {
+        let (mean, worst) = image_difference(&render(scene), &render(&through_link(scene)));
+        largest = largest.max(mean);
+        // Settings are rounded to 5 digits; strokes made in the app come back exactly.
+        assert!(
+            mean < 0.01 && worst <= 3,
+            "{name}: mean {mean:.3}, worst {worst}"
+        );
+    }
+    // The measure sees a change a user would barely notice: one stroke moved by 1% of its
+    // size gives a difference far above the link's.
+    let sketched = fixture::hand_drawn();
+    let mut moved = sketched.clone();
+    let plane = std::sync::Arc::make_mut(&mut moved.planes[0]);
+    plane.origin.y += 0.06;
+    let (mean, _) = image_difference(&render(&sketched), &render(&moved));
+    assert!(
+        mean > 10.0 * largest,
+        "moved {mean:.3} vs the link's {largest:.3}"
+    );
+}

@@ -1,10 +1,42 @@
 //! No subcommand: the desktop app in a window.
 
-use crate::ui::{CloudApp, StartOptions};
+use crate::ui::{CloudApp, Opening, Start, StartOptions};
 
-/// Opens the desktop window on the last session (autosaved), else the default scene.
-pub fn run() -> Result<(), String> {
-    let (scene, notice) = crate::ui::start_session(None);
+/// Opens the desktop window on a scene file or share link when one is given (keeping the
+/// last session aside), else on the last session (autosaved), else on the default scene.
+pub fn run(open: Option<&str>) -> Result<(), String> {
+    let bytes = match open {
+        Some(arg) if !arg.contains("#s=") => Some(
+            std::fs::metadata(arg)
+                .map_err(|e| format!("{arg}: {e}"))
+                .and_then(|m| {
+                    if m.len() > crate::limits::MAX_FILE_BYTES {
+                        Err(format!(
+                            "{arg}: more than the {} MiB a scene file may have",
+                            crate::limits::MAX_FILE_BYTES >> 20
+                        ))
+                    } else {
+                        std::fs::read(arg).map_err(|e| format!("{arg}: {e}"))
+                    }
+                })?,
+        ),
+        _ => None,
+    };
+    let opening = match (open, &bytes) {
+        (Some(path), Some(bytes)) => Opening::File(path, bytes),
+        (Some(link), None) => Opening::Link(link),
+        _ => Opening::Nothing,
+    };
+    let start = crate::ui::start_session(opening);
+    if let Some((message, true)) = &start.notice {
+        eprintln!("error: {message}");
+    }
+    let Start {
+        scene,
+        notice,
+        file,
+        ..
+    } = start;
     let options = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default()
             .with_title("cloudsketch")
@@ -21,6 +53,7 @@ pub fn run() -> Result<(), String> {
                     scene,
                     initial_cost: 1e-8,
                     notice,
+                    file,
                     autosave: true,
                     ..Default::default()
                 },

@@ -1,8 +1,10 @@
 //! The native command line: `cloudsketch` alone opens the desktop app; subcommands work
-//! headless. One file per subcommand: `new`, `render`, `sketch` (`bench` is `crate::bench`);
+//! headless. One file per subcommand: `new`, `render`, `sketch`, `link` (`bench` is
+//! `crate::bench`);
 //! `desktop` opens the window.
 
 mod desktop;
+mod link;
 mod new;
 mod render;
 mod sketch;
@@ -26,6 +28,8 @@ pub use render::parse_size;
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
+    /// Scene file (or share link) to open in the desktop app.
+    scene: Option<String>,
 }
 
 #[derive(Subcommand)]
@@ -41,8 +45,8 @@ enum Command {
     },
     /// Render a scene offscreen to PNG with the app's renderer (full quality).
     Render {
-        /// Scene JSON; the default scene when left out.
-        scene: Option<PathBuf>,
+        /// Scene JSON or share link (`…#s=…`); the default scene when left out.
+        scene: Option<String>,
         /// Output PNG.
         #[arg(short, long)]
         output: PathBuf,
@@ -74,6 +78,23 @@ enum Command {
         #[arg(long, default_value_t = 1)]
         seed: u64,
     },
+    /// Print a share link for a scene (`link SCENE.json`), or decode one back into a scene
+    /// file (`link --decode URL -o SCENE.json`).
+    #[command(arg_required_else_help = true)]
+    Link {
+        /// Scene JSON to make a link of.
+        #[arg(conflicts_with = "decode")]
+        scene: Option<String>,
+        /// A link to decode into a scene file (needs -o).
+        #[arg(long, value_name = "URL", requires = "output")]
+        decode: Option<String>,
+        /// Where to write the decoded scene JSON.
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+        /// The app's address the link opens.
+        #[arg(long, default_value = crate::share::DEFAULT_BASE)]
+        base: String,
+    },
     /// Run the benchmark suite.
     Bench {
         /// Print one JSON object instead of a table.
@@ -94,7 +115,7 @@ pub fn main() -> ExitCode {
         headless_vulkan();
     }
     let result = match cli.command {
-        None => desktop::run(),
+        None => desktop::run(cli.scene.as_deref()),
         Some(Command::New { preset, output }) => new::run(&preset, &output),
         Some(Command::Render {
             scene,
@@ -102,6 +123,16 @@ pub fn main() -> ExitCode {
             size,
             set,
         }) => render::run(scene.as_deref(), &output, &size, &set),
+        Some(Command::Link {
+            scene,
+            decode,
+            output,
+            base,
+        }) => match (scene, decode, output) {
+            (_, Some(url), Some(output)) => link::decode(&url, &output),
+            (Some(scene), None, _) => link::encode(&scene, &base),
+            _ => Err("give a scene file, or --decode URL -o SCENE.json".into()),
+        },
         Some(Command::Sketch {
             strokes,
             output,
@@ -154,15 +185,27 @@ pub fn read_capped(path: &Path) -> Result<String, String> {
     std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))
 }
 
-/// Reads and validates a scene document; each repair validation made is a warning.
+/// Reads and validates a scene document (as the app opens one); each repair validation made
+/// is a warning.
 pub fn read_scene(path: &Path) -> Result<Scene, String> {
-    let (mut scene, mut repairs) =
-        Scene::from_json(&read_capped(path)?).map_err(|e| format!("{}: {e}", path.display()))?;
-    repairs.extend(
-        crate::derive::check_cost(&mut scene).map_err(|e| format!("{}: {e}", path.display()))?,
-    );
+    let text = read_capped(path)?;
+    let name = path.display().to_string();
+    let (scene, repairs) =
+        crate::share::open_scene_file(&name, text.as_bytes()).map_err(|e| e.to_string())?;
     for r in repairs {
-        eprintln!("warning: {}: repaired {r}", path.display());
+        eprintln!("warning: {name}: repaired {r}");
+    }
+    Ok(scene)
+}
+
+/// Reads a scene from a file, or from a share link when the argument holds `#s=`.
+pub fn read_scene_or_link(arg: &str) -> Result<Scene, String> {
+    if !arg.contains("#s=") {
+        return read_scene(Path::new(arg));
+    }
+    let (scene, repairs) = crate::share::decode_link(arg).map_err(|e| e.to_string())?;
+    for r in repairs {
+        eprintln!("warning: the link's scene: repaired {r}");
     }
     Ok(scene)
 }

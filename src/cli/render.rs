@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use super::{read_scene, write};
+use super::{read_scene_or_link, write};
 use crate::render::offscreen::{MAX_SIDE, Offscreen};
 use crate::scene::{Scene, set_by_pointer};
 
@@ -21,11 +21,11 @@ pub fn parse_size(text: &str) -> Result<(u32, u32), String> {
     Ok((w, h))
 }
 
-/// `cloudsketch render [SCENE] -o OUT.png --size WxH --set PATH=VALUE…`.
-pub fn run(scene: Option<&Path>, output: &Path, size: &str, sets: &[String]) -> Result<(), String> {
+/// `cloudsketch render [SCENE|URL] -o OUT.png --size WxH --set PATH=VALUE…`.
+pub fn run(scene: Option<&str>, output: &Path, size: &str, sets: &[String]) -> Result<(), String> {
     let (width, height) = parse_size(size)?;
     let mut scene = match scene {
-        Some(path) => read_scene(path)?,
+        Some(arg) => read_scene_or_link(arg)?,
         None => Scene::default(),
     };
     for assignment in sets {

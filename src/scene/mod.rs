@@ -15,7 +15,10 @@ pub use crate::limits::{MAX_ELLIPSOIDS, MAX_PLANE_POINTS, MAX_PLANES};
 pub use camera::{OrbitCamera, Ray, StandardView};
 pub use document::{Document, Revisions};
 pub use edit::Edit;
-pub use plane::{DrawingPlane, StrokeKind, centre_of};
+pub use plane::{
+    DrawingPlane, MAX_GRID_EXPONENT, MAX_GRID_STEPS, STROKE_GRID, StrokeKind, centre_of,
+    grid_exponent, grid_point, grid_points, grid_step,
+};
 pub use pointer::{SetError, set_by_pointer};
 pub use presets::Preset;
 pub use reference::ReferenceImage;

@@ -136,7 +136,20 @@ impl DrawingPlane {
         };
         plane.origin = plane.to_world(centre.extend(0.0));
         plane.points = local.into_iter().map(|p| p - centre).collect();
+        plane.snap_to_grid();
         plane
+    }
+
+    /// Moves the stroke's points onto its grid ([`STROKE_GRID`]): done once when a stroke is
+    /// made, so files and links hold it exactly.
+    pub fn snap_to_grid(&mut self) {
+        if self.points.iter().all(|p| p.is_finite()) {
+            let e = grid_exponent(&self.points);
+            self.points = grid_points(&self.points, e)
+                .into_iter()
+                .map(|k| grid_point(k, e))
+                .collect();
+        }
     }
 
     pub(super) fn validate(&mut self, index: usize) -> Result<(), String> {
@@ -164,6 +177,95 @@ impl DrawingPlane {
         self.sketch.sanitize();
         Ok(())
     }
+}
+
+/// Steps across a stroke's larger side, at most, of the grid strokes are stored on: new
+/// strokes are snapped to it ([`DrawingPlane::snap_to_grid`]), and share links store points as
+/// steps of it, so a link reproduces a stroke exactly. A point moves by at most half a step:
+/// under 1/880 of the stroke's larger side, under half a pixel for an outline drawn up to
+/// 440 px across (pointer events report whole pixels).
+pub const STROKE_GRID: f64 = 480.0;
+
+/// Largest grid step exponent either way (eighths of an octave: steps of 2^±60).
+pub const MAX_GRID_EXPONENT: i64 = 480;
+
+/// Largest coordinate in grid steps.
+pub const MAX_GRID_STEPS: i64 = 1 << 30;
+
+/// 2^(i/8) for i in 0..8, written out so every platform computes the same steps.
+const EIGHTHS: [f64; 8] = [
+    1.0,
+    1.090_507_732_665_257_7,
+    1.189_207_115_002_721,
+    1.296_839_554_651_009_7,
+    1.414_213_562_373_095_1,
+    1.542_210_825_407_940_7,
+    1.681_792_830_507_429,
+    1.834_008_086_409_342_4,
+];
+
+/// The stroke grid's step for an exponent in eighths of an octave: 2^(e/8).
+pub fn grid_step(e: i64) -> f64 {
+    2f64.powi(e.div_euclid(8) as i32) * EIGHTHS[e.rem_euclid(8) as usize]
+}
+
+/// A coordinate in steps of `step`.
+fn steps(x: f32, step: f64) -> i64 {
+    (x as f64 / step).round() as i64
+}
+
+/// The grid exponent for a stroke: one its points already lie on when there is one near (a
+/// snapped stroke), else the finest whose steps across the larger side are at most
+/// [`STROKE_GRID`] and whose coordinates fit [`MAX_GRID_STEPS`].
+pub fn grid_exponent(points: &[Vec2]) -> i64 {
+    let (lo, hi) = points.iter().fold(
+        (Vec2::splat(f32::MAX), Vec2::splat(f32::MIN)),
+        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+    );
+    let extent = (hi - lo).max_element() as f64;
+    let reach = lo.abs().max(hi.abs()).max_element() as f64;
+    let mut e = if extent > 0.0 && extent.is_finite() {
+        (8.0 * (extent / STROKE_GRID).log2()).floor() as i64
+    } else {
+        -192
+    };
+    e = e.clamp(-MAX_GRID_EXPONENT, MAX_GRID_EXPONENT);
+    // Floating-point doubt at the boundary: step up until the side fits.
+    while e < MAX_GRID_EXPONENT
+        && (extent / grid_step(e) > STROKE_GRID
+            || reach / grid_step(e) >= (MAX_GRID_STEPS / 2) as f64)
+    {
+        e += 1;
+    }
+    let on_grid = |e: i64| {
+        let step = grid_step(e);
+        points.iter().all(|p| {
+            [p.x, p.y]
+                .iter()
+                .all(|&x| (steps(x, step) as f64 * step) as f32 == x)
+        })
+    };
+    // Snapping can widen the stroke by a step, which may have moved it to the next grid.
+    [e - 1, e]
+        .into_iter()
+        .filter(|e| (-MAX_GRID_EXPONENT..=MAX_GRID_EXPONENT).contains(e))
+        .find(|&e| on_grid(e))
+        .unwrap_or(e)
+}
+
+/// A stroke's points in steps of its grid ([`grid_exponent`]).
+pub fn grid_points(points: &[Vec2], e: i64) -> Vec<[i64; 2]> {
+    let step = grid_step(e);
+    points
+        .iter()
+        .map(|p| [steps(p.x, step), steps(p.y, step)])
+        .collect()
+}
+
+/// The point at grid steps `k`.
+pub fn grid_point(k: [i64; 2], e: i64) -> Vec2 {
+    let step = grid_step(e);
+    Vec2::new((k[0] as f64 * step) as f32, (k[1] as f64 * step) as f32)
 }
 
 /// Bounding box centre of plane points (used to re-centre imported strokes).

@@ -5,6 +5,7 @@ use super::autosave::Autosave;
 use super::guide::Guide;
 use super::notice::Notices;
 use super::panels::{ClockPanel, LIGHT, RENDER, ScenePanel, SketchPanel, ViewPanel, ViewStats};
+use super::scene_files::SceneFiles;
 use super::selection::Selection;
 use super::sketch_tool::{Axis, SketchTool, ToolContext};
 use super::viewport::{Viewport, ViewportContext};
@@ -47,8 +48,11 @@ pub struct StartOptions {
     pub host: Option<Box<dyn Host>>,
     /// Guessed cost of the volume pass in seconds per pixel·slice, refined by measurement.
     pub initial_cost: f64,
-    /// What to tell the user at start (a restored session, a bad link).
-    pub notice: Option<String>,
+    /// What to tell the user at start (a restored session, a bad link), and whether it
+    /// reports a failure.
+    pub notice: Option<(String, bool)>,
+    /// The file the document came from (what Save writes).
+    pub file: Option<String>,
     /// Write the document to the platform's store as it changes (the app; not tests).
     pub autosave: bool,
 }
@@ -60,6 +64,7 @@ impl Default for StartOptions {
             host: None,
             initial_cost: 2e-8,
             notice: None,
+            file: None,
             autosave: false,
         }
     }
@@ -97,6 +102,8 @@ pub struct CloudApp {
     published: Option<(u64, String)>,
     /// When to write the autosave (`None`: not autosaving).
     autosave: Option<Autosave>,
+    /// Open, Save, Copy link and the unsaved marker.
+    files: SceneFiles,
 }
 
 impl CloudApp {
@@ -114,10 +121,13 @@ impl CloudApp {
         super::platform::install(&cc.egui_ctx);
         let doc = Document::new(options.scene);
         let mut notices = Notices::default();
-        if let Some(text) = options.notice {
-            notices.note(0.0, text);
+        match options.notice {
+            Some((text, true)) => notices.error(0.0, text),
+            Some((text, false)) => notices.note(0.0, text),
+            None => {}
         }
         Self {
+            files: SceneFiles::new(&doc, options.file),
             autosave: options.autosave.then(|| Autosave::new(&doc)),
             doc,
             derived: Derived::default(),
@@ -184,6 +194,7 @@ impl CloudApp {
             change(&mut camera);
             self.doc.set_camera(camera);
         }
+        self.files.shortcuts(ctx, &self.doc, &mut self.notices);
         let now = ctx.input(|i| i.time);
         if undo {
             self.undo(now);
@@ -217,6 +228,8 @@ impl CloudApp {
                 }
             });
         });
+        self.files
+            .ui(ui, &mut self.doc, &mut self.selection, &mut self.notices);
         ui.horizontal(|ui| {
             let now = ui.input(|i| i.time);
             if ui
@@ -273,6 +286,38 @@ impl CloudApp {
                 }
                 Err(e) => self.notices.error(now, e.to_string()),
             }
+        }
+    }
+
+    /// Files that arrived (dropped, picked, read): scene files open, pictures go to the guide;
+    /// and links pasted into the address bar open.
+    fn arrivals(&mut self, ctx: &egui::Context) {
+        let dropped = ctx.input_mut(|i| std::mem::take(&mut i.raw.dropped_files));
+        let mut loaded: Vec<super::guide::Loaded> = dropped
+            .into_iter()
+            .filter_map(|f| super::platform::read_dropped(f, ctx))
+            .collect();
+        loaded.extend(super::platform::take_loaded());
+        let now = ctx.input(|i| i.time);
+        let (mut scenes, pictures): (Vec<_>, Vec<_>) = loaded.into_iter().partition(|item| {
+            item.as_ref()
+                .is_ok_and(|(name, bytes)| crate::share::file::is_scene_file(name, bytes))
+        });
+        scenes.extend(super::platform::take_scene_files());
+        for item in scenes {
+            match item {
+                Ok((name, bytes)) => {
+                    let cx = (&mut self.doc, &mut self.selection, &mut self.notices);
+                    self.files.open(cx, now, &name, &bytes);
+                }
+                Err(e) => self.notices.error(now, format!("Nothing opened: {e}")),
+            }
+        }
+        self.guide
+            .input(ctx, &mut self.doc, &mut self.notices, pictures);
+        for url in super::platform::take_links() {
+            let cx = (&mut self.doc, &mut self.selection, &mut self.notices);
+            self.files.open_link(cx, now, &url);
         }
     }
 
@@ -350,6 +395,9 @@ impl CloudApp {
             "guides_hidden": self.tool.hide_guides,
             "skeleton_shown": self.tool.show_skeleton,
             "panel_open": self.panel_open,
+            "file": self.files.name,
+            "unsaved": self.files.unsaved(&self.doc),
+            "link": self.files.last_link,
             "guide_image": self.doc.scene().reference.as_deref().map(|g| serde_json::json!({
                 "name": g.name, "size": g.size, "opacity": g.opacity, "visible": g.visible,
                 "in_front": g.in_front, "embedded": g.embedded(),
@@ -418,7 +466,7 @@ impl eframe::App for CloudApp {
         {
             ctx.request_repaint();
         }
-        self.guide.input(&ctx, &mut self.doc, &mut self.notices);
+        self.arrivals(&ctx);
         self.host_edits(&ctx);
         // Fixed width: growing values never shift the buttons under the pointer.
         let mut open = self.panel_open;

@@ -1,58 +1,131 @@
 //! Autosave: the document goes to the platform's store (the browser's localStorage, a file in
 //! the user's data folder natively) one second after it last changed, so a reload, a closed tab
 //! or a crash loses at most that second. At start the saved document is opened again, unless
-//! the page was opened on a preset (a link): then the saved one is kept aside as the previous
-//! session, never silently replaced.
+//! the page was opened on a preset, a share link or a file: then the saved one is kept aside as
+//! the previous session (the File group can open it), never silently replaced.
 
 use crate::scene::{Document, Preset, Scene};
 
 /// How long after the last change the document is written (seconds).
 pub const DELAY: f64 = 1.0;
 
-/// The document a session starts with, from the preset named in its link (if any) and the
-/// last autosave (if any), with what to tell the user, and whether the autosave must be kept
-/// aside before it is written over.
-pub fn starting_scene(
-    preset: Option<&str>,
-    autosave: Option<&str>,
-) -> (Scene, Option<String>, bool) {
-    match (preset, autosave) {
-        (Some(name), saved) => {
-            let scene = Preset::from_name(name)
-                .map(Scene::preset)
-                .unwrap_or_default();
-            let notice = Preset::from_name(name)
-                .is_none()
-                .then(|| format!("No preset called {name:?}: opened the default scene"));
-            (scene, notice, saved.is_some())
+/// What a session was asked to open (from its URL or command line).
+#[derive(Clone, Copy, Debug)]
+pub enum Opening<'a> {
+    /// A plain visit: continue the last session.
+    Nothing,
+    /// `?preset=NAME`.
+    Preset(&'a str),
+    /// A share link (`#s=…`).
+    Link(&'a str),
+    /// A scene file's name and bytes (the desktop app's path argument).
+    File(&'a str, &'a [u8]),
+}
+
+/// How a session starts.
+#[derive(Debug)]
+pub struct Start {
+    /// The document.
+    pub scene: Scene,
+    /// What to tell the user, and whether it reports a failure.
+    pub notice: Option<(String, bool)>,
+    /// The autosave must be kept aside before it is written over.
+    pub keep_previous: bool,
+    /// The file the document came from (what Save writes).
+    pub file: Option<String>,
+}
+
+/// The document a session starts with, from what it was asked to open and the last autosave
+/// (if any). Whatever was asked for opens and the last session is kept aside; when it cannot
+/// be opened, the last session continues and the message says why.
+pub fn starting_scene(opening: Opening, autosave: Option<&str>) -> Start {
+    let opened = |scene: Scene, notice: Option<(String, bool)>, file: Option<String>| Start {
+        scene,
+        notice,
+        keep_previous: autosave.is_some(),
+        file,
+    };
+    let failed = |message: String| {
+        let mut start = starting_scene(Opening::Nothing, autosave);
+        start.notice = Some((message, true));
+        start
+    };
+    let repaired = |what: String, repairs: Vec<String>| {
+        if repairs.is_empty() {
+            what
+        } else {
+            format!("{what}; repaired {}", repairs.join(", "))
         }
-        (None, Some(json)) => match Scene::from_json(json) {
-            Ok((scene, _)) => (
-                scene,
-                Some("Restored your last session (saved automatically)".to_owned()),
-                false,
-            ),
-            Err(e) => (
+    };
+    match opening {
+        Opening::Preset(name) => match Preset::from_name(name) {
+            Some(preset) => opened(Scene::preset(preset), None, None),
+            None => opened(
                 Scene::default(),
-                Some(format!(
-                    "The last session could not be restored ({e}); it is kept aside"
+                Some((
+                    format!("No preset called {name:?}: opened the default scene"),
+                    false,
                 )),
-                true,
+                None,
             ),
         },
-        (None, None) => (Scene::default(), None, false),
+        Opening::Link(text) => match crate::share::decode_link(text) {
+            Ok((scene, repairs)) => opened(
+                scene,
+                Some((
+                    repaired("Opened the scene from the link".into(), repairs),
+                    false,
+                )),
+                None,
+            ),
+            Err(e) => failed(format!("{e}; your last session is open instead")),
+        },
+        Opening::File(name, bytes) => match crate::share::open_scene_file(name, bytes) {
+            Ok((scene, repairs)) => opened(
+                scene,
+                Some((repaired(format!("Opened {name}"), repairs), false)),
+                Some(name.to_owned()),
+            ),
+            Err(e) => failed(format!("{e}; your last session is open instead")),
+        },
+        Opening::Nothing => match autosave.map(Scene::from_json) {
+            Some(Ok((scene, _))) => Start {
+                scene,
+                notice: Some((
+                    "Restored your last session (saved automatically)".to_owned(),
+                    false,
+                )),
+                keep_previous: false,
+                file: None,
+            },
+            Some(Err(e)) => Start {
+                scene: Scene::default(),
+                notice: Some((
+                    format!("The last session could not be restored ({e}); it is kept aside"),
+                    true,
+                )),
+                keep_previous: true,
+                file: None,
+            },
+            None => Start {
+                scene: Scene::default(),
+                notice: None,
+                keep_previous: false,
+                file: None,
+            },
+        },
     }
 }
 
-/// The document a session starts with ([`starting_scene`] over the platform's autosave), and
-/// what to tell the user; keeps the autosave aside when the session will not continue it.
-pub fn start_session(preset: Option<&str>) -> (Scene, Option<String>) {
+/// How a session starts ([`starting_scene`] over the platform's autosave); keeps the autosave
+/// aside when the session will not continue it.
+pub fn start_session(opening: Opening) -> Start {
     let saved = super::platform::load_autosave();
-    let (scene, notice, keep) = starting_scene(preset, saved.as_deref());
-    if keep {
+    let start = starting_scene(opening, saved.as_deref());
+    if start.keep_previous {
         super::platform::keep_previous_autosave();
     }
-    (scene, notice)
+    start
 }
 
 /// When to write the document.
@@ -150,16 +223,52 @@ mod tests {
         let mut edited = Scene::default();
         edited.ellipsoids.truncate(2);
         let json = edited.to_json();
-        let (scene, notice, keep) = starting_scene(None, Some(&json));
-        assert_eq!(scene, edited);
-        assert!(notice.unwrap().starts_with("Restored"));
-        assert!(!keep);
-        let (scene, _, keep) = starting_scene(Some("stratus"), Some(&json));
-        assert_eq!(scene, Scene::preset(Preset::Stratus));
-        assert!(keep, "the last session is kept aside");
-        let (scene, notice, keep) = starting_scene(None, Some("{ truncated"));
-        assert_eq!(scene, Scene::default());
-        assert!(notice.unwrap().contains("kept aside") && keep);
-        assert_eq!(starting_scene(None, None).0, Scene::default());
+        let start = starting_scene(Opening::Nothing, Some(&json));
+        assert_eq!(start.scene, edited);
+        assert!(start.notice.unwrap().0.starts_with("Restored"));
+        assert!(!start.keep_previous);
+        let start = starting_scene(Opening::Preset("stratus"), Some(&json));
+        assert_eq!(start.scene, Scene::preset(Preset::Stratus));
+        assert!(start.keep_previous, "the last session is kept aside");
+        let start = starting_scene(Opening::Nothing, Some("{ truncated"));
+        assert_eq!(start.scene, Scene::default());
+        let (text, error) = start.notice.unwrap();
+        assert!(text.contains("kept aside") && error && start.keep_previous);
+        assert_eq!(
+            starting_scene(Opening::Nothing, None).scene,
+            Scene::default()
+        );
+    }
+
+    #[test]
+    fn a_link_or_file_opens_and_keeps_the_last_session_a_broken_one_continues_it() {
+        let mut edited = Scene::default();
+        edited.ellipsoids.truncate(2);
+        let json = edited.to_json();
+        let stratus = Scene::preset(Preset::Stratus);
+        let url = crate::share::link_url("http://x/", &stratus).unwrap();
+        let start = starting_scene(Opening::Link(&url), Some(&json));
+        assert_eq!(start.scene.ellipsoids.len(), stratus.ellipsoids.len());
+        assert!(start.keep_previous);
+        assert!(!start.notice.unwrap().1);
+        let start = starting_scene(Opening::Link("http://x/#s=AQ-broken"), Some(&json));
+        assert_eq!(start.scene, edited, "the last session continues");
+        assert!(!start.keep_previous, "and is not set aside");
+        let (text, error) = start.notice.unwrap();
+        assert!(error && text.contains("damaged"), "{text}");
+        let file = stratus.to_json();
+        let start = starting_scene(Opening::File("s.json", file.as_bytes()), Some(&json));
+        assert_eq!(start.scene, stratus);
+        assert_eq!(start.file.as_deref(), Some("s.json"));
+        assert!(start.keep_previous);
+        let start = starting_scene(Opening::File("bad.json", b"\xff"), None);
+        assert_eq!(start.scene, Scene::default());
+        assert!(
+            start
+                .notice
+                .unwrap()
+                .0
+                .starts_with("bad.json: not a cloudsketch scene")
+        );
     }
 }

@@ -37,15 +37,15 @@ pub struct Guide {
 }
 
 impl Guide {
-    /// Takes dropped and picked files (an image becomes the document's reference image once
-    /// decoded) and finished decodes.
-    pub fn input(&mut self, ctx: &egui::Context, doc: &mut Document, notices: &mut Notices) {
-        let dropped = ctx.input_mut(|i| std::mem::take(&mut i.raw.dropped_files));
-        let mut loaded: Vec<Loaded> = dropped
-            .into_iter()
-            .filter_map(|f| files::read_dropped(f, ctx))
-            .collect();
-        loaded.extend(files::take_loaded());
+    /// Takes the loaded picture files (each becomes the document's reference image once
+    /// decoded; the app routes scene files elsewhere) and finished decodes.
+    pub fn input(
+        &mut self,
+        ctx: &egui::Context,
+        doc: &mut Document,
+        notices: &mut Notices,
+        loaded: Vec<Loaded>,
+    ) {
         for item in loaded {
             self.load(item);
         }

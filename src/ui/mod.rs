@@ -11,6 +11,7 @@
 //! - `gizmo`: the on-canvas Move, Rotate and Scale handles and their drag maths;
 //! - `picking`: what a click or a dragged box selects;
 //! - `guide`: the reference image (loading, texture, drawing, its panel group);
+//! - `scene_files`: Open, Save, Copy link, the unsaved marker and links pasted into the page;
 //! - `panels`: one struct per side-panel group, each with its own `ui()`;
 //! - `selection`, `notice`, `widgets`: small shared pieces;
 //! - `platform_native` / `platform_web`: the one platform seam (chosen by `cfg` on the module).
@@ -30,19 +31,20 @@ mod platform;
 #[cfg(target_arch = "wasm32")]
 #[path = "platform_web.rs"]
 mod platform;
+mod scene_files;
 mod selection;
 mod sketch_tool;
 mod viewport;
 mod widgets;
 
 pub use app::{CloudApp, Host, PageStatus, StartOptions};
-pub use autosave::start_session;
+pub use autosave::{Opening, Start, start_session};
 
 /// The view rectangle the UI's unit tests place things in: 1280×800 points at the origin.
 #[cfg(test)]
 fn test_view() -> egui::Rect {
     egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(1280.0, 800.0))
 }
-pub use platform::wake;
+pub use platform::{forget_opening_in_url, wake};
 pub use selection::Selection;
 pub use sketch_tool::Tool;

@@ -1,5 +1,6 @@
 //! The desktop side of the UI's one platform seam (`platform_web.rs` is the browser's): what
-//! the GL backend is called, and reading user files (dropped files and typed paths).
+//! the GL backend is called, reading user files (dropped files and typed paths), saving scene
+//! files and the autosave in the user's data folder.
 
 use super::guide::Loaded;
 use crate::limits::MAX_FILE_BYTES as MAX_BYTES;
@@ -66,6 +67,42 @@ pub fn store_autosave(json: &str) -> Result<(), String> {
     let tmp = dir.join("autosave.json.tmp");
     std::fs::write(&tmp, json).map_err(|e| format!("{}: {e}", tmp.display()))?;
     std::fs::rename(&tmp, dir.join("autosave.json")).map_err(|e| format!("{}: {e}", dir.display()))
+}
+
+/// The session kept aside by [`keep_previous_autosave`], if any.
+pub fn load_previous_autosave() -> Option<String> {
+    let path = autosave_dir()?.join("autosave.previous.json");
+    (std::fs::metadata(&path).ok()?.len() <= MAX_BYTES)
+        .then(|| std::fs::read_to_string(path).ok())?
+}
+
+/// Where share links point natively: the web app as `trunk serve` serves it.
+pub fn page_base() -> String {
+    crate::share::DEFAULT_BASE.to_owned()
+}
+
+/// Nothing to take out of an address bar natively.
+pub fn forget_opening_in_url() {}
+
+/// Links arrive only through the address bar, which the desktop app has not.
+pub fn take_links() -> Vec<String> {
+    Vec::new()
+}
+
+/// Writes a scene file at `path` (through a temporary file, so a failed write keeps the old).
+pub fn save_file(path: &str, text: &str) -> Result<String, String> {
+    let tmp = format!("{path}.tmp");
+    std::fs::write(&tmp, text).map_err(|e| format!("{path}: {e}"))?;
+    std::fs::rename(&tmp, path).map_err(|e| format!("{path}: {e}"))?;
+    Ok(path.to_owned())
+}
+
+/// No picker natively: Open reads the path typed in the File group.
+pub fn open_scene_picker() {}
+
+/// Scene files picked with Open (none natively: Open reads the typed path at once).
+pub fn take_scene_files() -> Vec<Loaded> {
+    Vec::new()
 }
 
 /// Keeps the last autosave aside before a new session writes over it.

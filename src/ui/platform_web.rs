@@ -1,7 +1,8 @@
 //! The browser side of the UI's one platform seam (`platform_native.rs` is the desktop's):
-//! what the GL backend is called, and reading user files — the page's hidden
-//! `<input type=file id="guide_input">` and dropped files, both read asynchronously into an
-//! inbox the app polls each frame.
+//! what the GL backend is called; reading user files — the page's hidden
+//! `<input type=file>`s (`guide_input` for pictures, `scene_input` for scenes) and dropped
+//! files, read asynchronously into an inbox the app polls each frame; saving as a download;
+//! the autosave in localStorage; links pasted into the address bar.
 
 use std::cell::RefCell;
 
@@ -25,6 +26,8 @@ thread_local! {
     static INBOX: RefCell<Vec<Loaded>> = const { RefCell::new(Vec::new()) };
     static SAMPLES: RefCell<Vec<(egui::Pos2, Option<f32>)>> = const { RefCell::new(Vec::new()) };
     static REPAINT: RefCell<Option<egui::Context>> = const { RefCell::new(None) };
+    static LINKS: RefCell<Vec<String>> = const { RefCell::new(Vec::new()) };
+    static SCENE_FILES: RefCell<Vec<Loaded>> = const { RefCell::new(Vec::new()) };
 }
 
 fn deliver(loaded: Loaded) {
@@ -51,6 +54,11 @@ pub fn store_autosave(json: &str) -> Result<(), String> {
     storage
         .set_item(AUTOSAVE_KEY, json)
         .map_err(|_| "the browser's storage for this page is full".to_owned())
+}
+
+/// The session kept aside by [`keep_previous_autosave`], if any.
+pub fn load_previous_autosave() -> Option<String> {
+    storage()?.get_item(PREVIOUS_KEY).ok().flatten()
 }
 
 /// Keeps the last autosave aside (under its own key) before a new session writes over it.
@@ -111,19 +119,98 @@ pub fn read_path(path: &str) -> Loaded {
     ))
 }
 
-fn input() -> Option<web_sys::HtmlInputElement> {
+fn input(id: &str) -> Option<web_sys::HtmlInputElement> {
     web_sys::window()?
         .document()?
-        .get_element_by_id("guide_input")?
+        .get_element_by_id(id)?
         .dyn_into()
         .ok()
+}
+
+/// The page's address without its query and fragment: what share links start with.
+pub fn page_base() -> String {
+    let Some(location) = web_sys::window().map(|w| w.location()) else {
+        return crate::share::DEFAULT_BASE.to_owned();
+    };
+    match (location.origin(), location.pathname()) {
+        (Ok(origin), Ok(path)) => format!("{origin}{path}"),
+        _ => crate::share::DEFAULT_BASE.to_owned(),
+    }
+}
+
+/// Takes a share link (`#s=…`) or a preset (`?preset=…`) out of the address bar once it is
+/// open, so a reload continues the autosaved session (which then holds that scene and every
+/// change since) instead of opening the link again over it.
+pub fn forget_opening_in_url() {
+    let Some(window) = web_sys::window() else {
+        return;
+    };
+    let location = window.location();
+    let search = location.search().unwrap_or_default();
+    let params = web_sys::UrlSearchParams::new_with_str(&search).ok();
+    let preset = params.as_ref().is_some_and(|p| p.has("preset"));
+    if !preset && !location.hash().unwrap_or_default().starts_with("#s=") {
+        return;
+    }
+    if let Some(p) = &params {
+        p.delete("preset");
+    }
+    let rest = params
+        .map(|p| String::from(p.to_string()))
+        .unwrap_or_default();
+    let query = if rest.is_empty() {
+        String::new()
+    } else {
+        format!("?{rest}")
+    };
+    let url = format!("{}{query}", location.pathname().unwrap_or_default());
+    if let Ok(history) = window.history() {
+        let _ = history.replace_state_with_url(&JsValue::NULL, "", Some(&url));
+    }
+}
+
+/// Share links pasted into the address bar of the open page since the last call.
+pub fn take_links() -> Vec<String> {
+    LINKS.with(|l| std::mem::take(&mut *l.borrow_mut()))
+}
+
+/// Saves a file as a download named `name`.
+pub fn save_file(name: &str, text: &str) -> Result<String, String> {
+    let fail = |e: JsValue| format!("the browser refused the download ({})", js_error(&e));
+    let document = web_sys::window()
+        .and_then(|w| w.document())
+        .ok_or("no document")?;
+    let parts = js_sys::Array::of1(&JsValue::from_str(text));
+    let options = web_sys::BlobPropertyBag::new();
+    options.set_type("application/json");
+    let blob = web_sys::Blob::new_with_str_sequence_and_options(&parts, &options).map_err(fail)?;
+    let url = web_sys::Url::create_object_url_with_blob(&blob).map_err(fail)?;
+    let anchor: web_sys::HtmlAnchorElement = document
+        .create_element("a")
+        .map_err(fail)?
+        .dyn_into()
+        .map_err(|e| fail(e.into()))?;
+    anchor.set_href(&url);
+    anchor.set_download(name);
+    anchor.click();
+    let _ = web_sys::Url::revoke_object_url(&url);
+    Ok(format!("{name} (a download)"))
+}
+
+/// Opens the browser's file picker for a scene file (called from a click or a key, so the
+/// browser allows it).
+pub fn open_scene_picker() {
+    if let Some(el) = input("scene_input") {
+        el.click();
+    }
 }
 
 /// Every position of the primary pointer while a button is held, coalesced samples
 /// included: the browser hands the page one move per frame, and a frame on a CPU adapter can
 /// take 150 ms, so a stroke drawn from the per-frame moves alone loses its shape.
 /// Keeps the browser from acting on the app's own Ctrl/Cmd shortcuts that eframe lets through:
-/// Ctrl+D (duplicate) would open the bookmark dialog. Text fields keep every key.
+/// Ctrl+D (duplicate) would open the bookmark dialog, Ctrl+S save the page, Ctrl+O open a
+/// file in the tab, Ctrl+L go to the address bar. Text fields keep every key.
 fn keep_browser_shortcuts() {
     let Some(document) = web_sys::window().and_then(|w| w.document()) else {
         return;
@@ -133,7 +220,12 @@ fn keep_browser_shortcuts() {
             .target()
             .and_then(|t| t.dyn_into::<web_sys::HtmlInputElement>().ok())
             .is_some();
-        if !typing && (e.ctrl_key() || e.meta_key()) && e.key().eq_ignore_ascii_case("d") {
+        // Ctrl+D duplicates (not a bookmark), Ctrl+S saves and Ctrl+O opens the app's scene,
+        // Ctrl+L copies its link (not the address bar).
+        let ours = ["d", "s", "o", "l"]
+            .iter()
+            .any(|k| e.key().eq_ignore_ascii_case(k));
+        if !typing && (e.ctrl_key() || e.meta_key()) && ours {
             e.prevent_default();
         }
     });
@@ -211,37 +303,70 @@ pub fn take_pointer_samples() -> Option<Vec<(egui::Pos2, Option<f32>)>> {
     Some(SAMPLES.with(|s| std::mem::take(&mut *s.borrow_mut())))
 }
 
-/// Installs the page's listeners: pointer samples, and the file input's change (once, at
-/// start-up).
+/// Installs the page's listeners: pointer samples, the file inputs' changes and the address
+/// bar's fragment (once, at start-up).
 pub fn install(ctx: &egui::Context) {
     REPAINT.with(|c| *c.borrow_mut() = Some(ctx.clone()));
     install_pointer_samples(ctx);
     keep_browser_shortcuts();
-    let Some(el) = input() else {
-        log::warn!("the page has no #guide_input: the Load… button will do nothing");
-        return;
-    };
-    let on_change = Closure::<dyn FnMut(web_sys::Event)>::new(move |_event: web_sys::Event| {
-        let Some(el) = input() else { return };
-        if let Some(file) = el.files().and_then(|f| f.get(0)) {
-            wasm_bindgen_futures::spawn_local(async move { deliver(read_file(file).await) });
+    for id in ["guide_input", "scene_input"] {
+        let inbox = if id == "scene_input" {
+            &SCENE_FILES
+        } else {
+            &INBOX
+        };
+        let Some(el) = input(id) else {
+            log::warn!("the page has no #{id}: its Open or Load button will do nothing");
+            continue;
+        };
+        let on_change = Closure::<dyn FnMut(web_sys::Event)>::new(move |_event: web_sys::Event| {
+            let Some(el) = input(id) else { return };
+            if let Some(file) = el.files().and_then(|f| f.get(0)) {
+                wasm_bindgen_futures::spawn_local(async move {
+                    let loaded = read_file(file).await;
+                    inbox.with(|i| i.borrow_mut().push(loaded));
+                    wake();
+                });
+            }
+            el.set_value(""); // choosing the same file again fires again
+        });
+        let _ = el.add_event_listener_with_callback("change", on_change.as_ref().unchecked_ref());
+        on_change.forget(); // lives as long as the page
+    }
+    let on_hash = Closure::<dyn FnMut(web_sys::Event)>::new(|_event: web_sys::Event| {
+        let hash = web_sys::window()
+            .and_then(|w| w.location().hash().ok())
+            .unwrap_or_default();
+        if hash.starts_with("#s=") {
+            LINKS.with(|l| l.borrow_mut().push(hash));
+            forget_opening_in_url();
+            wake();
         }
-        el.set_value(""); // choosing the same file again fires again
     });
-    let _ = el.add_event_listener_with_callback("change", on_change.as_ref().unchecked_ref());
-    on_change.forget(); // lives as long as the page
+    if let Some(window) = web_sys::window() {
+        let _ =
+            window.add_event_listener_with_callback("hashchange", on_hash.as_ref().unchecked_ref());
+    }
+    on_hash.forget(); // lives as long as the page
 }
 
-/// Opens the browser's file picker (called from a click, so the browser allows it).
+/// Opens the browser's file picker for a picture (called from a click, so the browser allows
+/// it).
 pub fn open_picker() {
-    if let Some(el) = input() {
+    if let Some(el) = input("guide_input") {
         el.click();
     }
 }
 
-/// Files that finished loading since the last call.
+/// Files that finished loading since the last call: pictures picked for the guide and
+/// dropped files.
 pub fn take_loaded() -> Vec<Loaded> {
     INBOX.with(|i| std::mem::take(&mut *i.borrow_mut()))
+}
+
+/// Scene files picked with Open since the last call.
+pub fn take_scene_files() -> Vec<Loaded> {
+    SCENE_FILES.with(|i| std::mem::take(&mut *i.borrow_mut()))
 }
 
 thread_local! {

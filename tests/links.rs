@@ -1,0 +1,84 @@
+//! Share links keep opening as the format evolves: `tests/fixtures/link_vN.txt` is the link
+//! of `share::fixture::every_part()` as format N wrote it, and `link_vN.json` the scene it
+//! opens to. A format change without a version bump fails here; so does a change that makes
+//! an old link open differently.
+//!
+//! After a deliberate format change: bump `LINK_VERSION`, keep decoding the old versions, and
+//! write the new fixtures with
+//! `CLOUDSKETCH_WRITE_LINK_FIXTURE=1 cargo test --test links` (old ones stay as they are).
+
+use std::path::PathBuf;
+
+use base64::Engine as _;
+use cloudsketch::scene::Scene;
+use cloudsketch::share::{LINK_VERSION, decode_link, encode_link, fixture};
+
+fn fixtures() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures")
+}
+
+/// The version byte and the inflated payload of a link (the compressed bytes may differ
+/// between compressor versions without any change of format).
+fn payload(link: &str) -> (u8, Vec<u8>) {
+    let token = &link[link.find("#s=").map_or(0, |i| i + 3)..];
+    let bytes = base64::engine::general_purpose::URL_SAFE_NO_PAD
+        .decode(token.trim())
+        .unwrap();
+    (
+        bytes[0],
+        miniz_oxide::inflate::decompress_to_vec(&bytes[1..]).unwrap(),
+    )
+}
+
+#[test]
+fn every_stored_link_version_still_opens_to_its_scene() {
+    if std::env::var_os("CLOUDSKETCH_WRITE_LINK_FIXTURE").is_some() {
+        let link = format!(
+            "http://127.0.0.1:8080/#s={}\n",
+            encode_link(&fixture::every_part()).unwrap()
+        );
+        let (scene, _) = decode_link(&link).unwrap();
+        let dir = fixtures();
+        std::fs::write(dir.join(format!("link_v{LINK_VERSION}.txt")), &link).unwrap();
+        std::fs::write(
+            dir.join(format!("link_v{LINK_VERSION}.json")),
+            scene.to_json(),
+        )
+        .unwrap();
+    }
+    for version in 1..=LINK_VERSION {
+        let link = std::fs::read_to_string(fixtures().join(format!("link_v{version}.txt")))
+            .unwrap_or_else(|e| panic!("the fixture of link format {version}: {e}"));
+        let json =
+            std::fs::read_to_string(fixtures().join(format!("link_v{version}.json"))).unwrap();
+        let (expected, _) = Scene::from_json(&json).unwrap();
+        let (opened, repairs) = decode_link(&link).unwrap();
+        assert!(repairs.is_empty(), "{repairs:?}");
+        assert_eq!(
+            opened, expected,
+            "a link of format {version} opens to a different scene than it did"
+        );
+    }
+}
+
+#[test]
+fn the_link_format_changes_only_with_its_version() {
+    let stored =
+        std::fs::read_to_string(fixtures().join(format!("link_v{LINK_VERSION}.txt"))).unwrap();
+    let now = encode_link(&fixture::every_part()).unwrap();
+    assert_eq!(payload(&stored).0, LINK_VERSION);
+    assert!(
+        payload(&stored) == payload(&now),
+        "the link of the fixture scene changed without a new LINK_VERSION: bump it, keep \
+         reading the old format, and add its fixtures (see this file's header)"
+    );
+}
+
+#[test]
+fn the_stored_links_do_not_carry_the_reference_picture() {
+    let link = std::fs::read_to_string(fixtures().join("link_v1.txt")).unwrap();
+    let (scene, _) = decode_link(&link).unwrap();
+    let reference = scene.reference.unwrap();
+    assert_eq!(reference.name, "sky.jpg");
+    assert!(reference.data.is_empty());
+}
