@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # Sets up whatever is missing (scripts/setup.sh) and runs every test: Rust unit and
-# integration tests (pure core, naga validation of shaders/, offscreen lavapipe renders, CLI),
-# the release web build, and the browser end-to-end tests in headless Chromium (WebGPU on
-# SwiftShader, then the WebGL2 fallback). Screenshots: web/test-results/screenshots/.
+# integration tests (pure core, naga validation of shaders/, offscreen lavapipe renders, CLI,
+# link fixtures), a 30-second fuzz run of the link decoders (nightly + cargo-fuzz, installed
+# here when missing), the release web build, and the browser end-to-end tests in headless
+# Chromium (WebGPU on SwiftShader, then the WebGL2 fallback). Screenshots:
+# web/test-results/screenshots/.
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$ROOT"
@@ -15,6 +17,29 @@ log "cargo test (native)"
 # a display (and print XDG_RUNTIME_DIR errors on a headless machine). The CLI does the same.
 export NODEVICE_SELECT=1
 cargo test --locked
+
+# The fuzz target needs nightly Rust and cargo-fuzz (test-only tools: not in setup.sh).
+CARGO_FUZZ_VERSION=0.13.2
+if ! rustup run nightly rustc --version >/dev/null 2>&1; then
+  log "rustup toolchain install nightly (for cargo-fuzz)"
+  rustup toolchain install nightly --profile minimal
+fi
+if ! cargo fuzz --version 2>/dev/null | grep -q "$CARGO_FUZZ_VERSION"; then
+  log "cargo install cargo-fuzz $CARGO_FUZZ_VERSION"
+  cargo install --locked cargo-fuzz --version "$CARGO_FUZZ_VERSION"
+fi
+log "fuzz the link decoders for 30 s (docs/scene-format.md)"
+fuzzing="$(mktemp -d)"
+mkdir "$fuzzing/corpus"
+cp fuzz/corpus/link_decode/* "$fuzzing/corpus/"
+if ! cargo +nightly fuzz run -O link_decode "$fuzzing/corpus" -- -max_total_time=30 \
+    -rss_limit_mb=2048 -max_len=65536 >"$fuzzing/log" 2>&1; then
+  tail -n 60 "$fuzzing/log"
+  log "the fuzz run found a failing input (fuzz/artifacts/link_decode/)"
+  exit 1
+fi
+grep -E 'Done [0-9]+ runs' "$fuzzing/log" || true
+rm -rf "$fuzzing"
 
 log "trunk build --release (wasm)"
 trunk build --release

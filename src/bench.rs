@@ -420,6 +420,59 @@ fn worst_documents_bench() -> Vec<BenchResult> {
         .collect()
 }
 
+/// Share links for every preset and for five hand-drawn strokes: the URL's length against the
+/// scene file's, and encoding and opening times against writing and opening the scene file
+/// (opening either includes the cost check that derives the field).
+fn links() -> Vec<BenchResult> {
+    use crate::share::{DEFAULT_BASE, decode_link, fixture, link_url, open_scene_file};
+    let mut scenes: Vec<(&str, Scene)> = Preset::ALL
+        .iter()
+        .map(|&(p, name)| (name, Scene::preset(p)))
+        .collect();
+    scenes.push(("sketched_5x200", fixture::hand_drawn()));
+    let mut out = Vec::new();
+    for (name, scene) in scenes {
+        let Ok(url) = link_url(DEFAULT_BASE, &scene) else {
+            continue;
+        };
+        let json = scene.to_json();
+        out.push(result(
+            &format!("link_chars_{name}"),
+            url.len() as f64,
+            "chars",
+            "scene_file_bytes",
+            json.len() as f64,
+        ));
+        let encode = time_median(9, &mut || {
+            std::hint::black_box(link_url(DEFAULT_BASE, &scene).ok());
+        });
+        let write = time_median(9, &mut || {
+            std::hint::black_box(scene.to_json());
+        });
+        out.push(result(
+            &format!("link_encode_{name}"),
+            encode * 1e3,
+            "ms",
+            "scene_file_write",
+            write * 1e3,
+        ));
+        let decode = time_median(5, &mut || {
+            std::hint::black_box(decode_link(&url).ok());
+        });
+        let open = time_median(5, &mut || {
+            std::hint::black_box(open_scene_file("bench.json", json.as_bytes()).ok());
+        });
+        out.push(result(
+            &format!("link_open_{name}"),
+            decode * 1e3,
+            "ms",
+            "scene_file_open",
+            open * 1e3,
+        ));
+    }
+    out
+}
+
 /// Runs the suite (or only the groups named in `only`, comma-separated) and prints it.
 pub fn run(json: bool, only: Option<&str>) -> Result<(), String> {
     let mut offscreen = Offscreen::new().map_err(|e| e.to_string())?;
@@ -448,6 +501,9 @@ pub fn run(json: bool, only: Option<&str>) -> Result<(), String> {
     }
     if wanted("field") {
         results.extend(field_at_scale());
+    }
+    if wanted("link") {
+        results.extend(links());
     }
     if wanted("render") {
         results.push(render_frame(&mut offscreen)?);

@@ -57,11 +57,12 @@ fn uses(code: &str, name: &str) -> bool {
     })
 }
 
-const PURE: [&str; 6] = [
+const PURE: [&str; 7] = [
     "src/scene/",
     "src/sketch/",
     "src/field/",
     "src/derive/",
+    "src/share/",
     "src/limits.rs",
     "src/seeded.rs",
 ];

@@ -82,3 +82,38 @@ fn the_stored_links_do_not_carry_the_reference_picture() {
     assert_eq!(reference.name, "sky.jpg");
     assert!(reference.data.is_empty());
 }
+
+/// The CI's short fuzz run (the long one is `cargo +nightly fuzz run link_decode`, see
+/// docs/scene-format.md): every input of the checked-in corpus, and seeded mutations of each
+/// (bytes changed, cut, doubled), through the decoders' contract.
+#[test]
+fn the_fuzz_corpus_and_its_mutations_decode_safely() {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("fuzz/corpus/link_decode");
+    let mut inputs: Vec<Vec<u8>> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| std::fs::read(e.unwrap().path()).unwrap())
+        .collect();
+    assert!(inputs.len() >= 10, "the corpus is checked in");
+    let mut rng = cloudsketch::seeded::SplitMix::new(12);
+    let seeds = inputs.clone();
+    for seed in &seeds {
+        for round in 0..40 {
+            let mut m = seed.clone();
+            let at = 1 + (rng.next_u64() as usize) % (m.len() - 1).max(1);
+            let last = at.min(m.len() - 1);
+            match round % 4 {
+                0 => m[last] ^= 1 << (rng.next_u64() % 8),
+                1 => m.truncate(at),
+                2 => {
+                    let tail = m[last..].to_vec();
+                    m.extend(tail);
+                }
+                _ => m[last] = (rng.next_u64() & 0xff) as u8,
+            }
+            inputs.push(m);
+        }
+    }
+    for input in &inputs {
+        cloudsketch::share::check_untrusted(input);
+    }
+}

@@ -100,8 +100,8 @@ enum Command {
         /// Print one JSON object instead of a table.
         #[arg(long)]
         json: bool,
-        /// Run only these groups, comma-separated: sketch, light, stroke, worst, field, render,
-        /// quality.
+        /// Run only these groups, comma-separated: sketch, light, stroke, worst, field, link,
+        /// render, quality.
         #[arg(long)]
         only: Option<String>,
     },

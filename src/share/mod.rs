@@ -13,3 +13,30 @@ pub use link::{
     DEFAULT_BASE, LINK_VERSION, LinkError, MAX_LINK_CHARS, decode_link, decode_payload,
     encode_link, link_url,
 };
+
+/// The decoders' contract on any bytes (the fuzz target's body, and the CI's smoke run over
+/// the checked-in corpus): `data[0]` even takes the rest as a link's text, odd as an inflated
+/// payload (random text rarely gets through the base64 and deflate layers). Decoding never
+/// panics and never allocates beyond its caps; a scene it returns is valid and encodes again.
+/// Panics when that contract is broken.
+pub fn check_untrusted(data: &[u8]) {
+    let Some((&way, rest)) = data.split_first() else {
+        return;
+    };
+    let decoded = if way & 1 == 0 {
+        match std::str::from_utf8(rest) {
+            Ok(text) => decode_link(text),
+            Err(_) => return,
+        }
+    } else {
+        decode_payload(rest)
+    };
+    if let Ok((scene, _)) = decoded {
+        let mut again = scene.clone();
+        assert!(again.validate().is_ok(), "a decoded scene is valid");
+        match encode_link(&scene) {
+            Ok(_) | Err(LinkError::SceneTooLarge { .. }) => {}
+            Err(e) => panic!("a decoded scene does not encode: {e}"),
+        }
+    }
+}

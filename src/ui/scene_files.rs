@@ -276,3 +276,98 @@ fn with_repairs(text: String, repairs: &[String]) -> String {
         format!("{text}; repaired {}", repairs.join(", "))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Preset;
+
+    #[test]
+    fn open_is_one_undo_step_save_clears_the_marker_and_a_broken_file_changes_nothing() {
+        let mut doc = Document::new(Scene::preset(Preset::Cumulus));
+        let mut selection = Selection::default();
+        let mut notices = Notices::default();
+        let mut files = SceneFiles::new(&doc, None);
+        assert!(!files.unsaved(&doc), "a fresh session has nothing unsaved");
+        let mut camera = doc.scene().camera.clone();
+        camera.yaw_deg += 30.0;
+        doc.set_camera(camera);
+        assert!(
+            !files.unsaved(&doc),
+            "a camera move is not an unsaved change"
+        );
+
+        let stratus = Scene::preset(Preset::Stratus);
+        let bytes = stratus.to_json().into_bytes();
+        files.open(
+            (&mut doc, &mut selection, &mut notices),
+            1.0,
+            "s.json",
+            &bytes,
+        );
+        assert_eq!(*doc.scene(), stratus);
+        assert_eq!(files.name, "s.json");
+        assert!(!files.unsaved(&doc));
+        assert!(doc.undo().is_some());
+        assert_eq!(
+            doc.scene().ellipsoids,
+            Scene::preset(Preset::Cumulus).ellipsoids
+        );
+        assert!(
+            files.unsaved(&doc),
+            "undoing the open is a change from the file"
+        );
+        doc.redo();
+
+        let before = doc.scene().clone();
+        files.open(
+            (&mut doc, &mut selection, &mut notices),
+            2.0,
+            "bad.json",
+            b"{\"planes\": 7}",
+        );
+        assert_eq!(*doc.scene(), before, "nothing opened");
+        let notice = notices.latest.clone().unwrap();
+        assert!(notice.error && notice.text.starts_with("Nothing opened: bad.json"));
+
+        let mut light = doc.scene().light.clone();
+        light.ambient = 0.9;
+        doc.apply(Edit::SetLight(light), None);
+        assert!(files.unsaved(&doc));
+        let dir = std::env::temp_dir().join(format!("cloudsketch-save-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        files.name = dir.join("saved").display().to_string();
+        files.save(&doc, &mut notices, 3.0);
+        assert!(!files.unsaved(&doc), "{:?}", notices.latest);
+        assert!(files.name.ends_with("saved.json"), "{}", files.name);
+        let (saved, _) = Scene::from_json(&std::fs::read_to_string(&files.name).unwrap()).unwrap();
+        assert_eq!(saved, *doc.scene());
+        let _ = std::fs::remove_dir_all(dir);
+    }
+
+    #[test]
+    fn a_link_opens_as_one_undo_step_and_a_broken_one_changes_nothing() {
+        let mut doc = Document::new(Scene::preset(Preset::Cumulus));
+        let (mut selection, mut notices) = (Selection::default(), Notices::default());
+        let mut files = SceneFiles::new(&doc, None);
+        let url = crate::share::link_url("http://x/", &Scene::preset(Preset::Cirrus)).unwrap();
+        files.open_link((&mut doc, &mut selection, &mut notices), 1.0, &url);
+        assert_eq!(
+            doc.scene().render.noise_filter,
+            Scene::preset(Preset::Cirrus).render.noise_filter
+        );
+        let before = doc.scene().clone();
+        files.open_link(
+            (&mut doc, &mut selection, &mut notices),
+            2.0,
+            &url[..url.len() - 9],
+        );
+        assert_eq!(*doc.scene(), before);
+        assert!(notices.latest.unwrap().text.contains("damaged"));
+        doc.undo();
+        assert_eq!(
+            doc.scene().ellipsoids,
+            Scene::preset(Preset::Cumulus).ellipsoids
+        );
+    }
+}
