@@ -319,7 +319,7 @@ fn field_at_scale() -> Vec<BenchResult> {
             let mut es = doc.scene().ellipsoids.clone();
             let i = (step * 7919) % es.len();
             let mut e = (*es[i]).clone();
-            e.center.x += if step % 2 == 0 { 0.4 } else { -0.4 };
+            e.center.x += if step.is_multiple_of(2) { 0.4 } else { -0.4 };
             es[i] = Arc::new(e);
             doc.apply(Edit::SetEllipsoids(es), None);
             std::hint::black_box(derived.density(doc.scene(), doc.revisions()));
@@ -368,6 +368,56 @@ fn field_at_scale() -> Vec<BenchResult> {
         ));
     }
     out
+}
+
+/// The other way to build the field (ARCHITECTURE.md, "The field at scale"): every texel
+/// evaluated on the GPU, one render pass per slice, against the CPU's full bake on the same
+/// grid and the CPU's partial update after one primitive moved (which the app uses).
+fn field_gpu_baseline(offscreen: &mut Offscreen) -> Result<Vec<BenchResult>, String> {
+    let mut out = Vec::new();
+    for n in [100, 2_000] {
+        let mut doc = Document::new(ellipsoid_bank(n));
+        let res = doc.scene().render.field_resolution;
+        let field = crate::derive::field_of(doc.scene());
+        let gpu = median(
+            offscreen
+                .time_field_on_gpu(&field, res, 4)
+                .map_err(|e| e.to_string())?
+                .split_off(1),
+        );
+        let cpu = time_median(5, &mut || {
+            std::hint::black_box(crate::field::bake(&field, res));
+        });
+        let mut derived = Derived::default();
+        derived.density(doc.scene(), doc.revisions());
+        let mut step = 0usize;
+        let moved = time_median(15, &mut || {
+            step += 1;
+            let mut es = doc.scene().ellipsoids.clone();
+            let i = (step * 7919) % es.len();
+            let mut e = (*es[i]).clone();
+            e.center.x += if step.is_multiple_of(2) { 0.4 } else { -0.4 };
+            es[i] = Arc::new(e);
+            doc.apply(Edit::SetEllipsoids(es), None);
+            std::hint::black_box(derived.density(doc.scene(), doc.revisions()));
+        });
+        let gpu_name = format!("field_gpu_full_{n}_ellipsoids");
+        out.push(result(
+            &gpu_name,
+            gpu * 1e3,
+            "ms",
+            &format!("field_cpu_full_bake_{n}_ellipsoids"),
+            cpu * 1e3,
+        ));
+        out.push(result(
+            &format!("field_cpu_one_of_{n}_moved_vs_gpu"),
+            moved * 1e3,
+            "ms",
+            &gpu_name,
+            gpu * 1e3,
+        ));
+    }
+    Ok(out)
 }
 
 /// Documents at the caps built to be slow (every primitive reaches every texel of the grid):
@@ -501,6 +551,7 @@ pub fn run(json: bool, only: Option<&str>) -> Result<(), String> {
     }
     if wanted("field") {
         results.extend(field_at_scale());
+        results.extend(field_gpu_baseline(&mut offscreen)?);
     }
     if wanted("link") {
         results.extend(links());

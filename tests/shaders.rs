@@ -1,10 +1,11 @@
 //! Every shader module the renderer compiles parses and validates with naga, every WGSL file in
-//! `shaders/` is part of one, and the WGSL `Volume` struct has exactly the size and member
-//! offsets of the Rust `VolumeUniforms` it mirrors.
+//! `shaders/` is part of one, and each WGSL uniform struct has exactly the size and member
+//! offsets of the Rust struct it mirrors (`Volume`/`VolumeUniforms`,
+//! `FieldSlice`/`FieldSliceUniforms`).
 
 use std::path::Path;
 
-use cloudsketch::render::gpu_types::VolumeUniforms;
+use cloudsketch::render::gpu_types::{FieldSliceUniforms, VolumeUniforms};
 use cloudsketch::render::shaders::MODULES;
 
 fn parse(name: &str, source: &str) -> naga::Module {
@@ -55,32 +56,49 @@ fn every_shader_file_is_composed_into_a_module() {
     assert!(on_disk >= 4);
 }
 
-#[test]
-fn wgsl_volume_struct_matches_the_rust_layout() {
-    let (_, _, source) = MODULES.iter().find(|(n, _, _)| *n == "volume").unwrap();
-    let module = parse("volume", source);
-    let (members, span) = module
+/// The WGSL struct `name` of `module`: its members' names and offsets, then its size.
+fn wgsl_layout(module: &str, name: &str) -> Vec<(String, usize)> {
+    let (_, _, source) = MODULES.iter().find(|(n, _, _)| *n == module).unwrap();
+    let parsed = parse(module, source);
+    let (members, span) = parsed
         .types
         .iter()
         .find_map(|(_, ty)| match (&ty.name, &ty.inner) {
-            (Some(n), naga::TypeInner::Struct { members, span }) if n == "Volume" => {
+            (Some(n), naga::TypeInner::Struct { members, span }) if n == name => {
                 Some((members.clone(), *span))
             }
             _ => None,
         })
-        .expect("struct Volume in volume_common.wgsl");
-    let wgsl: Vec<(String, usize)> = members
+        .unwrap_or_else(|| panic!("struct {name} in {module}"));
+    members
         .iter()
         .map(|m| (m.name.clone().unwrap_or_default(), m.offset as usize))
         .chain(std::iter::once((String::new(), span as usize)))
-        .collect();
-    let rust: Vec<(String, usize)> = VolumeUniforms::LAYOUT
-        .iter()
-        .map(|(n, o)| (n.to_string(), *o))
-        .collect();
+        .collect()
+}
+
+fn rust_layout(layout: &[(&str, usize)]) -> Vec<(String, usize)> {
+    layout.iter().map(|(n, o)| (n.to_string(), *o)).collect()
+}
+
+#[test]
+fn wgsl_volume_struct_matches_the_rust_layout() {
     assert_eq!(
-        wgsl, rust,
+        wgsl_layout("volume", "Volume"),
+        rust_layout(&VolumeUniforms::LAYOUT),
         "WGSL Volume vs Rust VolumeUniforms (name, offset; last: size)"
     );
-    assert_eq!(span as usize, std::mem::size_of::<VolumeUniforms>());
+    assert_eq!(
+        VolumeUniforms::LAYOUT.last().unwrap().1,
+        std::mem::size_of::<VolumeUniforms>()
+    );
+}
+
+#[test]
+fn wgsl_field_slice_struct_matches_the_rust_layout() {
+    assert_eq!(
+        wgsl_layout("field_eval", "FieldSlice"),
+        rust_layout(&FieldSliceUniforms::LAYOUT),
+        "WGSL FieldSlice vs Rust FieldSliceUniforms (name, offset; last: size)"
+    );
 }

@@ -14,7 +14,7 @@ pub use inside::{InsideMap, PlacedInside};
 
 pub use volume::{
     Baked, Baker, DensityVolume, MAX_RESOLUTION, bake, bake_brute_force, bake_work, density,
-    resolution_within,
+    lattice, resolution_within,
 };
 
 use glam::{Mat3, Vec2, Vec3};

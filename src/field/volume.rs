@@ -400,6 +400,14 @@ fn volume_of(grid: &Grid, values: Vec<f32>) -> DensityVolume {
     }
 }
 
+/// The grid [`bake`] samples `field` on: the centre of its first texel, texels per axis and
+/// the texel side (texel `i` is centred at `first + i·h`, to float rounding).
+pub fn lattice(field: &Field, resolution: u32) -> Option<(Vec3, UVec3, f32)> {
+    let grid = Grid::of(field, resolution)?;
+    let [xs, ys, zs] = grid.centers();
+    Some((Vec3::new(xs[0], ys[0], zs[0]), grid.dims, grid.h))
+}
+
 /// Samples `field` on a grid over its bounds, `resolution` texels along the longest side.
 pub fn bake(field: &Field, resolution: u32) -> DensityVolume {
     let Some(grid) = Grid::of(field, resolution) else {

@@ -52,6 +52,26 @@ pub struct VolumeUniforms {
     pub octaves: [[[f32; 4]; 4]; MAX_OCTAVES],
 }
 
+/// Uniforms of one slice of the GPU field evaluation (`struct FieldSlice` in
+/// `shaders/field_eval.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct FieldSliceUniforms {
+    /// Centre of texel (0, 0, 0) (xyz) and the texel side (w).
+    pub first_center: [f32; 4],
+    /// x: this slice's z, y: primitive count, z: rows of the primitive texture, w: unused.
+    pub slice: [u32; 4],
+}
+
+impl FieldSliceUniforms {
+    /// Names and byte offsets of the members, in order (checked against the WGSL struct).
+    pub const LAYOUT: [(&'static str, usize); 3] = [
+        ("first_center", offset_of!(Self, first_center)),
+        ("slice", offset_of!(Self, slice)),
+        ("", std::mem::size_of::<Self>()),
+    ];
+}
+
 /// What one image of the volume shows: a plain, `Send + Sync` copy of the document's view,
 /// light and render settings (the renderer turns it into uniforms).
 #[derive(Clone, Debug, PartialEq)]

@@ -4,12 +4,14 @@
 //!   [`passes`] (slice and composite pipelines, created once) and [`resources`] (textures,
 //!   samplers, accumulation targets);
 //! - [`gpu_types`]: the Pod structs mirrored in WGSL, and the plain [`View`] snapshot;
+//! - [`field_gpu`]: the field evaluated on the GPU, the baseline of the CPU bake in `bench`;
 //! - [`shaders`]: WGSL sources, composed;
 //! - [`progressive`]: the frame-time budget that picks preview and refinement work (pure);
 //! - [`noise`]: the periodic noise volume (pure);
 //! - [`viewport`]: the egui paint callback that runs the renderer inside the app;
 //! - `offscreen` (native): headless rendering for the CLI, benchmarks and tests.
 
+pub mod field_gpu;
 pub mod gpu_types;
 pub mod noise;
 pub mod passes;

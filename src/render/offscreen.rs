@@ -1,11 +1,13 @@
 //! Headless rendering on any wgpu adapter (lavapipe on CPU-only machines): `render`, `bench`
 //! and the image tests use it, with the same renderer and shaders as the app.
 
+use super::field_gpu::{FieldEvaluator, FieldGpuError};
 use super::gpu_types::{FULL_VIEW, View};
 use super::progressive::JobPlan;
 use super::renderer::{SliceJob, VolumeRenderer};
 use super::resources::accumulation_format;
 use crate::derive::Derived;
+use crate::field::{DensityVolume, Field};
 use crate::scene::{Document, Scene};
 
 pub use crate::limits::MAX_RENDER_SIDE as MAX_SIDE;
@@ -74,6 +76,8 @@ pub struct Offscreen {
     info: wgpu::AdapterInfo,
     renderer: VolumeRenderer,
     derived: Derived,
+    /// The GPU field evaluation (the bench's baseline), made on first use.
+    field_evaluator: Option<FieldEvaluator>,
 }
 
 impl Offscreen {
@@ -124,6 +128,7 @@ impl Offscreen {
             info,
             renderer,
             derived: Derived::default(),
+            field_evaluator: None,
         })
     }
 
@@ -170,6 +175,46 @@ impl Offscreen {
             self.device
                 .poll(wgpu::PollType::wait_indefinitely())
                 .map_err(|e| OffscreenError::Readback(e.to_string()))?;
+            times.push(start.elapsed().as_secs_f64());
+        }
+        Ok(times)
+    }
+
+    /// `field` evaluated on the GPU on the grid the CPU bake uses at `resolution`, read back.
+    pub fn field_on_gpu(
+        &mut self,
+        field: &Field,
+        resolution: u32,
+    ) -> Result<DensityVolume, FieldGpuError> {
+        let evaluator = self
+            .field_evaluator
+            .get_or_insert_with(|| FieldEvaluator::new(&self.device));
+        match evaluator.evaluate(&self.device, &self.queue, field, resolution)? {
+            Some(gpu) => FieldEvaluator::read_back(&self.device, &self.queue, &gpu),
+            None => Ok(DensityVolume::default()),
+        }
+    }
+
+    /// Times `runs` GPU evaluations of `field` into its 3D texture (primitives uploaded, every
+    /// slice rendered, waited for on the device; no readback: the renderer would sample the
+    /// texture where it is).
+    pub fn time_field_on_gpu(
+        &mut self,
+        field: &Field,
+        resolution: u32,
+        runs: usize,
+    ) -> Result<Vec<f64>, FieldGpuError> {
+        let evaluator = self
+            .field_evaluator
+            .get_or_insert_with(|| FieldEvaluator::new(&self.device));
+        let mut times = Vec::with_capacity(runs);
+        for _ in 0..runs {
+            let start = std::time::Instant::now();
+            let gpu = evaluator.evaluate(&self.device, &self.queue, field, resolution)?;
+            self.device
+                .poll(wgpu::PollType::wait_indefinitely())
+                .map_err(|e| FieldGpuError::Readback(e.to_string()))?;
+            drop(gpu);
             times.push(start.elapsed().as_secs_f64());
         }
         Ok(times)

@@ -20,8 +20,11 @@ pub const PLAIN_SLICES: &str = concat!(
 /// `shaders/composite.wgsl`.
 pub const COMPOSITE: &str = include_str!("../../shaders/composite.wgsl");
 
+/// `shaders/field_eval.wgsl`: the field evaluated on the GPU (the bench's baseline).
+pub const FIELD_EVAL: &str = include_str!("../../shaders/field_eval.wgsl");
+
 /// Every shader module with the files it is composed of, in order.
-pub const MODULES: [(&str, &[&str], &str); 3] = [
+pub const MODULES: [(&str, &[&str], &str); 4] = [
     ("volume", &["volume_common.wgsl", "volume.wgsl"], VOLUME),
     (
         "plain_slices",
@@ -29,4 +32,5 @@ pub const MODULES: [(&str, &[&str], &str); 3] = [
         PLAIN_SLICES,
     ),
     ("composite", &["composite.wgsl"], COMPOSITE),
+    ("field_eval", &["field_eval.wgsl"], FIELD_EVAL),
 ];

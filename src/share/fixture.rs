@@ -28,7 +28,8 @@ pub fn hand_drawn() -> Scene {
             .map(|i| {
                 // Uneven speed, as a hand moves: samples bunch where it slows down.
                 let u = i as f64 / 200.0;
-                let t = start + std::f64::consts::TAU * (u + 0.03 * (3.0 * u * 6.283).sin());
+                let t = start
+                    + std::f64::consts::TAU * (u + 0.03 * (3.0 * u * std::f64::consts::TAU).sin());
                 let rr = radius
                     * (1.0
                         + bumps

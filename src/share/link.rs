@@ -374,8 +374,8 @@ fn write_stroke(w: &mut Writer, plane: &DrawingPlane) {
         w.ivar(e);
         let q = grid_points(points, e);
         for (i, k) in q.iter().enumerate() {
-            for axis in 0..2 {
-                w.ivar(k[axis] - predict(i, &q, axis).unwrap_or(0));
+            for (axis, &v) in k.iter().enumerate() {
+                w.ivar(v - predict(i, &q, axis).unwrap_or(0));
             }
         }
     }
