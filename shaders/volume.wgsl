@@ -3,7 +3,9 @@
 // premultiplied "over" blending into a linear RGBA target.
 //
 // Density = blended implicit field (red of the volume texture) perturbed by octaves of
-// periodic noise; lighting = sun × transmittance toward the sun (green) + ambient sky.
+// periodic noise; lighting = sun × transmittance toward the sun (green) × a two-lobe
+// Henyey–Greenstein phase, plus octaves of multiple scattering (Wrenninge 2013: each octave
+// sees a half of the extinction, half the energy and half the asymmetry), + ambient sky.
 // Composed after volume_common.wgsl (uniforms and bindings).
 
 struct VsOut {
@@ -64,6 +66,41 @@ fn fbm(p: vec3<f32>) -> f32 {
     return select(0.5, sum / max(norm, 1e-6), norm > 0.0);
 }
 
+// Henyey–Greenstein's phase function scaled so that isotropic scattering is 1 (not 1/4π):
+// the image keeps today's brightness at g = 0.
+fn hg(cos_theta: f32, g: f32) -> f32 {
+    let d = 1.0 + g * g - 2.0 * g * cos_theta;
+    return (1.0 - g * g) / (d * sqrt(d));
+}
+
+// Two lobes: mostly forward (g), a little backward (−g/3), so the side facing the sun keeps
+// its light.
+fn phase(cos_theta: f32, g: f32) -> f32 {
+    return mix(hg(cos_theta, -g / 3.0), hg(cos_theta, g), 0.8);
+}
+
+// Light reaching the sample from the sun: transmittance `t` (raised to Dirtiness), through
+// the phase function for the angle between the sun's light and the view ray.
+fn sun_light(t: f32, cos_theta: f32) -> f32 {
+    let dirt = u.sun_color.w;
+    let g = u.sun_dir.w;
+    var light = pow(max(t, 1e-6), dirt) * phase(cos_theta, g);
+    // Multiple scattering: octaves with extinction ×½, energy ×½, asymmetry ×½ each.
+    let ms = u.sky_color.w;
+    if ms > 0.0 {
+        var a = 0.5;
+        var b = 0.5;
+        var c = 0.5;
+        for (var i = 0; i < 2; i = i + 1) {
+            light = light + ms * a * pow(max(t, 1e-6), dirt * b) * phase(cos_theta, g * c);
+            a = a * 0.5;
+            b = b * 0.5;
+            c = c * 0.5;
+        }
+    }
+    return light;
+}
+
 @fragment
 fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
     let uvw = (in.world - u.grid_min.xyz) * u.grid_inv_size.xyz;
@@ -98,11 +135,9 @@ fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
     if alpha <= 0.0 {
         discard;
     }
-    // Dirtiness scales the optical depth toward the sun: T^d = exp(−d·τ).
-    var sun = sample.g;
-    if u.sun_color.w != 1.0 {
-        sun = pow(sun, u.sun_color.w);
-    }
+    // Dirtiness scales the optical depth toward the sun: T^d = exp(−d·τ). The phase angle is
+    // between the sun's light (−sun_dir) and the light going to the eye (−view_dir).
+    let sun = sun_light(sample.g, dot(view_dir, u.sun_dir.xyz));
     let light = u.sun_color.rgb * sun + u.sky_color.rgb;
     return vec4<f32>(light * alpha, alpha);
 }

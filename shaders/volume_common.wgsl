@@ -23,9 +23,12 @@ struct Volume {
     // x: total slices, y: first slice of this draw (0 = farthest), z: slice spacing (world),
     // w: Sharpness (the alpha cut-off as a share of the slice's full opacity).
     slicing: vec4<f32>,
-    // Linear sun colour × intensity, sky colour × ambient (rgb); sun_color.w: Dirtiness.
+    // Linear sun colour × intensity, sky colour × ambient (rgb); sun_color.w: Dirtiness;
+    // sky_color.w: the multiple-scattering weight.
     sun_color: vec4<f32>,
     sky_color: vec4<f32>,
+    // Unit direction toward the sun (xyz); w: the phase function's asymmetry g.
+    sun_dir: vec4<f32>,
     // x: extinction per world unit, y: iso-level, z: soft-edge half-width, w: noise amount.
     media: vec4<f32>,
     // x: amplitude gain per octave, y: octaves, z: Table 2 filter (0 stratus, 1 cumulus,

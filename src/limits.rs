@@ -225,6 +225,22 @@ pub const AMBIENT: Param = Param::linear(
     3.0,
     0.45,
 );
+/// Forward scattering: the Henyey–Greenstein asymmetry g of the cloud's phase function.
+pub const FORWARD_SCATTERING: Param = Param::linear(
+    "forward scattering",
+    "How much more light the cloud sends on along the sun's direction: its edges glow when you look toward the sun (0: the same every way)",
+    0.0,
+    0.9,
+    0.5,
+);
+/// Multiple scattering: the weight of the light scattered more than once.
+pub const MULTIPLE_SCATTERING: Param = Param::linear(
+    "multiple scattering",
+    "Light that bounces inside the cloud: thick clouds stay bright inside instead of going black (0: single scattering only)",
+    0.0,
+    1.0,
+    0.5,
+);
 /// Sketch: simplification tolerance as a fraction of the outline's size.
 pub const SIMPLIFY: Param = Param::linear(
     "simplify",

@@ -543,3 +543,80 @@ fn the_gpu_field_evaluation_matches_the_cpu_bake() {
         .fold(0.0f32, f32::max);
     assert!(off > 100.0 * worst.max(1e-6), "{off} vs {worst}");
 }
+
+/// The luminance below which `share` of the cloud's pixels lie (0.5: the median).
+fn cloud_percentile(image: &Image, bg: [u8; 3], share: f64) -> f64 {
+    let mut v: Vec<f64> = (0..image.height)
+        .flat_map(|y| (0..image.width).map(move |x| (x, y)))
+        .map(|(x, y)| image.pixel(x, y))
+        .filter(|&p| differs(p, bg))
+        .map(luminance)
+        .collect();
+    v.sort_by(|a, b| a.total_cmp(b));
+    v.get(((v.len() as f64 * share) as usize).min(v.len().saturating_sub(1)))
+        .copied()
+        .unwrap_or(0.0)
+}
+
+#[test]
+fn forward_scattering_brightens_the_cloud_toward_the_sun_and_dims_it_with_the_sun_behind() {
+    let scene = with(
+        &Scene::default(),
+        &[
+            "/light/multiple_scattering=0",
+            "/light/sun_elevation_deg=10",
+        ],
+    );
+    let bg = background(&scene);
+    // The brightest tenth of the cloud: where light gets through (the silver lining when the
+    // sun is behind the cloud, the lit face when it is behind the viewer).
+    let mean = |sets: &[&str]| cloud_percentile(&render(&with(&scene, sets)), bg, 0.9);
+    // The camera looks toward −z: the sun at azimuth 270° is behind the cloud, at 90° behind
+    // the viewer.
+    let toward_iso = mean(&["/light/sun_azimuth_deg=270", "/light/forward_scattering=0"]);
+    let toward = mean(&[
+        "/light/sun_azimuth_deg=270",
+        "/light/forward_scattering=0.8",
+    ]);
+    let behind_iso = mean(&["/light/sun_azimuth_deg=90", "/light/forward_scattering=0"]);
+    let behind = mean(&["/light/sun_azimuth_deg=90", "/light/forward_scattering=0.8"]);
+    assert!(
+        toward > toward_iso * 1.2,
+        "toward the sun: {toward:.1} vs isotropic {toward_iso:.1}"
+    );
+    assert!(
+        behind < behind_iso * 0.9,
+        "sun behind the viewer: {behind:.1} vs isotropic {behind_iso:.1}"
+    );
+}
+
+#[test]
+fn multiple_scattering_lights_the_shadowed_side_more_than_the_lit_side() {
+    let scene = with(
+        &Scene::default(),
+        &[
+            "/light/sun_azimuth_deg=0",
+            "/light/sun_elevation_deg=5",
+            "/light/forward_scattering=0",
+        ],
+    );
+    let bg = background(&scene);
+    let (shade0, lit0) = half_brightness(
+        &render(&with(&scene, &["/light/multiple_scattering=0"])),
+        bg,
+    );
+    let (shade1, lit1) = half_brightness(
+        &render(&with(&scene, &["/light/multiple_scattering=1"])),
+        bg,
+    );
+    assert!(
+        shade1 > shade0 + 5.0,
+        "shadowed side {shade0:.1} → {shade1:.1}"
+    );
+    assert!(
+        shade1 / shade0 > lit1 / lit0,
+        "relative gain: shadowed {:.3}, lit {:.3}",
+        shade1 / shade0,
+        lit1 / lit0
+    );
+}

@@ -41,8 +41,10 @@ pub struct VolumeUniforms {
     /// Linear sun colour × intensity (rgb); w: Dirtiness (the exponent on the transmittance
     /// toward the sun).
     pub sun_color: [f32; 4],
-    /// Linear sky colour × ambient intensity (rgb).
+    /// Linear sky colour × ambient intensity (rgb); w: the multiple-scattering weight.
     pub sky_color: [f32; 4],
+    /// Unit direction toward the sun (xyz); w: the phase function's asymmetry g.
+    pub sun_dir: [f32; 4],
     /// x: extinction per world unit, y: iso-level, z: soft-edge half-width, w: noise amount.
     pub media: [f32; 4],
     /// x: amplitude gain per octave, y: octaves in use, z: Table 2 filter (0 stratus,
@@ -140,7 +142,7 @@ pub fn octave_transform(render: &RenderSettings, i: usize, time: f32) -> Mat4 {
 
 impl VolumeUniforms {
     /// Names and byte offsets of the members, in order (checked against the WGSL struct).
-    pub const LAYOUT: [(&'static str, usize); 15] = [
+    pub const LAYOUT: [(&'static str, usize); 16] = [
         ("view_proj", offset_of!(Self, view_proj)),
         ("eye", offset_of!(Self, eye)),
         ("forward", offset_of!(Self, forward)),
@@ -152,6 +154,7 @@ impl VolumeUniforms {
         ("slicing", offset_of!(Self, slicing)),
         ("sun_color", offset_of!(Self, sun_color)),
         ("sky_color", offset_of!(Self, sky_color)),
+        ("sun_dir", offset_of!(Self, sun_dir)),
         ("media", offset_of!(Self, media)),
         ("noise", offset_of!(Self, noise)),
         ("octaves", offset_of!(Self, octaves)),
@@ -198,7 +201,11 @@ impl VolumeUniforms {
             sphere: center.extend(radius).to_array(),
             slicing: [total as f32, first as f32, spacing, r.sharpness],
             sun_color: sun_color.extend(r.dirtiness).to_array(),
-            sky_color: sky_color.extend(1.0).to_array(),
+            sky_color: sky_color.extend(light.multiple_scattering).to_array(),
+            sun_dir: light
+                .sun_direction()
+                .extend(light.forward_scattering)
+                .to_array(),
             media: [
                 r.opacity,
                 ISO,

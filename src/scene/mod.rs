@@ -253,6 +253,12 @@ pub struct Lighting {
     pub ambient: f32,
     /// Background colour behind the cloud.
     pub background: [f32; 3],
+    /// Henyey–Greenstein asymmetry of the phase function (0: isotropic; toward 1: light goes
+    /// on along the sun's direction, the silver lining seen toward the sun).
+    pub forward_scattering: f32,
+    /// Weight of the approximated multiple scattering (octaves of light scattered again with
+    /// less extinction, after Wrenninge 2013): bright insides of thick clouds.
+    pub multiple_scattering: f32,
 }
 
 impl Default for Lighting {
@@ -265,6 +271,8 @@ impl Default for Lighting {
             sky_color: [0.55, 0.66, 0.85],
             ambient: limits::AMBIENT.default as f32,
             background: [0.33, 0.52, 0.78],
+            forward_scattering: limits::FORWARD_SCATTERING.default as f32,
+            multiple_scattering: limits::MULTIPLE_SCATTERING.default as f32,
         }
     }
 }
@@ -285,6 +293,8 @@ impl Lighting {
             finite_or(self.sun_azimuth_deg, limits::SUN_AZIMUTH.default as f32).rem_euclid(360.0);
         self.sun_intensity = limits::SUN_INTENSITY.fix_f32(self.sun_intensity);
         self.ambient = limits::AMBIENT.fix_f32(self.ambient);
+        self.forward_scattering = limits::FORWARD_SCATTERING.fix_f32(self.forward_scattering);
+        self.multiple_scattering = limits::MULTIPLE_SCATTERING.fix_f32(self.multiple_scattering);
         for c in [
             &mut self.sun_color,
             &mut self.sky_color,

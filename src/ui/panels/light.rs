@@ -1,4 +1,4 @@
-//! The Light group: sun, sky and background.
+//! The Light group: sun, sky, scattering and background.
 
 use egui::Ui;
 
@@ -15,6 +15,8 @@ fn body(ui: &mut Ui, l: &mut Lighting) {
     param(ui, &mut l.sun_elevation_deg, &limits::SUN_ELEVATION);
     param(ui, &mut l.sun_intensity, &limits::SUN_INTENSITY);
     param(ui, &mut l.ambient, &limits::AMBIENT);
+    param(ui, &mut l.forward_scattering, &limits::FORWARD_SCATTERING);
+    param(ui, &mut l.multiple_scattering, &limits::MULTIPLE_SCATTERING);
     srgb_button(ui, "sun colour", &mut l.sun_color);
     srgb_button(ui, "sky colour", &mut l.sky_color);
     srgb_button(ui, "background", &mut l.background);
