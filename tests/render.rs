@@ -620,3 +620,52 @@ fn multiple_scattering_lights_the_shadowed_side_more_than_the_lit_side() {
         lit1 / lit0
     );
 }
+
+/// The row of an image whose middle pixel is brightest (the sky's horizon band).
+fn brightest_row(image: &Image) -> u32 {
+    (0..image.height)
+        .max_by(|&a, &b| {
+            luminance(image.pixel(image.width / 2, a))
+                .total_cmp(&luminance(image.pixel(image.width / 2, b)))
+        })
+        .unwrap()
+}
+
+#[test]
+fn the_sky_gradient_puts_its_horizon_at_eye_level() {
+    let sky = with(
+        &Scene::preset(Preset::Empty),
+        &["/light/sky_gradient=true", "/camera/pitch_deg=0"],
+    );
+    let level = render(&sky);
+    let bg = background(&sky);
+    let horizon = sky.light.horizon_color.map(|v| (v * 255.0).round() as u8);
+    let near = |p: [u8; 4], c: [u8; 3]| (0..3).all(|i| p[i].abs_diff(c[i]) <= 12);
+    let mid = level.pixel(W / 2, H / 2 - 1);
+    assert!(
+        near(mid, horizon),
+        "eye level {mid:?} is the horizon {horizon:?}"
+    );
+    let top = level.pixel(W / 2, 0);
+    assert!(
+        !near(top, horizon) && luminance(top) < luminance(mid),
+        "the top {top:?} is toward the zenith ({bg:?})"
+    );
+    let bottom = level.pixel(W / 2, H - 1);
+    assert!(
+        luminance(bottom) < luminance(mid) - 20.0,
+        "below: {bottom:?}"
+    );
+    // Looking down by 15° lifts the horizon by tan 15° / tan 22.5° of the half height.
+    let down = render(&with(&sky, &["/camera/pitch_deg=15"]));
+    let expected =
+        H as f64 / 2.0 - (15f64.to_radians().tan() / 22.5f64.to_radians().tan()) * H as f64 / 2.0;
+    let row = brightest_row(&down) as f64;
+    assert!(
+        (row - expected).abs() <= 4.0,
+        "horizon at row {row}, expected {expected:.1}"
+    );
+    // Off, the background is one flat colour.
+    let flat = render(&with(&sky, &["/light/sky_gradient=false"]));
+    assert_eq!(flat.pixel(W / 2, 0), flat.pixel(W / 2, H - 1));
+}

@@ -1,11 +1,11 @@
 //! Every shader module the renderer compiles parses and validates with naga, every WGSL file in
 //! `shaders/` is part of one, and each WGSL uniform struct has exactly the size and member
 //! offsets of the Rust struct it mirrors (`Volume`/`VolumeUniforms`,
-//! `FieldSlice`/`FieldSliceUniforms`).
+//! `FieldSlice`/`FieldSliceUniforms`, `Sky`/`SkyUniforms`).
 
 use std::path::Path;
 
-use cloudsketch::render::gpu_types::{FieldSliceUniforms, VolumeUniforms};
+use cloudsketch::render::gpu_types::{FieldSliceUniforms, SkyUniforms, VolumeUniforms};
 use cloudsketch::render::shaders::MODULES;
 
 fn parse(name: &str, source: &str) -> naga::Module {
@@ -100,5 +100,14 @@ fn wgsl_field_slice_struct_matches_the_rust_layout() {
         wgsl_layout("field_eval", "FieldSlice"),
         rust_layout(&FieldSliceUniforms::LAYOUT),
         "WGSL FieldSlice vs Rust FieldSliceUniforms (name, offset; last: size)"
+    );
+}
+
+#[test]
+fn wgsl_sky_struct_matches_the_rust_layout() {
+    assert_eq!(
+        wgsl_layout("sky", "Sky"),
+        rust_layout(&SkyUniforms::LAYOUT),
+        "WGSL Sky vs Rust SkyUniforms (name, offset; last: size)"
     );
 }

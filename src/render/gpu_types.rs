@@ -54,6 +54,52 @@ pub struct VolumeUniforms {
     pub octaves: [[[f32; 4]; 4]; MAX_OCTAVES],
 }
 
+/// Uniforms of the sky gradient (`struct Sky` in `shaders/sky.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct SkyUniforms {
+    /// Unit view direction (xyz).
+    pub forward: [f32; 4],
+    /// Image-plane right × tan(fov/2) × aspect (xyz).
+    pub right: [f32; 4],
+    /// Image-plane up × tan(fov/2) (xyz).
+    pub up: [f32; 4],
+    /// sRGB-encoded zenith colour (the background's).
+    pub zenith: [f32; 4],
+    /// sRGB-encoded horizon colour.
+    pub horizon: [f32; 4],
+    /// sRGB-encoded colour below the horizon.
+    pub ground: [f32; 4],
+}
+
+impl SkyUniforms {
+    /// Names and byte offsets of the members, in order (checked against the WGSL struct).
+    pub const LAYOUT: [(&'static str, usize); 7] = [
+        ("forward", offset_of!(Self, forward)),
+        ("right", offset_of!(Self, right)),
+        ("up", offset_of!(Self, up)),
+        ("zenith", offset_of!(Self, zenith)),
+        ("horizon", offset_of!(Self, horizon)),
+        ("ground", offset_of!(Self, ground)),
+        ("", std::mem::size_of::<Self>()),
+    ];
+
+    /// The sky of `camera` and `light` in a view of `aspect` (width / height).
+    pub fn new(camera: &OrbitCamera, light: &Lighting, aspect: f32) -> Self {
+        let t = (camera.fov_y_deg.to_radians() * 0.5).tan();
+        let [hr, hg, hb] = light.horizon_color;
+        Self {
+            forward: camera.forward().extend(0.0).to_array(),
+            right: (camera.right() * t * aspect).extend(0.0).to_array(),
+            up: (camera.up() * t).extend(0.0).to_array(),
+            zenith: Vec3::from(light.background).extend(1.0).to_array(),
+            horizon: [hr, hg, hb, 1.0],
+            // A darker, slightly warmer haze below the horizon.
+            ground: [hr * 0.62, hg * 0.6, hb * 0.56, 1.0],
+        }
+    }
+}
+
 /// Uniforms of one slice of the GPU field evaluation (`struct FieldSlice` in
 /// `shaders/field_eval.wgsl`).
 #[repr(C)]

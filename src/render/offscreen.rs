@@ -278,6 +278,7 @@ impl Offscreen {
             });
         self.renderer
             .draw_slices(&self.device, &self.queue, &mut encoder, job, pipeline);
+        self.renderer.prepare_sky(&self.queue, &job.view);
         {
             let [r, g, b] = background.map(|v| v as f64);
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -296,6 +297,9 @@ impl Offscreen {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
+            if job.view.light.sky_gradient {
+                self.renderer.draw_sky(&mut pass);
+            }
             self.renderer.composite(&mut pass, job.plan.target);
         }
         (encoder, output)

@@ -1,11 +1,12 @@
-//! The two render passes: slices (view-aligned slices back to front into an accumulation
-//! target) and composite (the accumulated image over the output). Pipelines are created once.
+//! The render passes: sky (the gradient behind the cloud, when the document has one), slices
+//! (view-aligned slices back to front into an accumulation target) and composite (the
+//! accumulated image over the output). Pipelines are created once.
 //! The slice pass has its own ring of uniform slots addressed by dynamic offsets, so several
 //! slice draws recorded before one submit never overwrite each other's uniforms.
 
 use std::num::NonZeroU64;
 
-use super::gpu_types::VolumeUniforms;
+use super::gpu_types::{SkyUniforms, VolumeUniforms};
 use super::shaders;
 
 /// Slice draws one frame (one submit) may record.
@@ -233,5 +234,63 @@ impl CompositePass {
                 },
             ],
         })
+    }
+}
+
+/// The sky pass: a gradient over the whole view, drawn before the cloud's composite.
+pub struct SkyPass {
+    pipeline: wgpu::RenderPipeline,
+    uniforms: wgpu::Buffer,
+    bind_group: wgpu::BindGroup,
+}
+
+impl SkyPass {
+    /// Creates the pass writing into `output_format`.
+    pub fn new(device: &wgpu::Device, output_format: wgpu::TextureFormat) -> Self {
+        let size = std::mem::size_of::<SkyUniforms>() as u64;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("sky"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: NonZeroU64::new(size),
+                },
+                count: None,
+            }],
+        });
+        let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("sky uniforms"),
+            size,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("sky"),
+            layout: &layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: uniforms.as_entire_binding(),
+            }],
+        });
+        Self {
+            pipeline: pipeline(device, "sky", shaders::SKY, &layout, output_format),
+            uniforms,
+            bind_group,
+        }
+    }
+
+    /// Sets the sky the next [`SkyPass::draw`] draws.
+    pub fn write(&self, queue: &wgpu::Queue, uniforms: &SkyUniforms) {
+        queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(uniforms));
+    }
+
+    /// Draws the sky over the current render pass's viewport.
+    pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>) {
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &self.bind_group, &[]);
+        pass.draw(0..3, 0..1);
     }
 }

@@ -1,8 +1,8 @@
 //! The volume renderer: passes and resources together, used by the app's viewport (through an
 //! egui paint callback) and by offscreen rendering alike.
 
-use super::gpu_types::{View, VolumeUniforms};
-use super::passes::{CompositePass, SlicePass};
+use super::gpu_types::{SkyUniforms, View, VolumeUniforms};
+use super::passes::{CompositePass, SkyPass, SlicePass};
 use super::progressive::JobPlan;
 use super::resources::{TARGETS, Target, VolumeTextures, accumulation_texture, sampler};
 use crate::derive::Volumes;
@@ -21,6 +21,7 @@ pub struct VolumeRenderer {
     accum_format: wgpu::TextureFormat,
     slices: SlicePass,
     composite: CompositePass,
+    sky: SkyPass,
     clamp_sampler: wgpu::Sampler,
     repeat_sampler: wgpu::Sampler,
     textures: VolumeTextures,
@@ -39,6 +40,7 @@ impl VolumeRenderer {
             accum_format,
             slices: SlicePass::new(device, accum_format),
             composite: CompositePass::new(device, output_format),
+            sky: SkyPass::new(device, output_format),
             clamp_sampler: sampler(device, wgpu::AddressMode::ClampToEdge),
             repeat_sampler: sampler(device, wgpu::AddressMode::Repeat),
             textures: VolumeTextures::new(),
@@ -168,6 +170,19 @@ impl VolumeRenderer {
         pass.set_bind_group(0, bind_group, &[offset]);
         // Instances start at 0 (WebGL2 has no base instance); the first slice is a uniform.
         pass.draw(0..6, 0..count);
+    }
+
+    /// Sets the sky gradient of `view` (call before [`VolumeRenderer::draw_sky`]).
+    pub fn prepare_sky(&self, queue: &wgpu::Queue, view: &View) {
+        self.sky.write(
+            queue,
+            &SkyUniforms::new(&view.camera, &view.light, view.aspect),
+        );
+    }
+
+    /// Draws the sky gradient over the current render pass's viewport.
+    pub fn draw_sky(&self, pass: &mut wgpu::RenderPass<'_>) {
+        self.sky.draw(pass);
     }
 
     /// Draws accumulation target `index` over the current render pass's viewport.

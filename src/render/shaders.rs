@@ -23,8 +23,11 @@ pub const COMPOSITE: &str = include_str!("../../shaders/composite.wgsl");
 /// `shaders/field_eval.wgsl`: the field evaluated on the GPU (the bench's baseline).
 pub const FIELD_EVAL: &str = include_str!("../../shaders/field_eval.wgsl");
 
+/// `shaders/sky.wgsl`: the sky gradient behind the cloud.
+pub const SKY: &str = include_str!("../../shaders/sky.wgsl");
+
 /// Every shader module with the files it is composed of, in order.
-pub const MODULES: [(&str, &[&str], &str); 4] = [
+pub const MODULES: [(&str, &[&str], &str); 5] = [
     ("volume", &["volume_common.wgsl", "volume.wgsl"], VOLUME),
     (
         "plain_slices",
@@ -33,4 +36,5 @@ pub const MODULES: [(&str, &[&str], &str); 4] = [
     ),
     ("composite", &["composite.wgsl"], COMPOSITE),
     ("field_eval", &["field_eval.wgsl"], FIELD_EVAL),
+    ("sky", &["sky.wgsl"], SKY),
 ];

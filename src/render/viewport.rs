@@ -49,6 +49,39 @@ impl egui_wgpu::CallbackTrait for ViewportPaint {
     }
 }
 
+/// The sky gradient behind the cloud, over the whole view (drawn before [`ViewportPaint`]).
+pub struct SkyPaint {
+    /// Camera, light (its colours) and aspect of the view.
+    pub view: super::gpu_types::View,
+}
+
+impl egui_wgpu::CallbackTrait for SkyPaint {
+    fn prepare(
+        &self,
+        _device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        _screen: &egui_wgpu::ScreenDescriptor,
+        _encoder: &mut wgpu::CommandEncoder,
+        resources: &mut egui_wgpu::CallbackResources,
+    ) -> Vec<wgpu::CommandBuffer> {
+        if let Some(renderer) = resources.get::<VolumeRenderer>() {
+            renderer.prepare_sky(queue, &self.view);
+        }
+        Vec::new()
+    }
+
+    fn paint(
+        &self,
+        _info: egui::PaintCallbackInfo,
+        pass: &mut wgpu::RenderPass<'static>,
+        resources: &egui_wgpu::CallbackResources,
+    ) {
+        if let Some(renderer) = resources.get::<VolumeRenderer>() {
+            renderer.draw_sky(pass);
+        }
+    }
+}
+
 /// The active graphics backend, as the page and the panel name it.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct BackendInfo {

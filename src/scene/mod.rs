@@ -259,6 +259,11 @@ pub struct Lighting {
     /// Weight of the approximated multiple scattering (octaves of light scattered again with
     /// less extinction, after Wrenninge 2013): bright insides of thick clouds.
     pub multiple_scattering: f32,
+    /// A sky gradient behind the cloud: `background` at the zenith, `horizon_color` at eye
+    /// level, a haze below; off, the background is one flat colour.
+    pub sky_gradient: bool,
+    /// The sky's colour at the horizon (with `sky_gradient`).
+    pub horizon_color: [f32; 3],
 }
 
 impl Default for Lighting {
@@ -273,6 +278,8 @@ impl Default for Lighting {
             background: [0.33, 0.52, 0.78],
             forward_scattering: limits::FORWARD_SCATTERING.default as f32,
             multiple_scattering: limits::MULTIPLE_SCATTERING.default as f32,
+            sky_gradient: false,
+            horizon_color: [0.78, 0.84, 0.9],
         }
     }
 }
@@ -299,6 +306,7 @@ impl Lighting {
             &mut self.sun_color,
             &mut self.sky_color,
             &mut self.background,
+            &mut self.horizon_color,
         ] {
             for v in c.iter_mut() {
                 *v = finite_or(*v, 0.5).clamp(0.0, 1.0);

@@ -12,7 +12,7 @@ use crate::derive::Derived;
 use crate::render::SliceJob;
 use crate::render::View;
 use crate::render::progressive::{Budget, Progressive};
-use crate::render::viewport::ViewportPaint;
+use crate::render::viewport::{SkyPaint, ViewportPaint};
 use crate::scene::Document;
 
 /// The viewport's own state.
@@ -101,10 +101,27 @@ impl Viewport {
             cx.doc.set_camera(camera);
         }
 
-        // The background is the frame's clear colour (`CloudApp::clear_color`): no full-view
-        // fill of its own, one full-screen pass less on CPU adapters.
+        // A flat background is the frame's clear colour (`CloudApp::clear_color`): no
+        // full-view fill of its own, one full-screen pass less on CPU adapters. A gradient is
+        // a pass over the view, under the reference image and the cloud.
         let painter = ui.painter_at(rect);
         let scene = cx.doc.scene();
+        let aspect = rect.aspect_ratio();
+        if scene.light.sky_gradient && self.stats.backend.is_some() {
+            painter.add(egui_wgpu::Callback::new_paint_callback(
+                rect,
+                SkyPaint {
+                    view: View {
+                        camera: scene.camera.clone(),
+                        light: scene.light.clone(),
+                        render: scene.render.clone(),
+                        time: scene.time,
+                        aspect,
+                        crop: crate::render::FULL_VIEW,
+                    },
+                },
+            ));
+        }
         guide.paint(&painter, rect, cx.doc, false);
 
         let ppp = ui.ctx().pixels_per_point();
@@ -127,7 +144,6 @@ impl Viewport {
             });
         }
         let volumes = cx.derived.update(scene, cx.doc.revisions());
-        let aspect = rect.aspect_ratio();
         // Draw the volume only over the part of the view its box covers: fewer pixels to
         // slice, refine and composite on every frame.
         let density = &volumes.density.data;

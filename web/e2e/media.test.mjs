@@ -1,5 +1,6 @@
-// The cloud's media in the browser: a Table 2 filter changes the image, and with wind the
-// scene clock (Alt+A plays) moves the noise while the camera stays. Screenshots:
+// The cloud's media in the browser: a Table 2 filter changes the image, with wind the scene
+// clock (Alt+A plays) moves the noise while the camera stays, and the sky gradient puts the
+// horizon colour at eye level on both backends. Screenshots:
 // test-results/screenshots/media-*.png.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
@@ -76,5 +77,26 @@ for (const backend of ['webgpu', 'webgl2']) {
     } finally {
       await close();
     }
+  });
+}
+
+for (const backend of ['webgpu', 'webgl2']) {
+  test(`the sky gradient draws a horizon behind the cloud (${backend})`, { timeout: 180_000 }, async () => {
+    await withApp({ base: server.url, webgpu: backend === 'webgpu', query: '?preset=empty', viewport: { width: 1280, height: 800 } }, async (page) => {
+      const [vw, vh] = (await state(page)).view.viewport;
+      await page.evaluate(() => window.cloudsketch.set('/camera/pitch_deg=0'));
+      await page.evaluate(() => window.cloudsketch.set('/light/sky_gradient=true'));
+      const s = await until(page, (s) => s.scene.light.sky_gradient && s.scene.camera.pitch_deg === 0, 'the gradient');
+      await page.waitForTimeout(500);
+      const img = await screenshot(page, `media-sky-${backend}`);
+      const at = (x, y) => { const i = 4 * (Math.round(y) * img.width + Math.round(x)); return [img.data[i], img.data[i + 1], img.data[i + 2]]; };
+      const horizon = s.scene.light.horizon_color.map((v) => Math.round(v * 255));
+      const mid = at(vw * 0.4, vh / 2 - 2);
+      assert.ok(mid.every((v, i) => Math.abs(v - horizon[i]) <= 14), `eye level ${mid} is the horizon ${horizon}`);
+      const top = at(vw * 0.4, 3);
+      const zenith = s.scene.light.background.map((v) => Math.round(v * 255));
+      const dist = (a, b) => a.reduce((m, v, i) => Math.max(m, Math.abs(v - b[i])), 0);
+      assert.ok(dist(top, zenith) < dist(top, horizon), `the top ${top} leans to the zenith ${zenith}`);
+    });
   });
 }

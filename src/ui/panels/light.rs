@@ -20,4 +20,9 @@ fn body(ui: &mut Ui, l: &mut Lighting) {
     srgb_button(ui, "sun colour", &mut l.sun_color);
     srgb_button(ui, "sky colour", &mut l.sky_color);
     srgb_button(ui, "background", &mut l.background);
+    ui.checkbox(&mut l.sky_gradient, "sky gradient")
+        .on_hover_text("The background at the top of the sky, fading to the horizon colour at eye level; off: one flat colour");
+    if l.sky_gradient {
+        srgb_button(ui, "horizon", &mut l.horizon_color);
+    }
 }
