@@ -35,9 +35,9 @@ fn vs_main(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> 
 
 // Table 2's filters (Schpok et al. 2003) of one octave's noise t in [0, 1] (signed n = 2t − 1):
 // stratus n, cumulus |n|, wispy 1 − |2n|, veined (1 + |10n|)⁻¹; each in [0, 1].
-fn filtered(t: f32) -> f32 {
+fn filtered(t: f32, kind: f32) -> f32 {
     let n = 2.0 * t - 1.0;
-    switch i32(u.noise.z) {
+    switch i32(kind) {
         case 1: { return abs(n); }
         case 2: { return clamp(1.0 - abs(2.0 * n), 0.0, 1.0); }
         case 3: { return 1.0 / (1.0 + abs(10.0 * n)); }
@@ -45,11 +45,16 @@ fn filtered(t: f32) -> f32 {
     }
 }
 
-// Sum of filtered noise octaves in [0, 1], each octave a look-up of the periodic noise volume
-// (Perlin in red, Worley in green) through its own transform.
-fn fbm(p: vec3<f32>) -> f32 {
+// Sum of filtered noise octaves in [0, 1] in atmospheric tier `tier` (0: the base media),
+// each octave a look-up of the periodic noise volume (Perlin in red, Worley in green) through
+// its own transform; octave 0 moves with the base in every tier (the paper's Base tier).
+fn fbm(p: vec3<f32>, tier: i32) -> f32 {
     let octaves = i32(u.noise.y);
     let worley = u.noise.w > 0.5;
+    var kind = u.noise.z;
+    if tier > 0 {
+        kind = u.tier_filters[tier - 1];
+    }
     var amp = 1.0;
     var sum = 0.0;
     var norm = 0.0;
@@ -57,13 +62,47 @@ fn fbm(p: vec3<f32>) -> f32 {
         if i >= octaves {
             break;
         }
-        let q = (u.octaves[i] * vec4<f32>(p, 1.0)).xyz;
+        var m = u.octaves[i];
+        if tier > 0 && i > 0 {
+            m = u.tier_octaves[(tier - 1) * MAX_OCTAVES + i];
+        }
+        let q = (m * vec4<f32>(p, 1.0)).xyz;
         let s = textureSampleLevel(noise_tex, repeat_smp, q, 0.0);
-        sum = sum + amp * filtered(select(s.r, s.g, worley));
+        sum = sum + amp * filtered(select(s.r, s.g, worley), kind);
         norm = norm + amp;
         amp = amp * u.noise.x;
     }
     return select(0.5, sum / max(norm, 1e-6), norm > 0.0);
+}
+
+// The noise at `p` across the atmospheric tiers: each tier from its floor up, blended over
+// `tiers.z` around each floor so no row of the image shows a step (only there are two
+// tiers evaluated).
+fn tiered_noise(p: vec3<f32>) -> f32 {
+    let count = i32(u.tiers.w);
+    if count == 0 {
+        return fbm(p, 0);
+    }
+    let half = max(u.tiers.z * 0.5, 1e-4);
+    var total = 0.0;
+    var below = 1.0;
+    for (var k = 0; k <= MAX_TIERS; k = k + 1) {
+        if k > count {
+            break;
+        }
+        // How far `p` is into the tier above this one (1: wholly above its floor).
+        var above = 0.0;
+        if k < count {
+            let floor_k = u.tiers[k];
+            above = smoothstep(floor_k - half, floor_k + half, p.y);
+        }
+        let w = below - above;
+        if w > 1e-3 {
+            total = total + w * fbm(p, k);
+        }
+        below = above;
+    }
+    return total;
 }
 
 // Henyey–Greenstein's phase function scaled so that isotropic scattering is 1 (not 1/4π):
@@ -116,7 +155,7 @@ fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
     if field < iso - soft - 0.5 * amount {
         discard;
     }
-    let v = field + amount * (fbm(in.world) - 0.5);
+    let v = field + amount * (tiered_noise(in.world) - 0.5);
     let density = smoothstep(iso - soft, iso + soft, v);
     if density <= 0.0 {
         discard;

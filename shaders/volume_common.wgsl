@@ -4,6 +4,7 @@
 // src/render/gpu_types.rs, and a test compares their sizes and member offsets.
 
 const MAX_OCTAVES: i32 = 8;
+const MAX_TIERS: i32 = 2;
 
 struct Volume {
     // World → clip.
@@ -37,6 +38,12 @@ struct Volume {
     // Per-octave transform of world positions into noise-texture coordinates
     // (scale × rotation × translation; the scale grows by the lacunarity per octave).
     octaves: array<mat4x4<f32>, MAX_OCTAVES>,
+    // Atmospheric tiers: x, y: floors of tiers 1 and 2, z: blend height, w: how many.
+    tiers: vec4<f32>,
+    // x, y: Table 2 filters of tiers 1 and 2.
+    tier_filters: vec4<f32>,
+    // Per-octave transforms of tiers 1 and 2 (octave 0 is the base's in every tier).
+    tier_octaves: array<mat4x4<f32>, 16>,
 };
 
 @group(0) @binding(0) var<uniform> u: Volume;

@@ -41,6 +41,8 @@ pub const MAX_EMBEDDED_IMAGE_BYTES: usize = 4 << 20;
 pub const MAX_GUIDE_SIDE: u32 = 1024;
 /// Most undo steps kept.
 pub const MAX_UNDO: usize = 200;
+/// Atmospheric tiers above the base media (Schpok et al. 2003, §5.2).
+pub const MAX_TIERS: usize = 2;
 
 /// A numeric parameter: its range, default, the way its slider moves, and its name and
 /// meaning in an artist's words.
@@ -152,6 +154,22 @@ pub const TORQUE: Param = Param::linear(
     -90.0,
     90.0,
     0.0,
+);
+/// Altitude (world y) where an atmospheric tier begins.
+pub const TIER_FLOOR: Param = Param::linear(
+    "floor",
+    "Altitude where this tier's noise takes over from the one below",
+    -50.0,
+    200.0,
+    6.0,
+);
+/// Height over which two tiers blend at a floor.
+pub const TIER_BLEND: Param = Param::linear(
+    "tier blend",
+    "Height over which one tier's noise turns into the next, so no seam shows",
+    0.0,
+    20.0,
+    1.5,
 );
 /// Opacity: extinction per world unit of the densest cloud.
 pub const OPACITY: Param = Param::log(
@@ -310,6 +328,10 @@ mod tests {
             DIRTINESS,
             WIND,
             TORQUE,
+            TIER_FLOOR,
+            TIER_BLEND,
+            FORWARD_SCATTERING,
+            MULTIPLE_SCATTERING,
         ] {
             assert!(
                 p.min < p.max && (p.min..=p.max).contains(&p.default),

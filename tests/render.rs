@@ -669,3 +669,94 @@ fn the_sky_gradient_puts_its_horizon_at_eye_level() {
     let flat = render(&with(&sky, &["/light/sky_gradient=false"]));
     assert_eq!(flat.pixel(W / 2, 0), flat.pixel(W / 2, H - 1));
 }
+
+/// Per row, the mean luminance of the cloud's pixels (NaN where the row has none).
+fn row_means(image: &Image, bg: [u8; 3]) -> Vec<f64> {
+    (0..image.height)
+        .map(|y| {
+            let v: Vec<f64> = (0..image.width)
+                .map(|x| image.pixel(x, y))
+                .filter(|&p| differs(p, bg))
+                .map(luminance)
+                .collect();
+            if v.len() < 10 {
+                f64::NAN
+            } else {
+                v.iter().sum::<f64>() / v.len() as f64
+            }
+        })
+        .collect()
+}
+
+/// The screen row of world height `y` at the scene's focus (the camera's target column).
+fn row_of_height(scene: &Scene, y: f32) -> u32 {
+    let c = &scene.camera;
+    let p = glam::Vec3::new(c.target.x, y, c.target.z);
+    let clip = c.view_projection(W as f32 / H as f32) * p.extend(1.0);
+    ((1.0 - clip.y / clip.w) * 0.5 * H as f32).round() as u32
+}
+
+#[test]
+fn an_upper_tier_moves_with_its_own_wind_and_its_floor_shows_no_step() {
+    let scene = with(
+        &Scene::default(),
+        &[
+            "/render/noise_amount=0.6",
+            "/render/noise_octaves=4",
+            "/render/slices=192",
+            "/render/tiers=[{\"floor\":3.5,\"filter\":\"veined\",\"wind\":[3,0],\"torque\":0}]",
+        ],
+    );
+    let bg = background(&scene);
+    let floor_row = row_of_height(&scene, 3.5) as usize;
+    // Wind aloft only: after two seconds the image changes above the floor, not below.
+    let t0 = render(&scene);
+    let t2 = render(&with(&scene, &["/time=2"]));
+    let changed = |rows: std::ops::Range<usize>| {
+        rows.map(|y| {
+            (0..W)
+                .filter(|&x| {
+                    let (p, q) = (t0.pixel(x, y as u32), t2.pixel(x, y as u32));
+                    (0..3).any(|i| p[i].abs_diff(q[i]) > 8)
+                })
+                .count()
+        })
+        .sum::<usize>()
+    };
+    let above = changed(floor_row.saturating_sub(30)..floor_row.saturating_sub(6));
+    let below = changed(floor_row + 6..(floor_row + 30).min(H as usize));
+    assert!(
+        above > 150 && above > 5 * below,
+        "changed pixels above the floor {above}, below {below}"
+    );
+    // Blended over the floor, the rows' brightness changes no more there than across the
+    // image; with a hard floor (no blend) it steps.
+    let step_at_floor = |blend: &str| {
+        let rows = row_means(&render(&with(&scene, &[blend])), bg);
+        let jump = |y: usize| (rows[y + 1] - rows[y]).abs();
+        let near = (floor_row - 3..floor_row + 3)
+            .map(jump)
+            .filter(|v| v.is_finite())
+            .fold(0.0, f64::max);
+        let mut elsewhere: Vec<f64> = (0..rows.len() - 1)
+            .filter(|y| y.abs_diff(floor_row) > 8)
+            .map(jump)
+            .filter(|v| v.is_finite())
+            .collect();
+        elsewhere.sort_by(|a, b| a.total_cmp(b));
+        (near, elsewhere[elsewhere.len() * 9 / 10])
+    };
+    let (hard, typical_hard) = step_at_floor("/render/tier_blend=0");
+    let (soft, typical) = step_at_floor("/render/tier_blend=2");
+    eprintln!(
+        "hard {hard:.2} (typical {typical_hard:.2}), blended {soft:.2} (typical {typical:.2})"
+    );
+    assert!(
+        hard > 2.0 * soft,
+        "hard floor {hard:.2} vs blended {soft:.2}"
+    );
+    assert!(
+        soft <= 1.5 * typical.max(0.5),
+        "blended {soft:.2} vs typical {typical:.2}"
+    );
+}

@@ -13,6 +13,9 @@ use crate::scene::{Lighting, NoiseBasis, NoiseFilter, OrbitCamera, RenderSetting
 /// Noise octaves the slice shader can composite (`MAX_OCTAVES` in volume_common.wgsl).
 pub const MAX_OCTAVES: usize = 8;
 
+/// Atmospheric tiers above the base media the shader blends (`MAX_TIERS` in the WGSL).
+pub const MAX_TIERS: usize = crate::limits::MAX_TIERS;
+
 /// Uniforms of the slice shaders (`struct Volume` in `shaders/volume_common.wgsl`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
@@ -52,6 +55,12 @@ pub struct VolumeUniforms {
     pub noise: [f32; 4],
     /// Per-octave transform of world positions into noise-texture coordinates.
     pub octaves: [[[f32; 4]; 4]; MAX_OCTAVES],
+    /// Atmospheric tiers: x, y: the floors of tiers 1 and 2, z: the blend height, w: how many.
+    pub tiers: [f32; 4],
+    /// x, y: Table 2 filters of tiers 1 and 2 (as `noise.z`).
+    pub tier_filters: [f32; 4],
+    /// Per-octave transforms of tiers 1 and 2 (octave 0 is the base's in every tier).
+    pub tier_octaves: [[[f32; 4]; 4]; MAX_OCTAVES * MAX_TIERS],
 }
 
 /// Uniforms of the sky gradient (`struct Sky` in `shaders/sky.wgsl`).
@@ -173,12 +182,32 @@ pub fn crop_matrix(crop: [f32; 4]) -> Mat4 {
 /// second) and the torque turns it about the vertical through the origin, each octave
 /// `1 + i/2` times as fast as the first (finer detail moves faster, as turbulence does).
 pub fn octave_transform(render: &RenderSettings, i: usize, time: f32) -> Mat4 {
+    moving_octave(render, render.wind, render.torque, i, time)
+}
+
+/// [`octave_transform`] in atmospheric tier `tier` (1-based; 0 is the base media): its own
+/// wind and torque, except octave 0, which moves with the base everywhere (the paper's Base
+/// tier, which keeps the tiers one cloud).
+pub fn tier_octave_transform(render: &RenderSettings, tier: usize, i: usize, time: f32) -> Mat4 {
+    match render.tiers.get(tier.wrapping_sub(1)) {
+        Some(t) if i > 0 => moving_octave(render, t.wind, t.torque, i, time),
+        _ => octave_transform(render, i, time),
+    }
+}
+
+fn moving_octave(
+    render: &RenderSettings,
+    wind: [f32; 2],
+    torque: f32,
+    i: usize,
+    time: f32,
+) -> Mat4 {
     let freq = render.detail.powi(i as i32) / render.noise_scale.max(1e-3);
     let turn = Quat::from_axis_angle(Vec3::new(0.3, 1.0, 0.2).normalize(), i as f32 * 0.9);
     let shift = Vec3::new(0.37, 0.11, 0.73) * i as f32;
     let speed = time * (1.0 + 0.5 * i as f32);
-    let [wx, wz] = render.wind;
-    let drift = Mat4::from_rotation_y(-(render.torque * speed).to_radians())
+    let [wx, wz] = wind;
+    let drift = Mat4::from_rotation_y(-(torque * speed).to_radians())
         * Mat4::from_translation(-Vec3::new(wx, 0.0, wz) * speed);
     Mat4::from_translation(shift)
         * Mat4::from_quat(turn)
@@ -188,7 +217,7 @@ pub fn octave_transform(render: &RenderSettings, i: usize, time: f32) -> Mat4 {
 
 impl VolumeUniforms {
     /// Names and byte offsets of the members, in order (checked against the WGSL struct).
-    pub const LAYOUT: [(&'static str, usize); 16] = [
+    pub const LAYOUT: [(&'static str, usize); 19] = [
         ("view_proj", offset_of!(Self, view_proj)),
         ("eye", offset_of!(Self, eye)),
         ("forward", offset_of!(Self, forward)),
@@ -204,6 +233,9 @@ impl VolumeUniforms {
         ("media", offset_of!(Self, media)),
         ("noise", offset_of!(Self, noise)),
         ("octaves", offset_of!(Self, octaves)),
+        ("tiers", offset_of!(Self, tiers)),
+        ("tier_filters", offset_of!(Self, tier_filters)),
+        ("tier_octaves", offset_of!(Self, tier_octaves)),
         ("", std::mem::size_of::<Self>()),
     ];
 
@@ -221,12 +253,16 @@ impl VolumeUniforms {
         let forward = camera.forward();
         let (near, far) = box_depths(volume, center, forward);
         let spacing = (far - near).max(1e-6) / total as f32;
-        let filter = match r.noise_filter {
+        let filter_code = |f: NoiseFilter| match f {
             NoiseFilter::Stratus => 0.0,
             NoiseFilter::Cumulus => 1.0,
             NoiseFilter::Wispy => 2.0,
             NoiseFilter::Veined => 3.0,
         };
+        let filter = filter_code(r.noise_filter);
+        let tiers = &r.tiers[..r.tiers.len().min(MAX_TIERS)];
+        let floor = |k: usize| tiers.get(k).map_or(f32::MAX, |t| t.floor);
+        let tier_filter = |k: usize| tiers.get(k).map_or(filter, |t| filter_code(t.filter));
         let basis = match r.noise_basis {
             NoiseBasis::Perlin => 0.0,
             NoiseBasis::Worley => 1.0,
@@ -260,6 +296,12 @@ impl VolumeUniforms {
             ],
             noise: [0.5, octaves as f32, filter, basis],
             octaves: std::array::from_fn(|i| octave_transform(r, i, view.time).to_cols_array_2d()),
+            tiers: [floor(0), floor(1), r.tier_blend, tiers.len() as f32],
+            tier_filters: [tier_filter(0), tier_filter(1), 0.0, 0.0],
+            tier_octaves: std::array::from_fn(|j| {
+                tier_octave_transform(r, 1 + j / MAX_OCTAVES, j % MAX_OCTAVES, view.time)
+                    .to_cols_array_2d()
+            }),
         }
     }
 }

@@ -392,6 +392,38 @@ pub struct RenderSettings {
     pub wind: [f32; 2],
     /// Torque: how fast the noise turns about the vertical (degrees per second).
     pub torque: f32,
+    /// Atmospheric tiers above these base media, floors ascending (at most
+    /// [`limits::MAX_TIERS`]): each its own filter, wind and torque (Schpok et al. §5.2).
+    /// The first octave moves with the base wind and torque everywhere (the paper's Base tier),
+    /// which keeps the tiers one cloud.
+    pub tiers: Vec<Tier>,
+    /// Height over which one tier blends into the next around a floor.
+    pub tier_blend: f32,
+}
+
+/// An atmospheric tier: from `floor` up, the noise has its own character and motion.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Tier {
+    /// Altitude (world y) where the tier begins.
+    pub floor: f32,
+    /// Table 2's filter in this tier.
+    pub filter: NoiseFilter,
+    /// Wind in this tier (world units per second, x and z).
+    pub wind: [f32; 2],
+    /// Torque in this tier (degrees per second).
+    pub torque: f32,
+}
+
+impl Default for Tier {
+    fn default() -> Self {
+        Self {
+            floor: limits::TIER_FLOOR.default as f32,
+            filter: NoiseFilter::Wispy,
+            wind: [1.0, 0.0],
+            torque: 0.0,
+        }
+    }
 }
 
 impl Default for RenderSettings {
@@ -411,6 +443,8 @@ impl Default for RenderSettings {
             dirtiness: limits::DIRTINESS.default as f32,
             wind: [0.0; 2],
             torque: 0.0,
+            tiers: Vec::new(),
+            tier_blend: limits::TIER_BLEND.default as f32,
         }
     }
 }
@@ -429,6 +463,14 @@ impl RenderSettings {
         self.dirtiness = limits::DIRTINESS.fix_f32(self.dirtiness);
         self.wind = self.wind.map(|w| limits::WIND.fix_f32(w));
         self.torque = limits::TORQUE.fix_f32(self.torque);
+        self.tiers.truncate(limits::MAX_TIERS);
+        for t in &mut self.tiers {
+            t.floor = limits::TIER_FLOOR.fix_f32(t.floor);
+            t.wind = t.wind.map(|w| limits::WIND.fix_f32(w));
+            t.torque = limits::TORQUE.fix_f32(t.torque);
+        }
+        self.tiers.sort_by(|a, b| a.floor.total_cmp(&b.floor));
+        self.tier_blend = limits::TIER_BLEND.fix_f32(self.tier_blend);
     }
 }
 

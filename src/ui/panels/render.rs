@@ -4,7 +4,7 @@ use egui::Ui;
 
 use super::PartPanel;
 use crate::limits;
-use crate::scene::{Edit, NoiseBasis, NoiseFilter, RenderSettings};
+use crate::scene::{Edit, NoiseBasis, NoiseFilter, RenderSettings, Tier};
 use crate::ui::widgets::param;
 
 /// The Render group.
@@ -27,15 +27,7 @@ fn body(ui: &mut Ui, r: &mut RenderSettings) {
     egui::CollapsingHeader::new("Media: filter, basis, wind")
         .default_open(false)
         .show(ui, |ui| {
-            egui::ComboBox::from_label("filter")
-                .selected_text(r.noise_filter.label())
-                .show_ui(ui, |ui| {
-                    for f in NoiseFilter::ALL {
-                        ui.selectable_value(&mut r.noise_filter, f, f.label());
-                    }
-                })
-                .response
-                .on_hover_text("Schpok et al.'s Table 2: how each octave's noise is shaped");
+            filter_combo(ui, "filter", &mut r.noise_filter);
             ui.horizontal(|ui| {
                 ui.label("noise");
                 ui.selectable_value(&mut r.noise_basis, NoiseBasis::Perlin, "Perlin");
@@ -51,5 +43,68 @@ fn body(ui: &mut Ui, r: &mut RenderSettings) {
                 param(ui, wz, &limits::WIND);
             });
             param(ui, &mut r.torque, &limits::TORQUE);
+        });
+    tiers(ui, r);
+}
+
+fn filter_combo(ui: &mut Ui, id: &str, filter: &mut NoiseFilter) {
+    egui::ComboBox::from_id_salt(id)
+        .selected_text(filter.label())
+        .show_ui(ui, |ui| {
+            for f in NoiseFilter::ALL {
+                ui.selectable_value(filter, f, f.label());
+            }
+        })
+        .response
+        .on_hover_text("Schpok et al.'s Table 2: how each octave's noise is shaped");
+}
+
+/// Atmospheric tiers: from each floor up, the noise has its own filter and motion; the media
+/// above are the base, below the first floor (and their first octave moves everywhere).
+fn tiers(ui: &mut Ui, r: &mut RenderSettings) {
+    egui::CollapsingHeader::new(format!("Tiers ({})", r.tiers.len()))
+        .default_open(false)
+        .show(ui, |ui| {
+            let mut remove = None;
+            for (k, t) in r.tiers.iter_mut().enumerate() {
+                ui.horizontal(|ui| {
+                    ui.label(egui::RichText::new(format!("Tier {}", k + 1)).strong());
+                    if ui
+                        .small_button("remove")
+                        .on_hover_text("Back to the media below")
+                        .clicked()
+                    {
+                        remove = Some(k);
+                    }
+                });
+                param(ui, &mut t.floor, &limits::TIER_FLOOR);
+                filter_combo(ui, &format!("tier {k} filter"), &mut t.filter);
+                let [wx, wz] = &mut t.wind;
+                param(ui, wx, &limits::WIND);
+                param(ui, wz, &limits::WIND);
+                param(ui, &mut t.torque, &limits::TORQUE);
+            }
+            if let Some(k) = remove {
+                r.tiers.remove(k);
+            }
+            if r.tiers.len() < limits::MAX_TIERS
+                && ui
+                    .button("Add a tier")
+                    .on_hover_text(
+                        "Higher air with its own noise: wisps above a billowing base, faster wind aloft",
+                    )
+                    .clicked()
+            {
+                let floor = r.tiers.last().map_or(limits::TIER_FLOOR.default as f32, |t| t.floor + 4.0);
+                r.tiers.push(Tier {
+                    floor,
+                    ..Default::default()
+                });
+            }
+            param(ui, &mut r.tier_blend, &limits::TIER_BLEND);
+            // Floors stay in order: a tier's floor is never below the one under it.
+            for k in 1..r.tiers.len() {
+                r.tiers[k].floor = r.tiers[k].floor.max(r.tiers[k - 1].floor);
+            }
         });
 }
