@@ -100,3 +100,24 @@ for (const backend of ['webgpu', 'webgl2']) {
     });
   });
 }
+
+for (const backend of ['webgpu', 'webgl2']) {
+  test(`an upper tier changes the cloud above its floor only (${backend})`, { timeout: 180_000 }, async () => {
+    await withApp({ base: server.url, webgpu: backend === 'webgpu', viewport: { width: 1280, height: 800 } }, async (page) => {
+      const [vw, vh] = (await state(page)).view.viewport;
+      await page.mouse.click(5, vh - 5);
+      await page.evaluate(() => window.cloudsketch.set('/render/noise_amount=0.6'));
+      await until(page, (s) => s.scene.render.noise_amount === 0.6, 'noise');
+      await waitForFullQuality(page);
+      const plain = await screenshot(page, `media-tier-0-${backend}`);
+      // A veined tier from the focus point's height up (the camera's target, near the middle row).
+      await page.evaluate(() => window.cloudsketch.set('/render/tiers=[{"floor":3.0,"filter":"veined","wind":[0,0],"torque":0}]'));
+      await until(page, (s) => s.scene.render.tiers.length === 1, 'a tier');
+      await waitForFullQuality(page);
+      const tiered = await screenshot(page, `media-tier-1-${backend}`);
+      const upper = countChanged(plain, tiered, { x: 0, y: 0, w: vw, h: vh * 0.4 });
+      const lower = countChanged(plain, tiered, { x: 0, y: vh * 0.6, w: vw, h: vh * 0.4 });
+      assert.ok(upper > 2000 && upper > 4 * lower, `changed above ${upper} px, below ${lower} px`);
+    });
+  });
+}
