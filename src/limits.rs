@@ -39,6 +39,10 @@ pub const MAX_EMBEDDED_IMAGE_BYTES: usize = 4 << 20;
 /// before upload): about the height it fills in a 1920×1080 view, so it is never shrunk much
 /// on screen, where a texture without mipmaps would alias.
 pub const MAX_GUIDE_SIDE: u32 = 1024;
+/// A user's own presets (media and lighting saved under a name).
+pub const MAX_LOOKS: usize = 32;
+/// Characters of a user preset's name.
+pub const MAX_LOOK_NAME: usize = 40;
 /// Most undo steps kept.
 pub const MAX_UNDO: usize = 200;
 /// Atmospheric tiers above the base media (Schpok et al. 2003, §5.2).

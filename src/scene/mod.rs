@@ -6,6 +6,7 @@
 mod camera;
 mod document;
 mod edit;
+mod looks;
 mod plane;
 mod pointer;
 mod presets;
@@ -15,6 +16,7 @@ pub use crate::limits::{MAX_ELLIPSOIDS, MAX_PLANE_POINTS, MAX_PLANES};
 pub use camera::{OrbitCamera, Ray, StandardView};
 pub use document::{Document, Revisions};
 pub use edit::Edit;
+pub use looks::{Look, Looks};
 pub use plane::{
     DrawingPlane, MAX_GRID_EXPONENT, MAX_GRID_STEPS, STROKE_GRID, StrokeKind, centre_of,
     grid_exponent, grid_point, grid_points, grid_step,

@@ -268,7 +268,8 @@ impl CloudApp {
         p.clock.ui(ui, &mut self.doc);
         RENDER.ui(ui, &mut self.doc);
         LIGHT.ui(ui, &mut self.doc);
-        p.scene.ui(ui, &mut self.doc, &mut self.selection);
+        p.scene
+            .ui(ui, &mut self.doc, &mut self.selection, &mut self.notices);
         p.view.ui(ui, &self.viewport.stats, &mut self.doc);
         self.selection.retain_valid(self.doc.scene());
     }
@@ -395,6 +396,7 @@ impl CloudApp {
             "guides_hidden": self.tool.hide_guides,
             "skeleton_shown": self.tool.show_skeleton,
             "panel_open": self.panel_open,
+            "my_presets": self.panels.scene.looks.looks.iter().map(|l| l.name.as_str()).collect::<Vec<_>>(),
             "file": self.files.name,
             "unsaved": self.files.unsaved(&self.doc),
             "link": self.files.last_link,

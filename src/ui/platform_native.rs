@@ -53,27 +53,46 @@ fn autosave_dir() -> Option<std::path::PathBuf> {
     Some(base.join("cloudsketch"))
 }
 
-/// The last autosaved document, if any.
-pub fn load_autosave() -> Option<String> {
-    let path = autosave_dir()?.join("autosave.json");
+/// A file of the app's own in its data folder, within the size cap.
+fn load_data(name: &str) -> Option<String> {
+    let path = autosave_dir()?.join(name);
     (std::fs::metadata(&path).ok()?.len() <= MAX_BYTES)
         .then(|| std::fs::read_to_string(path).ok())?
 }
 
-/// Writes the autosave (to a temporary file first, so a crash mid-write keeps the last one).
-pub fn store_autosave(json: &str) -> Result<(), String> {
+/// Writes a file of the app's own in its data folder (to a temporary file first, so a crash
+/// mid-write keeps the last one).
+fn store_data(name: &str, json: &str) -> Result<(), String> {
     let dir = autosave_dir().ok_or("no home folder to keep it in")?;
     std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-    let tmp = dir.join("autosave.json.tmp");
+    let tmp = dir.join(format!("{name}.tmp"));
     std::fs::write(&tmp, json).map_err(|e| format!("{}: {e}", tmp.display()))?;
-    std::fs::rename(&tmp, dir.join("autosave.json")).map_err(|e| format!("{}: {e}", dir.display()))
+    std::fs::rename(&tmp, dir.join(name)).map_err(|e| format!("{}: {e}", dir.display()))
+}
+
+/// The last autosaved document, if any.
+pub fn load_autosave() -> Option<String> {
+    load_data("autosave.json")
+}
+
+/// Writes the autosave.
+pub fn store_autosave(json: &str) -> Result<(), String> {
+    store_data("autosave.json", json)
+}
+
+/// The user's own presets, if any were saved.
+pub fn load_looks() -> Option<String> {
+    load_data("presets.json")
+}
+
+/// Writes the user's own presets.
+pub fn store_looks(json: &str) -> Result<(), String> {
+    store_data("presets.json", json)
 }
 
 /// The session kept aside by [`keep_previous_autosave`], if any.
 pub fn load_previous_autosave() -> Option<String> {
-    let path = autosave_dir()?.join("autosave.previous.json");
-    (std::fs::metadata(&path).ok()?.len() <= MAX_BYTES)
-        .then(|| std::fs::read_to_string(path).ok())?
+    load_data("autosave.previous.json")
 }
 
 /// Where share links point natively: the web app as `trunk serve` serves it.

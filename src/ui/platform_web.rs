@@ -35,9 +35,10 @@ fn deliver(loaded: Loaded) {
     wake();
 }
 
-/// localStorage keys of the autosave and of the session kept aside.
+/// localStorage keys of the autosave, of the session kept aside and of the user's presets.
 const AUTOSAVE_KEY: &str = "cloudsketch.autosave";
 const PREVIOUS_KEY: &str = "cloudsketch.autosave.previous";
+const LOOKS_KEY: &str = "cloudsketch.presets";
 
 fn storage() -> Option<web_sys::Storage> {
     web_sys::window().and_then(|w| w.local_storage().ok().flatten())
@@ -53,6 +54,19 @@ pub fn store_autosave(json: &str) -> Result<(), String> {
     let storage = storage().ok_or("this browser keeps no local storage for the page")?;
     storage
         .set_item(AUTOSAVE_KEY, json)
+        .map_err(|_| "the browser's storage for this page is full".to_owned())
+}
+
+/// The user's own presets, if any were saved.
+pub fn load_looks() -> Option<String> {
+    storage()?.get_item(LOOKS_KEY).ok().flatten()
+}
+
+/// Writes the user's own presets.
+pub fn store_looks(json: &str) -> Result<(), String> {
+    let storage = storage().ok_or("this browser keeps no local storage for the page")?;
+    storage
+        .set_item(LOOKS_KEY, json)
         .map_err(|_| "the browser's storage for this page is full".to_owned())
 }
 

@@ -45,3 +45,25 @@ test('a reload continues the session; a link keeps it aside (webgpu)', { timeout
     await close();
   }
 });
+
+test('a user\'s own presets are kept by the page and listed after a reload (webgpu)', { timeout: 180_000 }, async () => {
+  const { browser, close } = await launch({ webgpu: true });
+  try {
+    const { page, errors } = await openApp(browser, server.url, '?preset=empty', { width: 1280, height: 800 });
+    await waitForBody(page, 'data-ready', (v) => v === 'true');
+    assert.deepEqual((await state(page)).view.my_presets, []);
+    // As the Scene group's "Save look" stores them; one entry out of range, one unnamed.
+    await page.evaluate(() => localStorage.setItem('cloudsketch.presets', JSON.stringify({
+      looks: [
+        { name: 'golden hour', light: { sun_elevation_deg: 6, ambient: 99 }, render: { noise_filter: 'wispy' } },
+        { name: '   ', light: {}, render: {} },
+      ],
+    })));
+    await page.reload();
+    await waitForBody(page, 'data-ready', (v) => v === 'true');
+    assert.deepEqual((await state(page)).view.my_presets, ['golden hour']);
+    assert.deepEqual(errors, []);
+  } finally {
+    await close();
+  }
+});

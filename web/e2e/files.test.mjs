@@ -143,9 +143,11 @@ test('a link opens on WebGL2 too', { timeout: 180_000 }, async () => {
     const { page, errors } = await openApp(browser, server.url, '?preset=stratus', VIEW, CLIPBOARD);
     await waitForBody(page, 'data-ready', (v) => v === 'true');
     assert.equal((await state(page)).view.backend, 'webgl2');
-    await page.mouse.click(100, 700);
-    await page.keyboard.press('Control+l');
-    const { view } = await until(page, (s) => s.view.link != null, 'a link');
+    // The File group's "Copy link" button, at the top of the side panel (300 px wide, at the
+    // right edge): its third button in the row under the file name.
+    await page.mouse.click(VIEW.width - 137, 59);
+    const { view } = await until(page, (s) => s.view.link != null, 'a link from the Copy link button');
+    assert.equal(await page.evaluate(() => navigator.clipboard.readText()), view.link);
     const { page: other } = await openApp(browser, view.link, '', VIEW);
     await waitForBody(other, 'data-ready', (v) => v === 'true');
     const s = await state(other);

@@ -1,20 +1,109 @@
-//! The Scene group: new scenes from presets, what the scene holds, and its ellipsoids (a list
-//! to select from, and the selected one's centre, radii and strength).
+//! The Scene group: new scenes from presets, the user's own presets (media and lighting
+//! saved under a name), what the scene holds, and its ellipsoids (a list to select from, and
+//! the selected one's centre, radii and strength).
 
 use egui::Ui;
 
-use crate::scene::{Document, Edit, Preset, Scene, StrokeKind};
+use crate::scene::{Document, Edit, Looks, Preset, Scene, StrokeKind};
 use crate::ui::ellipsoids;
+use crate::ui::notice::Notices;
+use crate::ui::platform;
 use crate::ui::selection::{Item, Selection};
 use crate::ui::widgets::{rotation_fields, vec3_fields};
 
 /// The Scene group.
-#[derive(Default)]
-pub struct ScenePanel;
+pub struct ScenePanel {
+    /// The user's own presets, as stored by the app.
+    pub looks: Looks,
+    /// The name typed for the next saved preset.
+    look_name: String,
+}
+
+impl Default for ScenePanel {
+    fn default() -> Self {
+        let looks = platform::load_looks()
+            .and_then(|json| Looks::from_json(&json).map_err(|e| log::warn!("{e}")).ok())
+            .unwrap_or_default();
+        Self {
+            looks,
+            look_name: String::new(),
+        }
+    }
+}
 
 impl ScenePanel {
+    /// The user's presets: each applies its media and lighting to the scene (one undo step;
+    /// right-click deletes it); a name and Save keep the current ones.
+    fn my_presets(&mut self, ui: &mut Ui, doc: &mut Document, notices: &mut Notices) {
+        let now = ui.input(|i| i.time);
+        let mut apply = None;
+        let mut delete = None;
+        ui.horizontal_wrapped(|ui| {
+            ui.label("Mine:");
+            if self.looks.looks.is_empty() {
+                ui.weak("none yet");
+            }
+            for look in &self.looks.looks {
+                let button = ui.small_button(&look.name).on_hover_text(
+                    "Its media and lighting on this scene (Ctrl+Z undoes); right-click to delete",
+                );
+                if button.clicked() {
+                    apply = Some(look.name.clone());
+                }
+                button.context_menu(|ui| {
+                    if ui.button("Delete this preset").clicked() {
+                        delete = Some(look.name.clone());
+                        ui.close();
+                    }
+                });
+            }
+        });
+        ui.horizontal(|ui| {
+            ui.add(
+                egui::TextEdit::singleline(&mut self.look_name)
+                    .desired_width(150.0)
+                    .hint_text("name"),
+            );
+            if ui
+                .button("Save look")
+                .on_hover_text("Keep this scene's media and lighting as a preset of your own")
+                .clicked()
+            {
+                match self.looks.save(&self.look_name, doc.scene()) {
+                    Ok(name) => {
+                        self.store(notices, now, format!("Saved the preset {name:?}"));
+                        self.look_name.clear();
+                    }
+                    Err(e) => notices.error(now, e),
+                }
+            }
+        });
+        if let Some(look) = apply.and_then(|name| self.looks.get(&name).cloned()) {
+            doc.apply(Edit::Replace(Box::new(look.applied_to(doc.scene()))), None);
+            notices.note(now, format!("Applied {:?} (Ctrl+Z undoes)", look.name));
+        }
+        if let Some(name) = delete {
+            self.looks.remove(&name);
+            self.store(notices, now, format!("Deleted the preset {name:?}"));
+        }
+    }
+
+    /// Writes the list to the app's store, saying how it went.
+    fn store(&self, notices: &mut Notices, now: f64, done: String) {
+        match platform::store_looks(&self.looks.to_json()) {
+            Ok(()) => notices.note(now, done),
+            Err(e) => notices.error(now, format!("The presets could not be kept: {e}")),
+        }
+    }
+
     /// Draws the group.
-    pub fn ui(&mut self, ui: &mut Ui, doc: &mut Document, selection: &mut Selection) {
+    pub fn ui(
+        &mut self,
+        ui: &mut Ui,
+        doc: &mut Document,
+        selection: &mut Selection,
+        notices: &mut Notices,
+    ) {
         egui::CollapsingHeader::new("Scene")
             .default_open(true)
             .show(ui, |ui| {
@@ -34,6 +123,7 @@ impl ScenePanel {
                         }
                     }
                 });
+                self.my_presets(ui, doc, notices);
                 ui.label(contents(doc.scene()));
                 ellipsoid_list(ui, doc, selection);
             });
