@@ -1,5 +1,5 @@
-// Shared by the slice shaders (volume.wgsl, plain_slices.wgsl): the `Volume` uniforms and the
-// bind group. WGSL has no include, so src/render/shaders.rs prepends this file to each of them
+// Shared by the slice shaders (volume.wgsl, plain_slices.wgsl) and the light pass
+// (light_march.wgsl): the `Volume` uniforms and the bind group. WGSL has no include, so src/render/shaders.rs prepends this file to each of them
 // and the tests validate the composed modules; `Volume` mirrors `VolumeUniforms` in
 // src/render/gpu_types.rs, and a test compares their sizes and member offsets.
 
@@ -47,8 +47,11 @@ struct Volume {
 };
 
 @group(0) @binding(0) var<uniform> u: Volume;
-// Density (red: the field value) and light (green: transmittance toward the sun).
+// The field value (red; green: the CPU's transmittance sweep, which the light volume replaced).
 @group(0) @binding(1) var volume_tex: texture_3d<f32>;
 @group(0) @binding(2) var clamp_smp: sampler;
 @group(0) @binding(3) var noise_tex: texture_3d<f32>;
 @group(0) @binding(4) var repeat_smp: sampler;
+// Transmittance toward the sun (red), computed on the GPU with the noise (light_march.wgsl);
+// the slices read it, the light pass writes it (and so binds no texture 5).
+@group(0) @binding(5) var light_tex: texture_3d<f32>;

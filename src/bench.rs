@@ -470,6 +470,47 @@ fn worst_documents_bench() -> Vec<BenchResult> {
         .collect()
 }
 
+/// The GPU light volume of the default cloud (its noise included) at the default light
+/// resolution and octaves, and without noise, against the CPU's transmittance sweep of the
+/// same field (which sees no noise).
+fn light_volume(offscreen: &mut Offscreen) -> Result<Vec<BenchResult>, String> {
+    let scene = Scene::default();
+    let doc = Document::new(scene.clone());
+    let volume = Derived::default()
+        .density(doc.scene(), doc.revisions())
+        .data;
+    let params = crate::derive::LightParams {
+        sun_dir: scene.light.sun_direction(),
+        extinction: scene.render.opacity,
+        softness: scene.render.softness,
+    };
+    let cpu = time_median(5, &mut || {
+        std::hint::black_box(crate::derive::sweep(&volume, &params));
+    });
+    let mut out = Vec::new();
+    for (name, octaves) in [
+        ("light_volume_gpu_2_octaves", 2u32),
+        ("light_volume_gpu_no_noise", 0),
+    ] {
+        let mut s = scene.clone();
+        s.render.light_octaves = octaves;
+        let gpu = median(
+            offscreen
+                .time_light_volume(&s, 4)
+                .map_err(|e| e.to_string())?
+                .split_off(1),
+        );
+        out.push(result(
+            name,
+            gpu * 1e3,
+            "ms",
+            "light_sweep_cpu_no_noise",
+            cpu * 1e3,
+        ));
+    }
+    Ok(out)
+}
+
 /// Share links for every preset and for five hand-drawn strokes: the URL's length against the
 /// scene file's, and encoding and opening times against writing and opening the scene file
 /// (opening either includes the cost check that derives the field).
@@ -561,6 +602,9 @@ pub fn run(json: bool, only: Option<&str>) -> Result<(), String> {
     }
     if wanted("quality") {
         results.extend(render_frames_by_quality(&mut offscreen)?);
+    }
+    if wanted("light") {
+        results.extend(light_volume(&mut offscreen)?);
     }
     let report = BenchReport { machine, results };
     if json {

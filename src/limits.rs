@@ -159,6 +159,22 @@ pub const TORQUE: Param = Param::linear(
     90.0,
     0.0,
 );
+/// Texels along the longest side of the light volume (transmittance toward the sun).
+pub const LIGHT_RESOLUTION: Param = Param::linear(
+    "light grid",
+    "Resolution of the light volume the shadows come from: finer shows smaller shadow detail, costs more whenever the light, the shape or the moving noise changes",
+    8.0,
+    96.0,
+    40.0,
+);
+/// Noise octaves the light volume sees.
+pub const LIGHT_OCTAVES: Param = Param::linear(
+    "light octaves",
+    "Octaves of noise the shadows see (0: shadows of the smooth shape only)",
+    0.0,
+    8.0,
+    2.0,
+);
 /// Altitude (world y) where an atmospheric tier begins.
 pub const TIER_FLOOR: Param = Param::linear(
     "floor",
@@ -334,6 +350,8 @@ mod tests {
             TORQUE,
             TIER_FLOOR,
             TIER_BLEND,
+            LIGHT_RESOLUTION,
+            LIGHT_OCTAVES,
             FORWARD_SCATTERING,
             MULTIPLE_SCATTERING,
         ] {

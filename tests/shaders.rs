@@ -1,11 +1,13 @@
 //! Every shader module the renderer compiles parses and validates with naga, every WGSL file in
 //! `shaders/` is part of one, and each WGSL uniform struct has exactly the size and member
 //! offsets of the Rust struct it mirrors (`Volume`/`VolumeUniforms`,
-//! `FieldSlice`/`FieldSliceUniforms`, `Sky`/`SkyUniforms`).
+//! `FieldSlice`/`FieldSliceUniforms`, `Sky`/`SkyUniforms`, `LightSlice`/`LightSliceUniforms`).
 
 use std::path::Path;
 
-use cloudsketch::render::gpu_types::{FieldSliceUniforms, SkyUniforms, VolumeUniforms};
+use cloudsketch::render::gpu_types::{
+    FieldSliceUniforms, LightSliceUniforms, SkyUniforms, VolumeUniforms,
+};
 use cloudsketch::render::shaders::MODULES;
 
 fn parse(name: &str, source: &str) -> naga::Module {
@@ -109,5 +111,14 @@ fn wgsl_sky_struct_matches_the_rust_layout() {
         wgsl_layout("sky", "Sky"),
         rust_layout(&SkyUniforms::LAYOUT),
         "WGSL Sky vs Rust SkyUniforms (name, offset; last: size)"
+    );
+}
+
+#[test]
+fn wgsl_light_slice_struct_matches_the_rust_layout() {
+    assert_eq!(
+        wgsl_layout("light_march", "LightSlice"),
+        rust_layout(&LightSliceUniforms::LAYOUT),
+        "WGSL LightSlice vs Rust LightSliceUniforms (name, offset; last: size)"
     );
 }

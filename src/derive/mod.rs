@@ -263,6 +263,15 @@ impl Derived {
         self.planes.derived(plane)
     }
 
+    /// Forgets the field grid (its texel size, kept across edits with hysteresis) and the
+    /// volumes, keeping the per-plane shapes: the next derivation samples the document on the
+    /// grid a fresh load would, so an image depends on the document alone (offscreen renders).
+    pub fn forget_grid(&mut self) {
+        self.baker = Baker::default();
+        self.density = None;
+        self.light = None;
+    }
+
     /// The work done so far.
     pub fn work(&self) -> Work {
         self.work

@@ -109,6 +109,26 @@ impl SkyUniforms {
     }
 }
 
+/// Uniforms of one slice of the light volume pass (`struct LightSlice` in
+/// `shaders/light_march.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct LightSliceUniforms {
+    /// x: this slice's z, y: march steps, z: noise octaves, w: unused.
+    pub slice: [u32; 4],
+    /// Texels of the light grid per axis (xyz); w: the march's step length (world).
+    pub dims: [f32; 4],
+}
+
+impl LightSliceUniforms {
+    /// Names and byte offsets of the members, in order (checked against the WGSL struct).
+    pub const LAYOUT: [(&'static str, usize); 3] = [
+        ("slice", offset_of!(Self, slice)),
+        ("dims", offset_of!(Self, dims)),
+        ("", std::mem::size_of::<Self>()),
+    ];
+}
+
 /// Uniforms of one slice of the GPU field evaluation (`struct FieldSlice` in
 /// `shaders/field_eval.wgsl`).
 #[repr(C)]

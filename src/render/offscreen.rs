@@ -220,12 +220,43 @@ impl Offscreen {
         Ok(times)
     }
 
+    /// Times `runs` computations of `scene`'s light volume on the GPU (every slice marched
+    /// toward the sun through the field and its noise), each waited for on the device.
+    pub fn time_light_volume(
+        &mut self,
+        scene: &Scene,
+        runs: usize,
+    ) -> Result<Vec<f64>, OffscreenError> {
+        let job = self.full_job(scene, 64, 64);
+        let mut times = Vec::with_capacity(runs);
+        for _ in 0..runs {
+            self.renderer.invalidate_light();
+            self.renderer.begin_frame();
+            let start = std::time::Instant::now();
+            let mut encoder = self
+                .device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                    label: Some("light volume (bench)"),
+                });
+            self.renderer
+                .update_light(&self.device, &self.queue, &mut encoder, &job.view);
+            self.queue.submit([encoder.finish()]);
+            self.device
+                .poll(wgpu::PollType::wait_indefinitely())
+                .map_err(|e| OffscreenError::Readback(e.to_string()))?;
+            times.push(start.elapsed().as_secs_f64());
+        }
+        Ok(times)
+    }
+
     /// Derives `scene`'s volumes (through the per-plane cache) and uploads them; returns the
     /// full-quality job for an image of `width`×`height`.
     fn full_job(&mut self, scene: &Scene, width: u32, height: u32) -> SliceJob {
         // A fresh document has fresh revisions: everything is derived again, except strokes
-        // the plane cache has already interpreted.
+        // the plane cache has already interpreted, on the grid a fresh load would choose (not
+        // the one the last render's history left), so the image depends on `scene` alone.
         let doc = Document::new(scene.clone());
+        self.derived.forget_grid();
         let volumes = self.derived.update(doc.scene(), doc.revisions());
         self.renderer.begin_frame();
         self.renderer.upload(&self.device, &self.queue, &volumes);
@@ -276,6 +307,8 @@ impl Offscreen {
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("offscreen"),
             });
+        self.renderer
+            .update_light(&self.device, &self.queue, &mut encoder, &job.view);
         self.renderer
             .draw_slices(&self.device, &self.queue, &mut encoder, job, pipeline);
         self.renderer.prepare_sky(&self.queue, &job.view);

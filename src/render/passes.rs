@@ -6,7 +6,7 @@
 
 use std::num::NonZeroU64;
 
-use super::gpu_types::{SkyUniforms, VolumeUniforms};
+use super::gpu_types::{LightSliceUniforms, SkyUniforms, VolumeUniforms};
 use super::shaders;
 
 /// Slice draws one frame (one submit) may record.
@@ -131,6 +131,7 @@ impl SlicePass {
                 sampler_entry(2),
                 texture_3d(3),
                 sampler_entry(4),
+                texture_3d(5),
             ],
         });
         let align = device.limits().min_uniform_buffer_offset_alignment.max(16) as u64;
@@ -292,5 +293,140 @@ impl SkyPass {
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &self.bind_group, &[]);
         pass.draw(0..3, 0..1);
+    }
+}
+
+/// Light slices one light volume may have (its grid's cap per side).
+pub const MAX_LIGHT_SLICES: u32 = 128;
+
+/// The light volume pass: transmittance toward the sun at every texel of a 3D texture, one
+/// render pass per z-slice, reading the slices' uniforms, field and noise (bindings 0–4 of
+/// their group; not 5, the light texture it writes).
+pub struct LightPass {
+    /// The pipeline.
+    pub pipeline: wgpu::RenderPipeline,
+    /// Layout of group 0: the slice group without the light texture.
+    pub volume_layout: wgpu::BindGroupLayout,
+    /// Per-slice uniforms (group 1), [`MAX_LIGHT_SLICES`] slots of `stride` bytes.
+    uniforms: wgpu::Buffer,
+    /// Group 1.
+    pub slice_group: wgpu::BindGroup,
+    stride: u64,
+}
+
+/// The light volume's format: transmittance in [0, 1], renderable and filterable everywhere.
+pub const LIGHT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R8Unorm;
+
+impl LightPass {
+    /// Creates the pass.
+    pub fn new(device: &wgpu::Device) -> Self {
+        let volume_size = std::mem::size_of::<VolumeUniforms>() as u64;
+        let volume_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("light volume: volume"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: true,
+                        min_binding_size: NonZeroU64::new(volume_size),
+                    },
+                    count: None,
+                },
+                texture_3d(1),
+                sampler_entry(2),
+                texture_3d(3),
+                sampler_entry(4),
+            ],
+        });
+        let size = std::mem::size_of::<LightSliceUniforms>() as u64;
+        let slice_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("light volume: slice"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: true,
+                    min_binding_size: NonZeroU64::new(size),
+                },
+                count: None,
+            }],
+        });
+        let align = device.limits().min_uniform_buffer_offset_alignment.max(16) as u64;
+        let stride = size.div_ceil(align) * align;
+        let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("light slices"),
+            size: stride * MAX_LIGHT_SLICES as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let slice_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("light volume: slice"),
+            layout: &slice_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: &uniforms,
+                    offset: 0,
+                    size: NonZeroU64::new(size),
+                }),
+            }],
+        });
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("light volume"),
+            source: wgpu::ShaderSource::Wgsl(shaders::LIGHT_MARCH.into()),
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("light volume"),
+            bind_group_layouts: &[Some(&volume_layout), Some(&slice_layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("light volume"),
+            layout: Some(&pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: wgpu::PrimitiveState::default(),
+            depth_stencil: None,
+            multisample: wgpu::MultisampleState::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_main"),
+                compilation_options: Default::default(),
+                targets: &[Some(wgpu::ColorTargetState {
+                    format: LIGHT_FORMAT,
+                    blend: None,
+                    write_mask: wgpu::ColorWrites::ALL,
+                })],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        Self {
+            pipeline,
+            volume_layout,
+            uniforms,
+            slice_group,
+            stride,
+        }
+    }
+
+    /// Writes the slices' uniforms; returns each slice's dynamic offset.
+    pub fn write(&self, queue: &wgpu::Queue, slices: &[LightSliceUniforms]) -> Vec<u32> {
+        let n = slices.len().min(MAX_LIGHT_SLICES as usize);
+        let mut bytes = vec![0u8; (self.stride * n as u64) as usize];
+        for (i, s) in slices[..n].iter().enumerate() {
+            let at = i * self.stride as usize;
+            bytes[at..at + std::mem::size_of::<LightSliceUniforms>()]
+                .copy_from_slice(bytemuck::bytes_of(s));
+        }
+        queue.write_buffer(&self.uniforms, 0, &bytes);
+        (0..n as u64).map(|i| (i * self.stride) as u32).collect()
     }
 }

@@ -1,10 +1,10 @@
 //! The volume renderer: passes and resources together, used by the app's viewport (through an
 //! egui paint callback) and by offscreen rendering alike.
 
-use super::gpu_types::{SkyUniforms, View, VolumeUniforms};
-use super::passes::{CompositePass, SkyPass, SlicePass};
+use super::gpu_types::{LightSliceUniforms, SkyUniforms, View, VolumeUniforms};
+use super::passes::{CompositePass, LIGHT_FORMAT, LightPass, MAX_LIGHT_SLICES, SkyPass, SlicePass};
 use super::progressive::JobPlan;
-use super::resources::{TARGETS, Target, VolumeTextures, accumulation_texture, sampler};
+use super::resources::{TARGETS, Target, VolumeTextures, accumulation_texture, sampler, upload_3d};
 use crate::derive::Volumes;
 
 /// One volume draw: the planner's job (which slices, into which target) and what it shows.
@@ -27,6 +27,36 @@ pub struct VolumeRenderer {
     textures: VolumeTextures,
     bind_group: Option<wgpu::BindGroup>,
     targets: [Option<Target>; TARGETS],
+    light_pass: LightPass,
+    /// The light volume: what it was computed for, its size, the texture.
+    light: Option<LightVolume>,
+    /// Full transmittance, bound until a light volume exists (made on the first upload).
+    light_placeholder: Option<wgpu::TextureView>,
+    /// Group 0 of the light pass (the slice group without the light texture).
+    light_bind_group: Option<wgpu::BindGroup>,
+}
+
+/// The light volume on the GPU. Each z-slice is rendered into `slice` (2D) and copied into
+/// the 3D texture: wgpu's WebGPU backend drops a 3D attachment's depth slice, so rendering
+/// into the 3D texture directly fails in browsers.
+struct LightVolume {
+    key: u64,
+    dims: [u32; 3],
+    texture: wgpu::Texture,
+    /// A view of the 3D texture, sampled by the slices.
+    view: wgpu::TextureView,
+    /// One z-slice's render target.
+    slice: wgpu::Texture,
+    slice_view: wgpu::TextureView,
+}
+
+/// The light grid for a density grid of `dims`: `resolution` texels along its longest side,
+/// the others in proportion (at least 2, at most [`MAX_LIGHT_SLICES`]).
+fn light_dims(dims: glam::UVec3, resolution: u32) -> [u32; 3] {
+    let longest = dims.max_element().max(1) as f32;
+    let res = resolution.clamp(2, MAX_LIGHT_SLICES) as f32;
+    dims.to_array()
+        .map(|d| ((d as f32 * res / longest).round() as u32).clamp(2, MAX_LIGHT_SLICES))
 }
 
 impl VolumeRenderer {
@@ -46,6 +76,10 @@ impl VolumeRenderer {
             textures: VolumeTextures::new(),
             bind_group: None,
             targets: [None, None],
+            light_pass: LightPass::new(device),
+            light: None,
+            light_placeholder: None,
+            light_bind_group: None,
         }
     }
 
@@ -61,13 +95,32 @@ impl VolumeRenderer {
 
     /// Uploads whatever changed in `volumes` since the last call.
     pub fn upload(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, volumes: &Volumes) {
+        if self.light_placeholder.is_none() {
+            self.light_placeholder = Some(upload_3d(
+                device,
+                queue,
+                "light placeholder",
+                [1, 1, 1],
+                LIGHT_FORMAT,
+                &[255],
+            ));
+        }
         if !self.textures.upload(device, queue, volumes) && self.bind_group.is_some() {
             return;
         }
+        self.rebuild_bind_groups(device);
+    }
+
+    /// The slice group (and the light pass's, which lacks the light texture) over the current
+    /// textures.
+    fn rebuild_bind_groups(&mut self, device: &wgpu::Device) {
         let t = &self.textures;
-        let (Some((_, volume)), Some((_, noise))) = (&t.volume, &t.noise) else {
+        let (Some((_, volume)), Some((_, noise)), Some(placeholder)) =
+            (&t.volume, &t.noise, &self.light_placeholder)
+        else {
             return;
         };
+        let light = self.light.as_ref().map_or(placeholder, |l| &l.view);
         let entries = [
             wgpu::BindGroupEntry {
                 binding: 0,
@@ -93,12 +146,170 @@ impl VolumeRenderer {
                 binding: 4,
                 resource: wgpu::BindingResource::Sampler(&self.repeat_sampler),
             },
+            wgpu::BindGroupEntry {
+                binding: 5,
+                resource: wgpu::BindingResource::TextureView(light),
+            },
         ];
         self.bind_group = Some(device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("volume"),
             layout: &self.slices.layout,
             entries: &entries,
         }));
+        self.light_bind_group = Some(device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("light volume: volume"),
+            layout: &self.light_pass.volume_layout,
+            entries: &entries[..5],
+        }));
+    }
+
+    /// Makes the next [`VolumeRenderer::update_light`] recompute the light volume (benchmarks).
+    pub fn invalidate_light(&mut self) {
+        if let Some(light) = &mut self.light {
+            light.key = 0;
+        }
+    }
+
+    /// Recomputes the light volume (transmittance toward the sun through the field and its
+    /// noise) when anything it depends on changed: the field, the sun, the media, the scene
+    /// time when the noise moves, the light's resolution or octaves. Call after
+    /// [`VolumeRenderer::upload`], before the frame's slices. Returns whether it ran.
+    pub fn update_light(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        view: &View,
+    ) -> bool {
+        let volume = self.textures.density_volume.clone();
+        let Some((generation, _)) = &self.textures.volume else {
+            return false;
+        };
+        if volume.is_empty() {
+            return false;
+        }
+        let r = &view.render;
+        let dims = light_dims(volume.dims, r.light_resolution);
+        let h = (volume.size / glam::UVec3::from_array(dims).as_vec3()).min_element();
+        let steps = ((volume.size.length() / h.max(1e-6)).ceil() as u32).clamp(1, 512);
+        let uniforms = VolumeUniforms::new(view, &volume, 1, 0);
+        let key = {
+            use std::hash::{Hash, Hasher};
+            let mut hasher = std::hash::DefaultHasher::new();
+            (generation, dims, steps, r.light_octaves).hash(&mut hasher);
+            let octaves = (r.light_octaves as usize).min(uniforms.octaves.len());
+            let parts: [&[u8]; 7] = [
+                bytemuck::bytes_of(&uniforms.sun_dir),
+                bytemuck::bytes_of(&uniforms.media),
+                bytemuck::bytes_of(&uniforms.noise),
+                bytemuck::cast_slice(&uniforms.octaves[..octaves]),
+                bytemuck::bytes_of(&uniforms.tiers),
+                bytemuck::bytes_of(&uniforms.tier_filters),
+                bytemuck::cast_slice(&uniforms.tier_octaves),
+            ];
+            parts.hash(&mut hasher);
+            hasher.finish()
+        };
+        if self.light.as_ref().is_some_and(|l| l.key == key) {
+            return false;
+        }
+        if self.light.as_ref().is_none_or(|l| l.dims != dims) {
+            let texture = device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("light volume"),
+                size: wgpu::Extent3d {
+                    width: dims[0],
+                    height: dims[1],
+                    depth_or_array_layers: dims[2],
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D3,
+                format: LIGHT_FORMAT,
+                usage: wgpu::TextureUsages::COPY_DST
+                    | wgpu::TextureUsages::TEXTURE_BINDING
+                    | wgpu::TextureUsages::COPY_SRC,
+                view_formats: &[],
+            });
+            let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
+            let slice = device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("light volume slice"),
+                size: wgpu::Extent3d {
+                    width: dims[0],
+                    height: dims[1],
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: LIGHT_FORMAT,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+                view_formats: &[],
+            });
+            let slice_view = slice.create_view(&wgpu::TextureViewDescriptor::default());
+            self.light = Some(LightVolume {
+                key,
+                dims,
+                texture,
+                view,
+                slice,
+                slice_view,
+            });
+            self.rebuild_bind_groups(device);
+        }
+        let (Some(light), Some(group)) = (&mut self.light, &self.light_bind_group) else {
+            return false;
+        };
+        light.key = key;
+        let offset = self.slices.write(queue, &uniforms);
+        let slices: Vec<LightSliceUniforms> = (0..dims[2])
+            .map(|z| LightSliceUniforms {
+                slice: [z, steps, r.light_octaves, 0],
+                dims: [dims[0] as f32, dims[1] as f32, dims[2] as f32, h],
+            })
+            .collect();
+        let offsets = self.light_pass.write(queue, &slices);
+        for (z, slice_offset) in offsets.into_iter().enumerate() {
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("light volume slice"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &light.slice_view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::WHITE),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: None,
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(&self.light_pass.pipeline);
+            pass.set_bind_group(0, group, &[offset]);
+            pass.set_bind_group(1, &self.light_pass.slice_group, &[slice_offset]);
+            pass.draw(0..3, 0..1);
+            drop(pass);
+            encoder.copy_texture_to_texture(
+                light.slice.as_image_copy(),
+                wgpu::TexelCopyTextureInfo {
+                    texture: &light.texture,
+                    mip_level: 0,
+                    origin: wgpu::Origin3d {
+                        x: 0,
+                        y: 0,
+                        z: z as u32,
+                    },
+                    aspect: wgpu::TextureAspect::All,
+                },
+                wgpu::Extent3d {
+                    width: dims[0],
+                    height: dims[1],
+                    depth_or_array_layers: 1,
+                },
+            );
+        }
+        true
     }
 
     fn ensure_target(&mut self, device: &wgpu::Device, index: usize, size: [u32; 2]) {

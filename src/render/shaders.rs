@@ -5,10 +5,18 @@
 /// `shaders/volume_common.wgsl`: the `Volume` uniforms and the slice bind group.
 pub const VOLUME_COMMON: &str = include_str!("../../shaders/volume_common.wgsl");
 
-/// The slice shader: `volume_common.wgsl` + `volume.wgsl`.
+/// The slice shader: `volume_common.wgsl` + `volume_noise.wgsl` + `volume.wgsl`.
 pub const VOLUME: &str = concat!(
     include_str!("../../shaders/volume_common.wgsl"),
+    include_str!("../../shaders/volume_noise.wgsl"),
     include_str!("../../shaders/volume.wgsl")
+);
+
+/// The light volume pass: `volume_common.wgsl` + `volume_noise.wgsl` + `light_march.wgsl`.
+pub const LIGHT_MARCH: &str = concat!(
+    include_str!("../../shaders/volume_common.wgsl"),
+    include_str!("../../shaders/volume_noise.wgsl"),
+    include_str!("../../shaders/light_march.wgsl")
 );
 
 /// The benchmark baseline: `volume_common.wgsl` + `plain_slices.wgsl`.
@@ -27,8 +35,21 @@ pub const FIELD_EVAL: &str = include_str!("../../shaders/field_eval.wgsl");
 pub const SKY: &str = include_str!("../../shaders/sky.wgsl");
 
 /// Every shader module with the files it is composed of, in order.
-pub const MODULES: [(&str, &[&str], &str); 5] = [
-    ("volume", &["volume_common.wgsl", "volume.wgsl"], VOLUME),
+pub const MODULES: [(&str, &[&str], &str); 6] = [
+    (
+        "volume",
+        &["volume_common.wgsl", "volume_noise.wgsl", "volume.wgsl"],
+        VOLUME,
+    ),
+    (
+        "light_march",
+        &[
+            "volume_common.wgsl",
+            "volume_noise.wgsl",
+            "light_march.wgsl",
+        ],
+        LIGHT_MARCH,
+    ),
     (
         "plain_slices",
         &["volume_common.wgsl", "plain_slices.wgsl"],

@@ -31,6 +31,7 @@ impl egui_wgpu::CallbackTrait for ViewportPaint {
             renderer.begin_frame();
             renderer.upload(device, queue, &self.volumes);
             if let Some(job) = &self.job {
+                renderer.update_light(device, queue, encoder, &job.view);
                 renderer.draw_slices(device, queue, encoder, job, None);
             }
         }

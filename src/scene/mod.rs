@@ -401,6 +401,10 @@ pub struct RenderSettings {
     pub tiers: Vec<Tier>,
     /// Height over which one tier blends into the next around a floor.
     pub tier_blend: f32,
+    /// Texels along the longest side of the light volume (the shadows' resolution).
+    pub light_resolution: u32,
+    /// Noise octaves the light volume sees (0: shadows of the smooth shape).
+    pub light_octaves: u32,
 }
 
 /// An atmospheric tier: from `floor` up, the noise has its own character and motion.
@@ -447,6 +451,8 @@ impl Default for RenderSettings {
             torque: 0.0,
             tiers: Vec::new(),
             tier_blend: limits::TIER_BLEND.default as f32,
+            light_resolution: limits::LIGHT_RESOLUTION.default as u32,
+            light_octaves: limits::LIGHT_OCTAVES.default as u32,
         }
     }
 }
@@ -473,6 +479,8 @@ impl RenderSettings {
         }
         self.tiers.sort_by(|a, b| a.floor.total_cmp(&b.floor));
         self.tier_blend = limits::TIER_BLEND.fix_f32(self.tier_blend);
+        self.light_resolution = limits::LIGHT_RESOLUTION.fix_u32(self.light_resolution);
+        self.light_octaves = limits::LIGHT_OCTAVES.fix_u32(self.light_octaves);
     }
 }
 

@@ -24,6 +24,8 @@ fn body(ui: &mut Ui, r: &mut RenderSettings) {
     param(ui, &mut r.softness, &limits::SOFTNESS);
     param(ui, &mut r.noise_octaves, &limits::OCTAVES);
     param(ui, &mut r.field_resolution, &limits::FIELD_RESOLUTION);
+    param(ui, &mut r.light_resolution, &limits::LIGHT_RESOLUTION);
+    param(ui, &mut r.light_octaves, &limits::LIGHT_OCTAVES);
     egui::CollapsingHeader::new("Media: filter, basis, wind")
         .default_open(false)
         .show(ui, |ui| {

@@ -1,0 +1,63 @@
+// The light volume (Schpok's shadows, past the paper's per-vertex ones): at every texel of a
+// coarse grid over the cloud's box, the transmittance toward the sun through the density the
+// slices draw — the field *with its noise* (fewer octaves: `LightSlice.slice.z`) — marched in
+// steps toward the sun. One render pass per z-slice of the 3D texture (WebGL2 can render into
+// 3D texture slices; it has no compute). Composed after volume_common.wgsl and
+// volume_noise.wgsl; `LightSlice` mirrors `LightSliceUniforms` in src/render/gpu_types.rs.
+
+struct LightSlice {
+    // x: this slice's z, y: march steps, z: noise octaves.
+    slice: vec4<u32>,
+    // Texels of the light grid per axis (xyz); w: the march's step length (world).
+    dims: vec4<f32>,
+};
+
+@group(1) @binding(0) var<uniform> ls: LightSlice;
+
+@vertex
+fn vs_main(@builtin(vertex_index) vi: u32) -> @builtin(position) vec4<f32> {
+    // One triangle over the whole target.
+    let xy = vec2<f32>(f32((vi << 1u) & 2u), f32(vi & 2u));
+    return vec4<f32>(xy * 2.0 - 1.0, 0.0, 1.0);
+}
+
+// The slices' density at world point `p` (the same field, iso-level, softness and noise).
+fn density_at(p: vec3<f32>, octaves: i32) -> f32 {
+    let uvw = (p - u.grid_min.xyz) * u.grid_inv_size.xyz;
+    let field = textureSampleLevel(volume_tex, clamp_smp, uvw, 0.0).r;
+    let iso = u.media.y;
+    let soft = u.media.z;
+    let amount = u.media.w;
+    if field < iso - soft - 0.5 * amount {
+        return 0.0;
+    }
+    var v = field;
+    if octaves > 0 {
+        v = field + amount * (tiered_noise(p, octaves) - 0.5);
+    }
+    return smoothstep(iso - soft, iso + soft, v);
+}
+
+@fragment
+fn fs_main(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
+    let texel = vec3<f32>(floor(pos.xy), f32(ls.slice.x)) + 0.5;
+    let size = 1.0 / u.grid_inv_size.xyz;
+    let start = u.grid_min.xyz + texel / ls.dims.xyz * size;
+    let dir = u.sun_dir.xyz;
+    let h = ls.dims.w;
+    let octaves = i32(ls.slice.z);
+    var tau = 0.0;
+    // Half a step in, then whole steps, until the ray leaves the box.
+    var p = start + dir * (0.5 * h);
+    for (var i = 0u; i < ls.slice.y; i = i + 1u) {
+        let uvw = (p - u.grid_min.xyz) * u.grid_inv_size.xyz;
+        if any(uvw < vec3<f32>(0.0)) || any(uvw > vec3<f32>(1.0)) {
+            break;
+        }
+        tau = tau + density_at(p, octaves) * h;
+        p = p + dir * h;
+    }
+    // Stored as T^(1/8) = exp(−τ/8): 8 bits keep deep shadow (T far below 1/255) that
+    // multiple scattering brings back (volume.wgsl raises it to 8·k for T^k).
+    return vec4<f32>(exp(-u.media.x * tau / 8.0), 0.0, 0.0, 1.0);
+}
