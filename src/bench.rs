@@ -311,19 +311,7 @@ fn field_at_scale() -> Vec<BenchResult> {
         let full = time_median(5, &mut || {
             std::hint::black_box(Derived::default().density(doc.scene(), doc.revisions()));
         });
-        let mut derived = Derived::default();
-        derived.density(doc.scene(), doc.revisions());
-        let mut step = 0usize;
-        let moved = time_median(15, &mut || {
-            step += 1;
-            let mut es = doc.scene().ellipsoids.clone();
-            let i = (step * 7919) % es.len();
-            let mut e = (*es[i]).clone();
-            e.center.x += if step.is_multiple_of(2) { 0.4 } else { -0.4 };
-            es[i] = Arc::new(e);
-            doc.apply(Edit::SetEllipsoids(es), None);
-            std::hint::black_box(derived.density(doc.scene(), doc.revisions()));
-        });
+        let (moved, mut derived) = one_ellipsoid_moved(&mut doc);
         let field = crate::derive::field_of(doc.scene());
         let brute = time_median(1, &mut || {
             std::hint::black_box(crate::field::bake_brute_force(&field, res));
@@ -370,6 +358,25 @@ fn field_at_scale() -> Vec<BenchResult> {
     out
 }
 
+/// The median time of the density update after one ellipsoid of `doc` moved (a different
+/// one each time), and the derivation cache it leaves.
+fn one_ellipsoid_moved(doc: &mut Document) -> (f64, Derived) {
+    let mut derived = Derived::default();
+    derived.density(doc.scene(), doc.revisions());
+    let mut step = 0usize;
+    let moved = time_median(15, &mut || {
+        step += 1;
+        let mut es = doc.scene().ellipsoids.clone();
+        let i = (step * 7919) % es.len();
+        let mut e = (*es[i]).clone();
+        e.center.x += if step.is_multiple_of(2) { 0.4 } else { -0.4 };
+        es[i] = Arc::new(e);
+        doc.apply(Edit::SetEllipsoids(es), None);
+        std::hint::black_box(derived.density(doc.scene(), doc.revisions()));
+    });
+    (moved, derived)
+}
+
 /// The other way to build the field (ARCHITECTURE.md, "The field at scale"): every texel
 /// evaluated on the GPU, one render pass per slice, against the CPU's full bake on the same
 /// grid and the CPU's partial update after one primitive moved (which the app uses).
@@ -388,19 +395,7 @@ fn field_gpu_baseline(offscreen: &mut Offscreen) -> Result<Vec<BenchResult>, Str
         let cpu = time_median(5, &mut || {
             std::hint::black_box(crate::field::bake(&field, res));
         });
-        let mut derived = Derived::default();
-        derived.density(doc.scene(), doc.revisions());
-        let mut step = 0usize;
-        let moved = time_median(15, &mut || {
-            step += 1;
-            let mut es = doc.scene().ellipsoids.clone();
-            let i = (step * 7919) % es.len();
-            let mut e = (*es[i]).clone();
-            e.center.x += if step.is_multiple_of(2) { 0.4 } else { -0.4 };
-            es[i] = Arc::new(e);
-            doc.apply(Edit::SetEllipsoids(es), None);
-            std::hint::black_box(derived.density(doc.scene(), doc.revisions()));
-        });
+        let (moved, _) = one_ellipsoid_moved(&mut doc);
         let gpu_name = format!("field_gpu_full_{n}_ellipsoids");
         out.push(result(
             &gpu_name,

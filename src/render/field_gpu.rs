@@ -8,6 +8,7 @@
 use std::num::NonZeroU64;
 
 use super::gpu_types::FieldSliceUniforms;
+use super::passes::full_pipeline;
 use super::shaders;
 use crate::field::{Blob, DensityVolume, Field, lattice};
 
@@ -76,40 +77,14 @@ impl FieldEvaluator {
                 },
             ],
         });
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("field_eval.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(shaders::FIELD_EVAL.into()),
-        });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("field evaluation"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("field evaluation"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: wgpu::PrimitiveState::default(),
-            depth_stencil: None,
-            multisample: wgpu::MultisampleState::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: FORMAT,
-                    blend: None,
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let pipeline = full_pipeline(
+            device,
+            "field evaluation",
+            shaders::FIELD_EVAL,
+            &[&layout],
+            FORMAT,
+            None,
+        );
         let align = device.limits().min_uniform_buffer_offset_alignment.max(16) as u64;
         Self {
             pipeline,

@@ -50,13 +50,8 @@ pub fn starting_scene(opening: Opening, autosave: Option<&str>) -> Start {
         start.notice = Some((message, true));
         start
     };
-    let repaired = |what: String, repairs: Vec<String>| {
-        if repairs.is_empty() {
-            what
-        } else {
-            format!("{what}; repaired {}", repairs.join(", "))
-        }
-    };
+    let repaired =
+        |what: String, repairs: Vec<String>| super::scene_files::with_repairs(what, &repairs);
     match opening {
         Opening::Preset(name) => match Preset::from_name(name) {
             Some(preset) => opened(Scene::preset(preset), None, None),

@@ -269,7 +269,8 @@ impl SceneFiles {
     }
 }
 
-fn with_repairs(text: String, repairs: &[String]) -> String {
+/// `text`, and what validation repaired, if anything.
+pub(super) fn with_repairs(text: String, repairs: &[String]) -> String {
     if repairs.is_empty() {
         text
     } else {

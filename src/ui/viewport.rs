@@ -106,20 +106,19 @@ impl Viewport {
         // a pass over the view, under the reference image and the cloud.
         let painter = ui.painter_at(rect);
         let scene = cx.doc.scene();
-        let aspect = rect.aspect_ratio();
+        // What this frame shows, for the sky and the volume alike.
+        let view = View {
+            camera: scene.camera.clone(),
+            light: scene.light.clone(),
+            render: scene.render.clone(),
+            time: scene.time,
+            aspect: rect.aspect_ratio(),
+            crop: crate::render::FULL_VIEW,
+        };
         if scene.light.sky_gradient && self.stats.backend.is_some() {
             painter.add(egui_wgpu::Callback::new_paint_callback(
                 rect,
-                SkyPaint {
-                    view: View {
-                        camera: scene.camera.clone(),
-                        light: scene.light.clone(),
-                        render: scene.render.clone(),
-                        time: scene.time,
-                        aspect,
-                        crop: crate::render::FULL_VIEW,
-                    },
-                },
+                SkyPaint { view: view.clone() },
             ));
         }
         guide.paint(&painter, rect, cx.doc, false);
@@ -151,7 +150,7 @@ impl Viewport {
             .then(|| {
                 scene
                     .camera
-                    .ndc_bounds(density.min, density.min + density.size, aspect)
+                    .ndc_bounds(density.min, density.min + density.size, view.aspect)
             })
             .flatten()
             .map(|ndc| PixelCrop::snap(ndc, px));
@@ -175,12 +174,8 @@ impl Viewport {
             let job = plan.job.map(|plan| SliceJob {
                 plan,
                 view: View {
-                    camera: scene.camera.clone(),
-                    light: scene.light.clone(),
-                    render: scene.render.clone(),
-                    time: scene.time,
-                    aspect,
                     crop: crop.ndc(px),
+                    ..view.clone()
                 },
             });
             if self.stats.backend.is_some() {
