@@ -165,7 +165,7 @@ pub const LIGHT_RESOLUTION: Param = Param::linear(
     "Resolution of the light volume the shadows come from: finer shows smaller shadow detail, costs more whenever the light, the shape or the moving noise changes",
     8.0,
     96.0,
-    40.0,
+    24.0,
 );
 /// Noise octaves the light volume sees.
 pub const LIGHT_OCTAVES: Param = Param::linear(

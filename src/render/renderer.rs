@@ -50,6 +50,9 @@ struct LightVolume {
     slice_view: wgpu::TextureView,
 }
 
+/// March steps of the light volume, at most.
+const MAX_LIGHT_STEPS: u32 = 48;
+
 /// The light grid for a density grid of `dims`: `resolution` texels along its longest side,
 /// the others in proportion (at least 2, at most [`MAX_LIGHT_SLICES`]).
 fn light_dims(dims: glam::UVec3, resolution: u32) -> [u32; 3] {
@@ -190,8 +193,13 @@ impl VolumeRenderer {
         }
         let r = &view.render;
         let dims = light_dims(volume.dims, r.light_resolution);
-        let h = (volume.size / glam::UVec3::from_array(dims).as_vec3()).min_element();
-        let steps = ((volume.size.length() / h.max(1e-6)).ceil() as u32).clamp(1, 512);
+        // Steps of a light texel across the box, at most [`MAX_LIGHT_STEPS`] (longer steps on a
+        // fine grid): the pass must stay cheap on CPU adapters, where it holds up a frame.
+        let diagonal = volume.size.length();
+        let h = (volume.size / glam::UVec3::from_array(dims).as_vec3())
+            .min_element()
+            .max(diagonal / MAX_LIGHT_STEPS as f32);
+        let steps = ((diagonal / h.max(1e-6)).ceil() as u32).clamp(1, MAX_LIGHT_STEPS);
         let uniforms = VolumeUniforms::new(view, &volume, 1, 0);
         let key = {
             use std::hash::{Hash, Hasher};
