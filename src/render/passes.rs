@@ -12,6 +12,25 @@ use super::shaders;
 /// Slice draws one frame (one submit) may record.
 pub const MAX_SLICE_DRAWS_PER_FRAME: u32 = 8;
 
+/// A uniform buffer entry of `size` bytes at `binding`, with a dynamic offset when `dynamic`.
+pub fn uniform_entry(
+    binding: u32,
+    visibility: wgpu::ShaderStages,
+    size: u64,
+    dynamic: bool,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: dynamic,
+            min_binding_size: NonZeroU64::new(size),
+        },
+        count: None,
+    }
+}
+
 fn texture_entry(
     binding: u32,
     view_dimension: wgpu::TextureViewDimension,
@@ -138,16 +157,7 @@ impl SlicePass {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("volume"),
             entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: true,
-                        min_binding_size: NonZeroU64::new(size),
-                    },
-                    count: None,
-                },
+                uniform_entry(0, wgpu::ShaderStages::VERTEX_FRAGMENT, size, true),
                 texture_3d(1),
                 sampler_entry(2),
                 texture_3d(3),
@@ -272,16 +282,7 @@ impl SkyPass {
         let size = std::mem::size_of::<SkyUniforms>() as u64;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("sky"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::FRAGMENT,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: false,
-                    min_binding_size: NonZeroU64::new(size),
-                },
-                count: None,
-            }],
+            entries: &[uniform_entry(0, wgpu::ShaderStages::FRAGMENT, size, false)],
         });
         let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("sky uniforms"),
@@ -345,16 +346,7 @@ impl LightPass {
         let volume_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("light volume: volume"),
             entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: true,
-                        min_binding_size: NonZeroU64::new(volume_size),
-                    },
-                    count: None,
-                },
+                uniform_entry(0, wgpu::ShaderStages::VERTEX_FRAGMENT, volume_size, true),
                 texture_3d(1),
                 sampler_entry(2),
                 texture_3d(3),
@@ -364,16 +356,7 @@ impl LightPass {
         let size = std::mem::size_of::<LightSliceUniforms>() as u64;
         let slice_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("light volume: slice"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::FRAGMENT,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: true,
-                    min_binding_size: NonZeroU64::new(size),
-                },
-                count: None,
-            }],
+            entries: &[uniform_entry(0, wgpu::ShaderStages::FRAGMENT, size, true)],
         });
         let align = device.limits().min_uniform_buffer_offset_alignment.max(16) as u64;
         let stride = size.div_ceil(align) * align;
