@@ -1,6 +1,6 @@
 // Benchmark baseline only: the plain slice shader of the toolchain notes. Every slice is a
-// quad over the whole viewport and every fragment takes four trilinear 3D-texture samples
-// (field and light in one, three noise octaves), with no bounding of the slices and no empty-space skipping.
+// quad over the whole viewport and every fragment takes five trilinear 3D-texture samples
+// (field, light, three noise octaves), with no bounding of the slices and no empty-space skipping.
 // `cloudsketch bench` reports the real renderer as a ratio against it.
 // Composed after volume_common.wgsl, like volume.wgsl (same uniforms and bind group).
 
@@ -27,7 +27,7 @@ fn vs_main(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> 
 fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
     let s = textureSampleLevel(volume_tex, clamp_smp, in.uvw, 0.0);
     let f = s.r;
-    let sun = s.g;
+    let sun = textureSampleLevel(light_tex, clamp_smp, in.uvw, 0.0).r;
     var n = 0.0;
     var scale = 1.0;
     for (var i = 0; i < 3; i = i + 1) {

@@ -198,8 +198,9 @@ pub fn sketched_scene(n: usize) -> Scene {
     scene
 }
 
-/// A light-slider tick (the sun's azimuth: the slider that costs most, a new light sweep) on a
-/// 10-stroke scene, until the next frame's volumes are ready, against deriving everything.
+/// A light-slider tick (the sun's azimuth, which makes the GPU rebuild its light volume: that
+/// pass is timed by the `light_volume_gpu_*` rows) on a 10-stroke scene, until the next
+/// frame's volumes are ready, against deriving everything.
 fn light_tick() -> Vec<BenchResult> {
     let mut doc = Document::new(sketched_scene(10));
     let mut derived = Derived::default();
@@ -301,8 +302,7 @@ pub fn ellipsoid_bank(n: usize) -> Scene {
 }
 
 /// The field's density volume for 100 and 2,000 ellipsoids: a full rebuild, and one primitive
-/// moved (the partial update), each against brute force (every primitive at every texel); the
-/// light sweep that follows a geometry change is reported apart.
+/// moved (the partial update), each against brute force (every primitive at every texel).
 fn field_at_scale() -> Vec<BenchResult> {
     let mut out = Vec::new();
     for n in [100, 2_000] {
@@ -311,19 +311,10 @@ fn field_at_scale() -> Vec<BenchResult> {
         let full = time_median(5, &mut || {
             std::hint::black_box(Derived::default().density(doc.scene(), doc.revisions()));
         });
-        let (moved, mut derived) = one_ellipsoid_moved(&mut doc);
+        let (moved, _) = one_ellipsoid_moved(&mut doc);
         let field = crate::derive::field_of(doc.scene());
         let brute = time_median(1, &mut || {
             std::hint::black_box(crate::field::bake_brute_force(&field, res));
-        });
-        let volume = derived.density(doc.scene(), doc.revisions()).data;
-        let params = crate::derive::LightParams {
-            sun_dir: doc.scene().light.sun_direction(),
-            extinction: doc.scene().render.opacity,
-            softness: doc.scene().render.softness,
-        };
-        let light = time_median(5, &mut || {
-            std::hint::black_box(crate::derive::sweep(&volume, &params));
         });
         let brute_name = format!("field_brute_force_{n}_ellipsoids");
         out.push(result(
@@ -346,13 +337,6 @@ fn field_at_scale() -> Vec<BenchResult> {
             "ms",
             &format!("field_full_rebuild_{n}_ellipsoids"),
             full * 1e3,
-        ));
-        out.push(result(
-            &format!("light_sweep_after_a_move_{n}_ellipsoids"),
-            light * 1e3,
-            "ms",
-            &format!("field_one_of_{n}_ellipsoids_moved"),
-            moved * 1e3,
         ));
     }
     out
@@ -465,42 +449,29 @@ fn worst_documents_bench() -> Vec<BenchResult> {
         .collect()
 }
 
-/// The GPU light volume of the default cloud (its noise included) at the default light
-/// resolution and octaves, and without noise, against the CPU's transmittance sweep of the
-/// same field (which sees no noise).
+/// The GPU light volume of the default cloud at the default light resolution with its noise
+/// (2 and 4 octaves), against the same pass without noise.
 fn light_volume(offscreen: &mut Offscreen) -> Result<Vec<BenchResult>, String> {
     let scene = Scene::default();
-    let doc = Document::new(scene.clone());
-    let volume = Derived::default()
-        .density(doc.scene(), doc.revisions())
-        .data;
-    let params = crate::derive::LightParams {
-        sun_dir: scene.light.sun_direction(),
-        extinction: scene.render.opacity,
-        softness: scene.render.softness,
-    };
-    let cpu = time_median(5, &mut || {
-        std::hint::black_box(crate::derive::sweep(&volume, &params));
-    });
-    let mut out = Vec::new();
-    for (name, octaves) in [
-        ("light_volume_gpu_2_octaves", 2u32),
-        ("light_volume_gpu_no_noise", 0),
-    ] {
+    let mut time = |octaves: u32| -> Result<f64, String> {
         let mut s = scene.clone();
         s.render.light_octaves = octaves;
-        let gpu = median(
+        Ok(median(
             offscreen
                 .time_light_volume(&s, 4)
                 .map_err(|e| e.to_string())?
                 .split_off(1),
-        );
+        ))
+    };
+    let plain = time(0)?;
+    let mut out = Vec::new();
+    for octaves in [2u32, 4] {
         out.push(result(
-            name,
-            gpu * 1e3,
+            &format!("light_volume_gpu_{octaves}_octaves"),
+            time(octaves)? * 1e3,
             "ms",
-            "light_sweep_cpu_no_noise",
-            cpu * 1e3,
+            "light_volume_gpu_no_noise",
+            plain * 1e3,
         ));
     }
     Ok(out)

@@ -279,6 +279,14 @@ pub const MULTIPLE_SCATTERING: Param = Param::linear(
     1.0,
     0.5,
 );
+/// Exposure in stops: the cloud's light (sun and sky) times 2^EV before tone mapping.
+pub const EXPOSURE: Param = Param::linear(
+    "exposure (EV)",
+    "Brightens or darkens the cloud's light before tone mapping, in photographic stops; the background keeps its colour",
+    -4.0,
+    4.0,
+    0.0,
+);
 /// Sketch: simplification tolerance as a fraction of the outline's size.
 pub const SIMPLIFY: Param = Param::linear(
     "simplify",
@@ -354,6 +362,7 @@ mod tests {
             LIGHT_OCTAVES,
             FORWARD_SCATTERING,
             MULTIPLE_SCATTERING,
+            EXPOSURE,
         ] {
             assert!(
                 p.min < p.max && (p.min..=p.max).contains(&p.default),

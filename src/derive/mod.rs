@@ -1,14 +1,13 @@
 //! The one pure derivation layer: document → spheres per plane (cached per plane) → field →
-//! density volume, and density volume + sun → light volume (cached apart, so a light slider
-//! re-interprets no stroke and re-bakes no geometry). Everything here is a deterministic
-//! function of the document; the renderer, the CLI and the app all consume [`Volumes`].
+//! density volume, keyed on the geometry's revision alone (a light or media slider
+//! re-interprets no stroke and re-bakes no geometry; the light toward the sun is the
+//! renderer's GPU light volume). Everything here is a deterministic function of the document;
+//! the renderer, the CLI, the exporters and the app all consume [`Volumes`].
 
-mod light;
 mod planes;
 
 use std::sync::Arc;
 
-pub use light::{LightParams, LightVolume, sweep};
 pub use planes::{PlaneCache, Shape};
 
 use crate::field::{
@@ -36,13 +35,11 @@ impl<T> Clone for Versioned<T> {
     }
 }
 
-/// What the renderer draws: the density volume, its light, and the noise seed.
+/// What the renderer draws: the density volume and the noise seed.
 #[derive(Clone, Debug)]
 pub struct Volumes {
     /// Field values on a grid.
     pub density: Versioned<DensityVolume>,
-    /// Transmittance toward the sun on the same grid.
-    pub light: Versioned<LightVolume>,
     /// Seed of the noise media.
     pub noise_seed: u64,
 }
@@ -54,8 +51,6 @@ pub struct Work {
     pub interpretations: u64,
     /// Fields assembled and baked into a density volume.
     pub bakes: u64,
-    /// Light sweeps.
-    pub sweeps: u64,
     /// Kernel evaluations and clip tests of all bakes ([`bake_work`] for a full one; a
     /// partial update counts what it re-evaluated).
     pub bake_work: u64,
@@ -156,12 +151,6 @@ struct GeometryKey {
     resolution: u32,
 }
 
-#[derive(Clone, Copy, PartialEq)]
-struct LightKey {
-    density: u64,
-    params: LightParams,
-}
-
 /// The derivation cache of one document (keep one per viewport or offscreen device).
 #[derive(Default)]
 pub struct Derived {
@@ -169,7 +158,6 @@ pub struct Derived {
     field: Option<(u64, Arc<Field>)>,
     density: Option<(GeometryKey, Versioned<DensityVolume>)>,
     baker: Baker,
-    light: Option<(LightKey, Versioned<LightVolume>)>,
     generation: u64,
     work: Work,
 }
@@ -221,31 +209,8 @@ impl Derived {
 
     /// The volumes of `scene` whose parts are at `revisions`; derives only what changed.
     pub fn update(&mut self, scene: &Scene, revisions: Revisions) -> Volumes {
-        let density = self.density(scene, revisions);
-        let lkey = LightKey {
-            density: density.generation,
-            params: LightParams {
-                sun_dir: scene.light.sun_direction(),
-                extinction: scene.render.opacity,
-                softness: scene.render.softness,
-            },
-        };
-        let light = match &self.light {
-            Some((k, v)) if *k == lkey => v.clone(),
-            _ => {
-                self.generation += 1;
-                self.work.sweeps += 1;
-                let v = Versioned {
-                    generation: self.generation,
-                    data: Arc::new(sweep(&density.data, &lkey.params)),
-                };
-                self.light = Some((lkey, v.clone()));
-                v
-            }
-        };
         Volumes {
-            density,
-            light,
+            density: self.density(scene, revisions),
             noise_seed: scene.seed,
         }
     }
@@ -269,7 +234,6 @@ impl Derived {
     pub fn forget_grid(&mut self) {
         self.baker = Baker::default();
         self.density = None;
-        self.light = None;
     }
 
     /// The work done so far.

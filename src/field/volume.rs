@@ -1,6 +1,6 @@
 //! The neutral density volume: a field (or, later, a simulation) sampled on a capped regular
 //! grid. The renderer uploads it as a 3D texture (WebGL2 has no storage buffers or compute),
-//! the light sweep reads it, and exporters will write it.
+//! and the exporters write it.
 //!
 //! Texels are cubes of side `h` on a lattice anchored at the world origin (texel centres at
 //! `(n + ½)·h`), so two grids of one texel size share their texels wherever they overlap: an

@@ -41,10 +41,10 @@ pub struct VolumeUniforms {
     /// z: spacing between slices in world units, w: Sharpness (the alpha cut-off as a share of
     /// a slice's opacity at full density, Table 2).
     pub slicing: [f32; 4],
-    /// Linear sun colour × intensity (rgb); w: Dirtiness (the exponent on the transmittance
+    /// Linear sun colour × intensity × 2^exposure (rgb); w: Dirtiness (the exponent on the transmittance
     /// toward the sun).
     pub sun_color: [f32; 4],
-    /// Linear sky colour × ambient intensity (rgb); w: the multiple-scattering weight.
+    /// Linear sky colour × ambient intensity × 2^exposure (rgb); w: the multiple-scattering weight.
     pub sky_color: [f32; 4],
     /// Unit direction toward the sun (xyz); w: the phase function's asymmetry g.
     pub sun_dir: [f32; 4],
@@ -264,8 +264,9 @@ impl VolumeUniforms {
         let (center, radius) = volume.bounding_sphere();
         let total = total.max(1);
         let (camera, light, r) = (&view.camera, &view.light, &view.render);
-        let sun_color = srgb_to_linear(light.sun_color) * light.sun_intensity;
-        let sky_color = srgb_to_linear(light.sky_color) * light.ambient;
+        let exposure = light.exposure.exp2();
+        let sun_color = srgb_to_linear(light.sun_color) * (light.sun_intensity * exposure);
+        let sky_color = srgb_to_linear(light.sky_color) * (light.ambient * exposure);
         let inv_size = Vec3::ONE / volume.size.max(Vec3::splat(1e-6));
         let octaves = r.noise_octaves.min(MAX_OCTAVES as u32);
         // Slices span only the depth the grid's box takes along the view (a flat layer seen

@@ -1,5 +1,5 @@
-//! GPU resources of the volume renderer: the volume (density and light) and noise 3D textures (uploaded
-//! only when their generation changes), samplers, and the accumulation targets.
+//! GPU resources of the volume renderer: the field and noise 3D textures (uploaded only when
+//! their generation changes), samplers, and the accumulation targets.
 
 use std::sync::Arc;
 
@@ -10,14 +10,11 @@ use crate::field::DensityVolume;
 /// Number of accumulation targets (a preview and a refinement).
 pub const TARGETS: usize = 2;
 
-/// Density and light interleaved as the bytes of an `Rg8Unorm` texture: one fetch per sample
-/// gives both (a second 3D texture cost the slice shader a third of its time on lavapipe).
-fn pack(density: &[f32], light: &[f32]) -> Vec<u8> {
-    let byte = |v: f32| (v.clamp(0.0, 1.0) * 255.0).round() as u8;
-    density
+/// The field as the bytes of an `R8Unorm` texture.
+fn pack(field: &[f32]) -> Vec<u8> {
+    field
         .iter()
-        .zip(light)
-        .flat_map(|(&d, &l)| [byte(d), byte(l)])
+        .map(|&v| (v.clamp(0.0, 1.0) * 255.0).round() as u8)
         .collect()
 }
 
@@ -80,8 +77,7 @@ fn refresh(
 
 /// The volume's textures as uploaded.
 pub struct VolumeTextures {
-    /// Density (red) and light (green) as uploaded, keyed by the light's generation (which
-    /// changes whenever the density does), and its view.
+    /// The field (red) as uploaded, keyed by the density volume's generation, and its view.
     pub volume: Option<(u64, wgpu::TextureView)>,
     /// The density volume uploaded (its box places the slices).
     pub density_volume: Arc<DensityVolume>,
@@ -101,14 +97,14 @@ impl VolumeTextures {
 
     /// Uploads whatever changed in `volumes`; returns whether any texture was replaced.
     pub fn upload(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, v: &Volumes) -> bool {
-        let (d, l) = (&v.density.data, &v.light.data);
-        let volume = refresh(&mut self.volume, v.light.generation, || {
-            let rg8 = wgpu::TextureFormat::Rg8Unorm;
-            if d.is_empty() || l.values.len() != d.values.len() {
-                upload_3d(device, queue, "volume", [1, 1, 1], rg8, &[0, 255])
+        let d = &v.density.data;
+        let volume = refresh(&mut self.volume, v.density.generation, || {
+            let r8 = wgpu::TextureFormat::R8Unorm;
+            if d.is_empty() {
+                upload_3d(device, queue, "volume", [1, 1, 1], r8, &[0])
             } else {
-                let bytes = pack(&d.values, &l.values);
-                upload_3d(device, queue, "volume", d.dims.to_array(), rg8, &bytes)
+                let bytes = pack(&d.values);
+                upload_3d(device, queue, "volume", d.dims.to_array(), r8, &bytes)
             }
         });
         if volume {

@@ -266,6 +266,8 @@ pub struct Lighting {
     pub sky_gradient: bool,
     /// The sky's colour at the horizon (with `sky_gradient`).
     pub horizon_color: [f32; 3],
+    /// Exposure in stops: sun and sky light times 2^EV before tone mapping.
+    pub exposure: f32,
 }
 
 impl Default for Lighting {
@@ -282,6 +284,7 @@ impl Default for Lighting {
             multiple_scattering: limits::MULTIPLE_SCATTERING.default as f32,
             sky_gradient: false,
             horizon_color: [0.78, 0.84, 0.9],
+            exposure: limits::EXPOSURE.default as f32,
         }
     }
 }
@@ -304,6 +307,7 @@ impl Lighting {
         self.ambient = limits::AMBIENT.fix_f32(self.ambient);
         self.forward_scattering = limits::FORWARD_SCATTERING.fix_f32(self.forward_scattering);
         self.multiple_scattering = limits::MULTIPLE_SCATTERING.fix_f32(self.multiple_scattering);
+        self.exposure = limits::EXPOSURE.fix_f32(self.exposure);
         for c in [
             &mut self.sun_color,
             &mut self.sky_color,

@@ -338,7 +338,8 @@ impl CloudApp {
         }
     }
 
-    fn publish(&mut self) {
+    fn publish(&mut self, ctx: &egui::Context) {
+        let widgets = super::widgets::take_marks(ctx);
         let Some(host) = self.host.as_mut() else {
             return;
         };
@@ -391,6 +392,11 @@ impl CloudApp {
                     "z": at(g.handle_end(Axis::Z)),
                 })
             }),
+            "sun_handle": super::sun_handle::orb(self.viewport.rect).map(|(c, r)| {
+                serde_json::json!({ "center": [c.x, c.y], "radius": r })
+            }),
+            "widgets": widgets,
+            "sun": [self.doc.scene().light.sun_azimuth_deg, self.doc.scene().light.sun_elevation_deg],
             "axis_lock": self.tool.axis_lock.map(|a| a.name()),
             "playing": self.panels.clock.playing,
             "guides_hidden": self.tool.hide_guides,
@@ -511,6 +517,6 @@ impl eframe::App for CloudApp {
             self.doc.end_merge();
         }
         self.autosave(&ctx);
-        self.publish();
+        self.publish(&ctx);
     }
 }

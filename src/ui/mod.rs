@@ -10,6 +10,7 @@
 //! - `ellipsoids`: adding, picking, moving, duplicating and deleting ellipsoids;
 //! - `gizmo`: the on-canvas Move, Rotate and Scale handles and their drag maths;
 //! - `picking`: what a click or a dragged box selects;
+//! - `sun_handle`: the orb in the view's corner that shows and turns the sun;
 //! - `guide`: the reference image (loading, texture, drawing, its panel group);
 //! - `scene_files`: Open, Save, Copy link, the unsaved marker and links pasted into the page;
 //! - `panels`: one struct per side-panel group, each with its own `ui()`;
@@ -34,6 +35,7 @@ mod platform;
 mod scene_files;
 mod selection;
 mod sketch_tool;
+mod sun_handle;
 mod viewport;
 mod widgets;
 

@@ -129,7 +129,7 @@ impl Viewport {
             (rect.height() * ppp).round().max(1.0) as u32,
         ];
         self.stats.viewport_px = px;
-        // The geometry first, timed apart (the light sweep follows in `update`).
+        // The geometry, timed.
         let (before, t0) = (cx.derived.work(), super::platform::now());
         let density = cx.derived.density(scene, cx.doc.revisions());
         let work = cx.derived.work();
@@ -200,6 +200,9 @@ impl Viewport {
         guide.paint(&ui.painter_at(rect), rect, cx.doc, true);
         self.status_line(ui, rect, cx.doc, cx.notices, now);
         tool.overlay(ui, rect, cx.doc, cx.derived, cx.selection);
+        if self.stats.backend.is_some() {
+            super::sun_handle::show(ui, rect, cx.doc);
+        }
     }
 
     fn status_line(

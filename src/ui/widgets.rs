@@ -45,16 +45,46 @@ pub fn install_fonts(ctx: &egui::Context) {
     ctx.set_fonts(font_definitions(true));
 }
 
+/// Where named widgets were drawn this frame (left, top, width, height in points), published
+/// in the page state so the browser tests press the real widgets rather than guessed places.
+type Marks = std::collections::BTreeMap<String, [f32; 4]>;
+
+fn marks_id() -> egui::Id {
+    egui::Id::unique("widget marks")
+}
+
+/// Records where the widget `name` was drawn this frame.
+pub fn mark(ui: &Ui, name: &str, rect: egui::Rect) {
+    ui.data_mut(|d| {
+        d.get_temp_mut_or_default::<Marks>(marks_id()).insert(
+            name.to_owned(),
+            [rect.left(), rect.top(), rect.width(), rect.height()],
+        );
+    });
+}
+
+/// Takes the marks recorded since the last call (call once a frame, after the UI).
+pub fn take_marks(ctx: &egui::Context) -> Marks {
+    ctx.data_mut(|d| d.remove_temp::<Marks>(marks_id()))
+        .unwrap_or_default()
+}
+
 /// A slider over a parameter's one range, with its label and tooltip (see [`crate::limits`]).
-/// Returns whether it changed.
+/// Its rail is marked as `param:LABEL` (see [`mark`]). Returns whether it changed.
 pub fn param<T: egui::emath::Numeric>(ui: &mut Ui, value: &mut T, param: &Param) -> bool {
-    ui.add(
-        Slider::new(value, T::from_f64(param.min)..=T::from_f64(param.max))
-            .logarithmic(param.logarithmic)
-            .text(param.label),
-    )
-    .on_hover_text(param.tip)
-    .changed()
+    let response = ui
+        .add(
+            Slider::new(value, T::from_f64(param.min)..=T::from_f64(param.max))
+                .logarithmic(param.logarithmic)
+                .text(param.label),
+        )
+        .on_hover_text(param.tip);
+    let rail = egui::Rect::from_min_size(
+        response.rect.min,
+        egui::vec2(ui.spacing().slider_width, response.rect.height()),
+    );
+    mark(ui, &format!("param:{}", param.label), rail);
+    response.changed()
 }
 
 /// A colour button for an sRGB colour in [0, 1]. Returns whether it changed.

@@ -4,7 +4,7 @@
 // test-results/screenshots/media-*.png.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { serve, launch, openApp, waitForBody, state, screenshot, countChanged, until, withApp, waitForFullQuality } from './harness.mjs';
+import { serve, launch, openApp, waitForBody, state, screenshot, countChanged, countDiffering, until, withApp, waitForFullQuality } from './harness.mjs';
 
 let server;
 before(async () => { server = await serve(); });
@@ -118,6 +118,103 @@ for (const backend of ['webgpu', 'webgl2']) {
       const upper = countChanged(plain, tiered, { x: 0, y: 0, w: vw, h: vh * 0.4 });
       const lower = countChanged(plain, tiered, { x: 0, y: vh * 0.6, w: vw, h: vh * 0.4 });
       assert.ok(upper > 2000 && upper > 4 * lower, `changed above ${upper} px, below ${lower} px`);
+    });
+  });
+}
+
+// The real widgets: each preset button of the Scene group, the Opacity slider and the sun
+// handle in the view's corner, pressed where the page state says the app drew them.
+for (const backend of ['webgpu', 'webgl2']) {
+  test(`preset buttons, the opacity slider and the sun handle change the image (${backend})`, { timeout: 300_000 }, async () => {
+    await withApp({ base: server.url, webgpu: backend === 'webgpu', viewport: { width: 1280, height: 800 } }, async (page) => {
+      let s = await state(page);
+      const [vw, vh] = s.view.viewport;
+      const body = { x: 0, y: 60, w: vw, h: vh - 90 };
+      const centre = (r) => [r[0] + r[2] / 2, r[1] + r[3] / 2];
+      const away = async () => { await page.mouse.move(5, vh - 5); };
+      // Scrolls the side panel (with the wheel, over the panel) until widget `name` is in view.
+      const reveal = async (name) => {
+        for (let i = 0; i < 20; i++) {
+          const r = (await state(page)).view.widgets[name];
+          assert.ok(r, `${name} is drawn`);
+          if (r[1] >= 10 && r[1] + r[3] <= vh - 10) return r;
+          await page.mouse.move(vw + 100, vh / 2);
+          await page.mouse.wheel(0, r[1] < 10 ? -200 : 200);
+          await page.waitForTimeout(150);
+        }
+        throw new Error(`${name} never came into view`);
+      };
+      await away();
+      await waitForFullQuality(page);
+      let last = await screenshot(page, `widgets-0-start-${backend}`);
+      // Every preset from its button: one undo step each, and an image unlike the last.
+      for (const name of ['stratus', 'cirrus', 'cumulonimbus', 'sunset', 'cumulus']) {
+        const undo = s.view.undo;
+        await page.mouse.click(...centre(await reveal(`preset:${name}`)));
+        s = await until(page, (s) => s.view.undo === undo + 1, `the ${name} preset`);
+        await away();
+        await waitForFullQuality(page);
+        const img = await screenshot(page, `widgets-preset-${name}-${backend}`);
+        const d = countChanged(last, img, body);
+        assert.ok(d > 0.05 * vw * vh, `${name}: ${d} px changed`);
+        last = img;
+      }
+      s = await state(page);
+      assert.equal(s.scene.light.sky_gradient, false, 'cumulus has a flat sky (coverage is measured against it)');
+      const bg = s.scene.light.background.map((v) => Math.round(v * 255));
+      const coverage = (img) => countDiffering(img, body, bg, 18);
+
+      // Opacity: a press near the right end of its slider's rail raises it; more pixels cover.
+      const opacity = s.scene.render.opacity;
+      const rail = await reveal('param:opacity');
+      await page.mouse.click(rail[0] + rail[2] * 0.93, rail[1] + rail[3] / 2);
+      s = await until(page, (s) => s.scene.render.opacity > opacity * 1.5, 'more opacity');
+      await away();
+      await waitForFullQuality(page);
+      const opaque = await screenshot(page, `widgets-opacity-${backend}`);
+      assert.ok(coverage(opaque) > coverage(last) * 1.02,
+        `opacity ${opacity} → ${s.scene.render.opacity.toFixed(2)}: coverage ${coverage(last)} → ${coverage(opaque)} px`);
+
+      // The sun: drag on the orb to its right, then to its left (a drag at pointer-move rate,
+      // one undo step each); the cloud's bright side follows it.
+      const orb = s.view.sun_handle;
+      assert.ok(orb, 'the sun handle is drawn');
+      const [cx, cy] = orb.center;
+      const r = orb.radius;
+      const dragSun = async (dx) => {
+        const undo = (await state(page)).view.undo;
+        await page.mouse.move(cx, cy + 0.2 * r);
+        await page.mouse.down();
+        await page.mouse.move(cx + dx * r, cy - 0.4 * r, { steps: 8 });
+        await page.mouse.up();
+        const s = await until(page, (s) => s.view.undo === undo + 1, 'one undo step for the drag');
+        await away();
+        await waitForFullQuality(page);
+        return s;
+      };
+      // How far right of the cloud's middle its brightness sits, in pixels.
+      const brightBias = (img) => {
+        let n = 0, sx = 0, sl = 0, slx = 0;
+        for (let y = body.y; y < body.y + body.h; y++) {
+          for (let x = body.x; x < body.x + body.w; x++) {
+            const i = 4 * (y * img.width + x);
+            const d = Math.abs(img.data[i] - bg[0]) + Math.abs(img.data[i + 1] - bg[1]) + Math.abs(img.data[i + 2] - bg[2]);
+            if (d <= 18) continue;
+            const l = 0.2126 * img.data[i] + 0.7152 * img.data[i + 1] + 0.0722 * img.data[i + 2];
+            n++; sx += x; sl += l; slx += l * x;
+          }
+        }
+        return slx / sl - sx / n;
+      };
+      const right = await dragSun(0.8);
+      const litRight = await screenshot(page, `widgets-sun-right-${backend}`);
+      const left = await dragSun(-0.8);
+      const litLeft = await screenshot(page, `widgets-sun-left-${backend}`);
+      assert.notDeepEqual(right.view.sun, left.view.sun, 'the sun turned');
+      const [br, bl] = [brightBias(litRight), brightBias(litLeft)];
+      assert.ok(br > bl + 3, `the bright side follows the sun: ${br.toFixed(1)} px right with the sun right, ${bl.toFixed(1)} px with it left`);
+      await page.keyboard.press('Control+z');
+      await until(page, (s) => JSON.stringify(s.view.sun) === JSON.stringify(right.view.sun), 'undo gives back the first drag\'s sun');
     });
   });
 }

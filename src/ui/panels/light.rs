@@ -15,10 +15,11 @@ fn body(ui: &mut Ui, l: &mut Lighting) {
     param(ui, &mut l.sun_elevation_deg, &limits::SUN_ELEVATION);
     param(ui, &mut l.sun_intensity, &limits::SUN_INTENSITY);
     param(ui, &mut l.ambient, &limits::AMBIENT);
+    param(ui, &mut l.exposure, &limits::EXPOSURE);
     param(ui, &mut l.forward_scattering, &limits::FORWARD_SCATTERING);
     param(ui, &mut l.multiple_scattering, &limits::MULTIPLE_SCATTERING);
-    srgb_button(ui, "sun colour", &mut l.sun_color);
-    srgb_button(ui, "sky colour", &mut l.sky_color);
+    srgb_button(ui, "lit colour (sun)", &mut l.sun_color);
+    srgb_button(ui, "shadow colour (sky)", &mut l.sky_color);
     srgb_button(ui, "background", &mut l.background);
     ui.checkbox(&mut l.sky_gradient, "sky gradient")
         .on_hover_text("The background at the top of the sky, fading to the horizon colour at eye level; off: one flat colour");

@@ -9,7 +9,7 @@ use crate::ui::ellipsoids;
 use crate::ui::notice::Notices;
 use crate::ui::platform;
 use crate::ui::selection::{Item, Selection};
-use crate::ui::widgets::{rotation_fields, vec3_fields};
+use crate::ui::widgets::{mark, rotation_fields, vec3_fields};
 
 /// The Scene group.
 pub struct ScenePanel {
@@ -110,13 +110,11 @@ impl ScenePanel {
                 ui.horizontal_wrapped(|ui| {
                     ui.label("New:");
                     for (preset, name) in Preset::ALL {
-                        if ui
-                            .small_button(name)
-                            .on_hover_text(format!(
-                                "Start again from the {name} preset (Ctrl+Z undoes)"
-                            ))
-                            .clicked()
-                        {
+                        let button = ui.small_button(name).on_hover_text(format!(
+                            "Start again from the {name} preset (Ctrl+Z undoes)"
+                        ));
+                        mark(ui, &format!("preset:{name}"), button.rect);
+                        if button.clicked() {
                             // A preset brings its own camera, framed for its cloud.
                             let scene = Scene::preset(preset);
                             doc.apply(Edit::Replace(Box::new(scene)), None);
