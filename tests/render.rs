@@ -776,3 +776,35 @@ fn a_cloud_shadows_the_one_below_and_the_shadow_has_the_noise_in_it() {
         "noise in the light volume changed the shadow by {changed:.2}"
     );
 }
+
+#[test]
+fn exposure_brightens_the_cloud_by_stops_and_leaves_the_background() {
+    let scene = Scene::default();
+    let bg = background(&scene);
+    let stats = |s: &Scene| {
+        let image = render(s);
+        let (mut sum, mut n) = (0.0, 0usize);
+        for y in 0..image.height {
+            for x in 0..image.width {
+                let p = image.pixel(x, y);
+                if differs(p, bg) {
+                    sum += luminance(p);
+                    n += 1;
+                }
+            }
+        }
+        (sum / n.max(1) as f64, image.pixel(2, 2))
+    };
+    let (dark, corner_dark) = stats(&with(&scene, &["/light/exposure=-1.5"]));
+    let (plain, corner) = stats(&scene);
+    let (bright, corner_bright) = stats(&with(&scene, &["/light/exposure=1.5"]));
+    assert!(
+        dark + 10.0 < plain && plain + 10.0 < bright,
+        "mean cloud luminance at −1.5 / 0 / +1.5 EV: {dark:.1} / {plain:.1} / {bright:.1}"
+    );
+    assert_eq!(
+        (corner_dark, corner_bright),
+        (corner, corner),
+        "the sky keeps its colour"
+    );
+}
