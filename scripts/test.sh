@@ -3,8 +3,9 @@
 # integration tests (pure core, naga validation of shaders/, offscreen lavapipe renders, CLI,
 # link fixtures), a 30-second fuzz run of the link decoders (nightly + cargo-fuzz, installed
 # here when missing), the release web build, and the browser end-to-end tests in headless
-# Chromium (WebGPU on SwiftShader, then the WebGL2 fallback). Screenshots:
-# web/test-results/screenshots/.
+# Chromium (WebGPU on SwiftShader, then the WebGL2 fallback), and the exports read back by
+# independent readers (OpenVDB's Python module, Mitsuba 3, the Khronos glTF validator).
+# Screenshots: web/test-results/screenshots/.
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$ROOT"
@@ -17,6 +18,26 @@ log "cargo test (native)"
 # a display (and print XDG_RUNTIME_DIR errors on a headless machine). The CLI does the same.
 export NODEVICE_SELECT=1
 cargo test --locked
+
+# Independent readers of the exports (test-only tools: not in setup.sh): Debian's OpenVDB
+# Python module, and Mitsuba 3 with numpy in a virtual environment inside the clone that sees
+# the system's site packages (where pyopenvdb lives).
+MITSUBA_VERSION=3.9.1
+if ! /usr/bin/python3 -c 'import pyopenvdb' 2>/dev/null; then
+  log "apt-get install python3-openvdb python3-venv"
+  $( [ "$(id -u)" = 0 ] || echo sudo ) apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $( [ "$(id -u)" = 0 ] || echo sudo ) apt-get install -y -qq --no-install-recommends python3-openvdb python3-venv
+fi
+VENV="$ROOT/target/export-venv"
+if ! "$VENV/bin/python" -c "import mitsuba, numpy, pyopenvdb; assert mitsuba.__version__ == '$MITSUBA_VERSION'" 2>/dev/null; then
+  log "python venv with mitsuba $MITSUBA_VERSION and numpy (target/export-venv)"
+  rm -rf "$VENV"
+  /usr/bin/python3 -m venv --system-site-packages "$VENV"
+  "$VENV/bin/pip" install -q "mitsuba==$MITSUBA_VERSION" numpy
+fi
+log "exports read by OpenVDB, Mitsuba and the glTF validator (files: target/export-check/)"
+"$VENV/bin/python" scripts/check_exports.py target/export-check
+(cd web && node check-glb.mjs ../target/export-check/cloud.glb)
 
 # The fuzz target needs nightly Rust and cargo-fuzz (test-only tools: not in setup.sh).
 CARGO_FUZZ_VERSION=0.13.2

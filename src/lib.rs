@@ -15,6 +15,7 @@
 //! - `cli`, `bench` (native) and `web` (wasm32): the entry points of each target.
 
 pub mod derive;
+pub mod export;
 pub mod field;
 pub mod limits;
 pub mod render;

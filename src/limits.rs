@@ -20,6 +20,10 @@ pub const MAX_PRIMITIVES: usize = 20_000;
 pub const MAX_TIME: f32 = 86_400.0;
 /// Most texels along one side of the density volume.
 pub const MAX_GRID_RESOLUTION: u32 = 128;
+/// Most texels along one side of an exported grid (VDB, Mitsuba, meshes).
+pub const MAX_EXPORT_RESOLUTION: u32 = 256;
+/// Most work (as [`MAX_BAKE_WORK`]) an export's sampling may do: a few seconds natively.
+pub const MAX_EXPORT_WORK: u64 = 1_200_000_000;
 /// Most work one bake of the density volume may do (kernel evaluations plus clip tests; about
 /// half a second natively). A document over it loads with a coarser field grid, or is refused
 /// when even a coarse grid is over; an edit that goes over bakes a coarser grid.
@@ -47,6 +51,8 @@ pub const MAX_LOOK_NAME: usize = 40;
 pub const MAX_UNDO: usize = 200;
 /// Atmospheric tiers above the base media (Schpok et al. 2003, §5.2).
 pub const MAX_TIERS: usize = 2;
+/// Noise octaves the media composite at most.
+pub const MAX_OCTAVES: usize = 8;
 
 /// A numeric parameter: its range, default, the way its slider moves, and its name and
 /// meaning in an artist's words.

@@ -57,7 +57,8 @@ fn uses(code: &str, name: &str) -> bool {
     })
 }
 
-const PURE: [&str; 7] = [
+const PURE: [&str; 8] = [
+    "src/export/",
     "src/scene/",
     "src/sketch/",
     "src/field/",

@@ -1,9 +1,10 @@
 //! The native command line: `cloudsketch` alone opens the desktop app; subcommands work
-//! headless. One file per subcommand: `new`, `render`, `sketch`, `link` (`bench` is
+//! headless. One file per subcommand: `new`, `render`, `sketch`, `link`, `export` (`bench` is
 //! `crate::bench`);
 //! `desktop` opens the window.
 
 mod desktop;
+mod export;
 mod link;
 mod new;
 mod render;
@@ -95,6 +96,39 @@ enum Command {
         #[arg(long, default_value = crate::share::DEFAULT_BASE)]
         base: String,
     },
+    /// Export the cloud for other tools: vdb (OpenVDB fog volume), mitsuba (scene XML + .vol),
+    /// glb, obj, ply (its surface), png (the rendered view).
+    Export {
+        /// Scene JSON or share link; the default scene when left out.
+        scene: Option<String>,
+        /// vdb, mitsuba, glb, obj, ply or png.
+        #[arg(long)]
+        format: String,
+        /// Output file (Mitsuba's .vol is written beside its XML).
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Grid texels along the cloud's longest side (8 to 256).
+        #[arg(long, default_value_t = 128)]
+        resolution: u32,
+        /// The file's up axis: y (the app's, glTF's) or z (Blender's).
+        #[arg(long, default_value = "y")]
+        up: String,
+        /// File length units per world unit.
+        #[arg(long, default_value_t = 1.0)]
+        scale: f32,
+        /// Leave the noise media out (the plain blended field).
+        #[arg(long)]
+        no_noise: bool,
+        /// Image size, WIDTHxHEIGHT (png; Mitsuba's sensor).
+        #[arg(long, default_value = "960x540")]
+        size: String,
+        /// PNG over a transparent background.
+        #[arg(long)]
+        transparent: bool,
+        /// Mitsuba's samples per pixel.
+        #[arg(long, default_value_t = 64)]
+        samples: u32,
+    },
     /// Run the benchmark suite.
     Bench {
         /// Print one JSON object instead of a table.
@@ -148,6 +182,29 @@ pub fn main() -> ExitCode {
             !no_extend,
             seed,
         ),
+        Some(Command::Export {
+            scene,
+            format,
+            output,
+            resolution,
+            up,
+            scale,
+            no_noise,
+            size,
+            transparent,
+            samples,
+        }) => export::run(&export::Request {
+            scene: scene.as_deref(),
+            format: &format,
+            output: &output,
+            resolution,
+            up: &up,
+            scale,
+            no_noise,
+            size: &size,
+            transparent,
+            samples,
+        }),
         Some(Command::Bench { json, only }) => crate::bench::run(json, only.as_deref()),
     };
     match result {

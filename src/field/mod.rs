@@ -8,13 +8,15 @@
 //! visible radius r gets R = 2r: its surface lies exactly at r.
 
 mod inside;
+pub mod media;
+pub mod noise;
 mod volume;
 
 pub use inside::{InsideMap, PlacedInside};
 
 pub use volume::{
-    Baked, Baker, DensityVolume, MAX_RESOLUTION, bake, bake_brute_force, bake_work, density,
-    lattice, resolution_within,
+    Baked, Baker, DensityVolume, MAX_RESOLUTION, bake, bake_brute_force, bake_fine, bake_fine_work,
+    bake_work, density, lattice, resolution_within,
 };
 
 use glam::{Mat3, Vec2, Vec3};

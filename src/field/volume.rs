@@ -94,22 +94,22 @@ pub struct Grid {
 
 impl Grid {
     /// The texel side that puts `resolution` texels along the longest side of `field`'s box.
-    fn texel_for(field: &Field, resolution: u32) -> Option<f32> {
+    fn texel_for(field: &Field, resolution: u32, cap: u32) -> Option<f32> {
         let (lo, hi) = field.bounds()?;
         let extent = (hi - lo).max_element().max(1e-3);
         // One texel of slack: the lattice's floor and ceiling add at most one.
-        let res = resolution.clamp(MIN_SIDE, MAX_RESOLUTION);
+        let res = resolution.clamp(MIN_SIDE, cap);
         Some(extent / (res - 1) as f32)
     }
 
     /// The grid of texel side `h` over `field`'s box, if that stays within the cap per side.
-    fn over(field: &Field, h: f32) -> Option<Self> {
+    fn over(field: &Field, h: f32, cap: u32) -> Option<Self> {
         let (lo, hi) = field.bounds()?;
         let h64 = h as f64;
         let first = (lo.as_dvec3() / h64).floor().as_i64vec3();
         let end = (hi.as_dvec3() / h64).ceil().as_i64vec3();
         let dims = (end - first).max(I64Vec3::splat(MIN_SIDE as i64));
-        (dims.max_element() <= MAX_RESOLUTION as i64).then(|| Self {
+        (dims.max_element() <= cap as i64).then(|| Self {
             origin: first,
             dims: dims.as_uvec3(),
             h,
@@ -118,9 +118,14 @@ impl Grid {
 
     /// The grid with `resolution` texels along the longest side of `field`'s box.
     pub fn of(field: &Field, resolution: u32) -> Option<Self> {
-        let h = Self::texel_for(field, resolution)?;
+        Self::capped(field, resolution, MAX_RESOLUTION)
+    }
+
+    /// [`Grid::of`] with another cap per side (exports go finer than the renderer's grid).
+    fn capped(field: &Field, resolution: u32, cap: u32) -> Option<Self> {
+        let h = Self::texel_for(field, resolution, cap)?;
         // Rounding can push a side one past the cap: widen the texel a hair.
-        Self::over(field, h).or_else(|| Self::over(field, h * 1.02))
+        Self::over(field, h, cap).or_else(|| Self::over(field, h * 1.02, cap))
     }
 
     /// World coordinates of the texel centres along each axis. They depend on the lattice
@@ -416,6 +421,22 @@ pub fn bake(field: &Field, resolution: u32) -> DensityVolume {
     bake_on(field, &grid)
 }
 
+/// [`bake`] at up to [`crate::limits::MAX_EXPORT_RESOLUTION`] texels along the longest side
+/// (exports; the renderer's grid stops at [`MAX_RESOLUTION`]).
+pub fn bake_fine(field: &Field, resolution: u32) -> DensityVolume {
+    let cap = crate::limits::MAX_EXPORT_RESOLUTION;
+    match Grid::capped(field, resolution, cap) {
+        Some(grid) => bake_on(field, &grid),
+        None => DensityVolume::default(),
+    }
+}
+
+/// [`bake_work`] of [`bake_fine`].
+pub fn bake_fine_work(field: &Field, resolution: u32) -> u64 {
+    let cap = crate::limits::MAX_EXPORT_RESOLUTION;
+    Grid::capped(field, resolution, cap).map_or(0, |grid| work_on(field, &grid))
+}
+
 /// Samples `field` at every texel of `grid`.
 fn bake_on(field: &Field, grid: &Grid) -> DensityVolume {
     let mut values = vec![0f32; grid.texels() as usize];
@@ -592,7 +613,7 @@ impl Baker {
         let partial = self.last.as_ref().and_then(|last| {
             let ratio = extent / last.extent;
             let grid = (last.resolution == resolution && (0.5..=2.0).contains(&ratio))
-                .then(|| Grid::over(field, last.grid.h))??;
+                .then(|| Grid::over(field, last.grid.h, MAX_RESOLUTION))??;
             let mut values = vec![0f32; grid.texels() as usize];
             let dirty = changed_boxes(&last.field, field)
                 .map(|boxes| copy_unchanged(&grid, last, &boxes, &mut values))

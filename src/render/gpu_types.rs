@@ -5,13 +5,14 @@
 use std::mem::offset_of;
 
 use bytemuck::{Pod, Zeroable};
-use glam::{Mat4, Quat, Vec3};
+use glam::{Mat4, Vec3};
 
+use crate::field::media::{octave_transform, tier_octave_transform};
 use crate::field::{DensityVolume, ISO};
 use crate::scene::{Lighting, NoiseBasis, NoiseFilter, OrbitCamera, RenderSettings};
 
 /// Noise octaves the slice shader can composite (`MAX_OCTAVES` in volume_common.wgsl).
-pub const MAX_OCTAVES: usize = 8;
+pub const MAX_OCTAVES: usize = crate::limits::MAX_OCTAVES;
 
 /// Atmospheric tiers above the base media the shader blends (`MAX_TIERS` in the WGSL).
 pub const MAX_TIERS: usize = crate::limits::MAX_TIERS;
@@ -196,45 +197,6 @@ pub fn crop_matrix(crop: [f32; 4]) -> Mat4 {
     ])
 }
 
-/// Transform of octave `i` at scene time `time`: world → noise-texture coordinates, scale ×
-/// rotate × translate with frequency `base × lacunarity^i`. Octaves are turned against each
-/// other so their lattices do not line up. The wind carries the noise along (world units per
-/// second) and the torque turns it about the vertical through the origin, each octave
-/// `1 + i/2` times as fast as the first (finer detail moves faster, as turbulence does).
-pub fn octave_transform(render: &RenderSettings, i: usize, time: f32) -> Mat4 {
-    moving_octave(render, render.wind, render.torque, i, time)
-}
-
-/// [`octave_transform`] in atmospheric tier `tier` (1-based; 0 is the base media): its own
-/// wind and torque, except octave 0, which moves with the base everywhere (the paper's Base
-/// tier, which keeps the tiers one cloud).
-pub fn tier_octave_transform(render: &RenderSettings, tier: usize, i: usize, time: f32) -> Mat4 {
-    match render.tiers.get(tier.wrapping_sub(1)) {
-        Some(t) if i > 0 => moving_octave(render, t.wind, t.torque, i, time),
-        _ => octave_transform(render, i, time),
-    }
-}
-
-fn moving_octave(
-    render: &RenderSettings,
-    wind: [f32; 2],
-    torque: f32,
-    i: usize,
-    time: f32,
-) -> Mat4 {
-    let freq = render.detail.powi(i as i32) / render.noise_scale.max(1e-3);
-    let turn = Quat::from_axis_angle(Vec3::new(0.3, 1.0, 0.2).normalize(), i as f32 * 0.9);
-    let shift = Vec3::new(0.37, 0.11, 0.73) * i as f32;
-    let speed = time * (1.0 + 0.5 * i as f32);
-    let [wx, wz] = wind;
-    let drift = Mat4::from_rotation_y(-(torque * speed).to_radians())
-        * Mat4::from_translation(-Vec3::new(wx, 0.0, wz) * speed);
-    Mat4::from_translation(shift)
-        * Mat4::from_quat(turn)
-        * Mat4::from_scale(Vec3::splat(freq))
-        * drift
-}
-
 impl VolumeUniforms {
     /// Names and byte offsets of the members, in order (checked against the WGSL struct).
     pub const LAYOUT: [(&'static str, usize); 19] = [
@@ -338,17 +300,7 @@ pub fn box_depths(volume: &DensityVolume, center: Vec3, forward: Vec3) -> (f32, 
         .fold((f32::MAX, f32::MIN), |(a, b), d| (a.min(d), b.max(d)))
 }
 
-/// sRGB-encoded colour → linear.
-pub fn srgb_to_linear(c: [f32; 3]) -> Vec3 {
-    let f = |v: f32| {
-        if v <= 0.04045 {
-            v / 12.92
-        } else {
-            ((v + 0.055) / 1.055).powf(2.4)
-        }
-    };
-    Vec3::new(f(c[0]), f(c[1]), f(c[2]))
-}
+pub use crate::scene::srgb_to_linear;
 
 #[cfg(test)]
 mod tests {

@@ -13,7 +13,6 @@
 
 pub mod field_gpu;
 pub mod gpu_types;
-pub mod noise;
 pub mod passes;
 pub mod progressive;
 pub mod renderer;

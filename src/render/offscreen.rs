@@ -148,7 +148,31 @@ impl Offscreen {
             return Err(OffscreenError::Size(width, height));
         }
         let job = self.full_job(scene, width, height);
-        self.draw(&job, scene.light.background)
+        self.draw(&job, Some(scene.light.background))
+    }
+
+    /// Renders `scene` like [`Offscreen::render`] over a transparent background (no sky): the
+    /// cloud's own alpha, colours not premultiplied (a PNG's straight alpha).
+    pub fn render_transparent(
+        &mut self,
+        scene: &Scene,
+        width: u32,
+        height: u32,
+    ) -> Result<Image, OffscreenError> {
+        if width == 0 || height == 0 || width > MAX_SIDE || height > MAX_SIDE {
+            return Err(OffscreenError::Size(width, height));
+        }
+        let job = self.full_job(scene, width, height);
+        let mut image = self.draw(&job, None)?;
+        for p in image.rgba.chunks_exact_mut(4) {
+            if p[3] > 0 {
+                let a = p[3] as f32 / 255.0;
+                for c in &mut p[..3] {
+                    *c = (*c as f32 / a).round().min(255.0) as u8;
+                }
+            }
+        }
+        Ok(image)
     }
 
     /// Times `frames` full-quality frames of `scene` (slices and composite, no readback), each
@@ -170,7 +194,8 @@ impl Offscreen {
         for _ in 0..frames {
             let start = std::time::Instant::now();
             self.renderer.begin_frame();
-            let (encoder, _output) = self.encode(&job, scene.light.background, pipeline.as_ref());
+            let (encoder, _output) =
+                self.encode(&job, Some(scene.light.background), pipeline.as_ref());
             self.queue.submit([encoder.finish()]);
             self.device
                 .poll(wgpu::PollType::wait_indefinitely())
@@ -283,7 +308,7 @@ impl Offscreen {
     fn encode(
         &mut self,
         job: &SliceJob,
-        background: [f32; 3],
+        background: Option<[f32; 3]>,
         pipeline: Option<&wgpu::RenderPipeline>,
     ) -> (wgpu::CommandEncoder, wgpu::Texture) {
         let [width, height] = job.plan.size;
@@ -313,7 +338,15 @@ impl Offscreen {
             .draw_slices(&self.device, &self.queue, &mut encoder, job, pipeline);
         self.renderer.prepare_sky(&self.queue, &job.view);
         {
-            let [r, g, b] = background.map(|v| v as f64);
+            let clear = match background {
+                Some([r, g, b]) => wgpu::Color {
+                    r: r as f64,
+                    g: g as f64,
+                    b: b as f64,
+                    a: 1.0,
+                },
+                None => wgpu::Color::TRANSPARENT,
+            };
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("offscreen composite"),
                 color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -321,7 +354,7 @@ impl Offscreen {
                     depth_slice: None,
                     resolve_target: None,
                     ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color { r, g, b, a: 1.0 }),
+                        load: wgpu::LoadOp::Clear(clear),
                         store: wgpu::StoreOp::Store,
                     },
                 })],
@@ -330,7 +363,7 @@ impl Offscreen {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            if job.view.light.sky_gradient {
+            if job.view.light.sky_gradient && background.is_some() {
                 self.renderer.draw_sky(&mut pass);
             }
             self.renderer.composite(&mut pass, job.plan.target);
@@ -338,7 +371,11 @@ impl Offscreen {
         (encoder, output)
     }
 
-    fn draw(&mut self, job: &SliceJob, background: [f32; 3]) -> Result<Image, OffscreenError> {
+    fn draw(
+        &mut self,
+        job: &SliceJob,
+        background: Option<[f32; 3]>,
+    ) -> Result<Image, OffscreenError> {
         let [width, height] = job.plan.size;
         let row = (width * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
             * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;

@@ -3,9 +3,9 @@
 
 use std::sync::Arc;
 
-use super::noise::{NOISE_SIZE, noise_volume};
 use crate::derive::Volumes;
 use crate::field::DensityVolume;
+use crate::field::noise::{NOISE_SIZE, noise_volume};
 
 /// Number of accumulation targets (a preview and a refinement).
 pub const TARGETS: usize = 2;

@@ -289,6 +289,18 @@ impl Default for Lighting {
     }
 }
 
+/// sRGB-encoded colour → linear.
+pub fn srgb_to_linear(c: [f32; 3]) -> Vec3 {
+    let f = |v: f32| {
+        if v <= 0.04045 {
+            v / 12.92
+        } else {
+            ((v + 0.055) / 1.055).powf(2.4)
+        }
+    };
+    Vec3::new(f(c[0]), f(c[1]), f(c[2]))
+}
+
 impl Lighting {
     /// Unit vector pointing from the scene toward the sun.
     pub fn sun_direction(&self) -> Vec3 {

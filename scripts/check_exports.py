@@ -1,0 +1,99 @@
+#!/usr/bin/env python3
+"""Reads the exports that `cargo test --test exports` wrote to target/export-check/ with
+independent readers:
+
+- OpenVDB's own Python module (Debian's python3-openvdb) opens each .vdb: a float fog volume
+  named "density"; at every probe point (world coordinates of the file) the grid holds the
+  value the field gives there, evaluated directly by the test, to float precision.
+- Mitsuba 3 (pip's `mitsuba`, variant scalar_rgb) renders the exported scenes with and without
+  the noise: the cloud covers the same pixels as the app's own render of that view (coverage
+  IoU >= 0.8; coverage = pixels more than 6/255 from the background), and the export with
+  the noise matches the app's image better than the one without.
+
+Usage: check_exports.py DIR. Exits non-zero with a message on the first failure.
+"""
+import json
+import os
+import sys
+
+
+def fail(msg):
+    print(f"check_exports: FAIL: {msg}")
+    sys.exit(1)
+
+
+def check_vdb(d):
+    import pyopenvdb as vdb
+    probes = sorted(f for f in os.listdir(d) if f.endswith(".probes.json"))
+    if len(probes) < 2:
+        fail(f"expected VDB probe files in {d}, found {probes}")
+    for name in probes:
+        spec = json.load(open(os.path.join(d, name)))
+        path = os.path.join(d, spec["file"])
+        grids, _ = vdb.readAll(path)
+        if len(grids) != 1:
+            fail(f"{path}: {len(grids)} grids")
+        g = grids[0]
+        if g.name != "density" or g.gridClass != vdb.GridClass.FOG_VOLUME or g.valueTypeName != "float":
+            fail(f"{path}: grid {g.name!r} of class {g.gridClass} and type {g.valueTypeName}")
+        box = g.evalActiveVoxelBoundingBox()
+        if (tuple(g.metadata["file_bbox_min"]), tuple(g.metadata["file_bbox_max"])) != (tuple(box[0]), tuple(box[1])):
+            fail(f"{path}: file_bbox metadata {g.metadata['file_bbox_min']}..{g.metadata['file_bbox_max']} vs active voxels {box}")
+        voxel = g.transform.voxelSize()
+        if any(abs(v - spec["voxel_size"]) > 1e-5 for v in voxel):
+            fail(f"{path}: voxel size {voxel}, expected {spec['voxel_size']}")
+        acc = g.getConstAccessor()
+        worst = 0.0
+        for p, want in zip(spec["points"], spec["values"]):
+            ijk = g.transform.worldToIndexCellCentered(tuple(p))
+            got = acc.getValue(ijk)
+            worst = max(worst, abs(got - want))
+            if abs(got - want) > 2e-4:
+                fail(f"{path}: at {p} (voxel {ijk}) the grid holds {got}, the field gives {want}")
+        print(f"check_exports: {spec['file']}: {len(spec['points'])} probes agree "
+              f"(worst {worst:.1e}); {g.activeVoxelCount()} active voxels")
+
+
+def check_mitsuba(d):
+    import mitsuba as mi
+    import numpy as np
+    mi.set_variant("scalar_rgb")
+    app = np.array(mi.Bitmap(os.path.join(d, "app_view.png")), dtype=np.float64)[:, :, :3]
+    background = np.array(json.load(open(os.path.join(d, "app_view.json")))["background"], dtype=np.float64)
+
+    def coverage(rgb8):
+        return (np.abs(rgb8 - background) > 6).any(axis=2)
+
+    app_cover = coverage(app)
+
+    def render(stem):
+        scene = mi.load_file(os.path.join(d, f"{stem}.xml"))
+        linear = np.array(mi.render(scene, seed=1), dtype=np.float64)
+        srgb = np.where(linear <= 0.0031308, linear * 12.92, 1.055 * np.power(np.clip(linear, 0, None), 1 / 2.4) - 0.055)
+        return np.clip(np.round(srgb * 255), 0, 255)
+
+    ious = {}
+    for stem in ["mitsuba_noise", "mitsuba_plain"]:
+        cover = coverage(render(stem))
+        union = (cover | app_cover).sum()
+        ious[stem] = (cover & app_cover).sum() / max(union, 1)
+        print(f"check_exports: {stem}: coverage {cover.sum()} px vs the app's {app_cover.sum()}, IoU {ious[stem]:.3f}")
+    if ious["mitsuba_noise"] < 0.8:
+        fail(f"Mitsuba's render covers other pixels than the app's (IoU {ious['mitsuba_noise']:.3f} < 0.8)")
+    if not ious["mitsuba_noise"] > ious["mitsuba_plain"]:
+        fail(f"the noise in the export does not bring Mitsuba closer to the app "
+             f"(IoU {ious['mitsuba_noise']:.3f} with, {ious['mitsuba_plain']:.3f} without)")
+
+
+def main():
+    d = sys.argv[1] if len(sys.argv) > 1 else "target/export-check"
+    what = sys.argv[2] if len(sys.argv) > 2 else "all"
+    if what in ("all", "vdb"):
+        check_vdb(d)
+    if what in ("all", "mitsuba"):
+        check_mitsuba(d)
+    print("check_exports: ok")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,126 @@
+//! A Mitsuba 3 scene (XML) around the cloud's `.vol` grid: the app's camera, the sun as a
+//! directional emitter, the sky (the app's background colour) as a constant emitter, and the
+//! grid as the extinction of a heterogeneous medium inside a null-surfaced box, with the
+//! app's opacity as its scale and its forward scattering as the Henyey–Greenstein phase.
+//! Mitsuba renders it with `mitsuba scene.xml` (any variant; `scalar_rgb` on a CPU).
+
+use std::fmt::Write as _;
+
+use glam::Vec3;
+
+use super::formats::grid_box;
+use super::grid::DensityGrid;
+use crate::scene::{Scene, srgb_to_linear};
+
+fn v3(v: Vec3) -> String {
+    format!("{:.6}, {:.6}, {:.6}", v.x, v.y, v.z)
+}
+
+/// The scene XML for `scene`, referring to its grid as `vol_name`, rendering `size` pixels
+/// with `samples` per pixel.
+pub fn write_xml(
+    scene: &Scene,
+    grid: &DensityGrid,
+    vol_name: &str,
+    size: [u32; 2],
+    samples: u32,
+) -> String {
+    let camera = &scene.camera;
+    let light = &scene.light;
+    let exposure = light.exposure.exp2();
+    let sun = srgb_to_linear(light.sun_color) * light.sun_intensity * exposure;
+    let sky = srgb_to_linear(light.background);
+    let (lo, hi) = grid_box(grid);
+    let center = (lo + hi) * 0.5;
+    let half = (hi - lo) * 0.5;
+    let (near, far) = camera.clip_range();
+    let mut x = String::new();
+    let _ = writeln!(x, "<?xml version=\"1.0\" encoding=\"utf-8\"?>");
+    let _ = writeln!(x, "<!-- cloudsketch: the cloud as shown, for Mitsuba 3 -->");
+    let _ = writeln!(x, "<scene version=\"3.0.0\">");
+    let _ = writeln!(
+        x,
+        "  <integrator type=\"volpath\"><integer name=\"max_depth\" value=\"64\"/></integrator>"
+    );
+    if camera.orthographic {
+        let h = camera.distance * (camera.fov_y_deg.to_radians() * 0.5).tan();
+        let _ = writeln!(x, "  <sensor type=\"orthographic\">");
+        let _ = writeln!(
+            x,
+            "    <transform name=\"to_world\"><scale x=\"{h:.6}\" y=\"{h:.6}\"/><lookat origin=\"{}\" target=\"{}\" up=\"{}\"/></transform>",
+            v3(camera.eye()),
+            v3(camera.target),
+            v3(camera.up())
+        );
+    } else {
+        let _ = writeln!(x, "  <sensor type=\"perspective\">");
+        let _ = writeln!(
+            x,
+            "    <float name=\"fov\" value=\"{:.4}\"/>",
+            camera.fov_y_deg
+        );
+        let _ = writeln!(x, "    <string name=\"fov_axis\" value=\"y\"/>");
+        let _ = writeln!(
+            x,
+            "    <transform name=\"to_world\"><lookat origin=\"{}\" target=\"{}\" up=\"{}\"/></transform>",
+            v3(camera.eye()),
+            v3(camera.target),
+            v3(camera.up())
+        );
+    }
+    let _ = writeln!(
+        x,
+        "    <float name=\"near_clip\" value=\"{near:.6}\"/><float name=\"far_clip\" value=\"{far:.6}\"/>"
+    );
+    let _ = writeln!(
+        x,
+        "    <sampler type=\"independent\"><integer name=\"sample_count\" value=\"{samples}\"/></sampler>"
+    );
+    let _ = writeln!(
+        x,
+        "    <film type=\"hdrfilm\"><integer name=\"width\" value=\"{}\"/><integer name=\"height\" value=\"{}\"/><string name=\"pixel_format\" value=\"rgb\"/><rfilter type=\"box\"/></film>",
+        size[0], size[1]
+    );
+    let _ = writeln!(x, "  </sensor>");
+    let _ = writeln!(
+        x,
+        "  <emitter type=\"directional\"><vector name=\"direction\" value=\"{}\"/><rgb name=\"irradiance\" value=\"{}\"/></emitter>",
+        v3(-light.sun_direction()),
+        v3(sun)
+    );
+    let _ = writeln!(
+        x,
+        "  <emitter type=\"constant\"><rgb name=\"radiance\" value=\"{}\"/></emitter>",
+        v3(sky)
+    );
+    let _ = writeln!(x, "  <shape type=\"cube\">");
+    let _ = writeln!(
+        x,
+        "    <transform name=\"to_world\"><scale value=\"{}\"/><translate value=\"{}\"/></transform>",
+        v3(half),
+        v3(center)
+    );
+    let _ = writeln!(x, "    <bsdf type=\"null\"/>");
+    let _ = writeln!(x, "    <medium type=\"heterogeneous\" name=\"interior\">");
+    let _ = writeln!(
+        x,
+        "      <volume type=\"gridvolume\" name=\"sigma_t\"><string name=\"filename\" value=\"{vol_name}\"/><transform name=\"to_world\"><scale value=\"{}\"/><translate value=\"{}\"/></transform></volume>",
+        v3(hi - lo),
+        v3(lo)
+    );
+    let _ = writeln!(
+        x,
+        "      <float name=\"scale\" value=\"{:.6}\"/>",
+        scene.render.opacity
+    );
+    let _ = writeln!(x, "      <rgb name=\"albedo\" value=\"0.98, 0.98, 0.98\"/>");
+    let _ = writeln!(
+        x,
+        "      <phase type=\"hg\"><float name=\"g\" value=\"{:.4}\"/></phase>",
+        light.forward_scattering
+    );
+    let _ = writeln!(x, "    </medium>");
+    let _ = writeln!(x, "  </shape>");
+    let _ = writeln!(x, "</scene>");
+    x
+}

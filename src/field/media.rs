@@ -1,0 +1,243 @@
+//! The cloud's noise media on the CPU (Schpok et al. 2003, §4 and Table 2): the octave
+//! transforms the renderer's shaders use (`shaders/volume_noise.wgsl`), and the same media
+//! evaluated here for exports that must hold the cloud as shown (Mitsuba, VDB). Sampling the
+//! same periodic noise volume through the same transforms, filters and tiers, it agrees with
+//! the GPU up to the filtering hardware's rounding.
+
+use glam::{Mat4, Quat, Vec3};
+
+use super::noise::{NOISE_SIZE, noise_volume};
+use super::{ISO, density};
+use crate::limits::{MAX_OCTAVES, MAX_TIERS};
+use crate::scene::{NoiseBasis, NoiseFilter, RenderSettings, Scene};
+
+/// Transform of octave `i` at scene time `time`: world → noise-texture coordinates, scale ×
+/// rotate × translate with frequency `base × lacunarity^i`. Octaves are turned against each
+/// other so their lattices do not line up. The wind carries the noise along (world units per
+/// second) and the torque turns it about the vertical through the origin, each octave
+/// `1 + i/2` times as fast as the first (finer detail moves faster, as turbulence does).
+pub fn octave_transform(render: &RenderSettings, i: usize, time: f32) -> Mat4 {
+    moving_octave(render, render.wind, render.torque, i, time)
+}
+
+/// [`octave_transform`] in atmospheric tier `tier` (1-based; 0 is the base media): its own
+/// wind and torque, except octave 0, which moves with the base everywhere (the paper's Base
+/// tier, which keeps the tiers one cloud).
+pub fn tier_octave_transform(render: &RenderSettings, tier: usize, i: usize, time: f32) -> Mat4 {
+    match render.tiers.get(tier.wrapping_sub(1)) {
+        Some(t) if i > 0 => moving_octave(render, t.wind, t.torque, i, time),
+        _ => octave_transform(render, i, time),
+    }
+}
+
+fn moving_octave(
+    render: &RenderSettings,
+    wind: [f32; 2],
+    torque: f32,
+    i: usize,
+    time: f32,
+) -> Mat4 {
+    let freq = render.detail.powi(i as i32) / render.noise_scale.max(1e-3);
+    let turn = Quat::from_axis_angle(Vec3::new(0.3, 1.0, 0.2).normalize(), i as f32 * 0.9);
+    let shift = Vec3::new(0.37, 0.11, 0.73) * i as f32;
+    let speed = time * (1.0 + 0.5 * i as f32);
+    let [wx, wz] = wind;
+    let drift = Mat4::from_rotation_y(-(torque * speed).to_radians())
+        * Mat4::from_translation(-Vec3::new(wx, 0.0, wz) * speed);
+    Mat4::from_translation(shift)
+        * Mat4::from_quat(turn)
+        * Mat4::from_scale(Vec3::splat(freq))
+        * drift
+}
+
+/// Table 2's filters of one octave's noise `t` in [0, 1] (signed `n = 2t − 1`).
+fn filtered(t: f32, filter: NoiseFilter) -> f32 {
+    let n = 2.0 * t - 1.0;
+    match filter {
+        NoiseFilter::Stratus => t,
+        NoiseFilter::Cumulus => n.abs(),
+        NoiseFilter::Wispy => (1.0 - (2.0 * n).abs()).clamp(0.0, 1.0),
+        NoiseFilter::Veined => 1.0 / (1.0 + (10.0 * n).abs()),
+    }
+}
+
+fn smoothstep(lo: f32, hi: f32, x: f32) -> f32 {
+    let t = ((x - lo) / (hi - lo)).clamp(0.0, 1.0);
+    t * t * (3.0 - 2.0 * t)
+}
+
+/// A scene's noise media at one time: density at any point, as the slice shader computes it.
+pub struct Media {
+    /// One channel of the noise volume (the basis in use), `NOISE_SIZE³` values in [0, 1].
+    texels: Vec<f32>,
+    octaves: usize,
+    amount: f32,
+    softness: f32,
+    filter: NoiseFilter,
+    /// Tier floors, filters and octave transforms (octave 0 always the base's).
+    tiers: Vec<(f32, NoiseFilter, [Mat4; MAX_OCTAVES])>,
+    base: [Mat4; MAX_OCTAVES],
+    blend: f32,
+}
+
+impl Media {
+    /// The media of `scene` at its clock's time.
+    pub fn new(scene: &Scene) -> Self {
+        let r = &scene.render;
+        let bytes = noise_volume(scene.seed);
+        let channel = match r.noise_basis {
+            NoiseBasis::Perlin => 0,
+            NoiseBasis::Worley => 1,
+        };
+        let texels = bytes
+            .iter()
+            .skip(channel)
+            .step_by(2)
+            .map(|&b| b as f32 / 255.0)
+            .collect();
+        let time = scene.time;
+        let tiers = r
+            .tiers
+            .iter()
+            .take(MAX_TIERS)
+            .enumerate()
+            .map(|(k, t)| {
+                let m = std::array::from_fn(|i| tier_octave_transform(r, k + 1, i, time));
+                (t.floor, t.filter, m)
+            })
+            .collect();
+        let octaves = (r.noise_octaves as usize).min(MAX_OCTAVES);
+        Self {
+            texels,
+            octaves,
+            amount: if octaves == 0 { 0.0 } else { r.noise_amount },
+            softness: r.softness,
+            filter: r.noise_filter,
+            tiers,
+            base: std::array::from_fn(|i| octave_transform(r, i, time)),
+            blend: r.tier_blend,
+        }
+    }
+
+    /// The noise volume at texture coordinates `q` (period 1), trilinear with wrapping as the
+    /// GPU's repeating sampler does (texel centres at `(i + ½)/N`).
+    fn sample(&self, q: Vec3) -> f32 {
+        let n = NOISE_SIZE as i64;
+        let p = q * NOISE_SIZE as f32 - Vec3::splat(0.5);
+        let f = p - p.floor();
+        let c = p.floor().as_i64vec3();
+        let at = |dx: i64, dy: i64, dz: i64| {
+            let x = (c.x + dx).rem_euclid(n);
+            let y = (c.y + dy).rem_euclid(n);
+            let z = (c.z + dz).rem_euclid(n);
+            self.texels[((z * n + y) * n + x) as usize]
+        };
+        let lerp = |a: f32, b: f32, t: f32| a + (b - a) * t;
+        let x00 = lerp(at(0, 0, 0), at(1, 0, 0), f.x);
+        let x10 = lerp(at(0, 1, 0), at(1, 1, 0), f.x);
+        let x01 = lerp(at(0, 0, 1), at(1, 0, 1), f.x);
+        let x11 = lerp(at(0, 1, 1), at(1, 1, 1), f.x);
+        lerp(lerp(x00, x10, f.y), lerp(x01, x11, f.y), f.z)
+    }
+
+    /// The filtered octaves summed in [0, 1] in tier `tier` (0: the base media).
+    fn fbm(&self, p: Vec3, tier: usize) -> f32 {
+        let (filter, transforms) = match tier {
+            0 => (self.filter, &self.base),
+            k => (self.tiers[k - 1].1, &self.tiers[k - 1].2),
+        };
+        let (mut amp, mut sum, mut norm) = (1.0, 0.0, 0.0);
+        for (i, m) in transforms.iter().enumerate().take(self.octaves) {
+            let m = if i == 0 { &self.base[0] } else { m };
+            sum += amp * filtered(self.sample(m.transform_point3(p)), filter);
+            norm += amp;
+            amp *= 0.5;
+        }
+        if norm > 0.0 { sum / norm } else { 0.5 }
+    }
+
+    /// The noise at `p` across the atmospheric tiers, blended around each floor.
+    pub fn noise(&self, p: Vec3) -> f32 {
+        if self.tiers.is_empty() {
+            return self.fbm(p, 0);
+        }
+        let half = (self.blend * 0.5).max(1e-4);
+        let (mut total, mut below) = (0.0, 1.0);
+        for k in 0..=self.tiers.len() {
+            let above = self
+                .tiers
+                .get(k)
+                .map_or(0.0, |t| smoothstep(t.0 - half, t.0 + half, p.y));
+            let w = below - above;
+            if w > 1e-3 {
+                total += w * self.fbm(p, k);
+            }
+            below = above;
+        }
+        total
+    }
+
+    /// Cloud density in [0, 1] at `p` where the field's value is `field`: the noise moves the
+    /// field before the soft iso-surface step (`volume.wgsl`).
+    pub fn density(&self, field: f32, p: Vec3) -> f32 {
+        if self.amount == 0.0 {
+            return density(field, self.softness);
+        }
+        if field < ISO - self.softness - 0.5 * self.amount {
+            return 0.0;
+        }
+        let v = field + self.amount * (self.noise(p) - 0.5);
+        smoothstep(ISO - self.softness, ISO + self.softness, v)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_media_move_the_surface_and_off_they_leave_the_plain_density() {
+        let mut scene = Scene::default();
+        let media = Media::new(&scene);
+        let points: Vec<Vec3> = (0..200)
+            .map(|i| {
+                Vec3::new(
+                    i as f32 * 0.037,
+                    (i % 7) as f32 * 0.11,
+                    (i % 13) as f32 * 0.05,
+                )
+            })
+            .collect();
+        let moved = points
+            .iter()
+            .filter(|&&p| {
+                (media.density(ISO, p) - density(ISO, scene.render.softness)).abs() > 0.05
+            })
+            .count();
+        assert!(
+            moved > 100,
+            "the noise moves the surface at {moved} of 200 points"
+        );
+        scene.render.noise_octaves = 0;
+        let plain = Media::new(&scene);
+        for p in points {
+            assert_eq!(plain.density(0.47, p), density(0.47, scene.render.softness));
+        }
+    }
+
+    #[test]
+    fn sampling_wraps_and_hits_texel_centres() {
+        let media = Media::new(&Scene::default());
+        let n = NOISE_SIZE as f32;
+        let centre = Vec3::new(3.5, 7.5, 1.5) / n;
+        assert!(
+            (media.sample(centre)
+                - media.texels[(NOISE_SIZE * NOISE_SIZE + 7 * NOISE_SIZE + 3) as usize])
+                .abs()
+                < 1e-6
+        );
+        assert!(
+            (media.sample(centre) - media.sample(centre + Vec3::new(1.0, -2.0, 3.0))).abs() < 1e-4
+        );
+    }
+}

@@ -1,0 +1,270 @@
+//! Exports as other tools read them. Here: the glb through the `gltf` crate (every edge shared
+//! by two faces of opposite orientation, the enclosed volume the field's), and the files that
+//! `scripts/check_exports.py` then reads with independent readers (written to
+//! `target/export-check/`): VDB grids with probe points whose values come from the field
+//! evaluated directly (OpenVDB's Python reader), Mitsuba scenes with and without the noise and
+//! the app's own render of that view (Mitsuba renders them), and a glb for the Khronos
+//! validator.
+
+use std::collections::HashMap;
+use std::path::PathBuf;
+
+use cloudsketch::export::{Axes, Format, Options, Up, export};
+use cloudsketch::field::media::Media;
+use cloudsketch::field::{ISO, bake_fine, density};
+use cloudsketch::render::offscreen::Offscreen;
+use cloudsketch::scene::Scene;
+use glam::Vec3;
+
+fn out_dir() -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("target/export-check");
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Positions and triangles of the glb's one primitive, read by the `gltf` crate.
+fn read_glb(bytes: &[u8]) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+    let gltf = gltf::Gltf::from_slice(bytes).expect("a valid glb");
+    let blob = gltf.blob.clone();
+    let mesh = gltf.meshes().next().expect("one mesh");
+    let prim = mesh.primitives().next().expect("one primitive");
+    let reader = prim.reader(|b| match b.source() {
+        gltf::buffer::Source::Bin => blob.as_deref(),
+        _ => None,
+    });
+    let positions: Vec<Vec3> = reader
+        .read_positions()
+        .expect("positions")
+        .map(Vec3::from)
+        .collect();
+    let indices: Vec<u32> = reader.read_indices().expect("indices").into_u32().collect();
+    let triangles = indices.chunks(3).map(|c| [c[0], c[1], c[2]]).collect();
+    (positions, triangles)
+}
+
+fn volume(positions: &[Vec3], triangles: &[[u32; 3]]) -> f64 {
+    triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| positions[i as usize].as_dvec3());
+            a.dot(b.cross(c)) / 6.0
+        })
+        .sum()
+}
+
+#[test]
+fn the_glb_is_closed_consistently_oriented_and_holds_the_fields_volume() {
+    let scene = Scene::default();
+    let options = Options {
+        resolution: 96,
+        noise: false,
+        ..Options::default()
+    };
+    let files = export(&scene, Format::Glb, &options, "cloud").unwrap();
+    std::fs::write(out_dir().join("cloud.glb"), &files[0].bytes).unwrap();
+    let (positions, triangles) = read_glb(&files[0].bytes);
+    assert!(triangles.len() > 1000, "{} triangles", triangles.len());
+    let mut directed: HashMap<(u32, u32), u32> = HashMap::new();
+    for t in &triangles {
+        for k in 0..3 {
+            *directed.entry((t[k], t[(k + 1) % 3])).or_default() += 1;
+        }
+    }
+    for (&(a, b), &n) in &directed {
+        assert!(
+            n == 1 && directed.get(&(b, a)) == Some(&1),
+            "edge {a}–{b}: {n} one way, {:?} the other",
+            directed.get(&(b, a))
+        );
+    }
+    // The field's own volume: texels at or above the iso level, on a grid twice as fine
+    // (independent of the mesher).
+    let fine = bake_fine(&cloudsketch::derive::field_of(&scene), 192);
+    let texel = fine.texel_size();
+    let inside = fine.values.iter().filter(|&&v| v >= ISO).count() as f64;
+    let expected = inside * (texel.x * texel.y * texel.z) as f64;
+    let got = volume(&positions, &triangles);
+    assert!(
+        (got - expected).abs() < 0.03 * expected,
+        "mesh volume {got:.3} vs the field's {expected:.3}"
+    );
+    // Z-up: the same solid turned (its height is now along z), scaled by 2.
+    let z = Options {
+        axes_up: Up::Z,
+        scale: 2.0,
+        ..options
+    };
+    let (pz, tz) = read_glb(&export(&scene, Format::Glb, &z, "cloud").unwrap()[0].bytes);
+    let extent = |ps: &[Vec3]| {
+        ps.iter().fold((Vec3::MAX, Vec3::MIN), |(lo, hi), &p| {
+            (lo.min(p), hi.max(p))
+        })
+    };
+    let (lo, hi) = extent(&positions);
+    let (lz, hz) = extent(&pz);
+    assert!(((hz.z - lz.z) - 2.0 * (hi.y - lo.y)).abs() < 1e-3);
+    assert!(((hz.y - lz.y) - 2.0 * (hi.z - lo.z)).abs() < 1e-3);
+    assert!((volume(&pz, &tz) - 8.0 * got).abs() < 1e-3 * got);
+}
+
+#[test]
+fn obj_and_ply_hold_the_same_mesh() {
+    let scene = Scene::default();
+    let options = Options {
+        resolution: 48,
+        ..Options::default()
+    };
+    let (positions, triangles) =
+        read_glb(&export(&scene, Format::Glb, &options, "c").unwrap()[0].bytes);
+    let obj = String::from_utf8(
+        export(&scene, Format::Obj, &options, "c").unwrap()[0]
+            .bytes
+            .clone(),
+    )
+    .unwrap();
+    let v: Vec<Vec3> = obj
+        .lines()
+        .filter_map(|l| l.strip_prefix("v "))
+        .map(|l| {
+            let c: Vec<f32> = l.split(' ').map(|x| x.parse().unwrap()).collect();
+            Vec3::new(c[0], c[1], c[2])
+        })
+        .collect();
+    let f: Vec<[u32; 3]> = obj
+        .lines()
+        .filter_map(|l| l.strip_prefix("f "))
+        .map(|l| {
+            let i: Vec<u32> = l
+                .split(' ')
+                .map(|x| x.split("//").next().unwrap().parse::<u32>().unwrap() - 1)
+                .collect();
+            [i[0], i[1], i[2]]
+        })
+        .collect();
+    assert_eq!((v.len(), f.len()), (positions.len(), triangles.len()));
+    assert_eq!(f, triangles);
+    let ply = export(&scene, Format::Ply, &options, "c").unwrap()[0]
+        .bytes
+        .clone();
+    let header_end = ply.windows(11).position(|w| w == b"end_header\n").unwrap() + 11;
+    let header = String::from_utf8_lossy(&ply[..header_end]);
+    assert!(header.contains(&format!("element vertex {}", positions.len())));
+    assert!(header.contains(&format!("element face {}", triangles.len())));
+    assert_eq!(
+        ply.len() - header_end,
+        positions.len() * 24 + triangles.len() * 13
+    );
+}
+
+#[test]
+fn vdb_grids_and_probes_for_openvdbs_own_reader() {
+    let scene = Scene::default();
+    let field = cloudsketch::derive::field_of(&scene);
+    let media = Media::new(&scene);
+    let softness = scene.render.softness;
+    for (up, noise) in [(Up::Y, false), (Up::Z, true)] {
+        let options = Options {
+            resolution: 64,
+            axes_up: up,
+            scale: 0.5,
+            noise,
+            ..Options::default()
+        };
+        let name = format!(
+            "cloud_{}_{}",
+            up.name(),
+            if noise { "noise" } else { "plain" }
+        );
+        let files = export(&scene, Format::Vdb, &options, &name).unwrap();
+        std::fs::write(out_dir().join(&files[0].name), &files[0].bytes).unwrap();
+        // Probes at the grid's texel centres (where the file's voxels sit), with the value
+        // the field and media give there, evaluated directly; and points far outside.
+        let grid = cloudsketch::export::sample(&scene, 64, noise).unwrap();
+        let axes = Axes { up, scale: 0.5 };
+        let mut probes = Vec::new();
+        let mut rng = 0x9e37_79b9_u64;
+        let mut next = |n: u32| {
+            rng ^= rng << 13;
+            rng ^= rng >> 7;
+            rng ^= rng << 17;
+            (rng % n as u64) as u32
+        };
+        let mut inside = 0;
+        while probes.len() < 400 {
+            let (x, y, z) = (next(grid.dims.x), next(grid.dims.y), next(grid.dims.z));
+            let p = grid.center(x, y, z);
+            let f = field.value(p);
+            let want = if noise {
+                media.density(f, p)
+            } else {
+                density(f, softness)
+            };
+            inside += (want > 0.0) as usize;
+            probes.push((axes.point(p), want));
+        }
+        for far in [Vec3::new(100.0, 0.0, 0.0), Vec3::new(0.0, -50.0, 30.0)] {
+            probes.push((axes.point(far), 0.0));
+        }
+        assert!(inside > 40, "{inside} probes in the cloud");
+        let json = serde_json::json!({
+            "file": files[0].name,
+            "points": probes.iter().map(|(p, _)| p.to_array()).collect::<Vec<_>>(),
+            "values": probes.iter().map(|(_, v)| v).collect::<Vec<_>>(),
+            "voxel_size": grid.h * 0.5,
+        });
+        std::fs::write(
+            out_dir().join(format!("{name}.probes.json")),
+            json.to_string(),
+        )
+        .unwrap();
+    }
+}
+
+#[test]
+fn mitsuba_scenes_and_the_apps_render_of_their_view() {
+    // Strong noise, so it shapes the silhouette (what the check compares).
+    let mut scene = Scene::default();
+    scene.render.noise_amount = 0.7;
+    let size = [160, 90];
+    for (stem, noise) in [("mitsuba_noise", true), ("mitsuba_plain", false)] {
+        let options = Options {
+            resolution: 96,
+            noise,
+            image: size,
+            samples: 16,
+            ..Options::default()
+        };
+        for f in export(&scene, Format::Mitsuba, &options, stem).unwrap() {
+            std::fs::write(out_dir().join(&f.name), &f.bytes).unwrap();
+        }
+        let xml = std::fs::read_to_string(out_dir().join(format!("{stem}.xml"))).unwrap();
+        assert!(xml.contains(&format!("value=\"{stem}.vol\"")));
+    }
+    let mut offscreen = Offscreen::new().expect("an offscreen adapter");
+    let image = offscreen.render(&scene, size[0], size[1]).unwrap();
+    std::fs::write(out_dir().join("app_view.png"), image.to_png().unwrap()).unwrap();
+    let background = scene.light.background.map(|c| (c * 255.0).round() as u8);
+    std::fs::write(
+        out_dir().join("app_view.json"),
+        serde_json::json!({ "background": background }).to_string(),
+    )
+    .unwrap();
+}
+
+#[test]
+fn a_transparent_png_has_the_clouds_alpha_and_no_sky() {
+    let scene = Scene::default();
+    let mut offscreen = Offscreen::new().expect("an offscreen adapter");
+    let clear = offscreen.render_transparent(&scene, 160, 90).unwrap();
+    let opaque = offscreen.render(&scene, 160, 90).unwrap();
+    let alpha: Vec<u8> = clear.rgba.chunks(4).map(|p| p[3]).collect();
+    assert_eq!(alpha[0], 0, "the corner is sky: transparent");
+    let covered = alpha.iter().filter(|&&a| a > 250).count();
+    assert!(covered > 500, "{covered} opaque pixels");
+    // Where the cloud is opaque both images agree.
+    let centre = (45 * 160 + 80) * 4;
+    assert!(alpha[45 * 160 + 80] > 250);
+    for c in 0..3 {
+        assert!(clear.rgba[centre + c].abs_diff(opaque.rgba[centre + c]) <= 2);
+    }
+}
