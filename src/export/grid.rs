@@ -38,49 +38,88 @@ impl DensityGrid {
     }
 }
 
-/// Samples `scene` on a grid of `resolution` texels along its longest side (at most
-/// [`MAX_EXPORT_RESOLUTION`]), with or without the noise media.
-pub fn sample(scene: &Scene, resolution: u32, noise: bool) -> Result<DensityGrid, ExportError> {
-    let resolution = resolution.clamp(8, MAX_EXPORT_RESOLUTION);
-    let field = crate::derive::field_of(scene);
-    let work = bake_fine_work(&field, resolution);
-    if work > MAX_EXPORT_WORK {
-        return Err(ExportError::TooLarge(format!(
-            "sampling this cloud at {resolution} texels would take {:.0} million field \
-             evaluations (at most {:.0} million): choose a lower resolution",
-            work as f64 / 1e6,
-            MAX_EXPORT_WORK as f64 / 1e6
-        )));
-    }
-    let volume = bake_fine(&field, resolution);
-    if volume.is_empty() {
-        return Err(ExportError::Empty);
-    }
-    Ok(to_density(scene, &volume, noise))
+/// A sampling under way: the field baked (the first step), then the density filled slab by
+/// slab, so an app can spread the work over frames and show progress.
+pub struct Sampling {
+    volume: DensityVolume,
+    grid: DensityGrid,
+    media: Option<Media>,
+    softness: f32,
+    next_z: u32,
 }
 
-fn to_density(scene: &Scene, volume: &DensityVolume, noise: bool) -> DensityGrid {
-    let h = volume.texel_size().x;
-    let grid = DensityGrid {
-        dims: volume.dims,
-        min: volume.center(0, 0, 0),
-        h,
-        values: Vec::new(),
-        field: volume.values.clone(),
-    };
-    let media = noise.then(|| Media::new(scene));
-    let softness = scene.render.softness;
-    let mut values = Vec::with_capacity(volume.values.len());
-    for z in 0..grid.dims.z {
-        for y in 0..grid.dims.y {
-            for x in 0..grid.dims.x {
-                let f = volume.values[grid.index(x, y, z)];
-                values.push(match &media {
-                    Some(m) => m.density(f, grid.center(x, y, z)),
-                    None => density(f, softness),
-                });
+impl Sampling {
+    /// Bakes `scene`'s field on a grid of `resolution` texels along its longest side (at most
+    /// [`MAX_EXPORT_RESOLUTION`]); the density follows with [`Sampling::step`].
+    pub fn start(scene: &Scene, resolution: u32, noise: bool) -> Result<Self, ExportError> {
+        let resolution = resolution.clamp(8, MAX_EXPORT_RESOLUTION);
+        let field = crate::derive::field_of(scene);
+        let work = bake_fine_work(&field, resolution);
+        if work > MAX_EXPORT_WORK {
+            return Err(ExportError::TooLarge(format!(
+                "sampling this cloud at {resolution} texels would take {:.0} million field \
+                 evaluations (at most {:.0} million): choose a lower resolution",
+                work as f64 / 1e6,
+                MAX_EXPORT_WORK as f64 / 1e6
+            )));
+        }
+        let volume = bake_fine(&field, resolution);
+        if volume.is_empty() {
+            return Err(ExportError::Empty);
+        }
+        let grid = DensityGrid {
+            dims: volume.dims,
+            min: volume.center(0, 0, 0),
+            h: volume.texel_size().x,
+            values: Vec::with_capacity(volume.values.len()),
+            field: Vec::new(),
+        };
+        Ok(Self {
+            volume,
+            grid,
+            media: noise.then(|| Media::new(scene)),
+            softness: scene.render.softness,
+            next_z: 0,
+        })
+    }
+
+    /// Fills the density of up to `slabs` more z-slabs; returns whether all are done.
+    pub fn step(&mut self, slabs: u32) -> bool {
+        let end = (self.next_z + slabs).min(self.grid.dims.z);
+        let g = &mut self.grid;
+        for z in self.next_z..end {
+            for y in 0..g.dims.y {
+                for x in 0..g.dims.x {
+                    let f = self.volume.values[((z * g.dims.y + y) * g.dims.x + x) as usize];
+                    let p = g.min + UVec3::new(x, y, z).as_vec3() * g.h;
+                    g.values.push(match &self.media {
+                        Some(m) => m.density(f, p),
+                        None => density(f, self.softness),
+                    });
+                }
             }
         }
+        self.next_z = end;
+        self.next_z >= self.grid.dims.z
     }
-    DensityGrid { values, ..grid }
+
+    /// The share of the density filled, in [0, 1].
+    pub fn progress(&self) -> f32 {
+        self.next_z as f32 / self.grid.dims.z.max(1) as f32
+    }
+
+    /// The finished grid (fills what is left first).
+    pub fn finish(mut self) -> DensityGrid {
+        while !self.step(u32::MAX) {}
+        DensityGrid {
+            field: self.volume.values,
+            ..self.grid
+        }
+    }
+}
+
+/// Samples `scene` on a grid of `resolution` texels along its longest side (at most
+/// [`MAX_EXPORT_RESOLUTION`]), with or without the noise media, in one go.
+pub fn sample(scene: &Scene, resolution: u32, noise: bool) -> Result<DensityGrid, ExportError> {
+    Ok(Sampling::start(scene, resolution, noise)?.finish())
 }

@@ -5,7 +5,8 @@
 //! - `grid`: the scene sampled on a grid of the chosen resolution, with or without its media;
 //! - `axes`: Y-up or Z-up and the unit scale;
 //! - `vdb`: the OpenVDB writer; `mitsuba`: the Mitsuba scene; `formats`: glb, OBJ, PLY, `.vol`;
-//! - `mesh`: the surface by marching tetrahedra (closed, manifold, outward).
+//! - `mesh`: the surface by marching tetrahedra (closed, manifold, outward);
+//! - `zip`: several files as one (stored) archive, for one browser download.
 
 mod axes;
 mod formats;
@@ -13,13 +14,15 @@ mod grid;
 mod mesh;
 mod mitsuba;
 mod vdb;
+mod zip;
 
 pub use axes::{Axes, Up};
 pub use formats::{grid_box, write_glb, write_obj, write_ply, write_vol};
-pub use grid::{DensityGrid, sample};
+pub use grid::{DensityGrid, Sampling, sample};
 pub use mesh::{Mesh, mesh};
 pub use mitsuba::write_xml;
 pub use vdb::write_vdb;
+pub use zip::zip;
 
 use crate::field::ISO;
 use crate::scene::Scene;
@@ -152,18 +155,6 @@ pub enum ExportError {
     NeedsRenderer,
 }
 
-/// The surface of `scene` at `options`' resolution: the field's iso-surface, or with the
-/// media the surface where their density reaches a half.
-pub fn surface(scene: &Scene, options: &Options) -> Result<Mesh, ExportError> {
-    let grid = sample(scene, options.resolution, options.noise)?;
-    let (values, iso) = if options.noise {
-        (&grid.values, 0.5)
-    } else {
-        (&grid.field, ISO)
-    };
-    Ok(mesh(grid.dims, grid.min, grid.h, values, iso))
-}
-
 /// Writes `scene` as `format`; the first file is the main one, named `STEM.EXT`.
 pub fn export(
     scene: &Scene,
@@ -171,34 +162,57 @@ pub fn export(
     options: &Options,
     stem: &str,
 ) -> Result<Vec<File>, ExportError> {
+    if format == Format::Png {
+        return Err(ExportError::NeedsRenderer);
+    }
+    let grid = sample(scene, options.resolution, options.noise)?;
+    Ok(write(scene, &grid, format, options, stem))
+}
+
+/// The surface of a sampled grid: the field's iso-surface, or with the media the surface
+/// where their density reaches a half.
+pub fn surface(grid: &DensityGrid, noise: bool) -> Mesh {
+    let (values, iso) = if noise {
+        (&grid.values, 0.5)
+    } else {
+        (&grid.field, ISO)
+    };
+    mesh(grid.dims, grid.min, grid.h, values, iso)
+}
+
+/// The files of `format` (not PNG: none) from a grid sampled with `options` (the last step
+/// of [`export`]).
+pub fn write(
+    scene: &Scene,
+    grid: &DensityGrid,
+    format: Format,
+    options: &Options,
+    stem: &str,
+) -> Vec<File> {
     let axes = options.axes();
     let file = |ext: &str, bytes: Vec<u8>| File {
         name: format!("{stem}.{ext}"),
         bytes,
     };
-    Ok(match format {
-        Format::Png => return Err(ExportError::NeedsRenderer),
-        Format::Vdb => {
-            let grid = sample(scene, options.resolution, options.noise)?;
-            vec![file(
-                "vdb",
-                write_vdb(&grid, axes, "density", scene.seed ^ 0x5644_4220),
-            )]
-        }
+    match format {
+        Format::Png => Vec::new(),
+        Format::Vdb => vec![file(
+            "vdb",
+            write_vdb(grid, axes, "density", scene.seed ^ 0x5644_4220),
+        )],
         Format::Mitsuba => {
-            let grid = sample(scene, options.resolution, options.noise)?;
             let vol = format!("{stem}.vol");
-            let xml = write_xml(scene, &grid, &vol, options.image, options.samples.max(1));
-            vec![file("xml", xml.into_bytes()), file("vol", write_vol(&grid))]
+            let xml = write_xml(scene, grid, &vol, options.image, options.samples.max(1));
+            vec![file("xml", xml.into_bytes()), file("vol", write_vol(grid))]
         }
         Format::Glb => vec![file(
             "glb",
-            write_glb(&surface(scene, options)?, axes, stem),
+            write_glb(&surface(grid, options.noise), axes, stem),
         )],
         Format::Obj => vec![file(
             "obj",
-            write_obj(&surface(scene, options)?, axes, stem),
+            write_obj(&surface(grid, options.noise), axes, stem),
         )],
-        Format::Ply => vec![file("ply", write_ply(&surface(scene, options)?, axes))],
-    })
+        Format::Ply => vec![file("ply", write_ply(&surface(grid, options.noise), axes))],
+    }
 }

@@ -19,6 +19,7 @@ pub struct SliceJob {
 /// Pipelines, samplers, textures and the accumulation targets.
 pub struct VolumeRenderer {
     accum_format: wgpu::TextureFormat,
+    output_format: wgpu::TextureFormat,
     slices: SlicePass,
     composite: CompositePass,
     sky: SkyPass,
@@ -71,6 +72,7 @@ impl VolumeRenderer {
     ) -> Self {
         Self {
             accum_format,
+            output_format,
             slices: SlicePass::new(device, accum_format),
             composite: CompositePass::new(device, output_format),
             sky: SkyPass::new(device, output_format),
@@ -78,7 +80,7 @@ impl VolumeRenderer {
             repeat_sampler: sampler(device, wgpu::AddressMode::Repeat),
             textures: VolumeTextures::new(),
             bind_group: None,
-            targets: [None, None],
+            targets: Default::default(),
             light_pass: LightPass::new(device),
             light: None,
             light_placeholder: None,
@@ -389,6 +391,11 @@ impl VolumeRenderer {
         pass.set_bind_group(0, bind_group, &[offset]);
         // Instances start at 0 (WebGL2 has no base instance); the first slice is a uniform.
         pass.draw(0..6, 0..count);
+    }
+
+    /// The format the composite and sky passes write.
+    pub fn output_format(&self) -> wgpu::TextureFormat {
+        self.output_format
     }
 
     /// Sets the sky gradient of `view` (call before [`VolumeRenderer::draw_sky`]).

@@ -7,8 +7,10 @@ use crate::derive::Volumes;
 use crate::field::DensityVolume;
 use crate::field::noise::{NOISE_SIZE, noise_volume};
 
-/// Number of accumulation targets (a preview and a refinement).
-pub const TARGETS: usize = 2;
+/// Number of accumulation targets (a preview, a refinement, and captures for export).
+pub const TARGETS: usize = 3;
+/// The accumulation target captures render into (see `render::capture`).
+pub const CAPTURE_TARGET: usize = 2;
 
 /// The field as the bytes of an `R8Unorm` texture.
 fn pack(field: &[f32]) -> Vec<u8> {

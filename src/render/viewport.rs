@@ -16,6 +16,8 @@ pub struct ViewportPaint {
     pub job: Option<SliceJob>,
     /// Accumulation target to composite into the frame.
     pub display: Option<usize>,
+    /// A capture of the view for export, advanced every frame until read back.
+    pub capture: Option<super::capture::Capture>,
 }
 
 impl egui_wgpu::CallbackTrait for ViewportPaint {
@@ -33,6 +35,9 @@ impl egui_wgpu::CallbackTrait for ViewportPaint {
             if let Some(job) = &self.job {
                 renderer.update_light(device, queue, encoder, &job.view);
                 renderer.draw_slices(device, queue, encoder, job, None);
+            }
+            if let Some(capture) = &self.capture {
+                capture.advance(renderer, device, queue);
             }
         }
         Vec::new()

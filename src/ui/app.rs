@@ -4,7 +4,9 @@
 use super::autosave::Autosave;
 use super::guide::Guide;
 use super::notice::Notices;
-use super::panels::{ClockPanel, LIGHT, RENDER, ScenePanel, SketchPanel, ViewPanel, ViewStats};
+use super::panels::{
+    ClockPanel, ExportPanel, LIGHT, RENDER, ScenePanel, SketchPanel, ViewPanel, ViewStats,
+};
 use super::scene_files::SceneFiles;
 use super::selection::Selection;
 use super::sketch_tool::{Axis, SketchTool, ToolContext};
@@ -77,6 +79,7 @@ const PANEL_WIDTH: f32 = 300.0;
 #[derive(Default)]
 struct Panels {
     clock: ClockPanel,
+    export: ExportPanel,
     sketch: SketchPanel,
     scene: ScenePanel,
     view: ViewPanel,
@@ -167,13 +170,14 @@ impl CloudApp {
         self.selection.retain_valid(self.doc.scene());
     }
 
-    /// Undo (Ctrl+Z), redo (Ctrl+Shift+Z, Ctrl+Y), frame (F), play (Alt+A), then the tools'
-    /// shortcuts.
+    /// Undo (Ctrl+Z), redo (Ctrl+Shift+Z, Ctrl+Y), frame (F), play (Alt+A), export (Ctrl+E),
+    /// then the tools' shortcuts.
     fn shortcuts(&mut self, ctx: &egui::Context) {
         if ctx.egui_wants_keyboard_input() {
             return;
         }
         use egui::{Key, Modifiers};
+        let export = ctx.input_mut(|i| i.consume_key(Modifiers::COMMAND, Key::E));
         let (undo, redo, frame, panel) = ctx.input_mut(|i| {
             let redo = i.consume_key(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z)
                 || i.consume_key(Modifiers::COMMAND, Key::Y);
@@ -204,6 +208,18 @@ impl CloudApp {
         }
         if frame {
             self.viewport.frame_request = true;
+        }
+        if export {
+            let ask = self.panels.export.start(
+                &self.doc,
+                &mut self.notices,
+                now,
+                self.viewport.stats.viewport_px,
+                &self.files.name,
+            );
+            if ask.capture.is_some() {
+                self.viewport.capture_request = ask.capture;
+            }
         }
         let mut tc = ToolContext {
             doc: &mut self.doc,
@@ -271,6 +287,16 @@ impl CloudApp {
         p.scene
             .ui(ui, &mut self.doc, &mut self.selection, &mut self.notices);
         p.view.ui(ui, &self.viewport.stats, &mut self.doc);
+        let ask = p.export.ui(
+            ui,
+            &self.doc,
+            &mut self.notices,
+            self.viewport.stats.viewport_px,
+            &self.files.name,
+        );
+        if ask.capture.is_some() {
+            self.viewport.capture_request = ask.capture;
+        }
         self.selection.retain_valid(self.doc.scene());
     }
 
@@ -397,6 +423,14 @@ impl CloudApp {
             }),
             "widgets": widgets,
             "sun": [self.doc.scene().light.sun_azimuth_deg, self.doc.scene().light.sun_elevation_deg],
+            "export": {
+                "format": self.panels.export.format.name(),
+                "progress": self.panels.export.progress(),
+                "last": self.panels.export.last.as_ref().map(|r| match r {
+                    Ok(names) => serde_json::json!({ "files": names }),
+                    Err(e) => serde_json::json!({ "error": e }),
+                }),
+            },
             "axis_lock": self.tool.axis_lock.map(|a| a.name()),
             "playing": self.panels.clock.playing,
             "guides_hidden": self.tool.hide_guides,
@@ -476,6 +510,15 @@ impl eframe::App for CloudApp {
         }
         self.arrivals(&ctx);
         self.host_edits(&ctx);
+        let now = ctx.input(|i| i.time);
+        if self.panels.export.step(&mut self.notices, now) {
+            ctx.request_repaint();
+        }
+        if let Some((size, pixels)) = self.viewport.captured.take() {
+            self.panels
+                .export
+                .captured(size, pixels, &mut self.notices, now);
+        }
         // Fixed width: growing values never shift the buttons under the pointer.
         let mut open = self.panel_open;
         egui::Panel::right("controls")

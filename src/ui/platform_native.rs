@@ -110,10 +110,28 @@ pub fn take_links() -> Vec<String> {
 
 /// Writes a scene file at `path` (through a temporary file, so a failed write keeps the old).
 pub fn save_file(path: &str, text: &str) -> Result<String, String> {
+    save_bytes(path, text.as_bytes(), "application/json")
+}
+
+/// Writes bytes at `path` (through a temporary file). The media type is the browser's concern.
+pub fn save_bytes(path: &str, bytes: &[u8], _mime: &str) -> Result<String, String> {
     let tmp = format!("{path}.tmp");
-    std::fs::write(&tmp, text).map_err(|e| format!("{path}: {e}"))?;
+    std::fs::write(&tmp, bytes).map_err(|e| format!("{path}: {e}"))?;
     std::fs::rename(&tmp, path).map_err(|e| format!("{path}: {e}"))?;
     Ok(path.to_owned())
+}
+
+/// Writes an RGBA image as a PNG file at `path`.
+pub fn save_png(path: &str, width: u32, height: u32, rgba: Vec<u8>) -> Result<String, String> {
+    let image = crate::render::offscreen::Image {
+        width,
+        height,
+        rgba,
+    };
+    let png = image
+        .to_png()
+        .map_err(|e| format!("PNG encoding failed: {e}"))?;
+    save_bytes(path, &png, "image/png")
 }
 
 /// No picker natively: Open reads the path typed in the File group.

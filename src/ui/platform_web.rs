@@ -188,17 +188,32 @@ pub fn take_links() -> Vec<String> {
     LINKS.with(|l| std::mem::take(&mut *l.borrow_mut()))
 }
 
-/// Saves a file as a download named `name`.
+/// Saves a scene file as a download named `name`.
 pub fn save_file(name: &str, text: &str) -> Result<String, String> {
-    let fail = |e: JsValue| format!("the browser refused the download ({})", js_error(&e));
+    save_bytes(name, text.as_bytes(), "application/json")
+}
+
+fn refused(e: JsValue) -> String {
+    format!("the browser refused the download ({})", js_error(&e))
+}
+
+/// Saves bytes as a download named `name` of media type `mime`.
+pub fn save_bytes(name: &str, bytes: &[u8], mime: &str) -> Result<String, String> {
+    let parts = js_sys::Array::of1(&js_sys::Uint8Array::from(bytes));
+    let options = web_sys::BlobPropertyBag::new();
+    options.set_type(mime);
+    let blob =
+        web_sys::Blob::new_with_u8_array_sequence_and_options(&parts, &options).map_err(refused)?;
+    download_blob(name, &blob)
+}
+
+/// Hands a blob to the browser as a download named `name`.
+fn download_blob(name: &str, blob: &web_sys::Blob) -> Result<String, String> {
+    let fail = refused;
     let document = web_sys::window()
         .and_then(|w| w.document())
         .ok_or("no document")?;
-    let parts = js_sys::Array::of1(&JsValue::from_str(text));
-    let options = web_sys::BlobPropertyBag::new();
-    options.set_type("application/json");
-    let blob = web_sys::Blob::new_with_str_sequence_and_options(&parts, &options).map_err(fail)?;
-    let url = web_sys::Url::create_object_url_with_blob(&blob).map_err(fail)?;
+    let url = web_sys::Url::create_object_url_with_blob(blob).map_err(fail)?;
     let anchor: web_sys::HtmlAnchorElement = document
         .create_element("a")
         .map_err(fail)?
@@ -208,6 +223,41 @@ pub fn save_file(name: &str, text: &str) -> Result<String, String> {
     anchor.set_download(name);
     anchor.click();
     let _ = web_sys::Url::revoke_object_url(&url);
+    Ok(format!("{name} (a download)"))
+}
+
+/// Encodes an RGBA image as PNG with the browser's own encoder (no codec in the wasm) and
+/// downloads it as `name`; the download starts once the browser has encoded it.
+pub fn save_png(name: &str, width: u32, height: u32, rgba: Vec<u8>) -> Result<String, String> {
+    let canvas = web_sys::OffscreenCanvas::new(width, height).map_err(refused)?;
+    let context: web_sys::OffscreenCanvasRenderingContext2d = canvas
+        .get_context("2d")
+        .map_err(refused)?
+        .ok_or("no 2D canvas")?
+        .dyn_into()
+        .map_err(|e| refused(e.into()))?;
+    let data = web_sys::ImageData::new_with_u8_clamped_array_and_sh(
+        wasm_bindgen::Clamped(&rgba),
+        width,
+        height,
+    )
+    .map_err(refused)?;
+    context.put_image_data(&data, 0.0, 0.0).map_err(refused)?;
+    let promise = canvas.convert_to_blob().map_err(refused)?;
+    let owned = name.to_owned();
+    wasm_bindgen_futures::spawn_local(async move {
+        let name = owned;
+        match wasm_bindgen_futures::JsFuture::from(promise).await {
+            Ok(blob) => {
+                if let Ok(blob) = blob.dyn_into::<web_sys::Blob>()
+                    && let Err(e) = download_blob(&name, &blob)
+                {
+                    log::error!("{e}");
+                }
+            }
+            Err(e) => log::error!("the browser could not encode the PNG ({})", js_error(&e)),
+        }
+    });
     Ok(format!("{name} (a download)"))
 }
 
@@ -235,8 +285,8 @@ fn keep_browser_shortcuts() {
             .and_then(|t| t.dyn_into::<web_sys::HtmlInputElement>().ok())
             .is_some();
         // Ctrl+D duplicates (not a bookmark), Ctrl+S saves and Ctrl+O opens the app's scene,
-        // Ctrl+L copies its link (not the address bar).
-        let ours = ["d", "s", "o", "l"]
+        // Ctrl+L copies its link (not the address bar), Ctrl+E exports (not a web search).
+        let ours = ["d", "s", "o", "l", "e"]
             .iter()
             .any(|k| e.key().eq_ignore_ascii_case(k));
         if !typing && (e.ctrl_key() || e.meta_key()) && ours {

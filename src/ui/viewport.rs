@@ -11,6 +11,7 @@ use super::sketch_tool::{SketchTool, ToolContext, ViewInput};
 use crate::derive::Derived;
 use crate::render::SliceJob;
 use crate::render::View;
+use crate::render::capture::Capture;
 use crate::render::progressive::{Budget, Progressive};
 use crate::render::viewport::{SkyPaint, ViewportPaint};
 use crate::scene::Document;
@@ -27,6 +28,12 @@ pub struct Viewport {
     pub frame_request: bool,
     /// Where the view was drawn last frame (in points).
     pub rect: egui::Rect,
+    /// A capture asked for by the Export group: size in pixels, transparent background.
+    pub capture_request: Option<([u32; 2], bool)>,
+    /// The capture under way (advanced by the paint callback every frame).
+    capture: Option<Capture>,
+    /// A finished capture: its size and pixels (straight-alpha RGBA), or why it failed.
+    pub captured: Option<([u32; 2], Result<Vec<u8>, String>)>,
 }
 
 /// Everything the viewport works on this frame: what the tools work on, the tools, the
@@ -49,6 +56,9 @@ impl Viewport {
             ready: false,
             frame_request: false,
             rect: egui::Rect::NOTHING,
+            capture_request: None,
+            capture: None,
+            captured: None,
         }
     }
 
@@ -170,6 +180,30 @@ impl Viewport {
         if plan.shown.is_some_and(|q| q.full) {
             self.ready = true;
         }
+        if let Some((size, transparent)) = self.capture_request.take() {
+            self.capture = Some(Capture::new(&view, size, transparent));
+        }
+        if let Some(capture) = &self.capture {
+            if let Some(result) = capture.take() {
+                self.captured = Some((capture.size, result));
+                self.capture = None;
+            } else {
+                ui.ctx().request_repaint();
+            }
+        }
+        let capture = self.capture.clone();
+        if crop.is_none() && capture.is_some() && self.stats.backend.is_some() {
+            // Nothing of the cloud in view: the capture still needs the callback to run.
+            painter.add(egui_wgpu::Callback::new_paint_callback(
+                rect,
+                ViewportPaint {
+                    volumes: volumes.clone(),
+                    job: None,
+                    display: None,
+                    capture: capture.clone(),
+                },
+            ));
+        }
         if let Some(crop) = crop {
             let job = plan.job.map(|plan| SliceJob {
                 plan,
@@ -190,6 +224,7 @@ impl Viewport {
                         volumes,
                         job,
                         display: plan.display,
+                        capture,
                     },
                 ));
             }

@@ -2,6 +2,7 @@
 //! what it needs (the document, the selection, the tool state), as egui's demo app does.
 
 mod clock;
+mod export;
 mod light;
 mod render;
 mod scene;
@@ -9,6 +10,7 @@ mod sketch;
 mod view;
 
 pub use clock::ClockPanel;
+pub use export::ExportPanel;
 pub use light::LIGHT;
 pub use render::RENDER;
 pub use scene::ScenePanel;

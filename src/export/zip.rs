@@ -1,0 +1,97 @@
+//! A minimal ZIP archive (entries stored, not compressed): how the browser hands over an
+//! export of several files (Mitsuba's XML and its grid) as one download.
+
+use super::File;
+
+/// CRC-32 (IEEE 802.3, reflected), as ZIP stores it.
+fn crc32(bytes: &[u8]) -> u32 {
+    let mut crc = !0u32;
+    for &b in bytes {
+        crc ^= b as u32;
+        for _ in 0..8 {
+            crc = (crc >> 1) ^ (0xEDB8_8320 & (crc & 1).wrapping_neg());
+        }
+    }
+    !crc
+}
+
+/// The files as one ZIP archive (at most 4 GiB in all; exports are far below).
+pub fn zip(files: &[File]) -> Vec<u8> {
+    let mut out = Vec::new();
+    let mut central = Vec::new();
+    for f in files {
+        let offset = out.len() as u32;
+        let crc = crc32(&f.bytes);
+        let (size, name) = (f.bytes.len() as u32, f.name.as_bytes());
+        // Local header: signature, version 2.0, flags (UTF-8 names), stored, time, date.
+        let common = |v: &mut Vec<u8>| {
+            v.extend(20u16.to_le_bytes());
+            v.extend(0x0800u16.to_le_bytes());
+            v.extend(0u16.to_le_bytes());
+            v.extend(0u16.to_le_bytes());
+            v.extend(0x21u16.to_le_bytes()); // 1980-01-01
+            v.extend(crc.to_le_bytes());
+            v.extend(size.to_le_bytes());
+            v.extend(size.to_le_bytes());
+            v.extend((name.len() as u16).to_le_bytes());
+            v.extend(0u16.to_le_bytes());
+        };
+        out.extend(0x0403_4b50u32.to_le_bytes());
+        common(&mut out);
+        out.extend(name);
+        out.extend(&f.bytes);
+        central.extend(0x0201_4b50u32.to_le_bytes());
+        central.extend(20u16.to_le_bytes()); // made by
+        common(&mut central);
+        central.extend([0u8; 8]); // comment length, disk, internal and external attributes
+        central.extend([0u8; 2]);
+        central.extend(offset.to_le_bytes());
+        central.extend(name);
+    }
+    let start = out.len() as u32;
+    let count = files.len() as u16;
+    out.extend(&central);
+    out.extend(0x0605_4b50u32.to_le_bytes());
+    out.extend([0u8; 4]);
+    out.extend(count.to_le_bytes());
+    out.extend(count.to_le_bytes());
+    out.extend((central.len() as u32).to_le_bytes());
+    out.extend(start.to_le_bytes());
+    out.extend(0u16.to_le_bytes());
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn crc_of_the_check_string() {
+        assert_eq!(crc32(b"123456789"), 0xCBF4_3926);
+    }
+
+    #[test]
+    fn the_archive_lists_its_files_with_their_bytes() {
+        let files = vec![
+            File {
+                name: "a.xml".into(),
+                bytes: b"<scene/>".to_vec(),
+            },
+            File {
+                name: "a.vol".into(),
+                bytes: vec![1, 2, 3],
+            },
+        ];
+        let z = zip(&files);
+        assert_eq!(&z[..4], b"PK\x03\x04");
+        let end = z.len() - 22;
+        assert_eq!(&z[end..end + 4], b"PK\x05\x06");
+        assert_eq!(u16::from_le_bytes([z[end + 10], z[end + 11]]), 2);
+        let dir = u32::from_le_bytes(z[end + 16..end + 20].try_into().unwrap()) as usize;
+        assert_eq!(&z[dir..dir + 4], b"PK\x01\x02");
+        // The second entry's data follows its local header.
+        let second = 30 + 5 + 8;
+        assert_eq!(&z[second..second + 4], b"PK\x03\x04");
+        assert_eq!(&z[second + 30 + 5..second + 30 + 5 + 3], &[1, 2, 3]);
+    }
+}

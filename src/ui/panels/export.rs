@@ -1,0 +1,296 @@
+//! The Export group: the cloud for other tools (OpenVDB, Mitsuba, glb, OBJ, PLY) or the view
+//! as a PNG. Sampling runs a slab at a time within a frame budget, with a progress bar, so
+//! the app stays responsive; the files then download (in the browser; Mitsuba's two as one
+//! ZIP) or are written beside the scene file (natively). Ctrl+E exports again.
+
+use egui::Ui;
+
+use crate::export::{Format, Options, Sampling, Up, write, zip};
+use crate::scene::{Document, Scene};
+use crate::ui::notice::Notices;
+use crate::ui::platform;
+use crate::ui::widgets::mark;
+
+/// Seconds of sampling per frame.
+const FRAME_BUDGET: f64 = 0.025;
+
+/// An export under way.
+enum Job {
+    /// Sampling the density; the scene as it was when the export began.
+    Sampling {
+        sampling: Sampling,
+        scene: Box<Scene>,
+        format: Format,
+        options: Options,
+        place: Place,
+    },
+    /// Waiting for the renderer's capture of the view.
+    Capture { place: Place },
+}
+
+/// Where an export's files go: their common name and (natively) their folder.
+struct Place {
+    dir: std::path::PathBuf,
+    stem: String,
+}
+
+impl Place {
+    /// From the scene file's name or path (`clouds/storm.json` → `clouds/`, `storm`).
+    fn of(scene_file: &str) -> Self {
+        let path = std::path::Path::new(scene_file);
+        let stem = path
+            .file_stem()
+            .and_then(|s| s.to_str())
+            .filter(|s| !s.is_empty())
+            .unwrap_or("cloud")
+            .to_owned();
+        Self {
+            dir: path.parent().map(|p| p.to_path_buf()).unwrap_or_default(),
+            stem,
+        }
+    }
+
+    /// Where file `name` goes (a download's name in the browser).
+    fn path(&self, name: &str) -> String {
+        self.dir.join(name).to_string_lossy().into_owned()
+    }
+}
+
+/// The Export group's state.
+pub struct ExportPanel {
+    /// The chosen format.
+    pub format: Format,
+    /// Resolution, axes, scale, noise, image size.
+    pub options: Options,
+    /// PNG width in pixels (the height follows the view's shape).
+    pub png_width: u32,
+    /// PNG over a transparent background.
+    pub transparent: bool,
+    job: Option<Job>,
+    /// The last export's result, for the page state: the file names or the error.
+    pub last: Option<Result<Vec<String>, String>>,
+}
+
+impl Default for ExportPanel {
+    fn default() -> Self {
+        Self {
+            format: Format::Glb,
+            options: Options::default(),
+            png_width: 1920,
+            transparent: false,
+            job: None,
+            last: None,
+        }
+    }
+}
+
+/// What the app must do for the group this frame.
+#[derive(Default)]
+pub struct ExportAsk {
+    /// Render a capture of the view at this size (pixels), transparent or not.
+    pub capture: Option<([u32; 2], bool)>,
+}
+
+impl ExportPanel {
+    /// The share of the running export done, if one runs.
+    pub fn progress(&self) -> Option<f32> {
+        match &self.job {
+            Some(Job::Sampling { sampling, .. }) => Some(sampling.progress() * 0.9),
+            Some(Job::Capture { .. }) => Some(0.5),
+            None => None,
+        }
+    }
+
+    /// Draws the group. `view_px` is the viewport's size in pixels; `scene_file` (the File
+    /// group's name or path) names the files and, natively, their folder.
+    pub fn ui(
+        &mut self,
+        ui: &mut Ui,
+        doc: &Document,
+        notices: &mut Notices,
+        view_px: [u32; 2],
+        scene_file: &str,
+    ) -> ExportAsk {
+        let mut ask = ExportAsk::default();
+        let header = egui::CollapsingHeader::new("Export")
+            .default_open(false)
+            .show(ui, |ui| {
+                ui.horizontal_wrapped(|ui| {
+                    for (format, name) in Format::ALL {
+                        let r = ui.selectable_label(self.format == format, name);
+                        mark(ui, &format!("export:{name}"), r.rect);
+                        if r.clicked() {
+                            self.format = format;
+                        }
+                    }
+                });
+                let o = &mut self.options;
+                if self.format == Format::Png {
+                    ui.horizontal(|ui| {
+                        ui.add(egui::DragValue::new(&mut self.png_width).range(16..=8192));
+                        let h = png_height(self.png_width, view_px);
+                        ui.label(format!("× {h} px (the view's shape)"));
+                    });
+                    let r = ui.checkbox(&mut self.transparent, "transparent background");
+                    mark(ui, "export:transparent", r.rect);
+                } else {
+                    ui.add(
+                        egui::Slider::new(&mut o.resolution, 16..=crate::limits::MAX_EXPORT_RESOLUTION)
+                            .text("grid (texels)"),
+                    )
+                    .on_hover_text("Texels along the cloud's longest side: finer grids take longer and make bigger files");
+                    ui.checkbox(&mut o.noise, "noise media as shown")
+                        .on_hover_text("Off: the plain blended field (a smooth surface, a soft density)");
+                    if self.format != Format::Mitsuba {
+                        ui.horizontal(|ui| {
+                            ui.label("up:");
+                            ui.selectable_value(&mut o.axes_up, Up::Y, "Y (glTF, Houdini)");
+                            ui.selectable_value(&mut o.axes_up, Up::Z, "Z (Blender)");
+                        });
+                        ui.add(egui::DragValue::new(&mut o.scale).range(1e-4..=1e4).speed(0.01).prefix("scale ×"));
+                    }
+                }
+                let running = self.job.is_some();
+                ui.horizontal(|ui| {
+                    let button = ui
+                        .add_enabled(!running, egui::Button::new(format!("Export {}", self.format.name())))
+                        .on_hover_text("Ctrl+E");
+                    mark(ui, "export:run", button.rect);
+                    if button.clicked() {
+                        ask = self.start(doc, notices, ui.input(|i| i.time), view_px, scene_file);
+                    }
+                    if running && ui.button("Cancel").clicked() {
+                        self.job = None;
+                        notices.note(ui.input(|i| i.time), "Export cancelled");
+                    }
+                });
+                if let Some(p) = self.progress() {
+                    ui.add(egui::ProgressBar::new(p).show_percentage());
+                }
+            });
+        mark(ui, "group:Export", header.header_response.rect);
+        ask
+    }
+
+    /// Starts an export of the document as the group is set (Ctrl+E, the button).
+    pub fn start(
+        &mut self,
+        doc: &Document,
+        notices: &mut Notices,
+        now: f64,
+        view_px: [u32; 2],
+        scene_file: &str,
+    ) -> ExportAsk {
+        if self.job.is_some() {
+            return ExportAsk::default();
+        }
+        let place = Place::of(scene_file);
+        if self.format == Format::Png {
+            let size = [
+                self.png_width.clamp(16, 8192),
+                png_height(self.png_width, view_px),
+            ];
+            self.job = Some(Job::Capture { place });
+            return ExportAsk {
+                capture: Some((size, self.transparent)),
+            };
+        }
+        let scene = doc.scene().clone();
+        match Sampling::start(&scene, self.options.resolution, self.options.noise) {
+            Ok(sampling) => {
+                self.job = Some(Job::Sampling {
+                    sampling,
+                    scene: Box::new(scene),
+                    format: self.format,
+                    options: self.options.clone(),
+                    place,
+                });
+            }
+            Err(e) => {
+                notices.error(now, format!("Could not export: {e}"));
+                self.last = Some(Err(e.to_string()));
+            }
+        }
+        ExportAsk::default()
+    }
+
+    /// Advances a running export within this frame's budget; saves its files when done.
+    /// Returns whether one is still running (the app keeps repainting).
+    pub fn step(&mut self, notices: &mut Notices, now: f64) -> bool {
+        let Some(Job::Sampling { sampling, .. }) = &mut self.job else {
+            return self.job.is_some();
+        };
+        let t0 = platform::now();
+        while !sampling.step(1) {
+            if platform::now() - t0 > FRAME_BUDGET {
+                return true;
+            }
+        }
+        let Some(Job::Sampling {
+            sampling,
+            scene,
+            format,
+            options,
+            place,
+        }) = self.job.take()
+        else {
+            return false;
+        };
+        let grid = sampling.finish();
+        let files = write(&scene, &grid, format, &options, &place.stem);
+        // The browser gets one download (several files as a ZIP); natively every file.
+        let saved: Result<Vec<String>, String> = if platform::HAS_PICKER && files.len() > 1 {
+            let name = format!("{}-{}.zip", place.stem, format.name());
+            platform::save_bytes(&name, &zip(&files), "application/zip").map(|w| vec![w])
+        } else {
+            files
+                .iter()
+                .map(|f| platform::save_bytes(&place.path(&f.name), &f.bytes, mime(format)))
+                .collect()
+        };
+        self.report(saved, notices, now);
+        false
+    }
+
+    /// Saves a finished capture of the view as the PNG export.
+    pub fn captured(
+        &mut self,
+        size: [u32; 2],
+        pixels: Result<Vec<u8>, String>,
+        notices: &mut Notices,
+        now: f64,
+    ) {
+        let Some(Job::Capture { place }) = self.job.take() else {
+            return;
+        };
+        let path = place.path(&format!("{}.png", place.stem));
+        let saved = pixels
+            .and_then(|rgba| platform::save_png(&path, size[0], size[1], rgba))
+            .map(|w| vec![w]);
+        self.report(saved, notices, now);
+    }
+
+    fn report(&mut self, saved: Result<Vec<String>, String>, notices: &mut Notices, now: f64) {
+        match &saved {
+            Ok(names) => notices.note(now, format!("Exported {}", names.join(", "))),
+            Err(e) => notices.error(now, format!("Could not export: {e}")),
+        }
+        self.last = Some(saved);
+    }
+}
+
+fn png_height(width: u32, view_px: [u32; 2]) -> u32 {
+    let aspect = view_px[1].max(1) as f64 / view_px[0].max(1) as f64;
+    ((width.clamp(16, 8192) as f64 * aspect).round() as u32).clamp(16, 8192)
+}
+
+fn mime(format: Format) -> &'static str {
+    match format {
+        Format::Glb => "model/gltf-binary",
+        Format::Obj => "model/obj",
+        Format::Ply => "application/octet-stream",
+        Format::Vdb => "application/octet-stream",
+        Format::Mitsuba => "application/xml",
+        Format::Png => "image/png",
+    }
+}

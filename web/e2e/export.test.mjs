@@ -1,0 +1,86 @@
+// Exports in the browser, through the Export group's real widgets: a glb of the cloud's surface
+// and PNGs of the view (over the sky, then transparent) download and parse. Screenshots:
+// test-results/screenshots/export-*.png.
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import fs from 'node:fs';
+import { PNG } from 'pngjs';
+import { serve, state, screenshot, until, withApp, waitForFullQuality } from './harness.mjs';
+
+let server;
+before(async () => { server = await serve(); });
+after(async () => { await server?.close(); });
+
+/** The JSON chunk and the binary chunk's length of a glb, checked against its header. */
+function parseGlb(bytes) {
+  const view = new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength);
+  assert.equal(String.fromCharCode(...bytes.subarray(0, 4)), 'glTF');
+  assert.equal(view.getUint32(4, true), 2, 'glTF 2');
+  assert.equal(view.getUint32(8, true), bytes.length, 'the header states the file length');
+  const jsonLength = view.getUint32(12, true);
+  assert.equal(String.fromCharCode(...bytes.subarray(16, 20)), 'JSON');
+  const json = JSON.parse(new TextDecoder().decode(bytes.subarray(20, 20 + jsonLength)));
+  const binLength = view.getUint32(20 + jsonLength, true);
+  return { json, binLength };
+}
+
+for (const backend of ['webgpu', 'webgl2']) {
+  test(`a glb and PNGs of the view download from the Export group (${backend})`, { timeout: 300_000 }, async () => {
+    await withApp({ base: server.url, webgpu: backend === 'webgpu', viewport: { width: 1280, height: 800 } }, async (page) => {
+      let s = await state(page);
+      const [vw, vh] = s.view.viewport;
+      const centre = (r) => [r[0] + r[2] / 2, r[1] + r[3] / 2];
+      const reveal = async (name) => {
+        for (let i = 0; i < 30; i++) {
+          const r = (await state(page)).view.widgets[name];
+          if (r && r[1] >= 2 && r[1] + r[3] <= vh - 2) return r;
+          await page.mouse.move(vw + 100, vh / 2);
+          await page.mouse.wheel(0, r && r[1] < 10 ? -200 : 200);
+          await page.waitForTimeout(150);
+        }
+        throw new Error(`${name} never came into view`);
+      };
+      const click = async (name) => page.mouse.click(...centre(await reveal(name)));
+      await page.mouse.click(5, vh - 5);
+      await waitForFullQuality(page);
+      await click('group:Export');
+      await reveal('export:run');
+
+      // The glb: a closed mesh's accessors, its binary chunk as long as its buffer.
+      await click('export:glb');
+      const [glb] = await Promise.all([page.waitForEvent('download', { timeout: 120_000 }), click('export:run')]);
+      assert.equal(glb.suggestedFilename(), 'untitled.glb');
+      const { json, binLength } = parseGlb(new Uint8Array(fs.readFileSync(await glb.path())));
+      const [pos, nor, idx] = json.accessors;
+      assert.ok(pos.count > 1000 && nor.count === pos.count, `${pos.count} vertices`);
+      assert.equal(idx.count % 3, 0);
+      assert.ok(idx.count / 3 > pos.count, `a closed surface has about twice as many triangles as vertices: ${idx.count / 3} for ${pos.count}`);
+      assert.equal(json.buffers[0].byteLength, binLength);
+      s = await until(page, (s) => s.view.export.last?.files, 'the export is reported');
+      assert.deepEqual(s.view.export.last.files, ['untitled.glb (a download)']);
+
+      // The PNG of the view at 1920 px wide, the view's shape: sky in the corner, cloud in the
+      // middle; then over a transparent background.
+      await click('export:png');
+      const [png] = await Promise.all([page.waitForEvent('download', { timeout: 120_000 }), click('export:run')]);
+      assert.equal(png.suggestedFilename(), 'untitled.png');
+      const img = PNG.sync.read(fs.readFileSync(await png.path()));
+      assert.equal(img.width, 1920);
+      assert.equal(img.height, Math.round(1920 * vh / vw));
+      const at = (im, x, y) => { const i = 4 * (Math.round(y) * im.width + Math.round(x)); return [...im.data.subarray(i, i + 4)]; };
+      const bg = s.scene.light.background.map((v) => Math.round(v * 255));
+      const corner = at(img, 3, 3);
+      assert.ok(corner.slice(0, 3).every((v, i) => Math.abs(v - bg[i]) <= 3) && corner[3] === 255, `sky in the corner: ${corner}`);
+      const middle = at(img, img.width / 2, img.height / 2);
+      assert.ok(middle.slice(0, 3).some((v, i) => Math.abs(v - bg[i]) > 30), `cloud in the middle: ${middle}`);
+      fs.copyFileSync(await png.path(), `test-results/screenshots/export-view-${backend}.png`);
+
+      await click('export:transparent');
+      const [clear] = await Promise.all([page.waitForEvent('download', { timeout: 120_000 }), click('export:run')]);
+      const t = PNG.sync.read(fs.readFileSync(await clear.path()));
+      assert.equal(at(t, 3, 3)[3], 0, 'a transparent corner');
+      assert.equal(at(t, t.width / 2, t.height / 2)[3], 255, 'an opaque middle');
+      await screenshot(page, `export-app-${backend}`);
+    });
+  });
+}
