@@ -563,6 +563,9 @@ pub fn run(json: bool, only: Option<&str>) -> Result<(), String> {
     if wanted("link") {
         results.extend(links());
     }
+    if wanted("mesh") {
+        results.extend(meshing());
+    }
     if wanted("render") {
         results.push(render_frame(&mut offscreen)?);
     }
@@ -592,4 +595,110 @@ pub fn run(json: bool, only: Option<&str>) -> Result<(), String> {
         }
     }
     Ok(())
+}
+
+/// Meshing the surface of 1,900 spheres at 128³, field sampling included, against plain
+/// marching cubes (the same per-cube table, every triangle with its own corners, no normals)
+/// on the same samples; the sampling reported apart.
+fn meshing() -> Vec<BenchResult> {
+    use crate::export::{sample, surface};
+    let mut scene = Scene::preset(Preset::Empty);
+    let mut rng = crate::seeded::SplitMix::new(1900);
+    let mut u = || rng.next_f64() as f32;
+    scene.ellipsoids = (0..1_900)
+        .map(|_| {
+            // A cumulus-like heap: wide at the base, rounded on top.
+            let (a, r) = (u() * std::f32::consts::TAU, u().sqrt() * 9.0);
+            let top = 4.5 * (1.0 - (r / 9.0).powi(2)).max(0.0);
+            let center = glam::Vec3::new(a.cos() * r, u() * top, a.sin() * r);
+            Arc::new(crate::scene::Ellipsoid::new(
+                center,
+                glam::Vec3::splat(0.7 + u() * 0.6),
+            ))
+        })
+        .collect();
+    let sampling = time_median(3, &mut || {
+        std::hint::black_box(sample(&scene, 128, false).ok());
+    });
+    let mut triangles = 0;
+    let ours = time_median(3, &mut || {
+        let g = sample(&scene, 128, false).expect("a cloud");
+        triangles = surface(&g, false).triangles.len();
+    });
+    let mut plain_triangles = 0;
+    let table = crate::export::mesh::table();
+    let plain = time_median(3, &mut || {
+        let g = sample(&scene, 128, false).expect("a cloud");
+        plain_triangles = plain_mc::mesh(table, g.dims, g.min, g.h, &g.field, crate::field::ISO);
+    });
+    log::info!("meshing: {triangles} triangles (shared corners), {plain_triangles} (plain)");
+    vec![
+        result(
+            "mesh_1900_spheres_128_with_sampling",
+            ours * 1e3,
+            "ms",
+            "plain_marching_cubes_same_samples",
+            plain * 1e3,
+        ),
+        result(
+            "mesh_sampling_alone_1900_spheres_128",
+            sampling * 1e3,
+            "ms",
+            "mesh_1900_spheres_128_with_sampling",
+            ours * 1e3,
+        ),
+    ]
+}
+
+/// Plain marching cubes, the meshing baseline: the same per-cube table, every triangle with
+/// its own three vertices (no shared corners, no normals). Returns the triangle count.
+mod plain_mc {
+    use glam::{IVec3, UVec3, Vec3};
+
+    use crate::export::mesh::{Case, EDGES};
+
+    fn corner(c: u8) -> IVec3 {
+        IVec3::new((c & 1) as i32, ((c >> 1) & 1) as i32, (c >> 2) as i32)
+    }
+
+    /// Marches every cube of the grid (outside it, below the iso level).
+    pub fn mesh(table: &[Case], dims: UVec3, min: Vec3, h: f32, values: &[f32], iso: f32) -> usize {
+        let d = dims.as_ivec3();
+        let value = |p: IVec3| {
+            if p.cmplt(IVec3::ZERO).any() || p.cmpge(d).any() {
+                iso - 1.0
+            } else {
+                values[((p.z * d.y + p.y) * d.x + p.x) as usize]
+            }
+        };
+        let mut positions: Vec<Vec3> = Vec::new();
+        for z in -1..d.z {
+            for y in -1..d.y {
+                for x in -1..d.x {
+                    let base = IVec3::new(x, y, z);
+                    let v: [f32; 8] = std::array::from_fn(|c| value(base + corner(c as u8)));
+                    let case = (0..8).fold(0usize, |m, c| m | (((v[c] >= iso) as usize) << c));
+                    for t in &table[case].triangles {
+                        for &e in t {
+                            // (Loop centres, rare, are placed at the cube's centre here.)
+                            let p = match EDGES.get(e as usize) {
+                                Some(&(a, b)) => {
+                                    let s = ((iso - v[a as usize])
+                                        / (v[b as usize] - v[a as usize]))
+                                        .clamp(0.0, 1.0);
+                                    let pa = min + (base + corner(a)).as_vec3() * h;
+                                    let pb = min + (base + corner(b)).as_vec3() * h;
+                                    pa + (pb - pa) * s
+                                }
+                                None => min + (base.as_vec3() + 0.5) * h,
+                            };
+                            positions.push(p);
+                        }
+                    }
+                }
+            }
+        }
+        std::hint::black_box(&positions);
+        positions.len() / 3
+    }
 }

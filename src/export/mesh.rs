@@ -1,13 +1,13 @@
-//! The blended implicit surface as a triangle mesh, by marching tetrahedra: every grid cube is
-//! split into the six tetrahedra around its main diagonal (the same split in every cube, so
-//! neighbouring cubes agree on their shared faces), and each tetrahedron the surface crosses
-//! gives one or two triangles with their corners on its edges. Corners are shared through the
-//! grid edge they lie on, and the grid is padded with outside values, so the mesh is closed,
-//! every edge has exactly two triangles (no face ambiguity as in marching cubes' table), and
-//! every triangle faces outward.
+//! The blended implicit surface as a triangle mesh, by marching cubes with a table built from
+//! the cube's faces: on each face the crossings are joined so that inside corners stay apart
+//! (the same choice the neighbouring cube makes on that face, so ambiguous faces never open a
+//! crack), the joined segments close into loops around each cube, and each loop is a fan of
+//! triangles facing away from the inside. Corners are shared through the grid edge they lie
+//! on (two rolling layers of edge indices, no hashing), and the grid is padded with outside
+//! values, so the mesh is closed, every edge has exactly two triangles, and every triangle
+//! faces outward.
 
-use std::collections::HashMap;
-use std::hash::{BuildHasherDefault, Hasher};
+use std::sync::OnceLock;
 
 use glam::{IVec3, UVec3, Vec3};
 
@@ -36,128 +36,219 @@ impl Mesh {
     }
 }
 
-/// A multiplicative hash for the edge keys (integers; SipHash is 3× slower here).
-#[derive(Default)]
-struct EdgeHasher(u64);
+/// Cube edges as corner pairs, lower corner first (corner bits: x 1, y 2, z 4).
+pub const EDGES: [(u8, u8); 12] = [
+    (0, 1),
+    (2, 3),
+    (4, 5),
+    (6, 7),
+    (0, 2),
+    (1, 3),
+    (4, 6),
+    (5, 7),
+    (0, 4),
+    (1, 5),
+    (2, 6),
+    (3, 7),
+];
 
-impl Hasher for EdgeHasher {
-    fn finish(&self) -> u64 {
-        self.0
+fn corner_offset(c: u8) -> IVec3 {
+    IVec3::new((c & 1) as i32, ((c >> 1) & 1) as i32, (c >> 2) as i32)
+}
+
+fn edge_of(a: u8, b: u8) -> u8 {
+    EDGES
+        .iter()
+        .position(|&(p, q)| (p, q) == (a, b) || (q, p) == (a, b))
+        .expect("adjacent corners") as u8
+}
+
+/// The cube's faces, each as its corners in counter-clockwise order seen from outside.
+fn faces() -> [[u8; 4]; 6] {
+    let raw: [[u8; 4]; 6] = [
+        [0, 2, 6, 4],
+        [1, 3, 7, 5],
+        [0, 1, 5, 4],
+        [2, 3, 7, 6],
+        [0, 1, 3, 2],
+        [4, 5, 7, 6],
+    ];
+    raw.map(|f| {
+        let p = f.map(|c| corner_offset(c).as_vec3());
+        let normal = (p[1] - p[0]).cross(p[3] - p[0]);
+        let outward = (p[0] + p[2]) * 0.5 - Vec3::splat(0.5);
+        if normal.dot(outward) > 0.0 {
+            f
+        } else {
+            [f[0], f[3], f[2], f[1]]
+        }
+    })
+}
+
+/// The surface inside one cube configuration: its loops (edge ids) and triangles, whose ids
+/// are edges (0–11) or the centre of loop `id − 12`.
+#[derive(Clone, Debug, Default)]
+pub struct Case {
+    /// The loops of crossing edges.
+    pub loops: Vec<Vec<u8>>,
+    /// Triangles facing away from the inside.
+    pub triangles: Vec<[u8; 3]>,
+}
+
+/// Whether two cube edges lie on a common face.
+fn share_face(faces: &[[u8; 4]; 6], a: u8, b: u8) -> bool {
+    let on = |f: &[u8; 4], e: u8| {
+        let (p, q) = EDGES[e as usize];
+        f.contains(&p) && f.contains(&q)
+    };
+    faces.iter().any(|f| on(f, a) && on(f, b))
+}
+
+/// Triangulates a loop (turning counter-clockwise about the inside) so that no triangle side
+/// other than the loop's own joins two points of one cube face (the cube across that face may
+/// join them too, and the edge would then have four triangles): a fan from an apex whose
+/// diagonals all cross the cube's inside, else a fan around the loop's centre.
+fn triangulate(faces: &[[u8; 4]; 6], lp: &[u8], centre: u8) -> Vec<[u8; 3]> {
+    let n = lp.len();
+    if n == 3 {
+        return vec![[lp[0], lp[2], lp[1]]];
     }
-    fn write(&mut self, _: &[u8]) {
-        unreachable!("only u64 keys")
-    }
-    fn write_u64(&mut self, k: u64) {
-        self.0 = (k ^ (k >> 29)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    let apex = (0..n).find(|&k| (2..n - 1).all(|j| !share_face(faces, lp[k], lp[(k + j) % n])));
+    match apex {
+        Some(k) => (1..n - 1)
+            .map(|j| [lp[k], lp[(k + j + 1) % n], lp[(k + j) % n]])
+            .collect(),
+        None => (0..n).map(|j| [centre, lp[(j + 1) % n], lp[j]]).collect(),
     }
 }
 
-/// The six tetrahedra of a cube around its 0–7 diagonal (corner bits: x 1, y 2, z 4).
-const TETS: [[u8; 4]; 6] = [
-    [0, 1, 3, 7],
-    [0, 1, 5, 7],
-    [0, 2, 3, 7],
-    [0, 2, 6, 7],
-    [0, 4, 5, 7],
-    [0, 4, 6, 7],
-];
+/// The surface of each of the 256 inside-corner masks.
+pub fn table() -> &'static [Case] {
+    static TABLE: OnceLock<Vec<Case>> = OnceLock::new();
+    TABLE.get_or_init(|| {
+        let faces = faces();
+        (0..256u32)
+            .map(|case| {
+                let inside = |c: u8| (case >> c) & 1 == 1;
+                // Directed segments on each face, from the crossing where the boundary walk
+                // leaves the inside to the one where it entered that run of inside corners:
+                // the inside lies on the segment's left, seen from outside the cube.
+                let mut segments: Vec<(u8, u8)> = Vec::new();
+                for f in faces {
+                    for k in 0..4 {
+                        if inside(f[k]) && !inside(f[(k + 1) % 4]) {
+                            let mut a = k;
+                            while inside(f[(a + 3) % 4]) {
+                                a = (a + 3) % 4;
+                            }
+                            let exit = edge_of(f[k], f[(k + 1) % 4]);
+                            let entry = edge_of(f[(a + 3) % 4], f[a]);
+                            segments.push((exit, entry));
+                        }
+                    }
+                }
+                let mut case = Case::default();
+                while let Some((start, mut next)) = segments.pop() {
+                    let mut lp = vec![start];
+                    while next != start {
+                        lp.push(next);
+                        let i = segments
+                            .iter()
+                            .position(|&(a, _)| a == next)
+                            .expect("the segments close into loops");
+                        next = segments.swap_remove(i).1;
+                    }
+                    let centre = 12 + case.loops.len() as u8;
+                    case.triangles.extend(triangulate(&faces, &lp, centre));
+                    case.loops.push(lp);
+                }
+                case
+            })
+            .collect()
+    })
+}
 
 /// Meshes the surface `value = iso` of `values` (on `dims` texels, x fastest) whose texel
 /// `(x, y, z)` is at `min + (x, y, z)·h`; outside the grid the value is below `iso`.
 pub fn mesh(dims: UVec3, min: Vec3, h: f32, values: &[f32], iso: f32) -> Mesh {
+    let table = table();
     let d = dims.as_ivec3();
+    let outside = iso - 1.0;
     let value = |p: IVec3| -> f32 {
         if p.cmplt(IVec3::ZERO).any() || p.cmpge(d).any() {
-            f32::NEG_INFINITY
+            outside
         } else {
             values[((p.z * d.y + p.y) * d.x + p.x) as usize]
         }
     };
-    let inside = |v: f32| v >= iso;
-    // Padded lattice index of a grid point (one layer of outside points on each side).
-    let pd = d + IVec3::splat(2);
-    let key = |p: IVec3, q: IVec3| -> u64 {
-        let a = p + IVec3::ONE;
-        let idx = ((a.z as i64 * pd.y as i64 + a.y as i64) * pd.x as i64 + a.x as i64) as u64;
-        let t = q - p;
-        idx * 8 + (t.x | (t.y << 1) | (t.z << 2)) as u64
-    };
+    // Vertex ids of grid edges by their lower point, in rolling layers: x and y edges of the
+    // cube layer's bottom (0) and top (1) planes, z edges between them.
+    let w = (d.x + 2) as usize;
+    let layer = w * (d.y + 2) as usize;
+    let mut xy = [vec![u32::MAX; 2 * layer], vec![u32::MAX; 2 * layer]];
+    let mut zs = vec![u32::MAX; layer];
     let mut mesh = Mesh::default();
-    let mut edges: HashMap<u64, u32, BuildHasherDefault<EdgeHasher>> = HashMap::default();
-    let mut vertex = |mesh: &mut Mesh, p: IVec3, q: IVec3, vp: f32, vq: f32| -> u32 {
-        let (p, q, vp, vq) = if (q - p).min_element() < 0 {
-            (q, p, vq, vp)
-        } else {
-            (p, q, vp, vq)
-        };
-        *edges.entry(key(p, q)).or_insert_with(|| {
-            // Outside the grid the value is −∞: the corner sits on the grid's boundary point.
-            let t = if vp.is_finite() && vq.is_finite() {
-                ((iso - vp) / (vq - vp)).clamp(0.0, 1.0)
-            } else if vp.is_finite() {
-                0.0
-            } else {
-                1.0
-            };
-            let a = min + p.as_vec3() * h;
-            let b = min + q.as_vec3() * h;
-            mesh.positions.push(a + (b - a) * t);
-            mesh.normals.push(Vec3::ZERO);
-            (mesh.positions.len() - 1) as u32
-        })
-    };
     for z in -1..d.z {
+        xy[1].fill(u32::MAX);
+        zs.fill(u32::MAX);
         for y in -1..d.y {
             for x in -1..d.x {
                 let base = IVec3::new(x, y, z);
-                let corner = |c: u8| {
-                    base + IVec3::new((c & 1) as i32, ((c >> 1) & 1) as i32, (c >> 2) as i32)
-                };
-                let v: [f32; 8] = std::array::from_fn(|c| value(corner(c as u8)));
-                let ins = v.iter().filter(|&&a| inside(a)).count();
-                if ins == 0 || ins == 8 {
+                let v: [f32; 8] = std::array::from_fn(|c| value(base + corner_offset(c as u8)));
+                let case = (0..8).fold(0usize, |m, c| m | (((v[c] >= iso) as usize) << c));
+                if case == 0 || case == 255 {
                     continue;
                 }
-                for tet in TETS {
-                    let (i, o): (Vec<u8>, Vec<u8>) =
-                        tet.iter().partition(|&&c| inside(v[c as usize]));
-                    if i.is_empty() || o.is_empty() {
-                        continue;
+                let case = &table[case];
+                // This cube's crossing edges: their shared vertices, made by whichever cube
+                // meets them first.
+                let mut ids = [u32::MAX; 12];
+                for &e in case.loops.iter().flatten() {
+                    let (a, b) = EDGES[e as usize];
+                    let lo = base + corner_offset(a);
+                    let at = (lo.y + 1) as usize * w + (lo.x + 1) as usize;
+                    let slot = match b - a {
+                        1 => &mut xy[corner_offset(a).z as usize][2 * at],
+                        2 => &mut xy[corner_offset(a).z as usize][2 * at + 1],
+                        _ => &mut zs[at],
+                    };
+                    if *slot == u32::MAX {
+                        let (va, vb) = (v[a as usize], v[b as usize]);
+                        let s = ((iso - va) / (vb - va)).clamp(0.0, 1.0);
+                        let pa = min + lo.as_vec3() * h;
+                        let pb = min + (base + corner_offset(b)).as_vec3() * h;
+                        mesh.positions.push(pa + (pb - pa) * s);
+                        *slot = (mesh.positions.len() - 1) as u32;
                     }
-                    let centroid = |cs: &[u8]| {
-                        cs.iter().map(|&c| corner(c).as_vec3()).sum::<Vec3>() / cs.len() as f32
-                    };
-                    let outward = centroid(&o) - centroid(&i);
-                    let mut tri = |mesh: &mut Mesh, e: [(u8, u8); 3]| {
-                        let ids = e.map(|(a, b)| {
-                            vertex(mesh, corner(a), corner(b), v[a as usize], v[b as usize])
-                        });
-                        // Orientation from the edges' midpoints: never degenerate, and the same
-                        // side as the true corners (they only slide along their edges).
-                        let m = e.map(|(a, b)| (corner(a).as_vec3() + corner(b).as_vec3()) * 0.5);
-                        let n = (m[1] - m[0]).cross(m[2] - m[0]);
-                        let ids = if n.dot(outward) >= 0.0 {
-                            ids
-                        } else {
-                            [ids[0], ids[2], ids[1]]
-                        };
-                        mesh.triangles.push(ids);
-                    };
-                    match (i.len(), o.len()) {
-                        (1, 3) => tri(&mut mesh, [(i[0], o[0]), (i[0], o[1]), (i[0], o[2])]),
-                        (3, 1) => tri(&mut mesh, [(i[0], o[0]), (i[1], o[0]), (i[2], o[0])]),
-                        _ => {
-                            // A quad around the tetrahedron: (i0,o0) (i0,o1) (i1,o1) (i1,o0).
-                            let q = [(i[0], o[0]), (i[0], o[1]), (i[1], o[1]), (i[1], o[0])];
-                            tri(&mut mesh, [q[0], q[1], q[2]]);
-                            tri(&mut mesh, [q[0], q[2], q[3]]);
+                    ids[e as usize] = *slot;
+                }
+                // Loop centres, where a loop needs one: the mean of its points.
+                let mut centres = [u32::MAX; 4];
+                for t in &case.triangles {
+                    let tri = t.map(|e| {
+                        if e < 12 {
+                            return ids[e as usize];
                         }
-                    }
+                        let k = (e - 12) as usize;
+                        if centres[k] == u32::MAX {
+                            let lp = &case.loops[k];
+                            let sum: Vec3 = lp
+                                .iter()
+                                .map(|&e| mesh.positions[ids[e as usize] as usize])
+                                .sum();
+                            mesh.positions.push(sum / lp.len() as f32);
+                            centres[k] = (mesh.positions.len() - 1) as u32;
+                        }
+                        centres[k]
+                    });
+                    mesh.triangles.push(tri);
                 }
             }
         }
+        xy.swap(0, 1);
     }
     // Area-weighted normals.
+    mesh.normals = vec![Vec3::ZERO; mesh.positions.len()];
     for t in &mesh.triangles {
         let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
         let n = (b - a).cross(c - a);
@@ -174,6 +265,8 @@ pub fn mesh(dims: UVec3, min: Vec3, h: f32, values: &[f32], iso: f32) -> Mesh {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    use std::collections::HashMap;
 
     /// Every undirected edge is used by exactly two triangles, once in each direction.
     pub fn assert_closed_and_oriented(mesh: &Mesh) {
@@ -223,6 +316,41 @@ mod tests {
         for (p, n) in m.positions.iter().zip(&m.normals) {
             assert!(p.normalize().dot(*n) > 0.9);
         }
+    }
+
+    #[test]
+    fn random_fields_with_every_ambiguous_face_give_closed_oriented_meshes() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut cases = [false; 256];
+        for _ in 0..300 {
+            let values: Vec<f32> = (0..216)
+                .map(|_| {
+                    state ^= state << 13;
+                    state ^= state >> 7;
+                    state ^= state << 17;
+                    (state % 1000) as f32 / 500.0 - 1.0
+                })
+                .collect();
+            for z in 0..5 {
+                for y in 0..5 {
+                    for x in 0..5 {
+                        let case = (0..8).fold(0, |m, c| {
+                            let p = UVec3::new(x, y, z).as_ivec3() + corner_offset(c);
+                            let v = values[((p.z * 6 + p.y) * 6 + p.x) as usize];
+                            m | (((v >= 0.0) as usize) << c)
+                        });
+                        cases[case] = true;
+                    }
+                }
+            }
+            let m = mesh(UVec3::splat(6), Vec3::ZERO, 1.0, &values, 0.0);
+            assert_closed_and_oriented(&m);
+            assert!(m.volume() > 0.0);
+        }
+        assert!(
+            cases.iter().filter(|&&c| c).count() > 250,
+            "most of the 256 cases met"
+        );
     }
 
     #[test]

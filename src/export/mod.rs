@@ -5,13 +5,13 @@
 //! - `grid`: the scene sampled on a grid of the chosen resolution, with or without its media;
 //! - `axes`: Y-up or Z-up and the unit scale;
 //! - `vdb`: the OpenVDB writer; `mitsuba`: the Mitsuba scene; `formats`: glb, OBJ, PLY, `.vol`;
-//! - `mesh`: the surface by marching tetrahedra (closed, manifold, outward);
+//! - `mesh`: the surface by marching cubes (closed, manifold, outward);
 //! - `zip`: several files as one (stored) archive, for one browser download.
 
 mod axes;
 mod formats;
 mod grid;
-mod mesh;
+pub mod mesh;
 mod mitsuba;
 mod vdb;
 mod zip;
