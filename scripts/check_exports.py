@@ -6,9 +6,10 @@ independent readers:
   named "density"; at every probe point (world coordinates of the file) the grid holds the
   value the field gives there, evaluated directly by the test, to float precision.
 - Mitsuba 3 (pip's `mitsuba`, variant scalar_rgb) renders the exported scenes with and without
-  the noise: the cloud covers the same pixels as the app's own render of that view (coverage
-  IoU >= 0.8; coverage = pixels more than 6/255 from the background), and the export with
-  the noise matches the app's image better than the one without.
+  the noise, and through an orthographic camera: the cloud covers the same pixels as the app's
+  own render of that view (coverage IoU >= 0.8; coverage = pixels more than 6/255 from the
+  background), and the export with the noise matches the app's image better than the one
+  without.
 
 Usage: check_exports.py DIR. Exits non-zero with a message on the first failure.
 """
@@ -58,13 +59,13 @@ def check_mitsuba(d):
     import mitsuba as mi
     import numpy as np
     mi.set_variant("scalar_rgb")
-    app = np.array(mi.Bitmap(os.path.join(d, "app_view.png")), dtype=np.float64)[:, :, :3]
     background = np.array(json.load(open(os.path.join(d, "app_view.json")))["background"], dtype=np.float64)
 
     def coverage(rgb8):
         return (np.abs(rgb8 - background) > 6).any(axis=2)
 
-    app_cover = coverage(app)
+    def app_coverage(name):
+        return coverage(np.array(mi.Bitmap(os.path.join(d, name)), dtype=np.float64)[:, :, :3])
 
     def render(stem):
         scene = mi.load_file(os.path.join(d, f"{stem}.xml"))
@@ -73,13 +74,16 @@ def check_mitsuba(d):
         return np.clip(np.round(srgb * 255), 0, 255)
 
     ious = {}
-    for stem in ["mitsuba_noise", "mitsuba_plain"]:
+    for stem, app in [("mitsuba_noise", "app_view.png"), ("mitsuba_plain", "app_view.png"),
+                      ("mitsuba_ortho", "app_view_ortho.png")]:
+        app_cover = app_coverage(app)
         cover = coverage(render(stem))
         union = (cover | app_cover).sum()
         ious[stem] = (cover & app_cover).sum() / max(union, 1)
         print(f"check_exports: {stem}: coverage {cover.sum()} px vs the app's {app_cover.sum()}, IoU {ious[stem]:.3f}")
-    if ious["mitsuba_noise"] < 0.8:
-        fail(f"Mitsuba's render covers other pixels than the app's (IoU {ious['mitsuba_noise']:.3f} < 0.8)")
+    for stem in ["mitsuba_noise", "mitsuba_ortho"]:
+        if ious[stem] < 0.8:
+            fail(f"{stem}: Mitsuba's render covers other pixels than the app's (IoU {ious[stem]:.3f} < 0.8)")
     if not ious["mitsuba_noise"] > ious["mitsuba_plain"]:
         fail(f"the noise in the export does not bring Mitsuba closer to the app "
              f"(IoU {ious['mitsuba_noise']:.3f} with, {ious['mitsuba_plain']:.3f} without)")

@@ -243,6 +243,24 @@ fn mitsuba_scenes_and_the_apps_render_of_their_view() {
     let mut offscreen = Offscreen::new().expect("an offscreen adapter");
     let image = offscreen.render(&scene, size[0], size[1]).unwrap();
     std::fs::write(out_dir().join("app_view.png"), image.to_png().unwrap()).unwrap();
+    // The same cloud seen through an orthographic camera (Mitsuba's orthographic sensor).
+    let mut ortho = scene.clone();
+    ortho.camera.orthographic = true;
+    let options = Options {
+        resolution: 96,
+        image: size,
+        samples: 16,
+        ..Options::default()
+    };
+    for f in export(&ortho, Format::Mitsuba, &options, "mitsuba_ortho").unwrap() {
+        std::fs::write(out_dir().join(&f.name), &f.bytes).unwrap();
+    }
+    let image = offscreen.render(&ortho, size[0], size[1]).unwrap();
+    std::fs::write(
+        out_dir().join("app_view_ortho.png"),
+        image.to_png().unwrap(),
+    )
+    .unwrap();
     let background = scene.light.background.map(|c| (c * 255.0).round() as u8);
     std::fs::write(
         out_dir().join("app_view.json"),

@@ -43,7 +43,10 @@ pub fn write_xml(
         "  <integrator type=\"volpath\"><integer name=\"max_depth\" value=\"64\"/></integrator>"
     );
     if camera.orthographic {
-        let h = camera.distance * (camera.fov_y_deg.to_radians() * 0.5).tan();
+        // Mitsuba's orthographic sensor spans [−1, 1] across the film's width: scaled by the
+        // view's half-width, its height follows the film's shape.
+        let aspect = size[0] as f32 / size[1].max(1) as f32;
+        let h = camera.distance * (camera.fov_y_deg.to_radians() * 0.5).tan() * aspect;
         let _ = writeln!(x, "  <sensor type=\"orthographic\">");
         let _ = writeln!(
             x,
