@@ -423,11 +423,40 @@ pub fn bake(field: &Field, resolution: u32) -> DensityVolume {
 
 /// [`bake`] at up to [`crate::limits::MAX_EXPORT_RESOLUTION`] texels along the longest side
 /// (exports; the renderer's grid stops at [`MAX_RESOLUTION`]).
+/// The grid is cut into z-slabs baked on the machine's cores (one where threads are not
+/// available, as in the browser); texels sit on the lattice, so each slab's texels are the
+/// whole grid's to the bit.
 pub fn bake_fine(field: &Field, resolution: u32) -> DensityVolume {
     let cap = crate::limits::MAX_EXPORT_RESOLUTION;
-    match Grid::capped(field, resolution, cap) {
-        Some(grid) => bake_on(field, &grid),
-        None => DensityVolume::default(),
+    let Some(grid) = Grid::capped(field, resolution, cap) else {
+        return DensityVolume::default();
+    };
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .min(grid.dims.z as usize / 8)
+        .max(1);
+    if threads == 1 {
+        return bake_on(field, &grid);
+    }
+    let per = grid.dims.z.div_ceil(threads as u32);
+    let slabs: Vec<Grid> = (0..grid.dims.z)
+        .step_by(per as usize)
+        .map(|z0| Grid {
+            origin: grid.origin + I64Vec3::new(0, 0, z0 as i64),
+            dims: UVec3::new(grid.dims.x, grid.dims.y, per.min(grid.dims.z - z0)),
+            h: grid.h,
+        })
+        .collect();
+    let parts: Option<Vec<Vec<f32>>> = std::thread::scope(|scope| {
+        let handles: Vec<_> = slabs
+            .iter()
+            .map(|slab| scope.spawn(move || bake_on(field, slab).values))
+            .collect();
+        handles.into_iter().map(|h| h.join().ok()).collect()
+    });
+    match parts {
+        Some(parts) => volume_of(&grid, parts.concat()),
+        None => bake_on(field, &grid),
     }
 }
 
@@ -1076,5 +1105,20 @@ mod tests {
             .map(|(a, b)| (a - b).abs())
             .fold(0.0, f32::max);
         assert!(worst < 1e-5, "{worst}");
+    }
+
+    #[test]
+    fn the_export_bake_in_slabs_equals_the_whole_grid_bake() {
+        let field = crate::derive::field_of(&crate::scene::Scene::default());
+        let fine = bake_fine(&field, 100);
+        let whole = bake(&field, 100);
+        assert_eq!(
+            (fine.dims, fine.min, fine.size),
+            (whole.dims, whole.min, whole.size)
+        );
+        assert!(
+            fine.values == whole.values,
+            "slab texels differ from the whole grid's"
+        );
     }
 }
