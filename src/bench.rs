@@ -566,6 +566,9 @@ pub fn run(json: bool, only: Option<&str>) -> Result<(), String> {
     if wanted("mesh") {
         results.extend(meshing());
     }
+    if wanted("simulate") {
+        results.extend(simulation());
+    }
     if wanted("render") {
         results.push(render_frame(&mut offscreen)?);
     }
@@ -701,4 +704,49 @@ mod plain_mc {
         std::hint::black_box(&positions);
         positions.len() / 3
     }
+}
+
+/// One automaton step on a 128×32×128 grid (x, y up, z) steered by three parcels, bit-parallel,
+/// against the plain byte-per-cell step with the same random words; and the smoothing into a
+/// density volume.
+fn simulation() -> Vec<BenchResult> {
+    use crate::simulate::{Parcel, Settings, Simulation, reference::Reference};
+    let settings = Settings {
+        cells: [128, 32, 128],
+        ..Settings::default()
+    };
+    let parcels: Vec<Parcel> = [(-6.0, 3.0, 0.0), (4.0, 4.0, 3.0), (0.0, 3.5, -7.0)]
+        .iter()
+        .map(|&(x, y, z)| Parcel {
+            center: glam::Vec3::new(x, y, z),
+            radii: glam::Vec3::new(6.0, 3.0, 5.0),
+            rotation: glam::Quat::IDENTITY,
+        })
+        .collect();
+    let mut sim = Simulation::new(&settings, &parcels);
+    sim.advance(30);
+    let step = time_median(9, &mut || sim.advance(1));
+    let wind = |_y: usize| 0.0;
+    let mut plain = Reference::of(sim.automaton());
+    let automaton = sim.automaton().clone();
+    let reference = time_median(3, &mut || plain.step(&automaton, &wind));
+    let smooth = time_median(5, &mut || {
+        std::hint::black_box(sim.density(None, 1.0));
+    });
+    vec![
+        result(
+            "simulation_step_128x32x128",
+            step * 1e3,
+            "ms",
+            "plain_byte_per_cell_step",
+            reference * 1e3,
+        ),
+        result(
+            "simulation_smoothing_128x32x128",
+            smooth * 1e3,
+            "ms",
+            "simulation_step_128x32x128",
+            step * 1e3,
+        ),
+    ]
 }

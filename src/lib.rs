@@ -22,6 +22,7 @@ pub mod render;
 pub mod scene;
 pub mod seeded;
 pub mod share;
+pub mod simulate;
 pub mod sketch;
 pub mod ui;
 

@@ -134,7 +134,7 @@ enum Command {
         /// Print one JSON object instead of a table.
         #[arg(long)]
         json: bool,
-        /// Run only these groups, comma-separated: sketch, light, stroke, worst, field, link, mesh,
+        /// Run only these groups, comma-separated: sketch, light, stroke, worst, field, link, mesh, simulate,
         /// render, quality.
         #[arg(long)]
         only: Option<String>,

@@ -1,0 +1,273 @@
+use super::reference::Reference;
+use super::*;
+
+fn random_automaton(dims: [usize; 3], seed: u64) -> Automaton {
+    let mut a = Automaton::new(dims, seed);
+    let mut s = seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1;
+    let mut next = move || {
+        s ^= s << 13;
+        s ^= s >> 7;
+        s ^= s << 17;
+        s
+    };
+    let [nx, _, _] = dims;
+    let tail = if nx % 64 == 0 {
+        u64::MAX
+    } else {
+        (1 << (nx % 64)) - 1
+    };
+    let words = a.words();
+    for bits in [&mut a.hum, &mut a.act, &mut a.cld] {
+        for (i, w) in bits.iter_mut().enumerate() {
+            *w = next() & next() & if (i + 1) % words == 0 { tail } else { u64::MAX };
+        }
+    }
+    let levels: Vec<u8> = (0..dims.iter().product::<usize>() * 3)
+        .map(|_| (next() % 8) as u8)
+        .collect();
+    for (k, kind) in [Kind::Hum, Kind::Act, Kind::Ext].into_iter().enumerate() {
+        let l = &levels;
+        a.set_levels(kind, |x, y, z| l[k + 3 * ((y * dims[2] + z) * dims[0] + x)]);
+    }
+    a
+}
+
+#[test]
+fn the_bit_parallel_step_equals_the_plain_one_bit_for_bit() {
+    for (dims, seed) in [
+        ([70, 5, 6], 1),
+        ([130, 4, 3], 2),
+        ([64, 6, 5], 3),
+        ([9, 7, 8], 4),
+    ] {
+        let mut a = random_automaton(dims, seed);
+        let wind = move |y: usize| 1.7 * y as f32 - 2.3;
+        a.set_wind(wind);
+        let mut r = Reference::of(&a);
+        for step in 0..12 {
+            r.step(&a, &wind);
+            a.advance();
+            assert!(r.same_as(&a), "{dims:?}: differs after step {}", step + 1);
+        }
+        assert!(a.cloud_cells() > 0);
+    }
+}
+
+#[test]
+fn rows_shift_across_words_and_lose_what_leaves() {
+    let mut row = vec![1u64 << 63, 1, 0];
+    shift_row(&mut row, 1);
+    assert_eq!(row, vec![0, 1 << 1 | 1, 0]);
+    shift_row(&mut row, 64);
+    assert_eq!(row, vec![0, 0, 1 << 1 | 1]);
+    shift_row(&mut row, -130);
+    assert_eq!(row, vec![0, 0, 0]);
+}
+
+#[test]
+fn certain_extinction_clears_every_cloud_in_one_step() {
+    let mut a = random_automaton([40, 5, 6], 9);
+    a.set_levels(Kind::Ext, |_, _, _| (LEVELS.len() - 1) as u8);
+    assert!(a.cloud_cells() > 0);
+    a.advance();
+    assert_eq!(a.cloud_cells(), 0);
+}
+
+#[test]
+fn without_resupply_the_cloud_stops_growing_once_the_vapour_is_used() {
+    let mut a = Automaton::new([48, 12, 12], 3);
+    // Vapour in a block, one activated seed cell, no re-supply, no extinction.
+    for y in 2..10 {
+        for z in 2..10 {
+            for x in 10..30 {
+                let (w, b) = a.at(x, y, z);
+                a.hum[w] |= 1 << b;
+            }
+        }
+    }
+    let (w, b) = a.at(15, 3, 5);
+    a.act[w] |= 1 << b;
+    let mut counts = Vec::new();
+    for _ in 0..60 {
+        a.advance();
+        counts.push(a.cloud_cells());
+    }
+    assert!(
+        counts.windows(2).all(|c| c[1] >= c[0]),
+        "never shrinks: {counts:?}"
+    );
+    assert!(counts[5] > counts[0], "it grows: {counts:?}");
+    let vapour: u64 = a.hum.iter().map(|w| w.count_ones() as u64).sum();
+    assert_eq!(vapour, 0, "the vapour is used up");
+    assert_eq!(counts[40], counts[59], "then the mass stays");
+    assert!(
+        counts[59] <= 8 * 8 * 20 + 1,
+        "no more cloud than vapour was: {}",
+        counts[59]
+    );
+}
+
+fn parcel_settings() -> (Settings, Vec<Parcel>) {
+    let settings = Settings {
+        cells: [64, 16, 32],
+        origin: [0.0, 0.0, 0.0],
+        cell_size: 1.0,
+        wind: [0.0, 0.0],
+        ..Settings::default()
+    };
+    let parcel = Parcel {
+        center: Vec3::new(20.0, 7.0, 16.0),
+        radii: Vec3::new(9.0, 5.0, 9.0),
+        rotation: Quat::IDENTITY,
+    };
+    (settings, vec![parcel])
+}
+
+#[test]
+fn clouds_form_inside_parcels_and_not_far_outside() {
+    let (settings, parcels) = parcel_settings();
+    let mut sim = Simulation::new(&settings, &parcels);
+    sim.advance(60);
+    let a = sim.automaton();
+    let [nx, ny, nz] = a.dims;
+    let (mut inside, mut far) = (0, 0);
+    for y in 0..ny {
+        for z in 0..nz {
+            for x in 0..nx {
+                if a.get(&a.cld, x, y, z) {
+                    let w = parcels[0].weight(settings.center(x, y, z));
+                    let local = (settings.center(x, y, z) - parcels[0].center) / parcels[0].radii;
+                    if w > 0.0 {
+                        inside += 1;
+                    } else if local.length() > 1.5 {
+                        far += 1;
+                    }
+                }
+            }
+        }
+    }
+    assert!(inside > 200, "{inside} cloud cells inside the parcel");
+    assert!(far * 50 < inside, "{far} far outside vs {inside} inside");
+    // Moving the parcel moves the cloud.
+    let moved = vec![Parcel {
+        center: Vec3::new(44.0, 7.0, 16.0),
+        ..parcels[0]
+    }];
+    let mut sim2 = Simulation::new(&settings, &moved);
+    sim2.advance(60);
+    let cx = |s: &Simulation| {
+        let a = s.automaton();
+        let [nx, ny, nz] = a.dims;
+        let (mut sum, mut n) = (0.0, 0.0);
+        for y in 0..ny {
+            for z in 0..nz {
+                for x in 0..nx {
+                    if a.get(&a.cld, x, y, z) {
+                        sum += x as f64;
+                        n += 1.0;
+                    }
+                }
+            }
+        }
+        sum / n
+    };
+    assert!(
+        (cx(&sim2) - cx(&sim) - 24.0).abs() < 3.0,
+        "{} → {}",
+        cx(&sim),
+        cx(&sim2)
+    );
+}
+
+#[test]
+fn wind_moves_the_cloud_mass_by_its_speed() {
+    // A frozen cloud (no vapour, no activation, no extinction) blown at 1.5 cells per step.
+    let mut a = Automaton::new([200, 4, 4], 5);
+    for y in 0..4 {
+        for z in 0..4 {
+            for x in 20..40 {
+                let (w, b) = a.at(x, y, z);
+                a.cld[w] |= 1 << b;
+            }
+        }
+    }
+    a.set_wind(|_| 1.5);
+    let centroid = |a: &Automaton| {
+        let (mut s, mut n) = (0.0, 0.0);
+        for y in 0..4 {
+            for z in 0..4 {
+                for x in 0..200 {
+                    if a.get(&a.cld, x, y, z) {
+                        s += x as f64;
+                        n += 1.0;
+                    }
+                }
+            }
+        }
+        s / n
+    };
+    let c0 = centroid(&a);
+    for _ in 0..40 {
+        a.advance();
+    }
+    assert!(
+        (centroid(&a) - c0 - 60.0).abs() < 1e-9,
+        "{} → {}",
+        c0,
+        centroid(&a)
+    );
+    assert_eq!(a.cloud_cells(), 20 * 16);
+}
+
+#[test]
+fn the_same_seed_gives_the_same_run_and_another_seed_another() {
+    let (settings, parcels) = parcel_settings();
+    let run = |seed| {
+        let mut sim = Simulation::new(
+            &Settings {
+                seed,
+                ..settings.clone()
+            },
+            &parcels,
+        );
+        sim.advance(30);
+        sim.automaton().cld.clone()
+    };
+    assert_eq!(run(7), run(7));
+    assert_ne!(run(7), run(8));
+}
+
+#[test]
+fn the_smoothed_density_is_the_share_of_cloud_around_each_cell() {
+    let (settings, parcels) = parcel_settings();
+    let mut sim = Simulation::new(&settings, &parcels);
+    sim.advance(40);
+    let v = sim.density(None, 1.0);
+    assert_eq!(v.values.len(), 64 * 16 * 32);
+    assert!(v.values.iter().all(|&q| (0.0..=1.0).contains(&q)));
+    // Brute force at one cell in the cloud: the mean of its 3×3×3 neighbourhood.
+    let a = sim.automaton();
+    let (x, y, z) = (20, 7, 16);
+    let mut sum = 0.0;
+    for dz in -1i32..=1 {
+        for dy in -1i32..=1 {
+            for dx in -1i32..=1 {
+                sum += a.get(
+                    &a.cld,
+                    (x + dx) as usize,
+                    (y + dy) as usize,
+                    (z + dz) as usize,
+                ) as u8 as f32;
+            }
+        }
+    }
+    let got = v.values[((z * 16 + y) * 64 + x) as usize];
+    assert!((got - sum / 27.0).abs() < 1e-5, "{got} vs {}", sum / 27.0);
+    // Halfway between two steps: the mean of both.
+    let before = sim.smoothed();
+    sim.advance(1);
+    let half = sim.density(Some(&before), 0.5);
+    let after = sim.smoothed();
+    let i = ((z * 16 + y) * 64 + x) as usize;
+    assert!((half.values[i] - 0.5 * (before[i] + after[i])).abs() < 1e-6);
+}
