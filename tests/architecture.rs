@@ -57,8 +57,9 @@ fn uses(code: &str, name: &str) -> bool {
     })
 }
 
-const PURE: [&str; 8] = [
+const PURE: [&str; 9] = [
     "src/export/",
+    "src/simulate/",
     "src/scene/",
     "src/sketch/",
     "src/field/",

@@ -1,5 +1,5 @@
 //! The native command line: `cloudsketch` alone opens the desktop app; subcommands work
-//! headless. One file per subcommand: `new`, `render`, `sketch`, `link`, `export` (`bench` is
+//! headless. One file per subcommand: `new`, `render`, `sketch`, `link`, `export`, `simulate` (`bench` is
 //! `crate::bench`);
 //! `desktop` opens the window.
 
@@ -8,6 +8,7 @@ mod export;
 mod link;
 mod new;
 mod render;
+mod simulate;
 mod sketch;
 
 use std::path::{Path, PathBuf};
@@ -57,6 +58,24 @@ enum Command {
         /// Override a scene value by JSON Pointer, e.g. /render/slices=256 (repeatable).
         #[arg(long = "set", value_name = "PATH=VALUE")]
         set: Vec<String>,
+        /// Render at this scene time in seconds (the media's wind, a simulation's steps).
+        #[arg(long)]
+        time: Option<f32>,
+    },
+    /// Run a scene's cloud simulation (the `simulated` preset without SCENE) and write the
+    /// smoothed density after N steps as a Mitsuba .vol or an OpenVDB .vdb.
+    Simulate {
+        /// Scene JSON or share link with a simulation; the `simulated` preset when left out.
+        scene: Option<String>,
+        /// Steps to run.
+        #[arg(long, default_value_t = 100)]
+        steps: u64,
+        /// Seed of the random terms (else the scene's).
+        #[arg(long)]
+        seed: Option<u64>,
+        /// Output: .vol or .vdb.
+        #[arg(short, long)]
+        output: PathBuf,
     },
     /// Turn drawn outlines into a scene (one drawing plane per stroke), headless.
     Sketch {
@@ -156,7 +175,14 @@ pub fn main() -> ExitCode {
             output,
             size,
             set,
-        }) => render::run(scene.as_deref(), &output, &size, &set),
+            time,
+        }) => render::run(scene.as_deref(), &output, &size, &set, time),
+        Some(Command::Simulate {
+            scene,
+            steps,
+            seed,
+            output,
+        }) => simulate::run(scene.as_deref(), steps, seed, &output),
         Some(Command::Link {
             scene,
             decode,

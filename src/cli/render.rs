@@ -21,8 +21,14 @@ pub fn parse_size(text: &str) -> Result<(u32, u32), String> {
     Ok((w, h))
 }
 
-/// `cloudsketch render [SCENE|URL] -o OUT.png --size WxH --set PATH=VALUE…`.
-pub fn run(scene: Option<&str>, output: &Path, size: &str, sets: &[String]) -> Result<(), String> {
+/// `cloudsketch render [SCENE|URL] -o OUT.png --size WxH --set PATH=VALUE… [--time T]`.
+pub fn run(
+    scene: Option<&str>,
+    output: &Path,
+    size: &str,
+    sets: &[String],
+    time: Option<f32>,
+) -> Result<(), String> {
     let (width, height) = parse_size(size)?;
     let mut scene = match scene {
         Some(arg) => read_scene_or_link(arg)?,
@@ -34,6 +40,15 @@ pub fn run(scene: Option<&str>, output: &Path, size: &str, sets: &[String]) -> R
             eprintln!("warning: --set {assignment}: repaired {r}");
         }
         scene = set;
+    }
+    if let Some(t) = time {
+        if !(t.is_finite() && (0.0..=crate::limits::MAX_TIME).contains(&t)) {
+            return Err(format!(
+                "--time {t}: 0 to {} seconds",
+                crate::limits::MAX_TIME
+            ));
+        }
+        scene.time = t;
     }
     let mut offscreen = Offscreen::new().map_err(|e| e.to_string())?;
     let start = std::time::Instant::now();

@@ -158,6 +158,12 @@ pub struct Derived {
     field: Option<(u64, Arc<Field>)>,
     density: Option<(GeometryKey, Versioned<DensityVolume>)>,
     baker: Baker,
+    /// The simulation run of a simulated scene, and its last density (keyed on the geometry
+    /// revision and the time).
+    player: Option<crate::simulate::Player>,
+    simulated: Option<((u64, u32), Versioned<DensityVolume>)>,
+    /// The run has not yet reached the scene's time (a far jump catches up over frames).
+    pub catching_up: bool,
     generation: u64,
     work: Work,
 }
@@ -182,6 +188,11 @@ impl Derived {
     /// The density volume of `scene`'s geometry at `revisions` (the geometry alone, without
     /// its light); re-evaluates only what changed since the last call.
     pub fn density(&mut self, scene: &Scene, revisions: Revisions) -> Versioned<DensityVolume> {
+        if let Some(settings) = &scene.simulation {
+            return self.simulated(settings, scene, revisions);
+        }
+        self.player = None;
+        self.catching_up = false;
         let gkey = GeometryKey {
             geometry: revisions.geometry,
             resolution: scene.render.field_resolution,
@@ -205,6 +216,46 @@ impl Derived {
                 v
             }
         }
+    }
+
+    /// The density of a simulated scene: the run's smoothed cloud at the scene's time.
+    fn simulated(
+        &mut self,
+        settings: &crate::simulate::Settings,
+        scene: &Scene,
+        revisions: Revisions,
+    ) -> Versioned<DensityVolume> {
+        let key = (revisions.geometry, scene.time.to_bits());
+        if let Some((k, v)) = &self.simulated
+            && *k == key
+            && !self.catching_up
+        {
+            return v.clone();
+        }
+        let parcels = crate::simulate::parcels(scene);
+        if self
+            .player
+            .as_ref()
+            .is_none_or(|p| !p.runs(settings, &parcels))
+        {
+            self.player = Some(crate::simulate::Player::new(settings, parcels));
+        }
+        let Some(player) = self.player.as_mut() else {
+            return Versioned {
+                generation: 0,
+                data: Arc::new(DensityVolume::default()),
+            };
+        };
+        let (volume, behind) = player.density(scene.time);
+        self.catching_up = behind;
+        self.generation += 1;
+        self.work.bakes += 1;
+        let v = Versioned {
+            generation: self.generation,
+            data: Arc::new(volume),
+        };
+        self.simulated = Some((key, v.clone()));
+        v
     }
 
     /// The volumes of `scene` whose parts are at `revisions`; derives only what changed.
@@ -234,6 +285,7 @@ impl Derived {
     pub fn forget_grid(&mut self) {
         self.baker = Baker::default();
         self.density = None;
+        self.simulated = None;
     }
 
     /// The work done so far.

@@ -52,19 +52,33 @@ impl Sampling {
     /// Bakes `scene`'s field on a grid of `resolution` texels along its longest side (at most
     /// [`MAX_EXPORT_RESOLUTION`]); the density follows with [`Sampling::step`].
     pub fn start(scene: &Scene, resolution: u32, noise: bool) -> Result<Self, ExportError> {
-        let resolution = resolution.clamp(8, MAX_EXPORT_RESOLUTION);
-        let field = crate::derive::field_of(scene);
-        let work = bake_fine_work(&field, resolution);
-        if work > MAX_EXPORT_WORK {
-            return Err(ExportError::TooLarge(format!(
-                "sampling this cloud at {resolution} texels would take {:.0} million field \
-                 evaluations (at most {:.0} million): choose a lower resolution",
-                work as f64 / 1e6,
-                MAX_EXPORT_WORK as f64 / 1e6
-            )));
-        }
-        let volume = bake_fine(&field, resolution);
-        if volume.is_empty() {
+        let volume = match &scene.simulation {
+            // A simulated cloud: the run's smoothed cloud at the scene's time, on its own grid.
+            Some(settings) => {
+                let mut player =
+                    crate::simulate::Player::new(settings, crate::simulate::parcels(scene));
+                let mut got = player.density(scene.time);
+                while got.1 {
+                    got = player.density(scene.time);
+                }
+                got.0
+            }
+            None => {
+                let resolution = resolution.clamp(8, MAX_EXPORT_RESOLUTION);
+                let field = crate::derive::field_of(scene);
+                let work = bake_fine_work(&field, resolution);
+                if work > MAX_EXPORT_WORK {
+                    return Err(ExportError::TooLarge(format!(
+                        "sampling this cloud at {resolution} texels would take {:.0} million \
+                         field evaluations (at most {:.0} million): choose a lower resolution",
+                        work as f64 / 1e6,
+                        MAX_EXPORT_WORK as f64 / 1e6
+                    )));
+                }
+                bake_fine(&field, resolution)
+            }
+        };
+        if volume.is_empty() || volume.values.iter().all(|&v| v <= 0.0) {
             return Err(ExportError::Empty);
         }
         let grid = DensityGrid {

@@ -282,7 +282,15 @@ impl Offscreen {
         // the one the last render's history left), so the image depends on `scene` alone.
         let doc = Document::new(scene.clone());
         self.derived.forget_grid();
-        let volumes = self.derived.update(doc.scene(), doc.revisions());
+        let mut volumes = self.derived.update(doc.scene(), doc.revisions());
+        // A simulation far from its start catches up over several calls (the app spreads
+        // them over frames); a render waits for it.
+        for _ in 0..1000 {
+            if !self.derived.catching_up {
+                break;
+            }
+            volumes = self.derived.update(doc.scene(), doc.revisions());
+        }
         self.renderer.begin_frame();
         self.renderer.upload(&self.device, &self.queue, &volumes);
         SliceJob {

@@ -81,7 +81,8 @@ fn diff(a: &Scene, b: &Scene) -> Changed {
     Changed {
         geometry: a.seed != b.seed
             || !same(&a.ellipsoids, &b.ellipsoids)
-            || !same(&a.planes, &b.planes),
+            || !same(&a.planes, &b.planes)
+            || a.simulation != b.simulation,
         light: a.light != b.light,
         render: a.render != b.render || a.time != b.time,
         camera: a.camera != b.camera,
@@ -167,6 +168,9 @@ impl Document {
         let mut changed = Changed::default();
         match &edit {
             Edit::SetLight(l) => changed.light = *l != s.light,
+            Edit::SetSimulation(sim) => {
+                changed.geometry = sim.as_ref() != s.simulation.as_deref();
+            }
             Edit::SetRender(r) => changed.render = *r != s.render,
             Edit::SetEllipsoids(e) => changed.geometry = !same(e, &s.ellipsoids),
             Edit::SetPlanes(p) => {
@@ -189,6 +193,7 @@ impl Document {
         let s = &mut self.scene;
         match edit {
             Edit::SetLight(l) => s.light = l,
+            Edit::SetSimulation(sim) => s.simulation = sim.map(Arc::new),
             Edit::SetRender(r) => s.render = r,
             Edit::SetEllipsoids(e) => s.ellipsoids = e,
             Edit::SetPlanes(p) => s.planes = p,

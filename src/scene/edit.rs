@@ -26,6 +26,8 @@ pub enum Edit {
     RemovePlane(usize),
     /// Set, change or remove the reference image.
     SetReference(Option<ReferenceImage>),
+    /// Turn the simulation on (with these settings), change it, or turn it off.
+    SetSimulation(Option<crate::simulate::Settings>),
     /// Replace the whole document (new, open, preset).
     Replace(Box<Scene>),
 }
@@ -42,6 +44,7 @@ impl Edit {
             Edit::InsertPlane(..) => "new drawing plane",
             Edit::RemovePlane(_) => "deleted drawing plane",
             Edit::SetReference(_) => "reference image",
+            Edit::SetSimulation(_) => "simulation",
             Edit::Replace(_) => "new scene",
         }
     }

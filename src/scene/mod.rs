@@ -81,6 +81,10 @@ pub struct Scene {
     /// The scene clock in seconds: where the media's wind and torque have carried the noise.
     /// Playing advances it; like the camera it is not an undo step.
     pub time: f32,
+    /// A cloud simulation (Dobashi et al. 2000): when present, the cloud is the automaton's
+    /// smoothed cloud at the scene's time, and the ellipsoids are its parcels.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub simulation: Option<Arc<crate::simulate::Settings>>,
 }
 
 impl Default for Scene {
@@ -191,6 +195,9 @@ impl Scene {
         self.camera.sanitize();
         self.light.sanitize();
         self.render.sanitize();
+        if let Some(sim) = &mut self.simulation {
+            Arc::make_mut(sim).sanitize();
+        }
         if !self.time.is_finite() || !(0.0..=limits::MAX_TIME).contains(&self.time) {
             self.time = if self.time.is_finite() {
                 self.time.clamp(0.0, limits::MAX_TIME)

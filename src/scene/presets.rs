@@ -27,17 +27,21 @@ pub enum Preset {
     Sunset,
     /// Nothing but sky: for sketching from scratch.
     Empty,
+    /// Clouds grown by the cellular automaton (Dobashi et al. 2000) in three air parcels, wind
+    /// stronger aloft, a low sun: press Play.
+    Simulated,
 }
 
 impl Preset {
     /// All presets with their names.
-    pub const ALL: [(Preset, &'static str); 6] = [
+    pub const ALL: [(Preset, &'static str); 7] = [
         (Preset::Cumulus, "cumulus"),
         (Preset::Stratus, "stratus"),
         (Preset::Cirrus, "cirrus"),
         (Preset::Cumulonimbus, "cumulonimbus"),
         (Preset::Sunset, "sunset"),
         (Preset::Empty, "empty"),
+        (Preset::Simulated, "simulated"),
     ];
 
     /// Looks a preset up by name.
@@ -122,6 +126,8 @@ impl Scene {
         let mut camera = OrbitCamera::default();
         let mut light = Lighting::default();
         let mut render = RenderSettings::default();
+        let mut simulation = None;
+        let mut time = 0.0;
         let ellipsoids = match preset {
             Preset::Cumulus => cumulus(),
             Preset::Stratus => {
@@ -181,6 +187,26 @@ impl Scene {
                 layer(14, 20.0, 8.0, 3.5, Vec3::new(2.6, 1.3, 2.2), 37)
             }
             Preset::Empty => Vec::new(),
+            Preset::Simulated => {
+                camera.target = Vec3::new(0.0, 3.0, 0.0);
+                camera.distance = 30.0;
+                camera.pitch_deg = 8.0;
+                render.noise_amount = 0.15;
+                render.softness = 0.2;
+                light.sun_elevation_deg = 14.0;
+                light.sun_azimuth_deg = 150.0;
+                simulation = Some(Arc::new(crate::simulate::Settings::default()));
+                // Forty steps in: the parcels have clouds when the preset opens.
+                time = 4.0;
+                [
+                    (Vec3::new(-7.0, 3.5, 0.0), Vec3::new(5.5, 2.5, 4.5)),
+                    (Vec3::new(3.0, 4.0, 2.5), Vec3::new(6.0, 3.0, 5.0)),
+                    (Vec3::new(1.0, 3.0, -7.0), Vec3::new(5.0, 2.2, 4.0)),
+                ]
+                .into_iter()
+                .map(|(c, r)| Ellipsoid::new(c, r))
+                .collect()
+            }
         };
         Scene {
             version: SCENE_VERSION,
@@ -191,7 +217,8 @@ impl Scene {
             ellipsoids: ellipsoids.into_iter().map(Arc::new).collect(),
             planes: Vec::new(),
             reference: None,
-            time: 0.0,
+            time,
+            simulation,
         }
     }
 }

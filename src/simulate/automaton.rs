@@ -27,7 +27,8 @@ const TABLE: usize = 1024;
 
 /// The nearest level of a probability (on a log scale above the smallest).
 pub fn level_of(p: f32) -> u8 {
-    if !(p > LEVELS[1] * 0.5) {
+    // (NaN and anything below half the smallest level: never.)
+    if p.is_nan() || p <= LEVELS[1] * 0.5 {
         return 0;
     }
     let mut best = 1;
@@ -37,6 +38,18 @@ pub fn level_of(p: f32) -> u8 {
         }
     }
     best as u8
+}
+
+/// The cells' bits, wind carry and step: what a snapshot keeps (the probability levels and
+/// random tables stay with the automaton).
+#[derive(Clone, Debug, PartialEq)]
+pub struct State {
+    hum: Vec<u64>,
+    act: Vec<u64>,
+    cld: Vec<u64>,
+    carry: Vec<f32>,
+    /// The step it was taken at.
+    pub step: u64,
 }
 
 /// The three random terms.
@@ -256,6 +269,26 @@ impl Automaton {
                 row[words - 1] &= tail;
             }
         }
+    }
+
+    /// A snapshot of the state.
+    pub fn state(&self) -> State {
+        State {
+            hum: self.hum.clone(),
+            act: self.act.clone(),
+            cld: self.cld.clone(),
+            carry: self.carry.clone(),
+            step: self.step,
+        }
+    }
+
+    /// Goes back (or forward) to a snapshot of this automaton.
+    pub fn restore(&mut self, s: &State) {
+        self.hum.clone_from(&s.hum);
+        self.act.clone_from(&s.act);
+        self.cld.clone_from(&s.cld);
+        self.carry.clone_from(&s.carry);
+        self.step = s.step;
     }
 
     /// Cells with cloud.

@@ -10,7 +10,7 @@
 mod automaton;
 pub mod reference;
 
-pub use automaton::{Automaton, Kind, LEVELS, level_of, shift_row};
+pub use automaton::{Automaton, Kind, LEVELS, State, level_of, shift_row};
 
 use glam::{Quat, UVec3, Vec3};
 
@@ -87,6 +87,28 @@ impl Default for Settings {
 pub const MAX_CELLS: u64 = 1 << 22;
 
 impl Settings {
+    /// Brings every value into its range (a loaded document's; the panel's sliders keep to
+    /// the same ranges).
+    pub fn sanitize(&mut self) {
+        let fix =
+            |v: f32, lo: f32, hi: f32, d: f32| if v.is_finite() { v.clamp(lo, hi) } else { d };
+        let d = Settings::default();
+        self.cells = self.cells.map(|c| c.clamp(4, 256));
+        for (o, od) in self.origin.iter_mut().zip(d.origin) {
+            *o = fix(*o, -1.0e4, 1.0e4, od);
+        }
+        self.cell_size = fix(self.cell_size, 0.01, 100.0, d.cell_size);
+        self.p_hum = fix(self.p_hum, 0.0, 1.0, d.p_hum);
+        self.p_act = fix(self.p_act, 0.0, 1.0, d.p_act);
+        self.p_ext_inside = fix(self.p_ext_inside, 0.0, 1.0, d.p_ext_inside);
+        self.p_ext_outside = fix(self.p_ext_outside, 0.0, 1.0, d.p_ext_outside);
+        for (w, wd) in self.wind.iter_mut().zip(d.wind) {
+            *w = fix(*w, -8.0, 8.0, wd);
+        }
+        self.rate = fix(self.rate, 0.5, 60.0, d.rate);
+        self.smoothing = self.smoothing.min(4);
+    }
+
     /// The grid's cells, capped: each side 4 to 256, at most [`MAX_CELLS`] in all.
     pub fn dims(&self) -> [usize; 3] {
         let mut d = self.cells.map(|c| c.clamp(4, 256) as usize);
@@ -140,6 +162,21 @@ impl Simulation {
             settings: settings.clone(),
             automaton,
         }
+    }
+
+    /// A snapshot of the run's state.
+    pub fn state(&self) -> State {
+        self.automaton.state()
+    }
+
+    /// Goes back (or forward) to a snapshot of this run.
+    pub fn restore(&mut self, state: &State) {
+        self.automaton.restore(state);
+    }
+
+    /// The settings it runs.
+    pub fn settings(&self) -> &Settings {
+        &self.settings
     }
 
     /// The automaton.
@@ -232,6 +269,125 @@ impl Simulation {
         DensityVolume {
             dims: UVec3::new(nx as u32, ny as u32, nz as u32),
             min: Vec3::from(self.settings.origin),
+            size: Vec3::new(nx as f32, ny as f32, nz as f32) * h,
+            values,
+        }
+    }
+}
+
+/// The parcels of a scene: its visible ellipsoids.
+pub fn parcels(scene: &crate::scene::Scene) -> Vec<Parcel> {
+    scene
+        .ellipsoids
+        .iter()
+        .filter(|e| !e.hidden)
+        .map(|e| Parcel {
+            center: e.center,
+            radii: e.radii,
+            rotation: e.rotation,
+        })
+        .collect()
+}
+
+/// Steps a run keeps snapshots at (every this many steps), and how many at most.
+const SNAPSHOT_EVERY: u64 = 32;
+const MAX_SNAPSHOTS: usize = 64;
+/// Steps one call may advance (a far jump catches up over several frames).
+pub const MAX_STEPS_PER_CALL: u64 = 200;
+/// The last step a scene's time reaches (later times show this step): about 6 s of stepping
+/// natively at 128×32×128, and every run's cost bounded.
+pub const MAX_STEP: u64 = 20_000;
+
+/// A run that plays to any scene time: snapshots every few steps make scrubbing back cheap
+/// (within a memory cap), the last smoothed steps are kept for the blend between steps.
+pub struct Player {
+    key: (Settings, Vec<Parcel>),
+    run: Simulation,
+    snapshots: Vec<State>,
+    smoothed: Vec<(u64, std::sync::Arc<Vec<f32>>)>,
+}
+
+impl Player {
+    /// A run of `settings` with `parcels`, at step 0.
+    pub fn new(settings: &Settings, parcels: Vec<Parcel>) -> Self {
+        let run = Simulation::new(settings, &parcels);
+        let snapshots = vec![run.state()];
+        Self {
+            key: (settings.clone(), parcels),
+            run,
+            snapshots,
+            smoothed: Vec::new(),
+        }
+    }
+
+    /// Whether it runs these settings and parcels.
+    pub fn runs(&self, settings: &Settings, parcels: &[Parcel]) -> bool {
+        self.key.0 == *settings && self.key.1 == parcels
+    }
+
+    /// The smoothed cloud at step `n`, or at the nearest step this call could reach.
+    fn smoothed_at(&mut self, n: u64) -> (u64, std::sync::Arc<Vec<f32>>) {
+        if let Some((s, v)) = self.smoothed.iter().find(|(s, _)| *s == n) {
+            return (*s, v.clone());
+        }
+        if self.run.step() > n
+            && let Some(snap) = self.snapshots.iter().rev().find(|s| s.step <= n)
+        {
+            self.run.restore(&snap.clone());
+        }
+        let mut budget = MAX_STEPS_PER_CALL;
+        while self.run.step() < n && budget > 0 {
+            self.run.advance(1);
+            budget -= 1;
+            let step = self.run.step();
+            if step.is_multiple_of(SNAPSHOT_EVERY)
+                && self.snapshots.last().is_none_or(|s| s.step < step)
+            {
+                self.snapshots.push(self.run.state());
+                if self.snapshots.len() > MAX_SNAPSHOTS {
+                    // Thin out: every other snapshot after the first.
+                    let mut i = 0;
+                    self.snapshots.retain(|_| {
+                        i += 1;
+                        i == 1 || i % 2 == 0
+                    });
+                }
+            }
+        }
+        let step = self.run.step();
+        let v = std::sync::Arc::new(self.run.smoothed());
+        self.smoothed.push((step, v.clone()));
+        if self.smoothed.len() > 3 {
+            self.smoothed.remove(0);
+        }
+        (step, v)
+    }
+
+    /// The density at scene time `time` (steps at the settings' rate, blended between two
+    /// steps); and whether the run is still catching up with that time.
+    pub fn density(&mut self, time: f32) -> (DensityVolume, bool) {
+        let target = ((time.max(0.0) * self.key.0.rate) as f64).min(MAX_STEP as f64);
+        let n = target.floor() as u64;
+        let t = (target - n as f64) as f32;
+        let (a, qa) = self.smoothed_at(n);
+        if a < n {
+            return (self.volume((*qa).clone()), true);
+        }
+        let (_, qb) = self.smoothed_at(n + 1);
+        let values = qa
+            .iter()
+            .zip(qb.iter())
+            .map(|(x, y)| x + (y - x) * t)
+            .collect();
+        (self.volume(values), false)
+    }
+
+    fn volume(&self, values: Vec<f32>) -> DensityVolume {
+        let [nx, ny, nz] = self.run.automaton().dims;
+        let h = self.key.0.cell_size.max(1e-3);
+        DensityVolume {
+            dims: UVec3::new(nx as u32, ny as u32, nz as u32),
+            min: Vec3::from(self.key.0.origin),
             size: Vec3::new(nx as f32, ny as f32, nz as f32) * h,
             values,
         }

@@ -271,3 +271,33 @@ fn the_smoothed_density_is_the_share_of_cloud_around_each_cell() {
     let i = ((z * 16 + y) * 64 + x) as usize;
     assert!((half.values[i] - 0.5 * (before[i] + after[i])).abs() < 1e-6);
 }
+
+#[test]
+fn a_player_scrubbed_back_and_forth_shows_what_a_fresh_run_shows() {
+    let (settings, parcels) = parcel_settings();
+    let fresh = |time: f32| {
+        Player::new(&settings, parcels.clone())
+            .density(time)
+            .0
+            .values
+    };
+    let mut player = Player::new(&settings, parcels.clone());
+    let late = player.density(9.05).0.values; // 90 steps and a half
+    let early = player.density(3.0).0.values; // back to step 30 (from a snapshot)
+    assert_eq!(early, fresh(3.0));
+    assert_eq!(player.density(9.05).0.values, late);
+    assert_eq!(late, fresh(9.05));
+    // Between two steps the density is their blend: neither step's own.
+    let (a, b) = (fresh(3.0), fresh(3.1));
+    let half = fresh(3.05);
+    assert!(
+        half.iter()
+            .zip(a.iter().zip(&b))
+            .all(|(h, (x, y))| (h - 0.5 * (x + y)).abs() < 1e-5)
+    );
+    assert_ne!(a, b);
+    // A far jump catches up over calls, never more than a bounded number of steps at once.
+    let mut far = Player::new(&settings, parcels);
+    let (_, behind) = far.density(100.0);
+    assert!(behind, "1,000 steps take more than one call");
+}

@@ -287,6 +287,7 @@ impl CloudApp {
         p.scene
             .ui(ui, &mut self.doc, &mut self.selection, &mut self.notices);
         p.view.ui(ui, &self.viewport.stats, &mut self.doc);
+        super::panels::simulation::ui(ui, &mut self.doc);
         let ask = p.export.ui(
             ui,
             &self.doc,

@@ -153,6 +153,10 @@ impl Viewport {
             });
         }
         let volumes = cx.derived.update(scene, cx.doc.revisions());
+        if cx.derived.catching_up {
+            // A simulation still stepping toward the scene's time: keep the frames coming.
+            ui.ctx().request_repaint();
+        }
         // Draw the volume only over the part of the view its box covers: fewer pixels to
         // slice, refine and composite on every frame.
         let density = &volumes.density.data;

@@ -129,7 +129,8 @@ for (const backend of ['webgpu', 'webgl2']) {
     await withApp({ base: server.url, webgpu: backend === 'webgpu', viewport: { width: 1280, height: 800 } }, async (page) => {
       let s = await state(page);
       const [vw, vh] = s.view.viewport;
-      const body = { x: 0, y: 60, w: vw, h: vh - 90 };
+      // Below the sun handle (its dot moves with the sun) and short of the panel's border.
+      const body = { x: 0, y: 130, w: vw - 12, h: vh - 160 };
       const centre = (r) => [r[0] + r[2] / 2, r[1] + r[3] / 2];
       const away = async () => { await page.mouse.move(5, vh - 5); };
       // Scrolls the side panel (with the wheel, over the panel) until widget `name` is in view.

@@ -6,6 +6,7 @@ mod export;
 mod light;
 mod render;
 mod scene;
+pub mod simulation;
 mod sketch;
 mod view;
 

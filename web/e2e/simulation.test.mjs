@@ -1,0 +1,68 @@
+// The cloud simulation in the browser: the `simulated` preset opens with clouds in its three
+// parcels; playing changes the image while the clouds stay where the parcels are; moving a
+// parcel moves where the clouds form. Screenshots: test-results/screenshots/simulation-*.png.
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import { serve, state, screenshot, countChanged, until, withApp, waitForFullQuality } from './harness.mjs';
+
+let server;
+before(async () => { server = await serve(); });
+after(async () => { await server?.close(); });
+
+/** The cloud's pixels (away from the flat sky `bg`): count, bounding box, mean x. */
+function cloud(img, rect, bg) {
+  let n = 0, sx = 0, x0 = Infinity, x1 = -Infinity, y0 = Infinity, y1 = -Infinity;
+  for (let y = rect.y; y < rect.y + rect.h; y++) {
+    for (let x = rect.x; x < rect.x + rect.w; x++) {
+      const i = 4 * (y * img.width + x);
+      const d = Math.abs(img.data[i] - bg[0]) + Math.abs(img.data[i + 1] - bg[1]) + Math.abs(img.data[i + 2] - bg[2]);
+      if (d > 18) { n++; sx += x; x0 = Math.min(x0, x); x1 = Math.max(x1, x); y0 = Math.min(y0, y); y1 = Math.max(y1, y); }
+    }
+  }
+  return { n, cx: sx / Math.max(n, 1), box: [x0, y0, x1, y1] };
+}
+
+for (const backend of ['webgpu', 'webgl2']) {
+  test(`the simulated preset plays inside its parcels and follows a moved parcel (${backend})`, { timeout: 300_000 }, async () => {
+    await withApp({ base: server.url, webgpu: backend === 'webgpu', query: '?preset=simulated', viewport: { width: 1280, height: 800 } }, async (page) => {
+      let s = await state(page);
+      assert.ok(s.scene.simulation, 'the preset simulates');
+      const [vw, vh] = s.view.viewport;
+      // Below the sun handle and short of the side panel's border, which would read as cloud.
+      const body = { x: 0, y: 130, w: vw - 12, h: vh - 160 };
+      const bg = s.scene.light.background.map((v) => Math.round(v * 255));
+      await page.mouse.click(5, vh - 5);
+      await waitForFullQuality(page);
+      const start = await screenshot(page, `simulation-1-start-${backend}`);
+      const c0 = cloud(start, body, bg);
+      assert.ok(c0.n > 2000, `clouds in the parcels at the start: ${c0.n} px`);
+
+      // Play for a few seconds of scene time: the image changes, the camera stays.
+      const camera = JSON.stringify(s.scene.camera);
+      const t0 = s.scene.time;
+      await page.keyboard.press('Alt+a');
+      s = await until(page, (s) => s.scene.time > t0 + 3, 'the clock runs', 90_000);
+      await page.keyboard.press('Alt+a');
+      s = await until(page, (s) => !s.view.playing, 'paused');
+      await waitForFullQuality(page);
+      const played = await screenshot(page, `simulation-2-played-${backend}`);
+      const changed = countChanged(start, played, body);
+      assert.ok(changed > 500, `the clouds evolved: ${changed} px changed after ${(s.scene.time - t0).toFixed(1)} s`);
+      assert.equal(JSON.stringify(s.scene.camera), camera, 'the camera stayed');
+      const c1 = cloud(played, body, bg);
+      const margin = 0.06 * vw;
+      assert.ok(c1.box[0] >= c0.box[0] - margin && c1.box[2] <= c0.box[2] + margin,
+        `the clouds stay in the parcels: x ${c0.box[0]}–${c0.box[2]} then ${c1.box[0]}–${c1.box[2]}`);
+
+      // Move the leftmost parcel far to the right: clouds form there, not where it was.
+      const undo = s.view.undo;
+      await page.evaluate(() => window.cloudsketch.set('/ellipsoids/0/center=[9.0, 3.5, 4.0]'));
+      await until(page, (s) => s.view.undo === undo + 1, 'the parcel moved');
+      await waitForFullQuality(page);
+      const moved = await screenshot(page, `simulation-3-parcel-moved-${backend}`);
+      const c2 = cloud(moved, body, bg);
+      assert.ok(c2.cx > c1.cx + 40, `the clouds' middle moves right with the parcel: ${c1.cx.toFixed(0)} → ${c2.cx.toFixed(0)} px`);
+      assert.ok(c2.box[2] > c1.box[2] + 40, `a cloud where the parcel went: right edge ${c1.box[2]} → ${c2.box[2]}`);
+    });
+  });
+}
