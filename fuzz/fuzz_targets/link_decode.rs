@@ -16,6 +16,8 @@ mod scene;
 mod seeded;
 #[path = "../../src/share/mod.rs"]
 mod share;
+#[path = "../../src/simulate/mod.rs"]
+mod simulate;
 #[path = "../../src/sketch/mod.rs"]
 mod sketch;
 

@@ -9,7 +9,7 @@ use std::sync::{Arc, Mutex};
 
 use super::progressive::JobPlan;
 use super::renderer::{SliceJob, VolumeRenderer};
-use super::resources::CAPTURE_TARGET;
+use super::resources::{CAPTURE_TARGET, copy_for_readback, read_rows, unpremultiply};
 use super::{FULL_VIEW, View};
 
 /// Where a capture stands; shared by the UI (which polls it) and the paint callback.
@@ -99,27 +99,10 @@ impl Capture {
         device: &wgpu::Device,
         queue: &wgpu::Queue,
     ) -> State {
-        let [width, height] = self.size;
-        let format = renderer.output_format();
         let bgra = matches!(
-            format,
+            renderer.output_format(),
             wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb
         );
-        let output = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("capture"),
-            size: wgpu::Extent3d {
-                width,
-                height,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
-        let target = output.create_view(&wgpu::TextureViewDescriptor::default());
         let slices = self.view.render.slices;
         let job = SliceJob {
             plan: JobPlan {
@@ -134,74 +117,15 @@ impl Capture {
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("capture"),
         });
-        renderer.update_light(device, queue, &mut encoder, &job.view);
-        renderer.draw_slices(device, queue, &mut encoder, &job, None);
-        let sky = self.view.light.sky_gradient && !self.transparent;
-        if sky {
-            renderer.prepare_sky(queue, &self.view);
-        }
-        {
-            let clear = if self.transparent {
-                wgpu::Color::TRANSPARENT
-            } else {
-                let [r, g, b] = self.view.light.background.map(|v| v as f64);
-                wgpu::Color { r, g, b, a: 1.0 }
-            };
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("capture composite"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &target,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(clear),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: None,
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            if sky {
-                renderer.draw_sky(&mut pass);
-            }
-            renderer.composite(&mut pass, CAPTURE_TARGET);
-        }
-        let row = (width * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
-            * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("capture readback"),
-            size: (row * height) as u64,
-            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-            mapped_at_creation: false,
-        });
-        encoder.copy_texture_to_buffer(
-            wgpu::TexelCopyTextureInfo {
-                texture: &output,
-                mip_level: 0,
-                origin: wgpu::Origin3d::ZERO,
-                aspect: wgpu::TextureAspect::All,
-            },
-            wgpu::TexelCopyBufferInfo {
-                buffer: &buffer,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(row),
-                    rows_per_image: Some(height),
-                },
-            },
-            wgpu::Extent3d {
-                width,
-                height,
-                depth_or_array_layers: 1,
-            },
-        );
+        let background = (!self.transparent).then_some(self.view.light.background);
+        let output = renderer.render_image(device, queue, &mut encoder, &job, background, None);
+        let (buffer, row) = copy_for_readback(device, &mut encoder, &output, self.size);
         queue.submit([encoder.finish()]);
         let mapped = Arc::new(AtomicBool::new(false));
         let flag = mapped.clone();
         buffer.slice(..).map_async(wgpu::MapMode::Read, move |r| {
-            // A failed map leaves the flag down; the read below reports it as empty.
+            // A failed map leaves the flag down (the capture then never completes; the
+            // export's Cancel remains).
             flag.store(r.is_ok(), Ordering::Release);
         });
         State::Reading {
@@ -213,29 +137,14 @@ impl Capture {
     }
 
     fn read(&self, buffer: &wgpu::Buffer, row: u32, bgra: bool) -> Result<Vec<u8>, String> {
-        let [width, height] = self.size;
-        let slice = buffer.slice(..);
-        let mapped = slice
-            .get_mapped_range()
-            .map_err(|e| format!("the capture could not be read back: {e}"))?;
-        let mut rgba = Vec::with_capacity((width * height * 4) as usize);
-        for y in 0..height as usize {
-            let start = y * row as usize;
-            rgba.extend_from_slice(&mapped[start..start + width as usize * 4]);
-        }
-        drop(mapped);
-        buffer.unmap();
-        for p in rgba.chunks_exact_mut(4) {
-            if bgra {
+        let mut rgba = read_rows(buffer, self.size, row)?;
+        if bgra {
+            for p in rgba.chunks_exact_mut(4) {
                 p.swap(0, 2);
             }
-            // The composite writes premultiplied colour; a PNG holds straight alpha.
-            if self.transparent && p[3] > 0 && p[3] < 255 {
-                let a = p[3] as f32 / 255.0;
-                for c in &mut p[..3] {
-                    *c = (*c as f32 / a).round().min(255.0) as u8;
-                }
-            }
+        }
+        if self.transparent {
+            unpremultiply(&mut rgba);
         }
         Ok(rgba)
     }

@@ -5,7 +5,7 @@ use super::field_gpu::{FieldEvaluator, FieldGpuError};
 use super::gpu_types::{FULL_VIEW, View};
 use super::progressive::JobPlan;
 use super::renderer::{SliceJob, VolumeRenderer};
-use super::resources::accumulation_format;
+use super::resources::{accumulation_format, copy_for_readback, read_rows, unpremultiply};
 use crate::derive::Derived;
 use crate::field::{DensityVolume, Field};
 use crate::scene::{Document, Scene};
@@ -67,6 +67,14 @@ impl Image {
         writer.finish()?;
         Ok(out)
     }
+}
+
+/// An image size the renderer accepts: 1 to [`MAX_SIDE`] pixels a side.
+fn check_size(width: u32, height: u32) -> Result<(), OffscreenError> {
+    if width == 0 || height == 0 || width > MAX_SIDE || height > MAX_SIDE {
+        return Err(OffscreenError::Size(width, height));
+    }
+    Ok(())
 }
 
 /// A headless device with the volume renderer.
@@ -144,9 +152,7 @@ impl Offscreen {
         width: u32,
         height: u32,
     ) -> Result<Image, OffscreenError> {
-        if width == 0 || height == 0 || width > MAX_SIDE || height > MAX_SIDE {
-            return Err(OffscreenError::Size(width, height));
-        }
+        check_size(width, height)?;
         let job = self.full_job(scene, width, height);
         self.draw(&job, Some(scene.light.background))
     }
@@ -159,19 +165,10 @@ impl Offscreen {
         width: u32,
         height: u32,
     ) -> Result<Image, OffscreenError> {
-        if width == 0 || height == 0 || width > MAX_SIDE || height > MAX_SIDE {
-            return Err(OffscreenError::Size(width, height));
-        }
+        check_size(width, height)?;
         let job = self.full_job(scene, width, height);
         let mut image = self.draw(&job, None)?;
-        for p in image.rgba.chunks_exact_mut(4) {
-            if p[3] > 0 {
-                let a = p[3] as f32 / 255.0;
-                for c in &mut p[..3] {
-                    *c = (*c as f32 / a).round().min(255.0) as u8;
-                }
-            }
-        }
+        unpremultiply(&mut image.rgba);
         Ok(image)
     }
 
@@ -185,9 +182,7 @@ impl Offscreen {
         frames: usize,
         baseline: bool,
     ) -> Result<Vec<f64>, OffscreenError> {
-        if width == 0 || height == 0 || width > MAX_SIDE || height > MAX_SIDE {
-            return Err(OffscreenError::Size(width, height));
-        }
+        check_size(width, height)?;
         let job = self.full_job(scene, width, height);
         let pipeline = baseline.then(|| self.renderer.baseline_pipeline(&self.device));
         let mut times = Vec::with_capacity(frames);
@@ -319,63 +314,19 @@ impl Offscreen {
         background: Option<[f32; 3]>,
         pipeline: Option<&wgpu::RenderPipeline>,
     ) -> (wgpu::CommandEncoder, wgpu::Texture) {
-        let [width, height] = job.plan.size;
-        let output = self.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("offscreen output"),
-            size: wgpu::Extent3d {
-                width,
-                height,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: OUTPUT_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
-        let view = output.create_view(&wgpu::TextureViewDescriptor::default());
         let mut encoder = self
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("offscreen"),
             });
-        self.renderer
-            .update_light(&self.device, &self.queue, &mut encoder, &job.view);
-        self.renderer
-            .draw_slices(&self.device, &self.queue, &mut encoder, job, pipeline);
-        self.renderer.prepare_sky(&self.queue, &job.view);
-        {
-            let clear = match background {
-                Some([r, g, b]) => wgpu::Color {
-                    r: r as f64,
-                    g: g as f64,
-                    b: b as f64,
-                    a: 1.0,
-                },
-                None => wgpu::Color::TRANSPARENT,
-            };
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("offscreen composite"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(clear),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: None,
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            if job.view.light.sky_gradient && background.is_some() {
-                self.renderer.draw_sky(&mut pass);
-            }
-            self.renderer.composite(&mut pass, job.plan.target);
-        }
+        let output = self.renderer.render_image(
+            &self.device,
+            &self.queue,
+            &mut encoder,
+            job,
+            background,
+            pipeline,
+        );
         (encoder, output)
     }
 
@@ -384,41 +335,12 @@ impl Offscreen {
         job: &SliceJob,
         background: Option<[f32; 3]>,
     ) -> Result<Image, OffscreenError> {
-        let [width, height] = job.plan.size;
-        let row = (width * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
-            * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-        let readback = self.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("offscreen readback"),
-            size: (row * height) as u64,
-            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-            mapped_at_creation: false,
-        });
+        let size = job.plan.size;
         let (mut encoder, output) = self.encode(job, background, None);
-        encoder.copy_texture_to_buffer(
-            wgpu::TexelCopyTextureInfo {
-                texture: &output,
-                mip_level: 0,
-                origin: wgpu::Origin3d::ZERO,
-                aspect: wgpu::TextureAspect::All,
-            },
-            wgpu::TexelCopyBufferInfo {
-                buffer: &readback,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(row),
-                    rows_per_image: Some(height),
-                },
-            },
-            wgpu::Extent3d {
-                width,
-                height,
-                depth_or_array_layers: 1,
-            },
-        );
+        let (readback, row) = copy_for_readback(&self.device, &mut encoder, &output, size);
         self.queue.submit([encoder.finish()]);
-        let slice = readback.slice(..);
         let (tx, rx) = std::sync::mpsc::channel();
-        slice.map_async(wgpu::MapMode::Read, move |r| {
+        readback.slice(..).map_async(wgpu::MapMode::Read, move |r| {
             let _ = tx.send(r);
         });
         self.device
@@ -427,19 +349,10 @@ impl Offscreen {
         rx.recv()
             .map_err(|e| OffscreenError::Readback(e.to_string()))?
             .map_err(|e| OffscreenError::Readback(e.to_string()))?;
-        let mapped = slice
-            .get_mapped_range()
-            .map_err(|e| OffscreenError::Readback(e.to_string()))?;
-        let mut rgba = Vec::with_capacity((width * height * 4) as usize);
-        for y in 0..height as usize {
-            let start = y * row as usize;
-            rgba.extend_from_slice(&mapped[start..start + width as usize * 4]);
-        }
-        drop(mapped);
-        readback.unmap();
+        let rgba = read_rows(&readback, size, row).map_err(OffscreenError::Readback)?;
         Ok(Image {
-            width,
-            height,
+            width: size[0],
+            height: size[1],
             rgba,
         })
     }

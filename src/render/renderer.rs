@@ -398,6 +398,74 @@ impl VolumeRenderer {
         self.output_format
     }
 
+    /// Records a whole image of `job` into a new texture in the output format (copyable):
+    /// the light volume when due, the slices, then the composite over `background` (with the
+    /// view's sky gradient) or, without one, over transparency. `pipeline` replaces the slice
+    /// pipeline (the bench's baseline). Offscreen renders and the app's captures both use it.
+    pub fn render_image(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        job: &SliceJob,
+        background: Option<[f32; 3]>,
+        pipeline: Option<&wgpu::RenderPipeline>,
+    ) -> wgpu::Texture {
+        let [width, height] = job.plan.size;
+        let output = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("image"),
+            size: wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: self.output_format,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let view = output.create_view(&wgpu::TextureViewDescriptor::default());
+        self.update_light(device, queue, encoder, &job.view);
+        self.draw_slices(device, queue, encoder, job, pipeline);
+        let sky = job.view.light.sky_gradient && background.is_some();
+        if sky {
+            self.prepare_sky(queue, &job.view);
+        }
+        let clear = match background {
+            Some([r, g, b]) => wgpu::Color {
+                r: r as f64,
+                g: g as f64,
+                b: b as f64,
+                a: 1.0,
+            },
+            None => wgpu::Color::TRANSPARENT,
+        };
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("image composite"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(clear),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        if sky {
+            self.draw_sky(&mut pass);
+        }
+        self.composite(&mut pass, job.plan.target);
+        drop(pass);
+        output
+    }
+
     /// Sets the sky gradient of `view` (call before [`VolumeRenderer::draw_sky`]).
     pub fn prepare_sky(&self, queue: &wgpu::Queue, view: &View) {
         self.sky.write(

@@ -186,6 +186,76 @@ pub fn accumulation_format(adapter: &wgpu::Adapter) -> wgpu::TextureFormat {
     }
 }
 
+/// Records a copy of a 2D RGBA8-sized `texture` of `size` into a new mappable buffer; returns
+/// it and its row pitch (rows padded to wgpu's copy alignment).
+pub fn copy_for_readback(
+    device: &wgpu::Device,
+    encoder: &mut wgpu::CommandEncoder,
+    texture: &wgpu::Texture,
+    size: [u32; 2],
+) -> (wgpu::Buffer, u32) {
+    let [width, height] = size;
+    let row = (width * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
+        * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("readback"),
+        size: (row * height) as u64,
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    encoder.copy_texture_to_buffer(
+        wgpu::TexelCopyTextureInfo {
+            texture,
+            mip_level: 0,
+            origin: wgpu::Origin3d::ZERO,
+            aspect: wgpu::TextureAspect::All,
+        },
+        wgpu::TexelCopyBufferInfo {
+            buffer: &buffer,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(row),
+                rows_per_image: Some(height),
+            },
+        },
+        wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        },
+    );
+    (buffer, row)
+}
+
+/// The pixels of a mapped readback buffer without the rows' padding, then unmaps it.
+pub fn read_rows(buffer: &wgpu::Buffer, size: [u32; 2], row: u32) -> Result<Vec<u8>, String> {
+    let [width, height] = size;
+    let slice = buffer.slice(..);
+    let mapped = slice
+        .get_mapped_range()
+        .map_err(|e| format!("the image could not be read back: {e}"))?;
+    let mut rgba = Vec::with_capacity((width * height * 4) as usize);
+    for y in 0..height as usize {
+        let start = y * row as usize;
+        rgba.extend_from_slice(&mapped[start..start + width as usize * 4]);
+    }
+    drop(mapped);
+    buffer.unmap();
+    Ok(rgba)
+}
+
+/// Premultiplied RGBA8 (what the composite writes) → straight alpha (what a PNG holds).
+pub fn unpremultiply(rgba: &mut [u8]) {
+    for p in rgba.chunks_exact_mut(4) {
+        if p[3] > 0 && p[3] < 255 {
+            let a = p[3] as f32 / 255.0;
+            for c in &mut p[..3] {
+                *c = (*c as f32 / a).round().min(255.0) as u8;
+            }
+        }
+    }
+}
+
 /// A linear-filtering sampler with the given addressing.
 pub fn sampler(device: &wgpu::Device, mode: wgpu::AddressMode) -> wgpu::Sampler {
     device.create_sampler(&wgpu::SamplerDescriptor {

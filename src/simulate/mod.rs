@@ -264,14 +264,18 @@ impl Simulation {
                 .collect(),
             _ => now,
         };
-        let [nx, ny, nz] = self.automaton.dims;
-        let h = self.settings.cell_size.max(1e-3);
-        DensityVolume {
-            dims: UVec3::new(nx as u32, ny as u32, nz as u32),
-            min: Vec3::from(self.settings.origin),
-            size: Vec3::new(nx as f32, ny as f32, nz as f32) * h,
-            values,
-        }
+        volume(&self.settings, self.automaton.dims, values)
+    }
+}
+
+/// The density volume of `values` on a run's grid of `dims` cells.
+fn volume(settings: &Settings, dims: [usize; 3], values: Vec<f32>) -> DensityVolume {
+    let [nx, ny, nz] = dims;
+    DensityVolume {
+        dims: UVec3::new(nx as u32, ny as u32, nz as u32),
+        min: Vec3::from(settings.origin),
+        size: Vec3::new(nx as f32, ny as f32, nz as f32) * settings.cell_size.max(1e-3),
+        values,
     }
 }
 
@@ -383,14 +387,7 @@ impl Player {
     }
 
     fn volume(&self, values: Vec<f32>) -> DensityVolume {
-        let [nx, ny, nz] = self.run.automaton().dims;
-        let h = self.key.0.cell_size.max(1e-3);
-        DensityVolume {
-            dims: UVec3::new(nx as u32, ny as u32, nz as u32),
-            min: Vec3::from(self.key.0.origin),
-            size: Vec3::new(nx as f32, ny as f32, nz as f32) * h,
-            values,
-        }
+        volume(&self.key.0, self.run.automaton().dims, values)
     }
 }
 
