@@ -1,7 +1,10 @@
 // The sky behind the cloud when the document asks for a gradient (Lighting::sky_gradient):
 // the background colour at the zenith, the horizon colour at eye level, and below the horizon
-// a darker haze, by each pixel's view ray. Colours are sRGB-encoded, as the flat background
-// (the clear colour) is. `Sky` mirrors `SkyUniforms` in src/render/gpu_types.rs.
+// a darker haze, by each pixel's view ray; and with Lighting::ground a ground plane whose
+// every point is darkened by the clouds' transmittance toward the sun (the light volume where
+// the sun's ray from that point enters the clouds' box: nothing shades it before). Colours
+// are sRGB-encoded, as the flat background (the clear colour) is. `Sky` mirrors `SkyUniforms`
+// in src/render/gpu_types.rs.
 
 struct Sky {
     // Unit view direction (xyz).
@@ -9,13 +12,53 @@ struct Sky {
     // Image-plane right × tan(fov/2) × aspect, and up × tan(fov/2) (xyz).
     right: vec4<f32>,
     up: vec4<f32>,
-    // sRGB-encoded colours (rgb).
+    // sRGB-encoded colours (rgb); horizon.w: 1 with the gradient, 0 for a flat sky.
     zenith: vec4<f32>,
     horizon: vec4<f32>,
     ground: vec4<f32>,
+    // The eye (xyz); w: 1 with a ground plane.
+    eye: vec4<f32>,
+    // An orthographic view's ray origins across the image (zero in perspective).
+    origin_right: vec4<f32>,
+    origin_up: vec4<f32>,
+    // The light volume's box: minimum (xyz; w: the ground's height), size (xyz; w: 1 when
+    // there is a light volume).
+    grid_min: vec4<f32>,
+    grid_size: vec4<f32>,
+    // Toward the sun (xyz).
+    sun_dir: vec4<f32>,
+    // The ground's sRGB colour in full sun.
+    ground_lit: vec4<f32>,
 };
 
 @group(0) @binding(0) var<uniform> sky: Sky;
+// Transmittance toward the sun, stored as T^(1/8) (light_march.wgsl).
+@group(0) @binding(1) var light_tex: texture_3d<f32>;
+@group(0) @binding(2) var light_smp: sampler;
+
+// The clouds' transmittance toward the sun from ground point `p`.
+fn sun_through_clouds(p: vec3<f32>) -> f32 {
+    if sky.grid_size.w < 0.5 {
+        return 1.0;
+    }
+    let lo = sky.grid_min.xyz;
+    let hi = lo + sky.grid_size.xyz;
+    let s = sky.sun_dir.xyz;
+    let inv = 1.0 / select(s, vec3<f32>(1e-6), abs(s) < vec3<f32>(1e-6));
+    let t0 = (lo - p) * inv;
+    let t1 = (hi - p) * inv;
+    let enter = max(max(min(t0.x, t1.x), min(t0.y, t1.y)), min(t0.z, t1.z));
+    let leave = min(min(max(t0.x, t1.x), max(t0.y, t1.y)), max(t0.z, t1.z));
+    if leave < max(enter, 0.0) {
+        return 1.0;
+    }
+    let q = p + s * max(enter, 0.0);
+    let uvw = clamp((q - lo) / sky.grid_size.xyz, vec3<f32>(0.0), vec3<f32>(1.0));
+    let t = textureSampleLevel(light_tex, light_smp, uvw, 0.0).r;
+    let t2 = t * t;
+    let t4 = t2 * t2;
+    return t4 * t4;
+}
 
 struct VsOut {
     @builtin(position) clip: vec4<f32>,
@@ -42,6 +85,26 @@ fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
         colour = mix(sky.horizon.rgb, sky.zenith.rgb, sqrt(min(e / 0.7, 1.0)));
     } else {
         colour = mix(sky.horizon.rgb, sky.ground.rgb, smoothstep(0.0, 0.12, -e));
+    }
+    if sky.horizon.w < 0.5 {
+        // No gradient: the flat background, the ground alone drawn over it.
+        colour = sky.zenith.rgb;
+    }
+    if sky.eye.w > 0.5 {
+        // The ground: where this pixel's ray meets the plane y = height.
+        let ortho = dot(sky.origin_right.xyz, sky.origin_right.xyz) > 0.0;
+        let dir = select(d, sky.forward.xyz, ortho);
+        let origin = sky.eye.xyz + in.ndc.x * sky.origin_right.xyz + in.ndc.y * sky.origin_up.xyz;
+        let t = (sky.grid_min.w - origin.y) / dir.y;
+        if dir.y < 0.0 && t > 0.0 {
+            let p = origin + dir * t;
+            // Sunlight on the ground (by the sun's height) through the clouds, plus the sky's.
+            let sun = max(sky.sun_dir.y, 0.0) * sun_through_clouds(p);
+            let lit = sky.ground_lit.rgb * (0.35 + 0.65 * sun);
+            // Far ground fades into the horizon's haze.
+            let haze = smoothstep(0.0, 0.25, -dir.y);
+            colour = mix(colour, lit, haze);
+        }
     }
     return vec4<f32>(colour, 1.0);
 }

@@ -293,6 +293,14 @@ pub const EXPOSURE: Param = Param::linear(
     4.0,
     0.0,
 );
+/// The ground plane's height (world y).
+pub const GROUND_HEIGHT: Param = Param::linear(
+    "ground height",
+    "Where the ground lies (world height); the clouds' shadows fall on it",
+    -50.0,
+    50.0,
+    0.0,
+);
 /// Sketch: simplification tolerance as a fraction of the outline's size.
 pub const SIMPLIFY: Param = Param::linear(
     "simplify",
@@ -369,6 +377,7 @@ mod tests {
             FORWARD_SCATTERING,
             MULTIPLE_SCATTERING,
             EXPOSURE,
+            GROUND_HEIGHT,
         ] {
             assert!(
                 p.min < p.max && (p.min..=p.max).contains(&p.default),

@@ -808,3 +808,48 @@ fn exposure_brightens_the_cloud_by_stops_and_leaves_the_background() {
         "the sky keeps its colour"
     );
 }
+
+#[test]
+fn the_ground_under_a_cloud_is_darker_than_open_ground() {
+    // Looking down on the default cloud over a ground plane, the sun high: the same view with
+    // a cloud too thin to stop light (and so to cast a shadow) is the baseline.
+    let scene = with(
+        &Scene::default(),
+        &[
+            "/light/ground=true",
+            "/light/ground_height=-1.5",
+            "/light/sun_elevation_deg=60",
+            "/camera/pitch_deg=35",
+            "/camera/distance=30",
+        ],
+    );
+    let shaded = render(&scene);
+    let clear = render(&with(&scene, &["/render/opacity=0.01"]));
+    let (mut darker, mut lighter_ground) = (0, 0);
+    for (a, b) in shaded.rgba.chunks(4).zip(clear.rgba.chunks(4)) {
+        let (la, lb) = (
+            luminance([a[0], a[1], a[2], 255]),
+            luminance([b[0], b[1], b[2], 255]),
+        );
+        if la + 12.0 < lb {
+            darker += 1;
+        }
+        // Open ground far from the cloud is the same in both (only its shadow differs).
+        if (la - lb).abs() <= 1.0 {
+            lighter_ground += 1;
+        }
+    }
+    let total = (W * H) as usize;
+    assert!(
+        darker > total / 50,
+        "{darker} of {total} pixels darker with the cloud's shadow"
+    );
+    assert!(
+        lighter_ground > total / 4,
+        "{lighter_ground} pixels unchanged"
+    );
+    // The ground is drawn (below the horizon the image is not the flat sky).
+    let bg = background(&scene);
+    let bottom = clear.pixel(W / 2, H - 3);
+    assert!(differs(bottom, bg), "ground at the bottom: {bottom:?}");
+}

@@ -76,34 +76,78 @@ pub struct SkyUniforms {
     pub up: [f32; 4],
     /// sRGB-encoded zenith colour (the background's).
     pub zenith: [f32; 4],
-    /// sRGB-encoded horizon colour.
+    /// sRGB-encoded horizon colour; w: 1 with the gradient, 0 for a flat sky.
     pub horizon: [f32; 4],
     /// sRGB-encoded colour below the horizon.
     pub ground: [f32; 4],
+    /// The eye (xyz); w: 1 with a ground plane.
+    pub eye: [f32; 4],
+    /// Where a pixel's ray starts across the image plane: right and up half-extents of an
+    /// orthographic view (xyz; zero in perspective, where every ray starts at the eye).
+    pub origin_right: [f32; 4],
+    /// See `origin_right`.
+    pub origin_up: [f32; 4],
+    /// The light volume's box: minimum corner (xyz); w: the ground's height.
+    pub grid_min: [f32; 4],
+    /// Its size (xyz); w: 1 when there is a light volume to shade the ground with.
+    pub grid_size: [f32; 4],
+    /// Unit vector toward the sun (xyz).
+    pub sun_dir: [f32; 4],
+    /// The ground's sRGB colour in full sun (rgb).
+    pub ground_lit: [f32; 4],
 }
 
 impl SkyUniforms {
     /// Names and byte offsets of the members, in order (checked against the WGSL struct).
-    pub const LAYOUT: [(&'static str, usize); 7] = [
+    pub const LAYOUT: [(&'static str, usize); 14] = [
         ("forward", offset_of!(Self, forward)),
         ("right", offset_of!(Self, right)),
         ("up", offset_of!(Self, up)),
         ("zenith", offset_of!(Self, zenith)),
         ("horizon", offset_of!(Self, horizon)),
         ("ground", offset_of!(Self, ground)),
+        ("eye", offset_of!(Self, eye)),
+        ("origin_right", offset_of!(Self, origin_right)),
+        ("origin_up", offset_of!(Self, origin_up)),
+        ("grid_min", offset_of!(Self, grid_min)),
+        ("grid_size", offset_of!(Self, grid_size)),
+        ("sun_dir", offset_of!(Self, sun_dir)),
+        ("ground_lit", offset_of!(Self, ground_lit)),
         ("", std::mem::size_of::<Self>()),
     ];
 
-    /// The sky of `camera` and `light` in a view of `aspect` (width / height).
-    pub fn new(camera: &OrbitCamera, light: &Lighting, aspect: f32) -> Self {
+    /// The sky of `camera` and `light` in a view of `aspect` (width / height), with the
+    /// ground shaded through the light volume over `grid` (its box), if any.
+    pub fn new(
+        camera: &OrbitCamera,
+        light: &Lighting,
+        aspect: f32,
+        grid: Option<(Vec3, Vec3)>,
+    ) -> Self {
         let t = (camera.fov_y_deg.to_radians() * 0.5).tan();
         let [hr, hg, hb] = light.horizon_color;
+        let half = camera.distance * t;
+        let (origin_right, origin_up) = if camera.orthographic {
+            (camera.right() * half * aspect, camera.up() * half)
+        } else {
+            (Vec3::ZERO, Vec3::ZERO)
+        };
+        let (min, size) = grid.unwrap_or((Vec3::ZERO, Vec3::ZERO));
+        let ground = light.ground as u8 as f32;
         Self {
+            eye: camera.eye().extend(ground).to_array(),
+            origin_right: origin_right.extend(0.0).to_array(),
+            origin_up: origin_up.extend(0.0).to_array(),
+            grid_min: min.extend(light.ground_height).to_array(),
+            grid_size: size.extend(grid.is_some() as u8 as f32).to_array(),
+            sun_dir: light.sun_direction().extend(0.0).to_array(),
+            ground_lit: Vec3::from(light.ground_color).extend(1.0).to_array(),
             forward: camera.forward().extend(0.0).to_array(),
             right: (camera.right() * t * aspect).extend(0.0).to_array(),
             up: (camera.up() * t).extend(0.0).to_array(),
             zenith: Vec3::from(light.background).extend(1.0).to_array(),
-            horizon: [hr, hg, hb, 1.0],
+            // w: 1 for the gradient, 0 for one flat colour (the ground alone asked for the pass).
+            horizon: [hr, hg, hb, light.sky_gradient as u8 as f32],
             // A darker, slightly warmer haze below the horizon.
             ground: [hr * 0.62, hg * 0.6, hb * 0.56, 1.0],
         }

@@ -129,7 +129,12 @@ impl Offscreen {
             })
             .await
             .map_err(|e| OffscreenError::Device(e.to_string()))?;
-        let renderer = VolumeRenderer::new(&device, OUTPUT_FORMAT, accumulation_format(&adapter));
+        let renderer = VolumeRenderer::new(
+            &device,
+            &queue,
+            OUTPUT_FORMAT,
+            accumulation_format(&adapter),
+        );
         Ok(Self {
             device,
             queue,

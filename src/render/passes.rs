@@ -273,16 +273,27 @@ impl CompositePass {
 pub struct SkyPass {
     pipeline: wgpu::RenderPipeline,
     uniforms: wgpu::Buffer,
+    layout: wgpu::BindGroupLayout,
     bind_group: wgpu::BindGroup,
 }
 
 impl SkyPass {
-    /// Creates the pass writing into `output_format`.
-    pub fn new(device: &wgpu::Device, output_format: wgpu::TextureFormat) -> Self {
+    /// Creates the pass writing into `output_format`, shading the ground through `light` (a
+    /// 3D texture of transmittance; rebind with [`SkyPass::bind_light`] when it changes).
+    pub fn new(
+        device: &wgpu::Device,
+        output_format: wgpu::TextureFormat,
+        light: &wgpu::TextureView,
+        sampler: &wgpu::Sampler,
+    ) -> Self {
         let size = std::mem::size_of::<SkyUniforms>() as u64;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("sky"),
-            entries: &[uniform_entry(0, wgpu::ShaderStages::FRAGMENT, size, false)],
+            entries: &[
+                uniform_entry(0, wgpu::ShaderStages::FRAGMENT, size, false),
+                texture_3d(1),
+                sampler_entry(2),
+            ],
         });
         let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("sky uniforms"),
@@ -290,19 +301,50 @@ impl SkyPass {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("sky"),
-            layout: &layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: uniforms.as_entire_binding(),
-            }],
-        });
+        let bind_group = Self::group(device, &layout, &uniforms, light, sampler);
         Self {
             pipeline: pipeline(device, "sky", shaders::SKY, &layout, output_format),
             uniforms,
+            layout,
             bind_group,
         }
+    }
+
+    fn group(
+        device: &wgpu::Device,
+        layout: &wgpu::BindGroupLayout,
+        uniforms: &wgpu::Buffer,
+        light: &wgpu::TextureView,
+        sampler: &wgpu::Sampler,
+    ) -> wgpu::BindGroup {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("sky"),
+            layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: uniforms.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(light),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: wgpu::BindingResource::Sampler(sampler),
+                },
+            ],
+        })
+    }
+
+    /// Shades the ground through this light volume from now on.
+    pub fn bind_light(
+        &mut self,
+        device: &wgpu::Device,
+        light: &wgpu::TextureView,
+        sampler: &wgpu::Sampler,
+    ) {
+        self.bind_group = Self::group(device, &self.layout, &self.uniforms, light, sampler);
     }
 
     /// Sets the sky the next [`SkyPass::draw`] draws.

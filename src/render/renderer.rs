@@ -31,8 +31,8 @@ pub struct VolumeRenderer {
     light_pass: LightPass,
     /// The light volume: what it was computed for, its size, the texture.
     light: Option<LightVolume>,
-    /// Full transmittance, bound until a light volume exists (made on the first upload).
-    light_placeholder: Option<wgpu::TextureView>,
+    /// Full transmittance, bound until a light volume exists.
+    light_placeholder: wgpu::TextureView,
     /// Group 0 of the light pass (the slice group without the light texture).
     light_bind_group: Option<wgpu::BindGroup>,
 }
@@ -67,23 +67,33 @@ impl VolumeRenderer {
     /// Creates pipelines for compositing into `output_format`, accumulating in `accum_format`.
     pub fn new(
         device: &wgpu::Device,
+        queue: &wgpu::Queue,
         output_format: wgpu::TextureFormat,
         accum_format: wgpu::TextureFormat,
     ) -> Self {
+        let placeholder = upload_3d(
+            device,
+            queue,
+            "light placeholder",
+            [1, 1, 1],
+            LIGHT_FORMAT,
+            &[255],
+        );
+        let clamp_sampler = sampler(device, wgpu::AddressMode::ClampToEdge);
         Self {
             accum_format,
             output_format,
             slices: SlicePass::new(device, accum_format),
             composite: CompositePass::new(device, output_format),
-            sky: SkyPass::new(device, output_format),
-            clamp_sampler: sampler(device, wgpu::AddressMode::ClampToEdge),
+            sky: SkyPass::new(device, output_format, &placeholder, &clamp_sampler),
+            clamp_sampler,
             repeat_sampler: sampler(device, wgpu::AddressMode::Repeat),
             textures: VolumeTextures::new(),
             bind_group: None,
             targets: Default::default(),
             light_pass: LightPass::new(device),
             light: None,
-            light_placeholder: None,
+            light_placeholder: placeholder,
             light_bind_group: None,
         }
     }
@@ -100,16 +110,6 @@ impl VolumeRenderer {
 
     /// Uploads whatever changed in `volumes` since the last call.
     pub fn upload(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, volumes: &Volumes) {
-        if self.light_placeholder.is_none() {
-            self.light_placeholder = Some(upload_3d(
-                device,
-                queue,
-                "light placeholder",
-                [1, 1, 1],
-                LIGHT_FORMAT,
-                &[255],
-            ));
-        }
         if !self.textures.upload(device, queue, volumes) && self.bind_group.is_some() {
             return;
         }
@@ -120,12 +120,14 @@ impl VolumeRenderer {
     /// textures.
     fn rebuild_bind_groups(&mut self, device: &wgpu::Device) {
         let t = &self.textures;
-        let (Some((_, volume)), Some((_, noise)), Some(placeholder)) =
-            (&t.volume, &t.noise, &self.light_placeholder)
-        else {
+        let light = self
+            .light
+            .as_ref()
+            .map_or(&self.light_placeholder, |l| &l.view);
+        self.sky.bind_light(device, light, &self.clamp_sampler);
+        let (Some((_, volume)), Some((_, noise))) = (&t.volume, &t.noise) else {
             return;
         };
-        let light = self.light.as_ref().map_or(placeholder, |l| &l.view);
         let entries = [
             wgpu::BindGroupEntry {
                 binding: 0,
@@ -429,7 +431,7 @@ impl VolumeRenderer {
         let view = output.create_view(&wgpu::TextureViewDescriptor::default());
         self.update_light(device, queue, encoder, &job.view);
         self.draw_slices(device, queue, encoder, job, pipeline);
-        let sky = job.view.light.sky_gradient && background.is_some();
+        let sky = (job.view.light.sky_gradient || job.view.light.ground) && background.is_some();
         if sky {
             self.prepare_sky(queue, &job.view);
         }
@@ -468,9 +470,13 @@ impl VolumeRenderer {
 
     /// Sets the sky gradient of `view` (call before [`VolumeRenderer::draw_sky`]).
     pub fn prepare_sky(&self, queue: &wgpu::Queue, view: &View) {
+        // The ground is shaded through the light volume, which spans the density's box.
+        let volume = &self.textures.density_volume;
+        let grid =
+            (self.light.is_some() && !volume.is_empty()).then_some((volume.min, volume.size));
         self.sky.write(
             queue,
-            &SkyUniforms::new(&view.camera, &view.light, view.aspect),
+            &SkyUniforms::new(&view.camera, &view.light, view.aspect, grid),
         );
     }
 

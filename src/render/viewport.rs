@@ -101,7 +101,12 @@ pub struct BackendInfo {
 /// is what the GL backend is called on this platform (`webgl2` in the browser).
 pub fn install(render_state: &egui_wgpu::RenderState, gl_name: &'static str) -> BackendInfo {
     let format = accumulation_format(&render_state.adapter);
-    let renderer = VolumeRenderer::new(&render_state.device, render_state.target_format, format);
+    let renderer = VolumeRenderer::new(
+        &render_state.device,
+        &render_state.queue,
+        render_state.target_format,
+        format,
+    );
     render_state
         .renderer
         .write()

@@ -275,6 +275,12 @@ pub struct Lighting {
     pub horizon_color: [f32; 3],
     /// Exposure in stops: sun and sky light times 2^EV before tone mapping.
     pub exposure: f32,
+    /// A ground plane below the sky, darkened where the clouds shade it from the sun.
+    pub ground: bool,
+    /// The ground's height (world y).
+    pub ground_height: f32,
+    /// The ground's colour in full sun (sRGB).
+    pub ground_color: [f32; 3],
 }
 
 impl Default for Lighting {
@@ -292,6 +298,9 @@ impl Default for Lighting {
             sky_gradient: false,
             horizon_color: [0.78, 0.84, 0.9],
             exposure: limits::EXPOSURE.default as f32,
+            ground: false,
+            ground_height: 0.0,
+            ground_color: [0.36, 0.42, 0.3],
         }
     }
 }
@@ -327,7 +336,9 @@ impl Lighting {
         self.forward_scattering = limits::FORWARD_SCATTERING.fix_f32(self.forward_scattering);
         self.multiple_scattering = limits::MULTIPLE_SCATTERING.fix_f32(self.multiple_scattering);
         self.exposure = limits::EXPOSURE.fix_f32(self.exposure);
+        self.ground_height = limits::GROUND_HEIGHT.fix_f32(self.ground_height);
         for c in [
+            &mut self.ground_color,
             &mut self.sun_color,
             &mut self.sky_color,
             &mut self.background,

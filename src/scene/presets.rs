@@ -195,6 +195,7 @@ impl Scene {
                 render.softness = 0.2;
                 light.sun_elevation_deg = 14.0;
                 light.sun_azimuth_deg = 150.0;
+                light.ground = true;
                 simulation = Some(Arc::new(crate::simulate::Settings::default()));
                 // Forty steps in: the parcels have clouds when the preset opens.
                 time = 4.0;

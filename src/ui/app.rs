@@ -419,7 +419,7 @@ impl CloudApp {
                     "z": at(g.handle_end(Axis::Z)),
                 })
             }),
-            "sun_handle": super::sun_handle::orb(self.viewport.rect).map(|(c, r)| {
+            "sun_handle": super::sun_handle::orb(self.viewport.rect).filter(|_| !self.tool.hide_guides).map(|(c, r)| {
                 serde_json::json!({ "center": [c.x, c.y], "radius": r })
             }),
             "widgets": widgets,

@@ -43,6 +43,12 @@ pub fn take_pointer_samples() -> Option<Vec<(egui::Pos2, Option<f32>)>> {
     None
 }
 
+/// A whole press → release within one frame: natively egui's events carry every move, so a
+/// drag is always seen as one; nothing to recover.
+pub fn take_finished_press() -> Option<Vec<(egui::Pos2, Option<f32>)>> {
+    None
+}
+
 /// Where the autosave lives: `$XDG_DATA_HOME/cloudsketch`, else `~/.local/share/cloudsketch`.
 fn autosave_dir() -> Option<std::path::PathBuf> {
     let base = std::env::var_os("XDG_DATA_HOME")

@@ -25,6 +25,9 @@ const MAX_BYTES: f64 = MAX_FILE_BYTES as f64;
 thread_local! {
     static INBOX: RefCell<Vec<Loaded>> = const { RefCell::new(Vec::new()) };
     static SAMPLES: RefCell<Vec<(egui::Pos2, Option<f32>)>> = const { RefCell::new(Vec::new()) };
+    /// The primary pointer's whole press → release, and the last one finished.
+    static PRESS: RefCell<Vec<(egui::Pos2, Option<f32>)>> = const { RefCell::new(Vec::new()) };
+    static FINISHED: RefCell<Option<Vec<(egui::Pos2, Option<f32>)>>> = const { RefCell::new(None) };
     static REPAINT: RefCell<Option<egui::Context>> = const { RefCell::new(None) };
     static LINKS: RefCell<Vec<String>> = const { RefCell::new(Vec::new()) };
     static SCENE_FILES: RefCell<Vec<Loaded>> = const { RefCell::new(Vec::new()) };
@@ -302,6 +305,20 @@ fn keep_browser_shortcuts() {
     on_key.forget(); // lives as long as the page
 }
 
+/// A pointer event's position in the canvas (points) and the pen's pressure (a mouse reports
+/// a constant 0.5, so only a pen's is kept).
+fn sample_at(e: &web_sys::PointerEvent, zoom: f32) -> Option<(egui::Pos2, Option<f32>)> {
+    let canvas = web_sys::window()
+        .and_then(|w| w.document())
+        .and_then(|d| d.get_element_by_id("cloudsketch_canvas"))?;
+    let rect = canvas.get_bounding_client_rect();
+    let pos = egui::pos2(
+        (e.client_x() as f32 - rect.left() as f32) / zoom,
+        (e.client_y() as f32 - rect.top() as f32) / zoom,
+    );
+    Some((pos, (e.pointer_type() == "pen").then(|| e.pressure())))
+}
+
 fn install_pointer_samples(ctx: &egui::Context) {
     let Some(document) = web_sys::window().and_then(|w| w.document()) else {
         return;
@@ -309,55 +326,82 @@ fn install_pointer_samples(ctx: &egui::Context) {
     let Some(canvas) = document.get_element_by_id("cloudsketch_canvas") else {
         return;
     };
-    let on_down = Closure::<dyn FnMut(web_sys::PointerEvent)>::new(|e: web_sys::PointerEvent| {
+    // Press and release are heard in the capture phase on the document, before eframe's own
+    // canvas listeners (which may run a frame inside them): a frame that sees the release
+    // also finds the whole press → release recorded.
+    let down_ctx = ctx.clone();
+    let on_down =
+        Closure::<dyn FnMut(web_sys::PointerEvent)>::new(move |e: web_sys::PointerEvent| {
+            if e.is_primary()
+                && e.target().is_some_and(|t| {
+                    t.dyn_ref::<web_sys::Element>()
+                        .is_some_and(|el| el.id() == "cloudsketch_canvas")
+                })
+            {
+                SAMPLES.with(|s| s.borrow_mut().clear());
+                PRESS.with(|p| {
+                    *p.borrow_mut() = sample_at(&e, down_ctx.zoom_factor()).into_iter().collect()
+                });
+            }
+        });
+    let _ = document.add_event_listener_with_callback_and_bool(
+        "pointerdown",
+        on_down.as_ref().unchecked_ref(),
+        true,
+    );
+    on_down.forget(); // lives as long as the page
+    let on_up = Closure::<dyn FnMut(web_sys::PointerEvent)>::new(|e: web_sys::PointerEvent| {
         if e.is_primary() {
-            SAMPLES.with(|s| s.borrow_mut().clear());
+            let press = PRESS.with(|p| std::mem::take(&mut *p.borrow_mut()));
+            if !press.is_empty() {
+                FINISHED.with(|f| *f.borrow_mut() = Some(press));
+            }
         }
     });
-    let _ =
-        canvas.add_event_listener_with_callback("pointerdown", on_down.as_ref().unchecked_ref());
-    on_down.forget(); // lives as long as the page
+    let _ = document.add_event_listener_with_callback_and_bool(
+        "pointerup",
+        on_up.as_ref().unchecked_ref(),
+        true,
+    );
+    on_up.forget(); // lives as long as the page
+    let _ = canvas;
     let ctx = ctx.clone();
     let on_move =
         Closure::<dyn FnMut(web_sys::PointerEvent)>::new(move |e: web_sys::PointerEvent| {
             if !e.is_primary() || e.buttons() == 0 {
                 return;
             }
-            let Some(canvas) = web_sys::window()
-                .and_then(|w| w.document())
-                .and_then(|d| d.get_element_by_id("cloudsketch_canvas"))
-            else {
-                return;
-            };
-            let rect = canvas.get_bounding_client_rect();
             let zoom = ctx.zoom_factor();
-            // Position in points, and the pen's pressure (a mouse reports a constant 0.5).
-            let at = |m: &web_sys::PointerEvent| {
-                let pos = egui::pos2(
-                    (m.client_x() as f32 - rect.left() as f32) / zoom,
-                    (m.client_y() as f32 - rect.top() as f32) / zoom,
-                );
-                (pos, (m.pointer_type() == "pen").then(|| m.pressure()))
-            };
             let coalesced = e.get_coalesced_events();
-            SAMPLES.with(|s| {
-                let mut s = s.borrow_mut();
-                if coalesced.length() == 0 {
-                    s.push(at(&e));
+            let mut new: Vec<(egui::Pos2, Option<f32>)> = Vec::new();
+            if coalesced.length() == 0 {
+                new.extend(sample_at(&e, zoom));
+            }
+            for c in coalesced.iter() {
+                if let Ok(m) = c.dyn_into::<web_sys::PointerEvent>() {
+                    new.extend(sample_at(&m, zoom));
                 }
-                for c in coalesced.iter() {
-                    if let Ok(m) = c.dyn_into::<web_sys::PointerEvent>() {
-                        s.push(at(&m));
-                    }
-                }
-                // A held button with no stroke being drawn must not grow this without bound.
-                let excess = s.len().saturating_sub(crate::limits::MAX_PLANE_POINTS);
-                s.drain(..excess);
-            });
+            }
+            // A held button with no stroke being drawn must not grow these without bound.
+            let cap = crate::limits::MAX_PLANE_POINTS;
+            for buffer in [&SAMPLES, &PRESS] {
+                buffer.with(|s| {
+                    let mut s = s.borrow_mut();
+                    s.extend_from_slice(&new);
+                    let excess = s.len().saturating_sub(cap);
+                    s.drain(..excess);
+                });
+            }
         });
     let _ =
         document.add_event_listener_with_callback("pointermove", on_move.as_ref().unchecked_ref());
     on_move.forget(); // lives as long as the page
+}
+
+/// The primary pointer's last whole press → release over the view (every sample, from the
+/// press), once: a stroke drawn within one long frame, which egui reports as a click.
+pub fn take_finished_press() -> Option<Vec<(egui::Pos2, Option<f32>)>> {
+    FINISHED.with(|f| f.borrow_mut().take())
 }
 
 /// Pointer positions (in points) since the last call, every sample the browser saw while the

@@ -70,6 +70,8 @@ pub struct SketchTool {
     pub show_skeleton: bool,
     /// A stroke is being drawn (between drag start and stop).
     drawing: bool,
+    /// The primary button last went down on the view itself (not on a handle over it).
+    pressed_on_view: bool,
     /// The world axis Rotate turns about (X, Y or Z), or free.
     pub axis_lock: Option<Axis>,
     /// The Move/Rotate/Scale drag under way: what it started from and the drag so far.
@@ -238,6 +240,15 @@ pub fn project(camera: &OrbitCamera, rect: Rect, p: Vec3) -> Option<Pos2> {
 /// A stroke's pen pressure, one value per point, when a pen drew it (any sample has a
 /// pressure); points without one (the press itself, samples from egui's events) take the
 /// nearest earlier value, or the first one known. Empty for the mouse and touch.
+/// Whether recorded samples are a drag, not a click: several points spread over more than a
+/// few points of the screen.
+fn is_drag(samples: &[(Pos2, Option<f32>)]) -> bool {
+    let Some(&(first, _)) = samples.first() else {
+        return false;
+    };
+    samples.len() >= 3 && samples.iter().any(|(p, _)| p.distance(first) > 6.0)
+}
+
 fn pen_pressure(samples: &[Option<f32>]) -> Vec<f32> {
     let Some(first) = samples.iter().flatten().next().copied() else {
         return Vec::new();
@@ -359,6 +370,8 @@ impl SketchTool {
         if alt || multi {
             self.stroke.clear();
             self.drawing = false;
+            // An orbit, not a stroke: its recorded press is dropped.
+            let _ = super::platform::take_finished_press();
             return true;
         }
         // Every pointer sample since the last frame, not one position per frame: on a slow
@@ -374,6 +387,8 @@ impl SketchTool {
                     .collect()
             })
         });
+        // The press → release the page recorded (see `quick` below).
+        let press = super::platform::take_finished_press();
         if response.drag_started_by(egui::PointerButton::Primary) {
             self.stroke.clear();
             self.pressure.clear();
@@ -396,13 +411,31 @@ impl SketchTool {
             }
         }
         let now = ui.input(|i| i.time);
-        if response.clicked_by(egui::PointerButton::Primary) {
+        // A whole stroke egui never saw as a drag (the press and the release one long frame
+        // apart on a slow adapter, with the moves between them): the page recorded every
+        // sample, so it is drawn all the same, if the press landed on the view itself.
+        if ui.input(|i| i.pointer.primary_pressed()) {
+            self.pressed_on_view = response.hovered();
+        }
+        let quick = press.filter(|p| {
+            self.pressed_on_view
+                && ui.input(|i| i.pointer.primary_released())
+                && !self.drawing
+                && is_drag(p)
+                && rect.contains(p[0].0)
+                && !response.drag_stopped_by(egui::PointerButton::Primary)
+        });
+        if response.clicked_by(egui::PointerButton::Primary) && quick.is_none() {
             tc.notices.error(
                 now,
                 "A click draws nothing: drag to draw an outline (a cut: a line across the cloud)",
             );
         }
-        if response.drag_stopped_by(egui::PointerButton::Primary) {
+        if let Some(p) = &quick {
+            self.stroke = p.iter().map(|s| s.0).collect();
+            self.pressure = p.iter().map(|s| s.1).collect();
+        }
+        if response.drag_stopped_by(egui::PointerButton::Primary) || quick.is_some() {
             self.drawing = false;
             let mut stroke = std::mem::take(&mut self.stroke);
             let pressure = pen_pressure(&std::mem::take(&mut self.pressure));

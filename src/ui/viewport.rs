@@ -125,7 +125,7 @@ impl Viewport {
             aspect: rect.aspect_ratio(),
             crop: crate::render::FULL_VIEW,
         };
-        if scene.light.sky_gradient && self.stats.backend.is_some() {
+        if (scene.light.sky_gradient || scene.light.ground) && self.stats.backend.is_some() {
             painter.add(egui_wgpu::Callback::new_paint_callback(
                 rect,
                 SkyPaint { view: view.clone() },
@@ -239,7 +239,8 @@ impl Viewport {
         guide.paint(&ui.painter_at(rect), rect, cx.doc, true);
         self.status_line(ui, rect, cx.doc, cx.notices, now);
         tool.overlay(ui, rect, cx.doc, cx.derived, cx.selection);
-        if self.stats.backend.is_some() {
+        // H (hide guides) hides the sun handle with the other overlays.
+        if self.stats.backend.is_some() && !tool.hide_guides {
             super::sun_handle::show(ui, rect, cx.doc);
         }
     }

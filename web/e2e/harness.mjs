@@ -101,11 +101,16 @@ export async function screenshot(page, name) {
   return { width: png.width, height: png.height, data: png.data, file };
 }
 
-/** Pixels of `img` inside `rect` ({x, y, w, h}) whose colour differs from `rgb` by more than `tol`. */
-export function countDiffering(img, rect, rgb, tol = 12) {
+/**
+ * Pixels of `img` inside `rect` ({x, y, w, h}) whose colour differs from `rgb` by more than
+ * `tol`, leaving out the pixels inside `skip` (a rect, e.g. the sun handle's box), if given.
+ */
+export function countDiffering(img, rect, rgb, tol = 12, skip = null) {
   let n = 0;
+  const skipped = (x, y) => skip && x >= skip.x && x < skip.x + skip.w && y >= skip.y && y < skip.y + skip.h;
   for (let y = rect.y; y < rect.y + rect.h; y++) {
     for (let x = rect.x; x < rect.x + rect.w; x++) {
+      if (skipped(x, y)) continue;
       const i = 4 * (y * img.width + x);
       const d = Math.abs(img.data[i] - rgb[0]) + Math.abs(img.data[i + 1] - rgb[1]) + Math.abs(img.data[i + 2] - rgb[2]);
       if (d > tol) n++;
@@ -134,6 +139,14 @@ export function recordTiming(entry) {
   const all = fs.existsSync(file) ? JSON.parse(fs.readFileSync(file, 'utf8')) : [];
   all.push({ ...entry, at: new Date().toISOString() });
   fs.writeFileSync(file, JSON.stringify(all, null, 2));
+}
+
+/** The sun handle's box in the page state's view (or null when it is not drawn). */
+export function sunHandleBox(view) {
+  const o = view.sun_handle;
+  if (!o) return null;
+  const r = o.radius + 6;
+  return { x: Math.floor(o.center[0] - r), y: Math.floor(o.center[1] - r), w: Math.ceil(2 * r), h: Math.ceil(2 * r) };
 }
 
 /** Polls the page state until `pred(state)` holds; throws with the view state on timeout. */

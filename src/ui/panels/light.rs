@@ -26,4 +26,10 @@ fn body(ui: &mut Ui, l: &mut Lighting) {
     if l.sky_gradient {
         srgb_button(ui, "horizon", &mut l.horizon_color);
     }
+    ui.checkbox(&mut l.ground, "ground")
+        .on_hover_text("A ground plane under the sky; the clouds' shadows fall on it");
+    if l.ground {
+        param(ui, &mut l.ground_height, &limits::GROUND_HEIGHT);
+        srgb_button(ui, "ground colour", &mut l.ground_color);
+    }
 }
