@@ -27,6 +27,10 @@ for (const backend of ['webgpu', 'webgl2']) {
     await withApp({ base: server.url, webgpu: backend === 'webgpu', query: '?preset=simulated', viewport: { width: 1280, height: 800 } }, async (page) => {
       let s = await state(page);
       assert.ok(s.scene.simulation, 'the preset simulates');
+      assert.ok(s.scene.light.ground, 'over a ground plane');
+      // Without the ground, every pixel away from the flat sky is cloud.
+      await page.evaluate(() => window.cloudsketch.set('/light/ground=false'));
+      s = await until(page, (s) => !s.scene.light.ground, 'no ground');
       const [vw, vh] = s.view.viewport;
       // Below the sun handle and short of the side panel's border, which would read as cloud.
       const body = { x: 0, y: 130, w: vw - 12, h: vh - 160 };
