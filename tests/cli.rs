@@ -464,3 +464,48 @@ fn link_makes_a_url_that_decodes_and_renders_and_refuses_a_broken_one() {
     ]);
     assert!(stderr(&out).contains("no \"#s=\" part"), "{}", stderr(&out));
 }
+
+#[test]
+fn export_and_simulate_refuse_bad_requests_clearly_and_write_what_is_asked() {
+    let out = temp("bad.vdb");
+    for (args, says) in [
+        (vec!["export", "--format", "stl"], "unknown format"),
+        (
+            vec!["export", "--format", "vdb", "--resolution", "9999"],
+            "--resolution 9999",
+        ),
+        (vec!["export", "--format", "vdb", "--up", "x"], "--up"),
+        (vec!["export", "--format", "vdb", "--scale=0"], "--scale"),
+        (vec!["simulate", "--steps", "999999999"], "--steps"),
+    ] {
+        let mut a = args.clone();
+        a.extend(["-o", out.to_str().unwrap()]);
+        let o = cloudsketch(&a);
+        assert!(!o.status.success(), "{args:?} succeeded");
+        assert!(stderr(&o).contains(says), "{args:?}: {}", stderr(&o));
+        assert!(
+            !o.stderr.windows(8).any(|w| w == b"panicked"),
+            "{args:?} panicked"
+        );
+    }
+    // A scene without a simulation says so; the default scene's file is not written.
+    let scene = temp("plain.json");
+    assert!(
+        cloudsketch(&["new", "-o", scene.to_str().unwrap()])
+            .status
+            .success()
+    );
+    let o = cloudsketch(&[
+        "simulate",
+        scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(stderr(&o).contains("no simulation"), "{}", stderr(&o));
+    // The simulated preset's run writes a VDB that starts with OpenVDB's magic.
+    let vdb = temp("sim.vdb");
+    let o = cloudsketch(&["simulate", "--steps", "30", "-o", vdb.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let bytes = std::fs::read(&vdb).unwrap();
+    assert_eq!(&bytes[..8], &0x5644_4220i64.to_le_bytes());
+}

@@ -196,10 +196,7 @@ impl Offscreen {
             self.renderer.begin_frame();
             let (encoder, _output) =
                 self.encode(&job, Some(scene.light.background), pipeline.as_ref());
-            self.queue.submit([encoder.finish()]);
-            self.device
-                .poll(wgpu::PollType::wait_indefinitely())
-                .map_err(|e| OffscreenError::Readback(e.to_string()))?;
+            self.submit_and_wait(encoder)?;
             times.push(start.elapsed().as_secs_f64());
         }
         Ok(times)
@@ -265,13 +262,19 @@ impl Offscreen {
                 });
             self.renderer
                 .update_light(&self.device, &self.queue, &mut encoder, &job.view);
-            self.queue.submit([encoder.finish()]);
-            self.device
-                .poll(wgpu::PollType::wait_indefinitely())
-                .map_err(|e| OffscreenError::Readback(e.to_string()))?;
+            self.submit_and_wait(encoder)?;
             times.push(start.elapsed().as_secs_f64());
         }
         Ok(times)
+    }
+
+    /// Submits `encoder` and waits for the device to finish it.
+    fn submit_and_wait(&self, encoder: wgpu::CommandEncoder) -> Result<(), OffscreenError> {
+        self.queue.submit([encoder.finish()]);
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map(|_| ())
+            .map_err(|e| OffscreenError::Readback(e.to_string()))
     }
 
     /// Derives `scene`'s volumes (through the per-plane cache) and uploads them; returns the
