@@ -4,7 +4,7 @@
 // every point is darkened by the clouds' transmittance toward the sun (the light volume where
 // the sun's ray from that point enters the clouds' box: nothing shades it before). Colours
 // are sRGB-encoded, as the flat background (the clear colour) is. `Sky` mirrors `SkyUniforms`
-// in src/render/gpu_types.rs.
+// in src/render/gpu_types.rs. Composed after sun_shadow.wgsl.
 
 struct Sky {
     // Unit view direction (xyz).
@@ -36,28 +36,14 @@ struct Sky {
 @group(0) @binding(1) var light_tex: texture_3d<f32>;
 @group(0) @binding(2) var light_smp: sampler;
 
-// The clouds' transmittance toward the sun from ground point `p`.
-fn sun_through_clouds(p: vec3<f32>) -> f32 {
+// The clouds' transmittance toward the sun from ground point `p` (sun_shadow.wgsl).
+fn ground_sun(p: vec3<f32>) -> f32 {
     if sky.grid_size.w < 0.5 {
         return 1.0;
     }
-    let lo = sky.grid_min.xyz;
-    let hi = lo + sky.grid_size.xyz;
-    let s = sky.sun_dir.xyz;
-    let inv = 1.0 / select(s, vec3<f32>(1e-6), abs(s) < vec3<f32>(1e-6));
-    let t0 = (lo - p) * inv;
-    let t1 = (hi - p) * inv;
-    let enter = max(max(min(t0.x, t1.x), min(t0.y, t1.y)), min(t0.z, t1.z));
-    let leave = min(min(max(t0.x, t1.x), max(t0.y, t1.y)), max(t0.z, t1.z));
-    if leave < max(enter, 0.0) {
-        return 1.0;
-    }
-    let q = p + s * max(enter, 0.0);
-    let uvw = clamp((q - lo) / sky.grid_size.xyz, vec3<f32>(0.0), vec3<f32>(1.0));
-    let t = textureSampleLevel(light_tex, light_smp, uvw, 0.0).r;
-    let t2 = t * t;
-    let t4 = t2 * t2;
-    return t4 * t4;
+    return sun_through_clouds(
+        p, sky.grid_min.xyz, sky.grid_size.xyz, sky.sun_dir.xyz, light_tex, light_smp,
+    );
 }
 
 struct VsOut {
@@ -99,7 +85,7 @@ fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
         if dir.y < 0.0 && t > 0.0 {
             let p = origin + dir * t;
             // Sunlight on the ground (by the sun's height) through the clouds, plus the sky's.
-            let sun = max(sky.sun_dir.y, 0.0) * sun_through_clouds(p);
+            let sun = max(sky.sun_dir.y, 0.0) * ground_sun(p);
             let lit = sky.ground_lit.rgb * (0.35 + 0.65 * sun);
             // Far ground fades into the horizon's haze.
             let haze = smoothstep(0.0, 0.25, -dir.y);

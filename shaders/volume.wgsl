@@ -7,18 +7,77 @@
 // light volume, which sees the noise) × a two-lobe
 // Henyey–Greenstein phase, plus octaves of multiple scattering (after Wrenninge 2013: each
 // octave sees 0.3 of the extinction, 0.6 of the energy and half the asymmetry), + ambient sky.
-// Composed after volume_common.wgsl (uniforms and bindings) and volume_noise.wgsl.
+// With shafts of light (Dobashi et al. 2000) the same draw also holds spherical shells
+// centred at the eye, merged with the slices back to front; `fs_shafts` draws both.
+// Composed after volume_common.wgsl (uniforms and bindings), volume_noise.wgsl and
+// sun_shadow.wgsl.
 
 struct VsOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) world: vec3<f32>,
+    // The shell this instance draws (−1: a slice).
+    @location(1) @interpolate(flat) shell: i32,
+    // A shell's points of the pixel's view ray on the near and far planes (homogeneous).
+    @location(2) near: vec4<f32>,
+    @location(3) far: vec4<f32>,
 };
+
+// Distance along the view from the eye to slice `j` (of the image; 0 = farthest).
+fn slice_depth(j: f32) -> f32 {
+    return dot(u.sphere.xyz - u.eye.xyz, u.forward.xyz) + u.grid_min.w - (j + 0.5) * u.slicing.z;
+}
+
+// How many shells lie farther from the eye than `depth` (Shells::beyond in gpu_types.rs).
+fn shells_beyond(depth: f32) -> i32 {
+    let n = ceil((u.shafts.x - depth) / u.shafts.y - 0.5);
+    return i32(clamp(n, 0.0, u.shells.w));
+}
+
+// Where slice `j` of this draw comes among the draw's slices and shells, back to front.
+fn slice_position(j: i32) -> i32 {
+    let first = i32(u.shells.x);
+    let beyond = clamp(shells_beyond(slice_depth(f32(j) + u.slicing.y)), first, first + i32(u.shells.y));
+    return j + beyond - first;
+}
 
 @vertex
 fn vs_main(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> VsOut {
+    var out: VsOut;
+    out.shell = -1;
+    out.near = vec4<f32>(0.0);
+    out.far = vec4<f32>(0.0);
+    var slice_in_draw = i32(ii);
+    if u.shells.y > 0.0 {
+        // Slices and the shafts' shells merged back to front: the slices at or before this
+        // instance (a binary search over their positions, which only grow) tell which it is.
+        let i = i32(ii);
+        var lo = 0;
+        var hi = i32(u.shells.z);
+        while lo < hi {
+            let mid = (lo + hi) / 2;
+            if slice_position(mid) <= i {
+                lo = mid + 1;
+            } else {
+                hi = mid;
+            }
+        }
+        if lo == 0 || slice_position(lo - 1) != i {
+            // A shell: one triangle over the whole image (the other three vertices collapse).
+            out.shell = i32(u.shells.x) + i - lo;
+            let k = vi % 6u;
+            let x = select(-1.0, 3.0, k == 1u);
+            let y = select(-1.0, 3.0, k == 2u);
+            out.clip = vec4<f32>(x, y, 0.0, 1.0);
+            out.near = u.inv_view_proj * vec4<f32>(x, y, 0.0, 1.0);
+            out.far = u.inv_view_proj * vec4<f32>(x, y, 1.0, 1.0);
+            out.world = vec3<f32>(0.0);
+            return out;
+        }
+        slice_in_draw = lo - 1;
+    }
     // Slice 0 is the farthest; slices span the grid box's depth along the view (from
     // grid_min.w toward the eye), and each quad covers the bounding sphere's cross-section.
-    let slice = f32(ii) + u.slicing.y;
+    let slice = f32(slice_in_draw) + u.slicing.y;
     let r = u.sphere.w;
     let d = u.grid_min.w - (slice + 0.5) * u.slicing.z;
     let half = sqrt(max(r * r - d * d, 0.0));
@@ -28,7 +87,6 @@ fn vs_main(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> 
     );
     let c = corners[vi % 6u] * half;
     let world = u.sphere.xyz + u.forward.xyz * d + u.right.xyz * c.x + u.up.xyz * c.y;
-    var out: VsOut;
     out.clip = u.view_proj * vec4<f32>(world, 1.0);
     out.world = world;
     return out;
@@ -73,8 +131,8 @@ fn sun_light(s: f32, cos_theta: f32) -> f32 {
     return light;
 }
 
-@fragment
-fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
+// One slice's light and opacity at a fragment, premultiplied (discards where it adds nothing).
+fn cloud(in: VsOut) -> vec4<f32> {
     let uvw = (in.world - u.grid_min.xyz) * u.grid_inv_size.xyz;
     if any(uvw < vec3<f32>(0.0)) || any(uvw > vec3<f32>(1.0)) {
         discard;
@@ -115,4 +173,60 @@ fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
     let sun = sun_light(t, dot(view_dir, u.sun_dir.xyz));
     let light = u.sun_color.rgb * sun + u.sky_color.rgb;
     return vec4<f32>(light * alpha, alpha);
+}
+
+@fragment
+fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
+    return cloud(in);
+}
+
+// Sunlight the air scatters toward the eye over one shell's stretch of the pixel's ray
+// (Dobashi et al. 2000): the sun's light through the clouds (the light volume, noise and
+// all) × the air's phase × the share the stretch scatters × what the air in front lets
+// through. Nothing below the ground, which hides it.
+fn shaft(in: VsOut) -> vec3<f32> {
+    let a = in.near.xyz / in.near.w;
+    let b = in.far.xyz / in.far.w;
+    let dir = normalize(b - a);
+    // The eye in perspective; the pixel's point of the eye's plane in an orthographic view.
+    let origin = a - dir * dot(a - u.eye.xyz, dir);
+    // A per-pixel offset within the stretch (interleaved gradient noise) turns the shells'
+    // steps into fine grain.
+    let jitter = fract(52.9829189 * fract(dot(in.clip.xy, vec2<f32>(0.06711056, 0.00583715))));
+    let spacing = u.shafts.y;
+    let r = u.shafts.x - (f32(in.shell) + jitter) * spacing;
+    if r <= 0.0 {
+        return vec3<f32>(0.0);
+    }
+    let p = origin + dir * r;
+    if p.y < u.air.x {
+        return vec3<f32>(0.0);
+    }
+    let sun = sun_through_clouds(
+        p, u.grid_min.xyz, 1.0 / u.grid_inv_size.xyz, u.sun_dir.xyz, light_tex, clamp_smp,
+    );
+    let sigma = u.shafts.z;
+    let scattered = (1.0 - exp(-sigma * spacing)) * exp(-sigma * r);
+    return u.sun_color.rgb * (u.shafts.w * sun * scattered * hg(dot(dir, u.sun_dir.xyz), u.air.y));
+}
+
+// The slice pass with shafts of light: the cloud into target 0 as fs_main draws it; into
+// target 1 the shells' light added (alpha 0) and every slice's opacity, so that clouds in
+// front of a shell hide its light. The composite adds target 1 over the cloud.
+struct ShaftsOut {
+    @location(0) cloud: vec4<f32>,
+    @location(1) shafts: vec4<f32>,
+};
+
+@fragment
+fn fs_shafts(in: VsOut) -> ShaftsOut {
+    var out: ShaftsOut;
+    if in.shell >= 0 {
+        out.cloud = vec4<f32>(0.0);
+        out.shafts = vec4<f32>(shaft(in), 0.0);
+        return out;
+    }
+    out.cloud = cloud(in);
+    out.shafts = vec4<f32>(0.0, 0.0, 0.0, out.cloud.a);
+    return out;
 }

@@ -44,6 +44,16 @@ struct Volume {
     tier_filters: vec4<f32>,
     // Per-octave transforms of tiers 1 and 2 (octave 0 is the base's in every tier).
     tier_octaves: array<mat4x4<f32>, 16>,
+    // Clip → world: each pixel's view ray, for the shells of the shafts of light.
+    inv_view_proj: mat4x4<f32>,
+    // Shells in this draw: x: the first, y: how many (0: no shafts), z: slices in this draw,
+    // w: shells in the whole image.
+    shells: vec4<f32>,
+    // x: distance of the farthest shell's outer boundary from the eye, y: the shells'
+    // spacing, z: the air's extinction per world unit, w: the shafts' intensity.
+    shafts: vec4<f32>,
+    // x: the ground's height (the air below it is hidden), y: the air's phase asymmetry g.
+    air: vec4<f32>,
 };
 
 @group(0) @binding(0) var<uniform> u: Volume;

@@ -301,6 +301,22 @@ pub const GROUND_HEIGHT: Param = Param::linear(
     50.0,
     0.0,
 );
+/// Shafts of light: how bright the sunlight the air scatters toward the eye is.
+pub const SHAFT_INTENSITY: Param = Param::linear(
+    "shaft intensity",
+    "How bright the shafts of light are: sunlight scattered toward you by the air between the clouds",
+    0.0,
+    4.0,
+    1.0,
+);
+/// Shafts of light: the air's extinction per world unit (haze).
+pub const SHAFT_DENSITY: Param = Param::linear(
+    "air density",
+    "How hazy the air is: denser air shows brighter, shorter shafts and veils what lies far away",
+    0.0,
+    0.05,
+    0.005,
+);
 /// Sketch: simplification tolerance as a fraction of the outline's size.
 pub const SIMPLIFY: Param = Param::linear(
     "simplify",
@@ -378,6 +394,8 @@ mod tests {
             MULTIPLE_SCATTERING,
             EXPOSURE,
             GROUND_HEIGHT,
+            SHAFT_INTENSITY,
+            SHAFT_DENSITY,
         ] {
             assert!(
                 p.min < p.max && (p.min..=p.max).contains(&p.default),

@@ -7,6 +7,9 @@
 //! (e.g. `full 640x480x128`); `window.cloudsketch.state()` returns the document and view;
 //! `window.cloudsketch.set("/reference/in_front=true")` makes one undoable edit by JSON
 //! Pointer, as the CLI's `--set` does. The page opens `#s=…` share links and `?preset=NAME`.
+//! `?bench=ca` times the cellular automaton's step and smoothing on the benchmarks' grid (as
+//! `cloudsketch bench --only simulate` does natively) once the app runs, and puts the figures
+//! in the state as `bench`.
 
 use std::cell::RefCell;
 
@@ -18,6 +21,7 @@ use crate::ui::{CloudApp, Host, Opening, PageStatus, Start, StartOptions};
 thread_local! {
     static STATE: RefCell<String> = const { RefCell::new(String::new()) };
     static EDITS: RefCell<Vec<String>> = const { RefCell::new(Vec::new()) };
+    static BENCH: RefCell<Option<String>> = const { RefCell::new(None) };
 }
 
 /// Starts the app in the page's `#cloudsketch_canvas`.
@@ -32,6 +36,7 @@ pub fn start() {
     }));
     install_state_accessor();
     let start = scene_from_url();
+    let bench = url_param("bench");
     let options = StartOptions {
         scene: start.scene,
         host: Some(Box::new(WebHost)),
@@ -44,6 +49,8 @@ pub fn start() {
         if let Err(message) = run(options).await {
             log::error!("{message}");
             show_error(&message);
+        } else if bench.as_deref() == Some("ca") {
+            bench_automaton();
         }
     });
 }
@@ -83,13 +90,7 @@ fn scene_from_url() -> Start {
         .as_ref()
         .and_then(|l| l.hash().ok())
         .unwrap_or_default();
-    let search = location
-        .as_ref()
-        .and_then(|l| l.search().ok())
-        .unwrap_or_default();
-    let preset = web_sys::UrlSearchParams::new_with_str(&search)
-        .ok()
-        .and_then(|p| p.get("preset"));
+    let preset = url_param("preset");
     let start = if hash.starts_with("#s=") {
         crate::ui::start_session(Opening::Link(&hash))
     } else if let Some(name) = &preset {
@@ -99,6 +100,42 @@ fn scene_from_url() -> Start {
     };
     crate::ui::forget_opening_in_url();
     start
+}
+
+/// The page address's query parameter `name` (`?name=value`).
+fn url_param(name: &str) -> Option<String> {
+    let search = web_sys::window()?.location().search().ok()?;
+    web_sys::UrlSearchParams::new_with_str(&search)
+        .ok()?
+        .get(name)
+}
+
+/// `?bench=ca`: the automaton's step and smoothing on the benchmarks' grid, timed by the page's
+/// clock (medians; the page's state shows them as `bench`).
+fn bench_automaton() {
+    use crate::simulate::{bench_simulation, time_steps};
+    let performance = web_sys::window().and_then(|w| w.performance());
+    let now = move || performance.as_ref().map_or(0.0, |p| p.now() / 1000.0);
+    let mut sim = bench_simulation();
+    sim.advance(1);
+    let step = time_steps(&mut sim, 9, &now);
+    let mut smoothing: Vec<f64> = (0..5)
+        .map(|_| {
+            let t = now();
+            std::hint::black_box(sim.density(None, 1.0));
+            now() - t
+        })
+        .collect();
+    smoothing.sort_by(f64::total_cmp);
+    let cells = sim.automaton().dims.iter().product::<usize>();
+    let figures = serde_json::json!({
+        "ca_step_ms": step * 1e3,
+        "ca_smoothing_ms": smoothing[2] * 1e3,
+        "cells": cells,
+        "gcells_per_s": cells as f64 / step / 1e9,
+    });
+    log::info!("bench: {figures}");
+    BENCH.with(|b| b.replace(Some(figures.to_string())));
 }
 
 /// Shows a message in the page's error box (and keeps the page usable as a page).
@@ -121,7 +158,13 @@ fn install_state_accessor() {
         return;
     };
     let state = Closure::<dyn Fn() -> JsValue>::new(|| {
-        STATE.with(|s| js_sys::JSON::parse(&s.borrow()).unwrap_or(JsValue::NULL))
+        let state = STATE.with(|s| js_sys::JSON::parse(&s.borrow()).unwrap_or(JsValue::NULL));
+        if let Some(bench) = BENCH.with(|b| b.borrow().clone())
+            && let Ok(figures) = js_sys::JSON::parse(&bench)
+        {
+            let _ = js_sys::Reflect::set(&state, &"bench".into(), &figures);
+        }
+        state
     });
     let set = Closure::<dyn Fn(String)>::new(|assignment: String| {
         EDITS.with(|e| e.borrow_mut().push(assignment));

@@ -853,3 +853,137 @@ fn the_ground_under_a_cloud_is_darker_than_open_ground() {
     let bottom = clear.pixel(W / 2, H - 3);
     assert!(differs(bottom, bg), "ground at the bottom: {bottom:?}");
 }
+
+/// A broken layer of three flat clouds over the ground, seen from below its edge looking
+/// toward a low sun behind it: the shadows of the clouds fall toward the camera.
+fn broken_layer() -> Scene {
+    use cloudsketch::scene::Ellipsoid;
+    use glam::Vec3;
+    let mut scene = with(
+        &Scene::default(),
+        &[
+            "/light/ground=true",
+            "/light/sun_azimuth_deg=270",
+            "/light/sun_elevation_deg=30",
+            "/camera/yaw_deg=0",
+            "/camera/pitch_deg=4",
+            "/camera/distance=34",
+            "/camera/target=[0,5,0]",
+        ],
+    );
+    scene.planes.clear();
+    scene.ellipsoids = [-11.0f32, 0.0, 11.0]
+        .map(|x| {
+            std::sync::Arc::new(Ellipsoid::new(
+                Vec3::new(x, 8.0, 0.0),
+                Vec3::new(3.2, 1.3, 3.5),
+            ))
+        })
+        .to_vec();
+    scene
+}
+
+/// Luminance of `on` less that of `off`, pixel by pixel.
+fn added_light(on: &Image, off: &Image) -> Vec<f64> {
+    on.rgba
+        .chunks(4)
+        .zip(off.rgba.chunks(4))
+        .map(|(a, b)| luminance([a[0], a[1], a[2], 255]) - luminance([b[0], b[1], b[2], 255]))
+        .collect()
+}
+
+#[test]
+fn shafts_of_light_brighten_the_air_in_the_gaps_and_add_nothing_when_off() {
+    let layer = broken_layer();
+    let off = render(&layer);
+    // Off, the shafts' own settings change nothing.
+    let strong = ["/light/shaft_intensity=4", "/light/shaft_density=0.05"];
+    assert_eq!(off.rgba, render(&with(&layer, &strong)).rgba);
+    let on_sets = ["/light/shafts=true", "/light/shaft_density=0.003"];
+    let on = render(&with(&layer, &on_sets));
+    // The baseline: the same clouds too thin to shade the air (and so to cast shafts).
+    let thin = with(&layer, &["/render/opacity=0.01"]);
+    let thin_term = added_light(&render(&with(&thin, &on_sets)), &render(&thin));
+    let term = added_light(&on, &off);
+    if let Ok(dir) = std::env::var("CLOUDSKETCH_TEST_IMAGES") {
+        std::fs::write(format!("{dir}/shafts_on.png"), on.to_png().unwrap()).unwrap();
+        std::fs::write(format!("{dir}/shafts_off.png"), off.to_png().unwrap()).unwrap();
+    }
+    // Shafts only add light, and they light the air over most of the view.
+    assert!(term.iter().all(|&t| t > -1.5), "shafts darkened a pixel");
+    let lit = term.iter().filter(|&&t| t > 2.0).count();
+    assert!(
+        lit > term.len() / 2,
+        "{lit} of {} pixels lit by the air",
+        term.len()
+    );
+    // Below the layer, along a row through the air between it and the ground, against the
+    // baseline pixel by pixel: the gaps are as bright as unshaded air, the clouds' shadows
+    // darker, and the two alternate (two gaps, three shadows).
+    let y = H * 53 / 100;
+    let ratio: Vec<f64> = (0..W)
+        .map(|x| {
+            let i = (y * W + x) as usize;
+            term[i] / thin_term[i].max(1.0)
+        })
+        .collect();
+    let (lo, hi) = ratio
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(a, b), &v| (a.min(v), b.max(v)));
+    assert!(
+        thin_term[(y * W) as usize] > 20.0,
+        "the baseline's air is dark"
+    );
+    assert!(hi > 0.97, "the gaps are dim: {hi:.2} of the unshaded air");
+    assert!(
+        lo < 0.85,
+        "no shadow in the air: {lo:.2} of the unshaded air"
+    );
+    let mid = 0.5 * (lo + hi);
+    let crossings = ratio
+        .windows(2)
+        .filter(|w| (w[0] > mid) != (w[1] > mid))
+        .count();
+    assert!(
+        crossings >= 4,
+        "{crossings} changes between shaft and shadow"
+    );
+}
+
+#[test]
+fn a_cloud_hides_the_shafts_behind_it_and_not_those_in_front() {
+    // Close to the default cloud, the sun to the side: most of the lit air along a view ray
+    // lies behind the cloud. Shells merged with the slices add to an opaque pixel only the air
+    // in front of it; drawn after every slice they would add all of it, before every slice
+    // none.
+    let scene = with(
+        &Scene::default(),
+        &[
+            "/camera/distance=14",
+            "/light/sun_azimuth_deg=270",
+            "/light/sun_elevation_deg=20",
+            "/light/ambient=0",
+            "/light/multiple_scattering=0",
+            "/light/ground=true",
+            "/light/ground_height=-40",
+        ],
+    );
+    let off = render(&scene);
+    let on = render(&with(
+        &scene,
+        &["/light/shafts=true", "/light/shaft_density=0.004"],
+    ));
+    let term = added_light(&on, &off);
+    let bg = background(&scene);
+    let x = W / 2;
+    let cloud_rows: Vec<u32> = (0..H).filter(|&y| differs(off.pixel(x, y), bg)).collect();
+    let (top, bottom) = (cloud_rows[0], *cloud_rows.last().unwrap());
+    assert!(top > 8, "the cloud's top is out of view");
+    let core = term[(((top + bottom) / 2) * W + x) as usize];
+    let sky = term[((top - 6) * W + x) as usize];
+    assert!(sky > 10.0, "the open sky's air adds {sky:.1}");
+    assert!(
+        core > 0.03 * sky && core < 0.5 * sky,
+        "an opaque pixel gets {core:.1} of the air's light, the open sky {sky:.1}"
+    );
+}

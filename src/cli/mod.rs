@@ -154,7 +154,7 @@ enum Command {
         #[arg(long)]
         json: bool,
         /// Run only these groups, comma-separated: sketch, light, stroke, worst, field, link, mesh, simulate,
-        /// render, quality.
+        /// shafts (the ground's shadow and the shafts of light), ca (simulate and shafts), render, quality.
         #[arg(long)]
         only: Option<String>,
     },

@@ -62,6 +62,89 @@ pub struct VolumeUniforms {
     pub tier_filters: [f32; 4],
     /// Per-octave transforms of tiers 1 and 2 (octave 0 is the base's in every tier).
     pub tier_octaves: [[[f32; 4]; 4]; MAX_OCTAVES * MAX_TIERS],
+    /// Clip → world (the inverse of `view_proj`): each pixel's view ray, for the shells.
+    pub inv_view_proj: [[f32; 4]; 4],
+    /// Shafts of light's shells in this draw: x: the first, y: how many (0: no shafts),
+    /// z: slices in this draw, w: shells in the whole image.
+    pub shells: [f32; 4],
+    /// x: distance of the farthest shell's outer boundary from the eye, y: the shells'
+    /// spacing, z: the air's extinction per world unit, w: the shafts' intensity.
+    pub shafts: [f32; 4],
+    /// x: the ground's height (the air below it is hidden; very low without a ground),
+    /// y: the air's phase asymmetry g.
+    pub air: [f32; 4],
+}
+
+/// The phase asymmetry of the air's scattering in the shafts: mildly forward, so shafts are
+/// brightest looking toward the sun, as crepuscular rays are.
+pub const AIR_ASYMMETRY: f32 = 0.3;
+
+/// Shells the shafts of light may use in one image, at most.
+pub const MAX_SHELLS: u32 = 128;
+
+/// The shafts of light's shells of one image (Dobashi et al. 2000): spheres centred at the
+/// eye (planes along the view in an orthographic one), `count` of them evenly spaced from
+/// `far` toward the eye, drawn back to front and merged with the slices by their distance
+/// along the view, so clouds in front of a shell hide its light and clouds behind it do not.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Shells {
+    /// Shells in the image.
+    pub count: u32,
+    /// Distance of the farthest shell's outer boundary from the eye.
+    pub far: f32,
+    /// Distance between neighbouring shells.
+    pub spacing: f32,
+}
+
+impl Shells {
+    /// The shells of `view` over `volume` in an image of `total` slices: none without shafts
+    /// or clouds. They reach from the eye to the farthest point the clouds can shade: the
+    /// box's corners carried away from the sun down to the ground (or two box diagonals).
+    pub fn new(view: &View, volume: &DensityVolume, total: u32) -> Option<Self> {
+        if !view.light.shafts || volume.is_empty() {
+            return None;
+        }
+        let camera = &view.camera;
+        let (eye, forward) = (camera.eye(), camera.forward());
+        let sun = view.light.sun_direction();
+        let diagonal = volume.size.length();
+        let far = (0..8)
+            .flat_map(|i| {
+                let corner = volume.min
+                    + volume.size
+                        * Vec3::new((i & 1) as f32, ((i >> 1) & 1) as f32, (i >> 2) as f32);
+                let reach = if view.light.ground && sun.y > 0.02 {
+                    ((corner.y - view.light.ground_height) / sun.y).clamp(0.0, 4.0 * diagonal)
+                } else {
+                    2.0 * diagonal
+                };
+                [corner, corner - sun * reach]
+            })
+            .map(|p| {
+                if camera.orthographic {
+                    (p - eye).dot(forward)
+                } else {
+                    (p - eye).length()
+                }
+            })
+            .fold(0.0f32, f32::max);
+        if far.is_nan() || far <= 0.0 {
+            return None;
+        }
+        let count = (total / 2).clamp(8, MAX_SHELLS);
+        Some(Self {
+            count,
+            far,
+            spacing: far / count as f32,
+        })
+    }
+
+    /// How many shells lie farther from the eye than `depth` (the shader's `shells_beyond`).
+    pub fn beyond(&self, depth: f32) -> u32 {
+        ((self.far - depth) / self.spacing - 0.5)
+            .ceil()
+            .clamp(0.0, self.count as f32) as u32
+    }
 }
 
 /// Uniforms of the sky gradient (`struct Sky` in `shaders/sky.wgsl`).
@@ -243,7 +326,7 @@ pub fn crop_matrix(crop: [f32; 4]) -> Mat4 {
 
 impl VolumeUniforms {
     /// Names and byte offsets of the members, in order (checked against the WGSL struct).
-    pub const LAYOUT: [(&'static str, usize); 19] = [
+    pub const LAYOUT: [(&'static str, usize); 23] = [
         ("view_proj", offset_of!(Self, view_proj)),
         ("eye", offset_of!(Self, eye)),
         ("forward", offset_of!(Self, forward)),
@@ -262,11 +345,23 @@ impl VolumeUniforms {
         ("tiers", offset_of!(Self, tiers)),
         ("tier_filters", offset_of!(Self, tier_filters)),
         ("tier_octaves", offset_of!(Self, tier_octaves)),
+        ("inv_view_proj", offset_of!(Self, inv_view_proj)),
+        ("shells", offset_of!(Self, shells)),
+        ("shafts", offset_of!(Self, shafts)),
+        ("air", offset_of!(Self, air)),
         ("", std::mem::size_of::<Self>()),
     ];
 
-    /// Uniforms for drawing `volume` as `view` shows it, in `total` slices, starting at `first`.
-    pub fn new(view: &View, volume: &DensityVolume, total: u32, first: u32) -> Self {
+    /// Uniforms for drawing slices `range` of `total` of `volume` as `view` shows it, with the
+    /// shafts of light's `shells` that lie among them (see [`VolumeUniforms::shells_of`]).
+    pub fn new(
+        view: &View,
+        volume: &DensityVolume,
+        total: u32,
+        range: std::ops::Range<u32>,
+        shells: Option<&Shells>,
+    ) -> Self {
+        let first = range.start;
         let (center, radius) = volume.bounding_sphere();
         let total = total.max(1);
         let (camera, light, r) = (&view.camera, &view.light, &view.render);
@@ -287,6 +382,36 @@ impl VolumeUniforms {
             NoiseFilter::Veined => 3.0,
         };
         let filter = filter_code(r.noise_filter);
+        let view_proj = crop_matrix(view.crop) * camera.view_projection(view.aspect);
+        let eye = camera.eye();
+        // The shells among slices `range`: those beyond the far boundary of its first slice
+        // (all of them when it is the image's first) and not beyond the far boundary of the
+        // slice after its last (all the rest when it is the image's last).
+        let (shell_range, shafts) = match shells {
+            Some(s) => {
+                let boundary = |j: u32| (center - eye).dot(forward) + far - j as f32 * spacing;
+                let k0 = if first == 0 {
+                    0
+                } else {
+                    s.beyond(boundary(first))
+                };
+                let k1 = if range.end >= total {
+                    s.count
+                } else {
+                    s.beyond(boundary(range.end))
+                };
+                (
+                    [k0 as f32, k1.saturating_sub(k0) as f32, s.count as f32],
+                    [s.far, s.spacing, light.shaft_density, light.shaft_intensity],
+                )
+            }
+            None => ([0.0; 3], [1.0, 1.0, 0.0, 0.0]),
+        };
+        let ground = if light.ground {
+            light.ground_height
+        } else {
+            -1.0e30
+        };
         let tiers = &r.tiers[..r.tiers.len().min(MAX_TIERS)];
         let floor = |k: usize| tiers.get(k).map_or(f32::MAX, |t| t.floor);
         let tier_filter = |k: usize| tiers.get(k).map_or(filter, |t| filter_code(t.filter));
@@ -295,11 +420,9 @@ impl VolumeUniforms {
             NoiseBasis::Worley => 1.0,
         };
         Self {
-            view_proj: (crop_matrix(view.crop) * camera.view_projection(view.aspect))
-                .to_cols_array_2d(),
+            view_proj: view_proj.to_cols_array_2d(),
             // w: 1 perspective, 0 orthographic (every view ray is `forward`).
-            eye: camera
-                .eye()
+            eye: eye
                 .extend(if camera.orthographic { 0.0 } else { 1.0 })
                 .to_array(),
             forward: camera.forward().extend(0.0).to_array(),
@@ -329,6 +452,15 @@ impl VolumeUniforms {
                 tier_octave_transform(r, 1 + j / MAX_OCTAVES, j % MAX_OCTAVES, view.time)
                     .to_cols_array_2d()
             }),
+            inv_view_proj: view_proj.inverse().to_cols_array_2d(),
+            shells: [
+                shell_range[0],
+                shell_range[1],
+                range.end.saturating_sub(first) as f32,
+                shell_range[2],
+            ],
+            shafts,
+            air: [ground, AIR_ASYMMETRY, 0.0, 0.0],
         }
     }
 }
@@ -363,7 +495,7 @@ mod tests {
             aspect: 1.5,
             crop: FULL_VIEW,
         };
-        let u = VolumeUniforms::new(&view, &volume, 64, 10);
+        let u = VolumeUniforms::new(&view, &volume, 64, 10..20, None);
         let center = Vec3::from_slice(&u.sphere[..3]);
         assert!(center.abs_diff_eq(volume.min + volume.size * 0.5, 1e-4));
         // The slices span the box's depth along the view, inside the bounding sphere.
@@ -375,6 +507,54 @@ mod tests {
             scene.camera.view_projection(1.5)
         );
         assert_eq!(u.slicing[1], 10.0);
+    }
+
+    #[test]
+    fn refinement_chunks_share_out_the_shells_once_each_among_their_slices() {
+        let mut scene = Scene::default();
+        scene.light.shafts = true;
+        let volume = crate::field::bake(&crate::derive::field_of(&scene), 16);
+        let view = View {
+            camera: scene.camera.clone(),
+            light: scene.light.clone(),
+            render: scene.render.clone(),
+            time: 0.0,
+            aspect: 1.5,
+            crop: FULL_VIEW,
+        };
+        let total = 100;
+        let shells = Shells::new(&view, &volume, total).expect("shells with shafts on");
+        assert_eq!(shells.count, 50);
+        // The shells reach past the cloud's far side.
+        let (center, _) = volume.bounding_sphere();
+        let eye = scene.camera.eye();
+        let forward = scene.camera.forward();
+        let (_, far) = box_depths(&volume, center, forward);
+        assert!(shells.far >= (center - eye).dot(forward) + far);
+        let mut next = 0;
+        for range in [0..7, 7..40, 40..41, 41..100] {
+            let u = VolumeUniforms::new(&view, &volume, total, range.clone(), Some(&shells));
+            let (k0, m) = (u.shells[0] as u32, u.shells[1] as u32);
+            assert_eq!(k0, next, "chunk {range:?} starts at shell {k0}");
+            assert_eq!(u.shells[2] as u32, range.len() as u32);
+            next = k0 + m;
+            // Each shell lies between the chunk's first slice's far boundary and the next
+            // chunk's.
+            let boundary = |j: u32| (center - eye).dot(forward) + far - j as f32 * u.slicing[2];
+            for k in k0..k0 + m {
+                let r = shells.far - (k as f32 + 0.5) * shells.spacing;
+                assert!(range.start == 0 || r <= boundary(range.start) + 1e-4);
+                assert!(range.end == total || r > boundary(range.end) - 1e-4);
+            }
+        }
+        assert_eq!(next, shells.count);
+        // Without shafts or without a cloud there are none.
+        let off = View {
+            light: Lighting::default(),
+            ..view.clone()
+        };
+        assert!(Shells::new(&off, &volume, total).is_none());
+        assert!(Shells::new(&view, &DensityVolume::default(), total).is_none());
     }
 
     #[test]

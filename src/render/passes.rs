@@ -100,11 +100,35 @@ pub fn full_pipeline(
     format: wgpu::TextureFormat,
     blend: Option<wgpu::BlendState>,
 ) -> wgpu::RenderPipeline {
+    targets_pipeline(device, label, source, layouts, "fs_main", &[format], blend)
+}
+
+/// A pipeline of `source`'s `vs_main` (no vertex buffers) and `fragment` into `formats`
+/// (one target each, all with `blend`; none: replace).
+pub fn targets_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    source: &str,
+    layouts: &[&wgpu::BindGroupLayout],
+    fragment: &str,
+    formats: &[wgpu::TextureFormat],
+    blend: Option<wgpu::BlendState>,
+) -> wgpu::RenderPipeline {
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some(label),
         source: wgpu::ShaderSource::Wgsl(source.into()),
     });
     let layouts: Vec<Option<&wgpu::BindGroupLayout>> = layouts.iter().map(|l| Some(*l)).collect();
+    let targets: Vec<Option<wgpu::ColorTargetState>> = formats
+        .iter()
+        .map(|&format| {
+            Some(wgpu::ColorTargetState {
+                format,
+                blend,
+                write_mask: wgpu::ColorWrites::ALL,
+            })
+        })
+        .collect();
     let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(label),
         bind_group_layouts: &layouts,
@@ -124,23 +148,22 @@ pub fn full_pipeline(
         multisample: wgpu::MultisampleState::default(),
         fragment: Some(wgpu::FragmentState {
             module: &module,
-            entry_point: Some("fs_main"),
+            entry_point: Some(fragment),
             compilation_options: Default::default(),
-            targets: &[Some(wgpu::ColorTargetState {
-                format,
-                blend,
-                write_mask: wgpu::ColorWrites::ALL,
-            })],
+            targets: &targets,
         }),
         multiview_mask: None,
         cache: None,
     })
 }
 
-/// The slice pass: pipeline, bind group layout and its ring of uniform slots.
+/// The slice pass: pipelines, bind group layout and its ring of uniform slots.
 pub struct SlicePass {
     /// The slice pipeline.
     pub pipeline: wgpu::RenderPipeline,
+    /// The slices with the shafts of light's shells among them, into two targets: the cloud
+    /// and the shafts (`fs_shafts`).
+    pub shafts_pipeline: wgpu::RenderPipeline,
     /// Layout of its bind group (uniforms, volume, sampler, noise, sampler).
     pub layout: wgpu::BindGroupLayout,
     /// Uniform ring, [`MAX_SLICE_DRAWS_PER_FRAME`] slots of `stride` bytes.
@@ -175,6 +198,15 @@ impl SlicePass {
         });
         Self {
             pipeline: pipeline(device, "volume slices", shaders::VOLUME, &layout, format),
+            shafts_pipeline: targets_pipeline(
+                device,
+                "volume slices with shafts of light",
+                shaders::VOLUME,
+                &[&layout],
+                "fs_shafts",
+                &[format, format],
+                Some(PREMULTIPLIED_OVER),
+            ),
             layout,
             uniforms,
             stride,
@@ -221,6 +253,10 @@ pub struct CompositePass {
     pub pipeline: wgpu::RenderPipeline,
     /// Layout of its bind group (source texture, sampler).
     pub layout: wgpu::BindGroupLayout,
+    /// The composite of a target with its shafts of light added (`fs_shafts`).
+    pub shafts_pipeline: wgpu::RenderPipeline,
+    /// Layout of its bind group (source texture, sampler, shafts texture).
+    pub shafts_layout: wgpu::BindGroupLayout,
 }
 
 impl CompositePass {
@@ -233,6 +269,14 @@ impl CompositePass {
                 sampler_entry(1),
             ],
         });
+        let shafts_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("composite with shafts"),
+            entries: &[
+                texture_entry(0, wgpu::TextureViewDimension::D2),
+                sampler_entry(1),
+                texture_entry(2, wgpu::TextureViewDimension::D2),
+            ],
+        });
         Self {
             pipeline: pipeline(
                 device,
@@ -242,7 +286,45 @@ impl CompositePass {
                 output_format,
             ),
             layout,
+            shafts_pipeline: targets_pipeline(
+                device,
+                "volume composite with shafts",
+                shaders::COMPOSITE,
+                &[&shafts_layout],
+                "fs_shafts",
+                &[output_format],
+                Some(PREMULTIPLIED_OVER),
+            ),
+            shafts_layout,
         }
+    }
+
+    /// The bind group that composites `source` with the shafts of light in `shafts`.
+    pub fn shafts_bind_group(
+        &self,
+        device: &wgpu::Device,
+        source: &wgpu::TextureView,
+        shafts: &wgpu::TextureView,
+        sampler: &wgpu::Sampler,
+    ) -> wgpu::BindGroup {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("composite with shafts"),
+            layout: &self.shafts_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::TextureView(source),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::Sampler(sampler),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: wgpu::BindingResource::TextureView(shafts),
+                },
+            ],
+        })
     }
 
     /// The bind group that composites `source`.

@@ -1,7 +1,7 @@
 //! The volume renderer: passes and resources together, used by the app's viewport (through an
 //! egui paint callback) and by offscreen rendering alike.
 
-use super::gpu_types::{LightSliceUniforms, SkyUniforms, View, VolumeUniforms};
+use super::gpu_types::{LightSliceUniforms, Shells, SkyUniforms, View, VolumeUniforms};
 use super::passes::{CompositePass, LIGHT_FORMAT, LightPass, MAX_LIGHT_SLICES, SkyPass, SlicePass};
 use super::progressive::JobPlan;
 use super::resources::{TARGETS, Target, VolumeTextures, accumulation_texture, sampler, upload_3d};
@@ -204,7 +204,7 @@ impl VolumeRenderer {
             .min_element()
             .max(diagonal / MAX_LIGHT_STEPS as f32);
         let steps = ((diagonal / h.max(1e-6)).ceil() as u32).clamp(1, MAX_LIGHT_STEPS);
-        let uniforms = VolumeUniforms::new(view, &volume, 1, 0);
+        let uniforms = VolumeUniforms::new(view, &volume, 1, 0..1, None);
         let key = {
             use std::hash::{Hash, Hasher};
             let mut hasher = std::hash::DefaultHasher::new();
@@ -324,20 +324,33 @@ impl VolumeRenderer {
         true
     }
 
-    fn ensure_target(&mut self, device: &wgpu::Device, index: usize, size: [u32; 2]) {
+    /// Makes accumulation target `index` `size` pixels, with a shafts target beside it when
+    /// `shafts`.
+    fn ensure_target(&mut self, device: &wgpu::Device, index: usize, size: [u32; 2], shafts: bool) {
         let size = [size[0].max(1), size[1].max(1)];
-        if self.targets[index].as_ref().is_some_and(|t| t.size == size) {
-            return;
+        if self.targets[index].as_ref().is_none_or(|t| t.size != size) {
+            let view = accumulation_texture(device, size, self.accum_format);
+            let composite = self
+                .composite
+                .bind_group(device, &view, &self.clamp_sampler);
+            self.targets[index] = Some(Target {
+                size,
+                view,
+                composite,
+                shafts: None,
+                has_shafts: false,
+            });
         }
-        let view = accumulation_texture(device, size, self.accum_format);
-        let composite = self
-            .composite
-            .bind_group(device, &view, &self.clamp_sampler);
-        self.targets[index] = Some(Target {
-            size,
-            view,
-            composite,
-        });
+        if let Some(target) = &mut self.targets[index]
+            && shafts
+            && target.shafts.is_none()
+        {
+            let view = accumulation_texture(device, size, self.accum_format);
+            let group =
+                self.composite
+                    .shafts_bind_group(device, &target.view, &view, &self.clamp_sampler);
+            target.shafts = Some((view, group));
+        }
     }
 
     /// A pipeline for the benchmark baseline, for [`VolumeRenderer::draw_slices`].
@@ -357,42 +370,67 @@ impl VolumeRenderer {
     ) {
         let plan = &job.plan;
         let index = plan.target.min(TARGETS - 1);
-        self.ensure_target(device, index, plan.size);
-        let volume = &self.textures.density_volume;
-        let uniforms = VolumeUniforms::new(&job.view, volume, plan.total, plan.range.start);
+        let volume = self.textures.density_volume.clone();
+        // The bench's baseline draws the plain slices alone.
+        let shells = Shells::new(&job.view, &volume, plan.total).filter(|_| pipeline.is_none());
+        self.ensure_target(device, index, plan.size, shells.is_some());
+        let uniforms = VolumeUniforms::new(
+            &job.view,
+            &volume,
+            plan.total,
+            plan.range.clone(),
+            shells.as_ref(),
+        );
         let offset = self.slices.write(queue, &uniforms);
-        let empty = volume.is_empty();
-        let (Some(target), Some(bind_group)) = (&self.targets[index], &self.bind_group) else {
+        let (Some(target), Some(bind_group)) = (&mut self.targets[index], &self.bind_group) else {
             return;
         };
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("volume slices"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &target.view,
+        if plan.clear {
+            target.has_shafts = shells.is_some();
+        }
+        let with_shafts = target.has_shafts && shells.is_some();
+        let load = if plan.clear {
+            wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT)
+        } else {
+            wgpu::LoadOp::Load
+        };
+        let attachment = |view| {
+            Some(wgpu::RenderPassColorAttachment {
+                view,
                 depth_slice: None,
                 resolve_target: None,
                 ops: wgpu::Operations {
-                    load: if plan.clear {
-                        wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT)
-                    } else {
-                        wgpu::LoadOp::Load
-                    },
+                    load,
                     store: wgpu::StoreOp::Store,
                 },
-            })],
+            })
+        };
+        let attachments = match (&target.shafts, with_shafts) {
+            (Some((shafts, _)), true) => vec![attachment(&target.view), attachment(shafts)],
+            _ => vec![attachment(&target.view)],
+        };
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("volume slices"),
+            color_attachments: &attachments,
             depth_stencil_attachment: None,
             timestamp_writes: None,
             occlusion_query_set: None,
             multiview_mask: None,
         });
         let count = plan.range.end.saturating_sub(plan.range.start);
-        if empty || count == 0 {
+        if volume.is_empty() || count == 0 {
             return;
         }
-        pass.set_pipeline(pipeline.unwrap_or(&self.slices.pipeline));
+        let (pipeline, shells) = match pipeline {
+            Some(p) => (p, 0),
+            None if with_shafts => (&self.slices.shafts_pipeline, uniforms.shells[1] as u32),
+            None => (&self.slices.pipeline, 0),
+        };
+        pass.set_pipeline(pipeline);
         pass.set_bind_group(0, bind_group, &[offset]);
         // Instances start at 0 (WebGL2 has no base instance); the first slice is a uniform.
-        pass.draw(0..6, 0..count);
+        // The shafts' shells of this draw come among its slices (volume.wgsl's vs_main).
+        pass.draw(0..6, 0..count + shells);
     }
 
     /// The format the composite and sky passes write.
@@ -490,8 +528,16 @@ impl VolumeRenderer {
         let Some(target) = self.targets.get(index).and_then(|t| t.as_ref()) else {
             return;
         };
-        pass.set_pipeline(&self.composite.pipeline);
-        pass.set_bind_group(0, &target.composite, &[]);
+        match &target.shafts {
+            Some((_, group)) if target.has_shafts => {
+                pass.set_pipeline(&self.composite.shafts_pipeline);
+                pass.set_bind_group(0, group, &[]);
+            }
+            _ => {
+                pass.set_pipeline(&self.composite.pipeline);
+                pass.set_bind_group(0, &target.composite, &[]);
+            }
+        }
         pass.draw(0..3, 0..1);
     }
 }

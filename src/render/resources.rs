@@ -142,6 +142,11 @@ pub struct Target {
     pub view: wgpu::TextureView,
     /// Composite bind group reading it.
     pub composite: wgpu::BindGroup,
+    /// The shafts of light's target beside it (made when first needed) and the composite
+    /// bind group reading both.
+    pub shafts: Option<(wgpu::TextureView, wgpu::BindGroup)>,
+    /// Whether the image in it was drawn with shafts of light.
+    pub has_shafts: bool,
 }
 
 /// Creates an accumulation target of `size` in `format`.

@@ -5,10 +5,12 @@
 /// `shaders/volume_common.wgsl`: the `Volume` uniforms and the slice bind group.
 pub const VOLUME_COMMON: &str = include_str!("../../shaders/volume_common.wgsl");
 
-/// The slice shader: `volume_common.wgsl` + `volume_noise.wgsl` + `volume.wgsl`.
+/// The slice shader: `volume_common.wgsl` + `volume_noise.wgsl` + `sun_shadow.wgsl` +
+/// `volume.wgsl`.
 pub const VOLUME: &str = concat!(
     include_str!("../../shaders/volume_common.wgsl"),
     include_str!("../../shaders/volume_noise.wgsl"),
+    include_str!("../../shaders/sun_shadow.wgsl"),
     include_str!("../../shaders/volume.wgsl")
 );
 
@@ -31,14 +33,22 @@ pub const COMPOSITE: &str = include_str!("../../shaders/composite.wgsl");
 /// `shaders/field_eval.wgsl`: the field evaluated on the GPU (the bench's baseline).
 pub const FIELD_EVAL: &str = include_str!("../../shaders/field_eval.wgsl");
 
-/// `shaders/sky.wgsl`: the sky gradient behind the cloud.
-pub const SKY: &str = include_str!("../../shaders/sky.wgsl");
+/// The sky gradient behind the cloud: `sun_shadow.wgsl` + `sky.wgsl`.
+pub const SKY: &str = concat!(
+    include_str!("../../shaders/sun_shadow.wgsl"),
+    include_str!("../../shaders/sky.wgsl")
+);
 
 /// Every shader module with the files it is composed of, in order.
 pub const MODULES: [(&str, &[&str], &str); 6] = [
     (
         "volume",
-        &["volume_common.wgsl", "volume_noise.wgsl", "volume.wgsl"],
+        &[
+            "volume_common.wgsl",
+            "volume_noise.wgsl",
+            "sun_shadow.wgsl",
+            "volume.wgsl",
+        ],
         VOLUME,
     ),
     (
@@ -57,5 +67,5 @@ pub const MODULES: [(&str, &[&str], &str); 6] = [
     ),
     ("composite", &["composite.wgsl"], COMPOSITE),
     ("field_eval", &["field_eval.wgsl"], FIELD_EVAL),
-    ("sky", &["sky.wgsl"], SKY),
+    ("sky", &["sun_shadow.wgsl", "sky.wgsl"], SKY),
 ];

@@ -281,6 +281,13 @@ pub struct Lighting {
     pub ground_height: f32,
     /// The ground's colour in full sun (sRGB).
     pub ground_color: [f32; 3],
+    /// Shafts of light (Dobashi et al. 2000): sunlight scattered by the air, dark where the
+    /// clouds shade the air from the sun, so light shows in shafts through their gaps.
+    pub shafts: bool,
+    /// How bright the shafts are.
+    pub shaft_intensity: f32,
+    /// The air's extinction per world unit.
+    pub shaft_density: f32,
 }
 
 impl Default for Lighting {
@@ -301,6 +308,9 @@ impl Default for Lighting {
             ground: false,
             ground_height: 0.0,
             ground_color: [0.36, 0.42, 0.3],
+            shafts: false,
+            shaft_intensity: limits::SHAFT_INTENSITY.default as f32,
+            shaft_density: limits::SHAFT_DENSITY.default as f32,
         }
     }
 }
@@ -337,6 +347,8 @@ impl Lighting {
         self.multiple_scattering = limits::MULTIPLE_SCATTERING.fix_f32(self.multiple_scattering);
         self.exposure = limits::EXPOSURE.fix_f32(self.exposure);
         self.ground_height = limits::GROUND_HEIGHT.fix_f32(self.ground_height);
+        self.shaft_intensity = limits::SHAFT_INTENSITY.fix_f32(self.shaft_intensity);
+        self.shaft_density = limits::SHAFT_DENSITY.fix_f32(self.shaft_density);
         for c in [
             &mut self.ground_color,
             &mut self.sun_color,

@@ -52,6 +52,13 @@ pub struct State {
     pub step: u64,
 }
 
+impl State {
+    /// Bytes it holds.
+    pub fn bytes(&self) -> usize {
+        (self.hum.len() + self.act.len() + self.cld.len()) * 8 + self.carry.len() * 4
+    }
+}
+
 /// The three random terms.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Kind {
@@ -79,6 +86,8 @@ pub struct Automaton {
     membership: [Vec<Vec<u64>>; 3],
     /// Per level: its random words.
     tables: Vec<Vec<u64>>,
+    /// Per kind and level: this step's key, which picks each word's draw from the table.
+    keys: [[u64; LEVELS.len()]; 3],
     /// Wind along x per layer y, cells per step (may be negative), and its carried fraction.
     wind: Vec<f32>,
     carry: Vec<f32>,
@@ -109,9 +118,10 @@ impl Automaton {
                     .collect()
             })
             .collect();
-        Self {
+        let mut automaton = Self {
             dims,
             words,
+            keys: [[0; LEVELS.len()]; 3],
             hum: vec![0; n],
             act: vec![0; n],
             cld: vec![0; n],
@@ -121,7 +131,19 @@ impl Automaton {
             carry: vec![0.0; ny],
             seed,
             step: 0,
-        }
+        };
+        automaton.refresh_keys();
+        automaton
+    }
+
+    /// This step's key per kind and level (two hashes each, once a step).
+    fn refresh_keys(&mut self) {
+        let (seed, step) = (self.seed, self.step);
+        self.keys = std::array::from_fn(|kind| {
+            std::array::from_fn(|l| {
+                hash64(seed ^ hash64((step << 24) ^ ((kind as u64) << 3) ^ l as u64))
+            })
+        });
     }
 
     /// Words per row.
@@ -173,9 +195,13 @@ impl Automaton {
     }
 
     /// The random mask of `kind` for word `w` at the current step: bit i is 1 with the
-    /// probability of cell i's level.
+    /// probability of cell i's level. The word drawn from a level's table is picked by the
+    /// step's key for that kind and level mixed with `w` (a Fibonacci hash: neighbouring words
+    /// draw far-apart entries).
+    #[inline]
     pub fn random_word(&self, kind: Kind, w: usize) -> u64 {
         let mut mask = 0;
+        let keys = &self.keys[kind as usize];
         for (l, members) in self.membership[kind as usize].iter().enumerate().skip(1) {
             let Some(&m) = members.get(w) else {
                 continue;
@@ -183,13 +209,8 @@ impl Automaton {
             if m == 0 {
                 continue;
             }
-            let h = hash64(
-                self.seed
-                    ^ hash64(
-                        (self.step << 24) ^ ((w as u64) << 6) ^ ((kind as u64) << 3) ^ l as u64,
-                    ),
-            );
-            mask |= m & self.tables[l][(h as usize) % TABLE];
+            let pick = ((keys[l] ^ w as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 54) as usize;
+            mask |= m & self.tables[l][pick % TABLE];
         }
         mask
     }
@@ -208,15 +229,31 @@ impl Automaton {
         let words = self.words;
         let n = self.act.len();
         let (mut hum, mut act, mut cld) = (vec![0u64; n], vec![0u64; n], vec![0u64; n]);
-        let a = &self.act;
-        let row = |y: isize, z: isize| -> Option<usize> {
-            (y >= 0 && z >= 0 && (y as usize) < ny && (z as usize) < nz)
-                .then(|| (y as usize * nz + z as usize) * words)
-        };
+        // `act` with one row of zeros after it: the neighbour of every cell past an edge.
+        let mut a = Vec::with_capacity(n + words);
+        a.extend_from_slice(&self.act);
+        a.resize(n + words, 0);
         let tail = self.tail_mask();
-        for y in 0..ny as isize {
-            for z in 0..nz as isize {
-                let r = row(y, z).unwrap_or(0);
+        for y in 0..ny {
+            for z in 0..nz {
+                let r = (y * nz + z) * words;
+                let row = |dy: isize, dz: isize| {
+                    let (y, z) = (y as isize + dy, z as isize + dz);
+                    if y >= 0 && z >= 0 && (y as usize) < ny && (z as usize) < nz {
+                        (y as usize * nz + z as usize) * words
+                    } else {
+                        n
+                    }
+                };
+                let near = [
+                    row(0, 1),
+                    row(0, -1),
+                    row(0, 2),
+                    row(0, -2),
+                    row(1, 0),
+                    row(-1, 0),
+                    row(-2, 0),
+                ];
                 for w in 0..words {
                     let i = r + w;
                     let prev = if w > 0 { a[i - 1] } else { 0 };
@@ -226,10 +263,8 @@ impl Automaton {
                         | (a[i] >> 2 | next << 62)
                         | (a[i] << 1 | prev >> 63)
                         | (a[i] << 2 | prev >> 62);
-                    for (dy, dz) in [(0, 1), (0, -1), (0, 2), (0, -2), (1, 0), (-1, 0), (-2, 0)] {
-                        if let Some(o) = row(y + dy, z + dz) {
-                            f |= a[o + w];
-                        }
+                    for o in near {
+                        f |= a[o + w];
                     }
                     let (h, ac, c) = (self.hum[i], a[i], self.cld[i]);
                     let keep = if w + 1 == words { tail } else { u64::MAX };
@@ -242,6 +277,7 @@ impl Automaton {
         (self.hum, self.act, self.cld) = (hum, act, cld);
         self.blow();
         self.step += 1;
+        self.refresh_keys();
     }
 
     /// Moves every layer along x by its wind, carrying the fraction.
@@ -289,6 +325,7 @@ impl Automaton {
         self.cld.clone_from(&s.cld);
         self.carry.clone_from(&s.carry);
         self.step = s.step;
+        self.refresh_keys();
     }
 
     /// Cells with cloud.

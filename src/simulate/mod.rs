@@ -203,53 +203,38 @@ impl Simulation {
         let a = &self.automaton;
         let [nx, ny, nz] = a.dims;
         let r = self.settings.smoothing.min(4) as usize;
-        let mut v = vec![0f32; nx * ny * nz];
         let words = a.words();
-        for y in 0..ny {
-            for z in 0..nz {
+        // Separable running box sums, in whole cell counts (at most 9³ per cell: u16), cells
+        // past the edge counting as empty. Along x from the bits, line by line; along y and z
+        // a row (or a plane) at a time, so every step is a contiguous, vectorisable sweep.
+        let mut counts = vec![0u16; nx * ny * nz];
+        // Each byte of cloud bits as eight 0/1 counts, looked up rather than shifted out.
+        let unpack: [[u16; 8]; 256] =
+            std::array::from_fn(|b| std::array::from_fn(|i| (b >> i) as u16 & 1));
+        let mut bits = vec![0u16; words * 64 + 2 * r];
+        for z in 0..nz {
+            for y in 0..ny {
                 let row = &a.cld[(y * nz + z) * words..][..words];
-                let line = &mut v[(z * ny + y) * nx..][..nx];
-                for (w, &bits) in row.iter().enumerate() {
-                    let mut b = bits;
-                    while b != 0 {
-                        line[w * 64 + b.trailing_zeros() as usize] = 1.0;
-                        b &= b - 1;
+                for (w, &word) in row.iter().enumerate() {
+                    for (k, byte) in word.to_le_bytes().into_iter().enumerate() {
+                        bits[r + w * 64 + 8 * k..][..8].copy_from_slice(&unpack[byte as usize]);
                     }
+                }
+                // Cells past the grid's edge count as empty.
+                bits[r + nx..].fill(0);
+                let line = &mut counts[(z * ny + y) * nx..][..nx];
+                line.copy_from_slice(&bits[..nx]);
+                for d in 1..=2 * r {
+                    line.iter_mut()
+                        .zip(&bits[d..d + nx])
+                        .for_each(|(c, &b)| *c += b);
                 }
             }
         }
-        // Separable running box sums along x, y, z (cells past the edge count as empty).
-        let mut out = vec![0f32; v.len()];
-        let plane = nx * ny;
-        let passes: [(usize, usize, Vec<usize>); 3] = [
-            (nx, 1, (0..ny * nz).map(|l| l * nx).collect()),
-            (
-                ny,
-                nx,
-                (0..nz)
-                    .flat_map(|z| (0..nx).map(move |x| z * plane + x))
-                    .collect(),
-            ),
-            (nz, plane, (0..plane).collect()),
-        ];
-        let scale = 1.0 / (2 * r + 1) as f32;
-        for (n, stride, starts) in passes {
-            for start in starts {
-                let at = |i: usize| start + i * stride;
-                let mut sum: f32 = (0..r.min(n)).map(|i| v[at(i)]).sum();
-                for i in 0..n {
-                    if i + r < n {
-                        sum += v[at(i + r)];
-                    }
-                    out[at(i)] = (sum * scale).clamp(0.0, 1.0);
-                    if i >= r {
-                        sum -= v[at(i - r)];
-                    }
-                }
-            }
-            std::mem::swap(&mut v, &mut out);
-        }
-        v
+        box_sum_rows(&mut counts, nx, ny, nz, r);
+        box_sum_rows(&mut counts, nx * ny, nz, 1, r);
+        let scale = 1.0 / ((2 * r + 1) as f32).powi(3);
+        counts.iter().map(|&c| c as f32 * scale).collect()
     }
 
     /// The density volume of the current step (`previous`: the last step's smoothed values,
@@ -268,6 +253,31 @@ impl Simulation {
     }
 }
 
+/// Replaces `v`, `outer` blocks of `n` rows of `len` values each, by the sums of each row's
+/// `2r + 1` neighbouring rows within its block (rows past the block's edges count as zero).
+fn box_sum_rows(v: &mut [u16], len: usize, n: usize, outer: usize, r: usize) {
+    let mut sum = vec![0u16; len];
+    let mut out = vec![0u16; len * n];
+    for block in v.chunks_exact_mut(len * n).take(outer) {
+        sum.fill(0);
+        for row in block.chunks_exact(len).take(r) {
+            sum.iter_mut().zip(row).for_each(|(s, &x)| *s += x);
+        }
+        for i in 0..n {
+            if i + r < n {
+                let add = &block[(i + r) * len..][..len];
+                sum.iter_mut().zip(add).for_each(|(s, &x)| *s += x);
+            }
+            out[i * len..][..len].copy_from_slice(&sum);
+            if i >= r {
+                let sub = &block[(i - r) * len..][..len];
+                sum.iter_mut().zip(sub).for_each(|(s, &x)| *s -= x);
+            }
+        }
+        block.copy_from_slice(&out);
+    }
+}
+
 /// The density volume of `values` on a run's grid of `dims` cells.
 fn volume(settings: &Settings, dims: [usize; 3], values: Vec<f32>) -> DensityVolume {
     let [nx, ny, nz] = dims;
@@ -277,6 +287,42 @@ fn volume(settings: &Settings, dims: [usize; 3], values: Vec<f32>) -> DensityVol
         size: Vec3::new(nx as f32, ny as f32, nz as f32) * settings.cell_size.max(1e-3),
         values,
     }
+}
+
+/// The benchmarks' simulation (`cloudsketch bench`'s `ca_` entries and the page's
+/// `?bench=ca`): 256×64×256 cells (x, y up, z; [`MAX_CELLS`]) at a 0.125 cell under three
+/// parcels, 30 steps in, so clouds have formed.
+pub fn bench_simulation() -> Simulation {
+    let settings = Settings {
+        cells: [256, 64, 256],
+        cell_size: 0.125,
+        ..Settings::default()
+    };
+    let parcels: Vec<Parcel> = [(-6.0, 3.0, 0.0), (4.0, 4.0, 3.0), (0.0, 3.5, -7.0)]
+        .iter()
+        .map(|&(x, y, z)| Parcel {
+            center: Vec3::new(x, y, z),
+            radii: Vec3::new(6.0, 3.0, 5.0),
+            rotation: Quat::IDENTITY,
+        })
+        .collect();
+    let mut sim = Simulation::new(&settings, &parcels);
+    sim.advance(30);
+    sim
+}
+
+/// Median seconds of one step over `runs` steps of `sim`, timed by `now` (seconds; the
+/// platform's clock: the bench's and the page's differ).
+pub fn time_steps(sim: &mut Simulation, runs: usize, now: &dyn Fn() -> f64) -> f64 {
+    let mut times: Vec<f64> = (0..runs.max(1))
+        .map(|_| {
+            let t = now();
+            sim.advance(1);
+            now() - t
+        })
+        .collect();
+    times.sort_by(f64::total_cmp);
+    times[times.len() / 2]
 }
 
 /// The parcels of a scene: its visible ellipsoids.
@@ -296,6 +342,8 @@ pub fn parcels(scene: &crate::scene::Scene) -> Vec<Parcel> {
 /// Steps a run keeps snapshots at (every this many steps), and how many at most.
 const SNAPSHOT_EVERY: u64 = 32;
 const MAX_SNAPSHOTS: usize = 64;
+/// Bytes the snapshots of one run may hold (a 256×64×256 run's state is 1.5 MiB: 32 of them).
+pub const SNAPSHOT_BYTES: usize = 48 << 20;
 /// Steps one call may advance (a far jump catches up over several frames).
 pub const MAX_STEPS_PER_CALL: u64 = 200;
 /// The last step a scene's time reaches (later times show this step): about 6 s of stepping
@@ -308,6 +356,8 @@ pub struct Player {
     key: (Settings, Vec<Parcel>),
     run: Simulation,
     snapshots: Vec<State>,
+    /// Bytes the snapshots may hold.
+    snapshot_bytes: usize,
     smoothed: Vec<(u64, std::sync::Arc<Vec<f32>>)>,
 }
 
@@ -320,8 +370,20 @@ impl Player {
             key: (settings.clone(), parcels),
             run,
             snapshots,
+            snapshot_bytes: SNAPSHOT_BYTES,
             smoothed: Vec::new(),
         }
+    }
+
+    /// The same with at most `bytes` of snapshots (tests).
+    pub fn with_snapshot_bytes(mut self, bytes: usize) -> Self {
+        self.snapshot_bytes = bytes;
+        self
+    }
+
+    /// Bytes the snapshots hold now.
+    pub fn snapshot_bytes(&self) -> usize {
+        self.snapshots.iter().map(State::bytes).sum()
     }
 
     /// Whether it runs these settings and parcels.
@@ -348,7 +410,9 @@ impl Player {
                 && self.snapshots.last().is_none_or(|s| s.step < step)
             {
                 self.snapshots.push(self.run.state());
-                if self.snapshots.len() > MAX_SNAPSHOTS {
+                let each = self.snapshots[0].bytes().max(1);
+                let cap = (self.snapshot_bytes / each).clamp(2, MAX_SNAPSHOTS);
+                while self.snapshots.len() > cap {
                     // Thin out: every other snapshot after the first.
                     let mut i = 0;
                     self.snapshots.retain(|_| {

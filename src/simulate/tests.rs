@@ -245,24 +245,46 @@ fn the_smoothed_density_is_the_share_of_cloud_around_each_cell() {
     let v = sim.density(None, 1.0);
     assert_eq!(v.values.len(), 64 * 16 * 32);
     assert!(v.values.iter().all(|&q| (0.0..=1.0).contains(&q)));
-    // Brute force at one cell in the cloud: the mean of its 3×3×3 neighbourhood.
-    let a = sim.automaton();
-    let (x, y, z) = (20, 7, 16);
-    let mut sum = 0.0;
-    for dz in -1i32..=1 {
-        for dy in -1i32..=1 {
-            for dx in -1i32..=1 {
-                sum += a.get(
-                    &a.cld,
-                    (x + dx) as usize,
-                    (y + dy) as usize,
-                    (z + dz) as usize,
-                ) as u8 as f32;
+    // Brute force at every cell, edges included (cells past them count as empty): the mean of
+    // its (2r+1)³ neighbourhood, for the default half-width and a wider one.
+    let brute = |sim: &Simulation, r: i32| -> Vec<f32> {
+        let a = sim.automaton();
+        let [nx, ny, nz] = a.dims.map(|d| d as i32);
+        let mut out = Vec::new();
+        for z in 0..nz {
+            for y in 0..ny {
+                for x in 0..nx {
+                    let mut sum = 0u32;
+                    for dz in -r..=r {
+                        for dy in -r..=r {
+                            for dx in -r..=r {
+                                let (i, j, k) = (x + dx, y + dy, z + dz);
+                                let inside = (0..nx).contains(&i)
+                                    && (0..ny).contains(&j)
+                                    && (0..nz).contains(&k);
+                                sum += (inside && a.get(&a.cld, i as usize, j as usize, k as usize))
+                                    as u32;
+                            }
+                        }
+                    }
+                    out.push(sum as f32 / ((2 * r + 1) as f32).powi(3));
+                }
             }
         }
-    }
-    let got = v.values[((z * 16 + y) * 64 + x) as usize];
-    assert!((got - sum / 27.0).abs() < 1e-5, "{got} vs {}", sum / 27.0);
+        out
+    };
+    let same = |a: &[f32], b: &[f32]| a.iter().zip(b).all(|(p, q)| (p - q).abs() < 1e-6);
+    assert!(v.values.iter().any(|&q| q > 0.5), "no cloud to smooth");
+    assert!(same(&v.values, &brute(&sim, 1)));
+    let wide = Simulation {
+        settings: Settings {
+            smoothing: 3,
+            ..sim.settings.clone()
+        },
+        automaton: sim.automaton.clone(),
+    };
+    assert!(same(&wide.smoothed(), &brute(&wide, 3)));
+    let (x, y, z) = (20, 7, 16);
     // Halfway between two steps: the mean of both.
     let before = sim.smoothed();
     sim.advance(1);
@@ -300,4 +322,36 @@ fn a_player_scrubbed_back_and_forth_shows_what_a_fresh_run_shows() {
     let mut far = Player::new(&settings, parcels);
     let (_, behind) = far.density(100.0);
     assert!(behind, "1,000 steps take more than one call");
+}
+
+#[test]
+fn scrubbing_snapshots_stay_within_their_byte_cap_and_still_give_the_fresh_run() {
+    let (settings, parcels) = parcel_settings();
+    let fresh = |time: f32| {
+        Player::new(&settings, parcels.clone())
+            .density(time)
+            .0
+            .values
+    };
+    let one = Simulation::new(&settings, &parcels).state().bytes();
+    let cap = 5 * one;
+    let mut player = Player::new(&settings, parcels.clone()).with_snapshot_bytes(cap);
+    // 40 s at 10 steps a second: 400 steps, a snapshot every 32 (12 of them uncapped).
+    let mut t = 0.0;
+    while t < 40.0 {
+        t += 10.0;
+        while player.density(t).1 {}
+    }
+    assert!(
+        player.snapshot_bytes() <= cap,
+        "{} bytes of snapshots, cap {cap}",
+        player.snapshot_bytes()
+    );
+    assert!(player.snapshot_bytes() >= 2 * one);
+    // Scrubbing back still lands on what a fresh run shows.
+    assert_eq!(player.density(13.0).0.values, fresh(13.0));
+    // An uncapped player keeps more.
+    let mut uncapped = Player::new(&settings, parcels.clone());
+    while uncapped.density(40.0).1 {}
+    assert!(uncapped.snapshot_bytes() > cap);
 }

@@ -158,13 +158,17 @@ impl Viewport {
             ui.ctx().request_repaint();
         }
         // Draw the volume only over the part of the view its box covers: fewer pixels to
-        // slice, refine and composite on every frame.
+        // slice, refine and composite on every frame. Shafts of light fill the whole view.
         let density = &volumes.density.data;
         let crop = (!density.is_empty())
             .then(|| {
-                scene
-                    .camera
-                    .ndc_bounds(density.min, density.min + density.size, view.aspect)
+                if scene.light.shafts {
+                    Some(crate::render::FULL_VIEW)
+                } else {
+                    scene
+                        .camera
+                        .ndc_bounds(density.min, density.min + density.size, view.aspect)
+                }
             })
             .flatten()
             .map(|ndc| PixelCrop::snap(ndc, px));

@@ -3,7 +3,13 @@
 // parcel moves where the clouds form. Screenshots: test-results/screenshots/simulation-*.png.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { serve, state, screenshot, countChanged, until, withApp, waitForFullQuality } from './harness.mjs';
+import fs from 'node:fs';
+import path from 'node:path';
+import { execFileSync } from 'node:child_process';
+import { fileURLToPath } from 'node:url';
+import { serve, state, screenshot, countChanged, until, withApp, waitForFullQuality, recordTiming } from './harness.mjs';
+
+const here = path.dirname(fileURLToPath(import.meta.url));
 
 let server;
 before(async () => { server = await serve(); });
@@ -44,9 +50,15 @@ for (const backend of ['webgpu', 'webgl2']) {
       // Play for a few seconds of scene time: the image changes, the camera stays.
       const camera = JSON.stringify(s.scene.camera);
       const t0 = s.scene.time;
+      const wall0 = Date.now();
       await page.keyboard.press('Alt+a');
       s = await until(page, (s) => s.scene.time > t0 + 3, 'the clock runs', 90_000);
+      const wall = (Date.now() - wall0) / 1000;
       await page.keyboard.press('Alt+a');
+      // Steps the page simulated per second of wall time while playing (the clock is the
+      // scene's: `rate` steps per scene second).
+      const steps = (s.scene.time - t0) * s.scene.simulation.rate;
+      recordTiming({ test: 'simulation_play_128x32x128', backend, stepsPerSecond: steps / wall, sceneSeconds: s.scene.time - t0, wallSeconds: wall });
       s = await until(page, (s) => !s.view.playing, 'paused');
       await waitForFullQuality(page);
       const played = await screenshot(page, `simulation-2-played-${backend}`);
@@ -70,3 +82,26 @@ for (const backend of ['webgpu', 'webgl2']) {
     });
   });
 }
+
+// The automaton's step in the page (`?bench=ca`): the same grid and code as the native bench's
+// `ca_step_256x64x256`, timed by the page's clock. Both figures go to
+// test-results/timings.json with their ratio; speed is not asserted.
+test('the page times the automaton as the native bench does (?bench=ca)', { timeout: 240_000 }, async () => {
+  await withApp({ base: server.url, webgpu: true, query: '?preset=empty&bench=ca', viewport: { width: 1280, height: 800 } }, async (page) => {
+    const s = await until(page, (s) => s.bench, 'the page bench', 180_000);
+    const b = s.bench;
+    assert.equal(b.cells, 256 * 64 * 256, 'the benchmarks\' grid');
+    assert.ok(b.ca_step_ms > 0 && b.ca_smoothing_ms > 0, JSON.stringify(b));
+    let native = null;
+    const exe = path.resolve(here, '../../target/release/cloudsketch');
+    if (fs.existsSync(exe)) {
+      const out = execFileSync(exe, ['bench', '--json', '--only', 'simulate'], { encoding: 'utf8', env: { ...process.env, NODEVICE_SELECT: '1' } });
+      const step = JSON.parse(out).results.find((r) => r.name === 'ca_step_256x64x256');
+      native = step?.value ?? null;
+    }
+    recordTiming({
+      test: 'ca_step_256x64x256', backend: 'wasm', pageMs: b.ca_step_ms, pageSmoothingMs: b.ca_smoothing_ms,
+      nativeMs: native, pageOverNative: native ? b.ca_step_ms / native : null,
+    });
+  });
+});

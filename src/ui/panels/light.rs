@@ -5,7 +5,7 @@ use egui::Ui;
 use super::PartPanel;
 use crate::limits;
 use crate::scene::{Edit, Lighting};
-use crate::ui::widgets::{param, srgb_button};
+use crate::ui::widgets::{mark, param, srgb_button};
 
 /// The Light group.
 pub const LIGHT: PartPanel<Lighting> = PartPanel::new("Light", |s| &s.light, Edit::SetLight, body);
@@ -31,5 +31,12 @@ fn body(ui: &mut Ui, l: &mut Lighting) {
     if l.ground {
         param(ui, &mut l.ground_height, &limits::GROUND_HEIGHT);
         srgb_button(ui, "ground colour", &mut l.ground_color);
+    }
+    let r = ui.checkbox(&mut l.shafts, "shafts of light")
+        .on_hover_text("Sunlight scattered by the air, dark in the clouds' shadows: shafts of light through the gaps between clouds, brightest looking toward the sun");
+    mark(ui, "light:shafts", r.rect);
+    if l.shafts {
+        param(ui, &mut l.shaft_intensity, &limits::SHAFT_INTENSITY);
+        param(ui, &mut l.shaft_density, &limits::SHAFT_DENSITY);
     }
 }
