@@ -70,10 +70,35 @@ for (const backend of ['webgpu', 'webgl2']) {
       assert.ok(c1.box[0] >= c0.box[0] - margin && c1.box[2] <= c0.box[2] + margin,
         `the clouds stay in the parcels: x ${c0.box[0]}–${c0.box[2]} then ${c1.box[0]}–${c1.box[2]}`);
 
-      // Move the leftmost parcel far to the right: clouds form there, not where it was.
+      // Drag the leftmost parcel far to the right with the move gizmo's X arrow (selected
+      // from its E1 button in the Scene group): clouds form there, not where it was.
       const undo = s.view.undo;
-      await page.evaluate(() => window.cloudsketch.set('/ellipsoids/0/center=[9.0, 3.5, 4.0]'));
-      await until(page, (s) => s.view.undo === undo + 1, 'the parcel moved');
+      let button = null;
+      for (let i = 0; i < 20 && !button; i++) {
+        const r = (await state(page)).view.widgets['ellipsoid:1'];
+        assert.ok(r, 'the E1 button is drawn');
+        if (r[1] >= 10 && r[1] + r[3] <= vh - 10) { button = r; break; }
+        await page.mouse.move(vw + 100, vh / 2);
+        await page.mouse.wheel(0, r[1] < 10 ? -200 : 200);
+        await page.waitForTimeout(150);
+      }
+      assert.ok(button, 'E1 came into view');
+      await page.mouse.click(button[0] + button[2] / 2, button[1] + button[3] / 2);
+      await page.mouse.move(5, vh - 5);
+      await page.keyboard.press('g');
+      s = await until(page, (s) => s.view.gizmo?.x, 'the move gizmo on the first parcel');
+      const c0p = s.scene.ellipsoids[0].center;
+      const { center, x: xEnd } = s.view.gizmo;
+      const grab = [center[0] + 0.7 * (xEnd[0] - center[0]), center[1] + 0.7 * (xEnd[1] - center[1])];
+      await page.mouse.move(grab[0], grab[1]);
+      await page.mouse.down();
+      for (let i = 1; i <= 30; i++) await page.mouse.move(grab[0] + i * 20, grab[1] + (i % 2 ? -8 : 8));
+      await page.mouse.up();
+      s = await until(page, (s) => s.view.undo === undo + 1, 'the parcel moved, one undo step');
+      const c1p = s.scene.ellipsoids[0].center;
+      assert.ok(c1p[0] > c0p[0] + 8, `dragged far right: x ${c0p[0]} → ${c1p[0].toFixed(2)}`);
+      assert.ok(Math.abs(c1p[1] - c0p[1]) < 1e-4 && Math.abs(c1p[2] - c0p[2]) < 1e-4, 'along x only');
+      await page.mouse.move(5, vh - 5);
       await waitForFullQuality(page);
       const moved = await screenshot(page, `simulation-3-parcel-moved-${backend}`);
       const c2 = cloud(moved, body, bg);

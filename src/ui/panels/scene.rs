@@ -146,13 +146,11 @@ fn ellipsoid_list(ui: &mut Ui, doc: &mut Document, selection: &mut Selection) {
                     if doc.scene().ellipsoids[i].hidden {
                         label = label.weak().italics();
                     }
-                    if ui
-                        .selectable_label(selected, label)
-                        .on_hover_text(
-                            "Click to select, Shift+click to add; italic ones are hidden (Shift+H)",
-                        )
-                        .clicked()
-                    {
+                    let r = ui.selectable_label(selected, label).on_hover_text(
+                        "Click to select, Shift+click to add; italic ones are hidden (Shift+H)",
+                    );
+                    mark(ui, &format!("ellipsoid:{}", i + 1), r.rect);
+                    if r.clicked() {
                         clicked = Some((i, selected));
                     }
                 }
