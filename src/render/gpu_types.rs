@@ -131,7 +131,7 @@ impl Shells {
         if far.is_nan() || far <= 0.0 {
             return None;
         }
-        let count = (total / 2).clamp(8, MAX_SHELLS);
+        let count = (total / 4).clamp(8, MAX_SHELLS);
         Some(Self {
             count,
             far,
@@ -524,7 +524,7 @@ mod tests {
         };
         let total = 100;
         let shells = Shells::new(&view, &volume, total).expect("shells with shafts on");
-        assert_eq!(shells.count, 50);
+        assert_eq!(shells.count, 25);
         // The shells reach past the cloud's far side.
         let (center, _) = volume.bounding_sphere();
         let eye = scene.camera.eye();
