@@ -711,9 +711,10 @@ mod plain_mc {
 }
 
 /// The cellular automaton (Dobashi et al. 2000): one step of the benchmarks' 256×64×256
-/// simulation (three parcels, random terms), bit-parallel, against the plain byte-per-cell
-/// step with the same random words built into the same binary; the step's rate in cells per
-/// second; and the smoothing into a density volume against the step.
+/// simulation (three parcels, random terms), bit-parallel on every core and on one (as the
+/// page runs it), against the plain byte-per-cell step with the same random words built into
+/// the same binary; the step's rate in cells per second; and the smoothing into a density
+/// volume against the step.
 fn simulation() -> Vec<BenchResult> {
     use crate::simulate::{bench_simulation, reference::Reference, time_steps};
     let mut sim = bench_simulation();
@@ -722,6 +723,9 @@ fn simulation() -> Vec<BenchResult> {
     sim.advance(1);
     let step = time_steps(&mut sim, 9, &now);
     let cells = sim.automaton().dims.iter().product::<usize>() as f64;
+    sim.set_threads(Some(1));
+    let one_thread = time_steps(&mut sim, 9, &now);
+    sim.set_threads(None);
     let wind = |_y: usize| 0.0;
     let mut plain = Reference::of(sim.automaton());
     let automaton = sim.automaton().clone();
@@ -733,6 +737,13 @@ fn simulation() -> Vec<BenchResult> {
         result(
             "ca_step_256x64x256",
             step * 1e3,
+            "ms",
+            "ca_plain_byte_per_cell_step",
+            reference * 1e3,
+        ),
+        result(
+            "ca_step_256x64x256_one_thread",
+            one_thread * 1e3,
             "ms",
             "ca_plain_byte_per_cell_step",
             reference * 1e3,

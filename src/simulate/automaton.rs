@@ -88,6 +88,8 @@ pub struct Automaton {
     tables: Vec<Vec<u64>>,
     /// Per kind and level: this step's key, which picks each word's draw from the table.
     keys: [[u64; LEVELS.len()]; 3],
+    /// Threads a step may use (`None`: every core).
+    threads: Option<usize>,
     /// Wind along x per layer y, cells per step (may be negative), and its carried fraction.
     wind: Vec<f32>,
     carry: Vec<f32>,
@@ -122,6 +124,7 @@ impl Automaton {
             dims,
             words,
             keys: [[0; LEVELS.len()]; 3],
+            threads: None,
             hum: vec![0; n],
             act: vec![0; n],
             cld: vec![0; n],
@@ -223,7 +226,23 @@ impl Automaton {
         }
     }
 
-    /// One step of growth, extinction, re-supply and wind.
+    /// Threads a step may use: the machine's cores (1 where threads are not available, as in
+    /// the browser), or what [`Automaton::set_threads`] asked for.
+    fn threads(&self) -> usize {
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+        self.threads
+            .unwrap_or(cores)
+            .clamp(1, cores.min(self.dims[1]))
+    }
+
+    /// Uses at most `n` threads per step (the bench's one-thread figure; `None`: every core).
+    pub fn set_threads(&mut self, n: Option<usize>) {
+        self.threads = n;
+    }
+
+    /// One step of growth, extinction, re-supply and wind. Layers of y are shared out among
+    /// the machine's cores; each writes only its own layers, so the result is the same on any
+    /// number of them.
     pub fn advance(&mut self) {
         let [_, ny, nz] = self.dims;
         let words = self.words;
@@ -233,8 +252,40 @@ impl Automaton {
         let mut a = Vec::with_capacity(n + words);
         a.extend_from_slice(&self.act);
         a.resize(n + words, 0);
+        let threads = self.threads();
+        if threads <= 1 || n < (1 << 14) {
+            self.step_layers(&a, 0, &mut hum, &mut act, &mut cld);
+        } else {
+            let layer = nz * words;
+            let per = ny.div_ceil(threads) * layer;
+            let this = &*self;
+            let a = &a;
+            std::thread::scope(|scope| {
+                for (i, ((h, ac), c)) in hum
+                    .chunks_mut(per)
+                    .zip(act.chunks_mut(per))
+                    .zip(cld.chunks_mut(per))
+                    .enumerate()
+                {
+                    scope.spawn(move || this.step_layers(a, i * per / layer, h, ac, c));
+                }
+            });
+        }
+        (self.hum, self.act, self.cld) = (hum, act, cld);
+        self.blow();
+        self.step += 1;
+        self.refresh_keys();
+    }
+
+    /// The growth, extinction and re-supply of the layers from `y0` on that `hum`, `act` and
+    /// `cld` (whole layers) hold, reading `a`: this step's activation with a row of zeros after.
+    fn step_layers(&self, a: &[u64], y0: usize, hum: &mut [u64], act: &mut [u64], cld: &mut [u64]) {
+        let [_, ny, nz] = self.dims;
+        let words = self.words;
+        let n = self.act.len();
         let tail = self.tail_mask();
-        for y in 0..ny {
+        let layers = hum.len() / (nz * words);
+        for y in y0..y0 + layers {
             for z in 0..nz {
                 let r = (y * nz + z) * words;
                 let row = |dy: isize, dz: isize| {
@@ -254,6 +305,7 @@ impl Automaton {
                     row(-1, 0),
                     row(-2, 0),
                 ];
+                let out = r - y0 * nz * words;
                 for w in 0..words {
                     let i = r + w;
                     let prev = if w > 0 { a[i - 1] } else { 0 };
@@ -268,16 +320,12 @@ impl Automaton {
                     }
                     let (h, ac, c) = (self.hum[i], a[i], self.cld[i]);
                     let keep = if w + 1 == words { tail } else { u64::MAX };
-                    hum[i] = ((h & !ac) | self.random_word(Kind::Hum, i)) & keep;
-                    cld[i] = ((c | ac) & !self.random_word(Kind::Ext, i)) & keep;
-                    act[i] = ((!ac & h & f) | self.random_word(Kind::Act, i)) & keep;
+                    hum[out + w] = ((h & !ac) | self.random_word(Kind::Hum, i)) & keep;
+                    cld[out + w] = ((c | ac) & !self.random_word(Kind::Ext, i)) & keep;
+                    act[out + w] = ((!ac & h & f) | self.random_word(Kind::Act, i)) & keep;
                 }
             }
         }
-        (self.hum, self.act, self.cld) = (hum, act, cld);
-        self.blow();
-        self.step += 1;
-        self.refresh_keys();
     }
 
     /// Moves every layer along x by its wind, carrying the fraction.

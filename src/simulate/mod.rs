@@ -179,6 +179,11 @@ impl Simulation {
         &self.settings
     }
 
+    /// Uses at most `n` threads per step (`None`: every core; see [`Automaton::set_threads`]).
+    pub fn set_threads(&mut self, n: Option<usize>) {
+        self.automaton.set_threads(n);
+    }
+
     /// The automaton.
     pub fn automaton(&self) -> &Automaton {
         &self.automaton
@@ -203,38 +208,66 @@ impl Simulation {
         let a = &self.automaton;
         let [nx, ny, nz] = a.dims;
         let r = self.settings.smoothing.min(4) as usize;
-        let words = a.words();
         // Separable running box sums, in whole cell counts (at most 9³ per cell: u16), cells
-        // past the edge counting as empty. Along x from the bits, line by line; along y and z
-        // a row (or a plane) at a time, so every step is a contiguous, vectorisable sweep.
-        let mut counts = vec![0u16; nx * ny * nz];
+        // past the edge counting as empty: along x from the bits line by line, then along y
+        // and along z a whole row at a time, so every step is a contiguous, vectorisable
+        // sweep. Slabs of z (x and y), then columns of each plane (z) are shared out among
+        // the cores.
+        let plane = nx * ny;
+        let mut counts = vec![0u16; plane * nz];
+        let threads = std::thread::available_parallelism()
+            .map_or(1, |n| n.get())
+            .min(nz)
+            .min(if counts.len() < 1 << 18 { 1 } else { 8 });
+        let per = nz.div_ceil(threads) * plane;
+        let slab = |i: usize, chunk: &mut [u16]| {
+            let layers = chunk.len() / plane;
+            self.sum_x(i * per / plane, chunk, r);
+            box_sum_rows(chunk, nx, ny, layers, r);
+        };
+        run_parts(threads, counts.chunks_mut(per).collect(), &slab);
+        // Along z: each part a range of every plane's values, all planes.
+        let width = plane.div_ceil(threads);
+        let mut parts: Vec<Vec<&mut [u16]>> = (0..threads).map(|_| Vec::new()).collect();
+        for layer in counts.chunks_mut(plane) {
+            for (t, piece) in layer.chunks_mut(width).enumerate() {
+                parts[t].push(piece);
+            }
+        }
+        run_parts(threads, parts, &|_, mut rows: Vec<&mut [u16]>| {
+            box_sum_slices(&mut rows, r)
+        });
+        let scale = 1.0 / ((2 * r + 1) as f32).powi(3);
+        counts.iter().map(|&c| c as f32 * scale).collect()
+    }
+
+    /// The box sums of half-width `r` along x of the cloud bits, for the lines of layers
+    /// `z0..` that `out` holds (each `nx` counts, y then z).
+    fn sum_x(&self, z0: usize, out: &mut [u16], r: usize) {
+        let a = &self.automaton;
+        let [nx, ny, nz] = a.dims;
+        let words = a.words();
         // Each byte of cloud bits as eight 0/1 counts, looked up rather than shifted out.
         let unpack: [[u16; 8]; 256] =
             std::array::from_fn(|b| std::array::from_fn(|i| (b >> i) as u16 & 1));
         let mut bits = vec![0u16; words * 64 + 2 * r];
-        for z in 0..nz {
-            for y in 0..ny {
-                let row = &a.cld[(y * nz + z) * words..][..words];
-                for (w, &word) in row.iter().enumerate() {
-                    for (k, byte) in word.to_le_bytes().into_iter().enumerate() {
-                        bits[r + w * 64 + 8 * k..][..8].copy_from_slice(&unpack[byte as usize]);
-                    }
-                }
-                // Cells past the grid's edge count as empty.
-                bits[r + nx..].fill(0);
-                let line = &mut counts[(z * ny + y) * nx..][..nx];
-                line.copy_from_slice(&bits[..nx]);
-                for d in 1..=2 * r {
-                    line.iter_mut()
-                        .zip(&bits[d..d + nx])
-                        .for_each(|(c, &b)| *c += b);
+        for (k, line) in out.chunks_exact_mut(nx).enumerate() {
+            let (y, z) = (k % ny, z0 + k / ny);
+            let row = &a.cld[(y * nz + z) * words..][..words];
+            for (w, &word) in row.iter().enumerate() {
+                for (k, byte) in word.to_le_bytes().into_iter().enumerate() {
+                    bits[r + w * 64 + 8 * k..][..8].copy_from_slice(&unpack[byte as usize]);
                 }
             }
+            // Cells past the grid's edge count as empty.
+            bits[r + nx..].fill(0);
+            line.copy_from_slice(&bits[..nx]);
+            for d in 1..=2 * r {
+                line.iter_mut()
+                    .zip(&bits[d..d + nx])
+                    .for_each(|(c, &b)| *c += b);
+            }
         }
-        box_sum_rows(&mut counts, nx, ny, nz, r);
-        box_sum_rows(&mut counts, nx * ny, nz, 1, r);
-        let scale = 1.0 / ((2 * r + 1) as f32).powi(3);
-        counts.iter().map(|&c| c as f32 * scale).collect()
     }
 
     /// The density volume of the current step (`previous`: the last step's smoothed values,
@@ -275,6 +308,44 @@ fn box_sum_rows(v: &mut [u16], len: usize, n: usize, outer: usize, r: usize) {
             }
         }
         block.copy_from_slice(&out);
+    }
+}
+
+/// Runs `work(i, part)` for every part, on up to `threads` scoped threads (inline for one).
+fn run_parts<T: Send>(threads: usize, parts: Vec<T>, work: &(dyn Fn(usize, T) + Sync)) {
+    if threads <= 1 {
+        parts.into_iter().enumerate().for_each(|(i, p)| work(i, p));
+        return;
+    }
+    std::thread::scope(|scope| {
+        for (i, p) in parts.into_iter().enumerate() {
+            scope.spawn(move || work(i, p));
+        }
+    });
+}
+
+/// Replaces each of `rows` (equal lengths) by the sum of its `2r + 1` neighbouring rows
+/// (rows past the ends count as zero).
+fn box_sum_slices(rows: &mut [&mut [u16]], r: usize) {
+    let (n, len) = (rows.len(), rows.first().map_or(0, |r| r.len()));
+    let mut sum = vec![0u16; len];
+    let mut window: std::collections::VecDeque<Vec<u16>> = std::collections::VecDeque::new();
+    for row in rows.iter().take(r) {
+        sum.iter_mut().zip(row.iter()).for_each(|(s, &x)| *s += x);
+    }
+    for i in 0..n {
+        if i + r < n {
+            sum.iter_mut()
+                .zip(rows[i + r].iter())
+                .for_each(|(s, &x)| *s += x);
+        }
+        // Keep the input rows the window still needs before overwriting this one.
+        window.push_back(rows[i].to_vec());
+        rows[i].copy_from_slice(&sum);
+        if i >= r {
+            let old = window.pop_front().unwrap_or_default();
+            sum.iter_mut().zip(&old).for_each(|(s, &x)| *s -= x);
+        }
     }
 }
 

@@ -284,6 +284,23 @@ fn the_smoothed_density_is_the_share_of_cloud_around_each_cell() {
         automaton: sim.automaton.clone(),
     };
     assert!(same(&wide.smoothed(), &brute(&wide, 3)));
+    // A grid big enough to be smoothed on several threads (2^18 cells), its layers shared out.
+    let big_settings = Settings {
+        cells: [128, 32, 64],
+        ..settings.clone()
+    };
+    let big_parcel = Parcel {
+        center: Vec3::new(60.0, 12.0, 30.0),
+        radii: Vec3::new(50.0, 10.0, 28.0),
+        rotation: Quat::IDENTITY,
+    };
+    let mut big = Simulation::new(&big_settings, &[big_parcel]);
+    big.advance(30);
+    assert!(
+        big.smoothed().iter().any(|&q| q > 0.5),
+        "no cloud in the big grid"
+    );
+    assert!(same(&big.smoothed(), &brute(&big, 1)));
     let (x, y, z) = (20, 7, 16);
     // Halfway between two steps: the mean of both.
     let before = sim.smoothed();
@@ -354,4 +371,31 @@ fn scrubbing_snapshots_stay_within_their_byte_cap_and_still_give_the_fresh_run()
     let mut uncapped = Player::new(&settings, parcels.clone());
     while uncapped.density(40.0).1 {}
     assert!(uncapped.snapshot_bytes() > cap);
+}
+
+#[test]
+fn a_step_shared_among_threads_is_the_one_thread_step_to_the_bit() {
+    // Big enough to be shared out (at least 2^14 words), with parcels, wind and every rule.
+    let settings = Settings {
+        cells: [128, 32, 256],
+        origin: [0.0, 0.0, 0.0],
+        cell_size: 1.0,
+        wind: [0.0, 1.5],
+        ..Settings::default()
+    };
+    let parcels = vec![Parcel {
+        center: Vec3::new(60.0, 12.0, 120.0),
+        radii: Vec3::new(50.0, 10.0, 90.0),
+        rotation: Quat::IDENTITY,
+    }];
+    let mut one = Simulation::new(&settings, &parcels);
+    one.automaton.set_threads(Some(1));
+    let mut many = Simulation::new(&settings, &parcels);
+    many.automaton.set_threads(Some(4));
+    one.advance(25);
+    many.advance(25);
+    assert!(one.automaton().cloud_cells() > 1000, "no clouds formed");
+    assert_eq!(one.automaton().cld, many.automaton().cld);
+    assert_eq!(one.automaton().hum, many.automaton().hum);
+    assert_eq!(one.automaton().act, many.automaton().act);
 }

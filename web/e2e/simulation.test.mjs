@@ -109,7 +109,7 @@ for (const backend of ['webgpu', 'webgl2']) {
 }
 
 // The automaton's step in the page (`?bench=ca`): the same grid and code as the native bench's
-// `ca_step_256x64x256`, timed by the page's clock. Both figures go to
+// `ca_step_256x64x256_one_thread` (the page has one thread), timed by the page's clock. Both figures go to
 // test-results/timings.json with their ratio; speed is not asserted.
 test('the page times the automaton as the native bench does (?bench=ca)', { timeout: 240_000 }, async () => {
   await withApp({ base: server.url, webgpu: true, query: '?preset=empty&bench=ca', viewport: { width: 1280, height: 800 } }, async (page) => {
@@ -121,7 +121,7 @@ test('the page times the automaton as the native bench does (?bench=ca)', { time
     const exe = path.resolve(here, '../../target/release/cloudsketch');
     if (fs.existsSync(exe)) {
       const out = execFileSync(exe, ['bench', '--json', '--only', 'simulate'], { encoding: 'utf8', env: { ...process.env, NODEVICE_SELECT: '1' } });
-      const step = JSON.parse(out).results.find((r) => r.name === 'ca_step_256x64x256');
+      const step = JSON.parse(out).results.find((r) => r.name === 'ca_step_256x64x256_one_thread');
       native = step?.value ?? null;
     }
     recordTiming({
