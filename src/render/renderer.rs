@@ -374,21 +374,22 @@ impl VolumeRenderer {
         // The bench's baseline draws the plain slices alone.
         let shells = Shells::new(&job.view, &volume, plan.total).filter(|_| pipeline.is_none());
         self.ensure_target(device, index, plan.size, shells.is_some());
+        let (Some(target), Some(bind_group)) = (&mut self.targets[index], &self.bind_group) else {
+            return;
+        };
+        // An image is drawn with shafts or without from its first chunk to its last.
+        if plan.clear {
+            target.has_shafts = shells.is_some();
+        }
+        let with_shafts = target.has_shafts && shells.is_some();
         let uniforms = VolumeUniforms::new(
             &job.view,
             &volume,
             plan.total,
             plan.range.clone(),
-            shells.as_ref(),
+            shells.as_ref().filter(|_| with_shafts),
         );
         let offset = self.slices.write(queue, &uniforms);
-        let (Some(target), Some(bind_group)) = (&mut self.targets[index], &self.bind_group) else {
-            return;
-        };
-        if plan.clear {
-            target.has_shafts = shells.is_some();
-        }
-        let with_shafts = target.has_shafts && shells.is_some();
         let load = if plan.clear {
             wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT)
         } else {
