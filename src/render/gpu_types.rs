@@ -483,10 +483,9 @@ mod tests {
     use super::*;
     use crate::scene::Scene;
 
-    #[test]
-    fn uniforms_cover_the_volume() {
-        let scene = Scene::default();
-        let volume = crate::field::bake(&crate::derive::field_of(&scene), 16);
+    /// The whole view of `scene` at aspect 1.5, and its field baked coarsely.
+    fn view_and_volume(scene: &Scene) -> (View, DensityVolume) {
+        let volume = crate::field::bake(&crate::derive::field_of(scene), 16);
         let view = View {
             camera: scene.camera.clone(),
             light: scene.light.clone(),
@@ -495,6 +494,13 @@ mod tests {
             aspect: 1.5,
             crop: FULL_VIEW,
         };
+        (view, volume)
+    }
+
+    #[test]
+    fn uniforms_cover_the_volume() {
+        let scene = Scene::default();
+        let (view, volume) = view_and_volume(&scene);
         let u = VolumeUniforms::new(&view, &volume, 64, 10..20, None);
         let center = Vec3::from_slice(&u.sphere[..3]);
         assert!(center.abs_diff_eq(volume.min + volume.size * 0.5, 1e-4));
@@ -513,15 +519,7 @@ mod tests {
     fn refinement_chunks_share_out_the_shells_once_each_among_their_slices() {
         let mut scene = Scene::default();
         scene.light.shafts = true;
-        let volume = crate::field::bake(&crate::derive::field_of(&scene), 16);
-        let view = View {
-            camera: scene.camera.clone(),
-            light: scene.light.clone(),
-            render: scene.render.clone(),
-            time: 0.0,
-            aspect: 1.5,
-            crop: FULL_VIEW,
-        };
+        let (view, volume) = view_and_volume(&scene);
         let total = 100;
         let shells = Shells::new(&view, &volume, total).expect("shells with shafts on");
         assert_eq!(shells.count, 25);

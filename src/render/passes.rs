@@ -299,54 +299,39 @@ impl CompositePass {
         }
     }
 
-    /// The bind group that composites `source` with the shafts of light in `shafts`.
-    pub fn shafts_bind_group(
-        &self,
-        device: &wgpu::Device,
-        source: &wgpu::TextureView,
-        shafts: &wgpu::TextureView,
-        sampler: &wgpu::Sampler,
-    ) -> wgpu::BindGroup {
-        device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("composite with shafts"),
-            layout: &self.shafts_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::TextureView(source),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::Sampler(sampler),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: wgpu::BindingResource::TextureView(shafts),
-                },
-            ],
-        })
-    }
-
-    /// The bind group that composites `source`.
+    /// The bind group that composites `source`, with the shafts of light in `shafts` (for
+    /// `shafts_pipeline`) or without.
     pub fn bind_group(
         &self,
         device: &wgpu::Device,
         source: &wgpu::TextureView,
+        shafts: Option<&wgpu::TextureView>,
         sampler: &wgpu::Sampler,
     ) -> wgpu::BindGroup {
+        let mut entries = vec![
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::TextureView(source),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: wgpu::BindingResource::Sampler(sampler),
+            },
+        ];
+        if let Some(shafts) = shafts {
+            entries.push(wgpu::BindGroupEntry {
+                binding: 2,
+                resource: wgpu::BindingResource::TextureView(shafts),
+            });
+        }
+        let (label, layout) = match shafts {
+            Some(_) => ("composite with shafts", &self.shafts_layout),
+            None => ("composite", &self.layout),
+        };
         device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("composite"),
-            layout: &self.layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::TextureView(source),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::Sampler(sampler),
-                },
-            ],
+            label: Some(label),
+            layout,
+            entries: &entries,
         })
     }
 }

@@ -332,7 +332,7 @@ impl VolumeRenderer {
             let view = accumulation_texture(device, size, self.accum_format);
             let composite = self
                 .composite
-                .bind_group(device, &view, &self.clamp_sampler);
+                .bind_group(device, &view, None, &self.clamp_sampler);
             self.targets[index] = Some(Target {
                 size,
                 view,
@@ -348,7 +348,7 @@ impl VolumeRenderer {
             let view = accumulation_texture(device, size, self.accum_format);
             let group =
                 self.composite
-                    .shafts_bind_group(device, &target.view, &view, &self.clamp_sampler);
+                    .bind_group(device, &target.view, Some(&view), &self.clamp_sampler);
             target.shafts = Some((view, group));
         }
     }

@@ -141,6 +141,23 @@ export function recordTiming(entry) {
   fs.writeFileSync(file, JSON.stringify(all, null, 2));
 }
 
+/**
+ * Scrolls the side panel (with the wheel, over the panel) until widget `name` (a mark in the
+ * page state's `view.widgets`) is in view; returns its rectangle [x, y, w, h].
+ */
+export async function reveal(page, name) {
+  const [vw, vh] = (await state(page)).view.viewport;
+  for (let i = 0; i < 20; i++) {
+    const r = (await state(page)).view.widgets[name];
+    if (!r) throw new Error(`${name} is not drawn`);
+    if (r[1] >= 10 && r[1] + r[3] <= vh - 10) return r;
+    await page.mouse.move(vw + 100, vh / 2);
+    await page.mouse.wheel(0, r[1] < 10 ? -200 : 200);
+    await page.waitForTimeout(150);
+  }
+  throw new Error(`${name} never came into view`);
+}
+
 /** The sun handle's box in the page state's view (or null when it is not drawn). */
 export function sunHandleBox(view) {
   const o = view.sun_handle;

@@ -4,7 +4,7 @@
 // test-results/screenshots/media-*.png.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { serve, launch, openApp, waitForBody, state, screenshot, countChanged, countDiffering, until, withApp, waitForFullQuality } from './harness.mjs';
+import { serve, launch, openApp, waitForBody, state, screenshot, countChanged, countDiffering, until, withApp, waitForFullQuality, reveal as revealWidget } from './harness.mjs';
 
 let server;
 before(async () => { server = await serve(); });
@@ -133,18 +133,7 @@ for (const backend of ['webgpu', 'webgl2']) {
       const body = { x: 0, y: 130, w: vw - 12, h: vh - 160 };
       const centre = (r) => [r[0] + r[2] / 2, r[1] + r[3] / 2];
       const away = async () => { await page.mouse.move(5, vh - 5); };
-      // Scrolls the side panel (with the wheel, over the panel) until widget `name` is in view.
-      const reveal = async (name) => {
-        for (let i = 0; i < 20; i++) {
-          const r = (await state(page)).view.widgets[name];
-          assert.ok(r, `${name} is drawn`);
-          if (r[1] >= 10 && r[1] + r[3] <= vh - 10) return r;
-          await page.mouse.move(vw + 100, vh / 2);
-          await page.mouse.wheel(0, r[1] < 10 ? -200 : 200);
-          await page.waitForTimeout(150);
-        }
-        throw new Error(`${name} never came into view`);
-      };
+      const reveal = (name) => revealWidget(page, name);
       await away();
       await waitForFullQuality(page);
       let last = await screenshot(page, `widgets-0-start-${backend}`);
@@ -236,16 +225,7 @@ for (const backend of ['webgpu', 'webgl2']) {
       await away();
       await waitForFullQuality(page);
       const before = await screenshot(page, `shafts-0-off-${backend}`);
-      let box = null;
-      for (let i = 0; i < 20 && !box; i++) {
-        const r = (await state(page)).view.widgets['light:shafts'];
-        assert.ok(r, 'the shafts checkbox is drawn');
-        if (r[1] >= 10 && r[1] + r[3] <= vh - 10) { box = r; break; }
-        await page.mouse.move(vw + 100, vh / 2);
-        await page.mouse.wheel(0, r[1] < 10 ? -200 : 200);
-        await page.waitForTimeout(150);
-      }
-      assert.ok(box, 'the shafts checkbox came into view');
+      const box = await revealWidget(page, 'light:shafts');
       const undo = s.view.undo;
       await page.mouse.click(box[0] + 8, box[1] + box[3] / 2);
       s = await until(page, (s) => s.scene.light.shafts && s.view.undo === undo + 1, 'shafts on, one undo step');

@@ -7,7 +7,7 @@ import fs from 'node:fs';
 import path from 'node:path';
 import { execFileSync } from 'node:child_process';
 import { fileURLToPath } from 'node:url';
-import { serve, state, screenshot, countChanged, until, withApp, waitForFullQuality, recordTiming } from './harness.mjs';
+import { serve, state, screenshot, countChanged, until, withApp, waitForFullQuality, recordTiming, reveal } from './harness.mjs';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
 
@@ -73,16 +73,7 @@ for (const backend of ['webgpu', 'webgl2']) {
       // Drag the leftmost parcel far to the right with the move gizmo's X arrow (selected
       // from its E1 button in the Scene group): clouds form there, not where it was.
       const undo = s.view.undo;
-      let button = null;
-      for (let i = 0; i < 20 && !button; i++) {
-        const r = (await state(page)).view.widgets['ellipsoid:1'];
-        assert.ok(r, 'the E1 button is drawn');
-        if (r[1] >= 10 && r[1] + r[3] <= vh - 10) { button = r; break; }
-        await page.mouse.move(vw + 100, vh / 2);
-        await page.mouse.wheel(0, r[1] < 10 ? -200 : 200);
-        await page.waitForTimeout(150);
-      }
-      assert.ok(button, 'E1 came into view');
+      const button = await reveal(page, 'ellipsoid:1');
       await page.mouse.click(button[0] + button[2] / 2, button[1] + button[3] / 2);
       await page.mouse.move(5, vh - 5);
       await page.keyboard.press('g');
