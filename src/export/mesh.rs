@@ -174,31 +174,64 @@ pub fn mesh(dims: UVec3, min: Vec3, h: f32, values: &[f32], iso: f32) -> Mesh {
     let table = table();
     let d = dims.as_ivec3();
     let outside = iso - 1.0;
-    let value = |p: IVec3| -> f32 {
-        if p.cmplt(IVec3::ZERO).any() || p.cmpge(d).any() {
-            outside
-        } else {
-            values[((p.z * d.y + p.y) * d.x + p.x) as usize]
-        }
-    };
-    // Vertex ids of grid edges by their lower point, in rolling layers: x and y edges of the
-    // cube layer's bottom (0) and top (1) planes, z edges between them.
+    // Two padded planes of values (z and z + 1) with a ring of outside values, and whether
+    // each is inside, so the loop over cubes reads them without bounds tests.
     let w = (d.x + 2) as usize;
     let layer = w * (d.y + 2) as usize;
+    let fill = |z: i32, plane: &mut Vec<f32>, inside: &mut Vec<u8>| {
+        plane.fill(outside);
+        if (0..d.z).contains(&z) {
+            let (nx, ny) = (d.x as usize, d.y as usize);
+            for y in 0..ny {
+                let from = (z as usize * ny + y) * nx;
+                let to = (y + 1) * w + 1;
+                plane[to..to + nx].copy_from_slice(&values[from..from + nx]);
+            }
+        }
+        for (b, &v) in inside.iter_mut().zip(plane.iter()) {
+            *b = (v >= iso) as u8;
+        }
+    };
+    let mut planes = [vec![outside; layer], vec![outside; layer]];
+    let mut inside = [vec![0u8; layer], vec![0u8; layer]];
+    // Vertex ids of grid edges by their lower point, in rolling layers: x and y edges of the
+    // cube layer's bottom (0) and top (1) planes, z edges between them.
     let mut xy = [vec![u32::MAX; 2 * layer], vec![u32::MAX; 2 * layer]];
     let mut zs = vec![u32::MAX; layer];
     let mut mesh = Mesh::default();
     for z in -1..d.z {
         xy[1].fill(u32::MAX);
         zs.fill(u32::MAX);
+        {
+            let [p0, p1] = &mut planes;
+            let [i0, i1] = &mut inside;
+            if z == -1 {
+                fill(z, p0, i0);
+            } else {
+                std::mem::swap(p0, p1);
+                std::mem::swap(i0, i1);
+            }
+            fill(z + 1, p1, i1);
+        }
+        let (in0, in1) = (&inside[0], &inside[1]);
         for y in -1..d.y {
+            let row = (y + 1) as usize * w;
             for x in -1..d.x {
-                let base = IVec3::new(x, y, z);
-                let v: [f32; 8] = std::array::from_fn(|c| value(base + corner_offset(c as u8)));
-                let case = (0..8).fold(0usize, |m, c| m | (((v[c] >= iso) as usize) << c));
+                let i = row + (x + 1) as usize;
+                let case = (in0[i]
+                    | in0[i + 1] << 1
+                    | in0[i + w] << 2
+                    | in0[i + w + 1] << 3
+                    | in1[i] << 4
+                    | in1[i + 1] << 5
+                    | in1[i + w] << 6
+                    | in1[i + w + 1] << 7) as usize;
                 if case == 0 || case == 255 {
                     continue;
                 }
+                let base = IVec3::new(x, y, z);
+                let v: [f32; 8] =
+                    std::array::from_fn(|c| planes[c >> 2][i + (c & 1) + ((c >> 1) & 1) * w]);
                 let case = &table[case];
                 // This cube's crossing edges: their shared vertices, made by whichever cube
                 // meets them first.

@@ -88,6 +88,60 @@ impl Blob {
     pub fn value(&self, p: Vec3) -> f32 {
         self.strength * wyvill((self.to_unit * (p - self.center)).length_squared())
     }
+
+    /// The primitive along the line of points `(x, y, z)` for every x: what a bake needs once
+    /// per texel row (the same values as [`Blob::value`] up to float rounding).
+    #[inline]
+    pub fn row(&self, y: f32, z: f32) -> BlobRow {
+        let m = &self.to_unit;
+        let (dy, dz) = (y - self.center.y, z - self.center.z);
+        let across = m.y_axis * dy + m.z_axis * dz;
+        BlobRow {
+            center_x: self.center.x,
+            a: m.x_axis.length_squared(),
+            b: m.x_axis.dot(across),
+            c: across.length_squared(),
+            strength: self.strength,
+        }
+    }
+}
+
+/// A primitive along one line parallel to x ([`Blob::row`]). In the primitive's unit space the
+/// point at `x` is `along·dx + across` (dx = x − center_x), whose squared length is the
+/// quadratic a·dx² + 2b·dx + c: two multiply-adds per texel of a row.
+#[derive(Clone, Copy, Debug)]
+pub struct BlobRow {
+    center_x: f32,
+    a: f32,
+    b: f32,
+    c: f32,
+    strength: f32,
+}
+
+impl BlobRow {
+    /// The primitive's contribution at `x`.
+    #[inline]
+    pub fn value(&self, x: f32) -> f32 {
+        let dx = x - self.center_x;
+        self.strength * wyvill((self.a * dx + 2.0 * self.b) * dx + self.c)
+    }
+
+    /// The open interval of x where the contribution can be non-zero (the line's chord through
+    /// the unit ball of influence), if the line meets it; rounding may widen the true chord by
+    /// a few ulps, so callers add slack.
+    pub fn reach(&self) -> Option<(f32, f32)> {
+        // a·dx² + 2b·dx + c < 1.
+        let (a, b, c) = (self.a, self.b, self.c);
+        let disc = b * b - a * (c - 1.0);
+        if a <= 0.0 || disc <= 0.0 {
+            return None;
+        }
+        let (root, inv) = (disc.sqrt(), 1.0 / a);
+        Some((
+            self.center_x - (b + root) * inv,
+            self.center_x + (root - b) * inv,
+        ))
+    }
 }
 
 /// A cut stroke: nothing of the cloud survives below its line, within its footprint.

@@ -229,36 +229,48 @@ impl Dirty {
         }
     }
 
-    /// The dirty parts of the texel rows of box `(a, b)` (inclusive): (index of the row's
-    /// first texel, x range).
-    fn rows(
-        &self,
-        dims: UVec3,
-        (a, b): (UVec3, UVec3),
-    ) -> impl Iterator<Item = (usize, std::ops::Range<usize>)> + '_ {
+    /// Calls `f` with the dirty part of each texel row of box `(a, b)` (inclusive); plain
+    /// loops, as a bake calls it for every row of every primitive.
+    #[inline]
+    fn each_row(&self, dims: UVec3, (a, b): (UVec3, UVec3), mut f: impl FnMut(Row)) {
         let (nx, ny) = (dims.x as usize, dims.y as usize);
         // Only the part of the box inside the dirty bounds has dirty rows (none without them).
-        let (a, b) = match self.bounds {
-            Some((lo, hi)) => (a.max(lo), b.min(hi)),
-            None => (UVec3::ONE, UVec3::ZERO),
+        let Some((lo, hi)) = self.bounds else {
+            return;
         };
-        let empty = a.cmpgt(b).any();
-        let (a, b) = if empty {
-            (UVec3::ONE, UVec3::ZERO)
-        } else {
-            (a, b)
-        };
-        (a.z..=b.z).flat_map(move |k| {
-            (a.y..=b.y).flat_map(move |j| {
+        let (a, b) = (a.max(lo), b.min(hi));
+        if a.cmpgt(b).any() {
+            return;
+        }
+        for k in a.z..=b.z {
+            for j in a.y..=b.y {
                 let brick_row = (j / BRICK + self.bricks.y * (k / BRICK)) as usize;
-                let row = (k as usize * ny + j as usize) * nx;
-                self.runs[brick_row].iter().filter_map(move |r| {
+                let at = (k as usize * ny + j as usize) * nx;
+                for r in &self.runs[brick_row] {
                     let (lo, hi) = (r.start.max(a.x), r.end.min(b.x + 1));
-                    (lo < hi).then_some((row, lo as usize..hi as usize))
-                })
-            })
-        })
+                    if lo < hi {
+                        f(Row {
+                            at,
+                            j: j as usize,
+                            k: k as usize,
+                            xs: lo as usize..hi as usize,
+                        });
+                    }
+                }
+            }
+        }
     }
+}
+
+/// A dirty run of one texel row.
+struct Row {
+    /// The index of the row's first texel (x = 0).
+    at: usize,
+    /// The row's y and z texel indices.
+    j: usize,
+    k: usize,
+    /// The dirty x range.
+    xs: std::ops::Range<usize>,
 }
 
 /// Calls `sink` with the index and centre of every dirty texel of box `bx`, counting them.
@@ -271,15 +283,54 @@ fn splat(
     work: &mut u64,
     mut sink: impl FnMut(usize, Vec3),
 ) {
-    let (nx, ny) = (dims.x as usize, dims.y as usize);
-    for (row, xs) in dirty.rows(dims, bx) {
-        let (j, k) = ((row / nx) % ny, row / (nx * ny));
+    dirty.each_row(dims, bx, |Row { at: row, j, k, xs }| {
         *work += xs.len() as u64;
         let (y, z) = (ys_c[j], zs_c[k]);
         for i in xs {
             sink(row + i, Vec3::new(xs_c[i], y, z));
         }
-    }
+    });
+}
+
+/// Adds `blob` into the dirty texels of box `bx`, row by row, visiting only the texels of each
+/// row within the primitive's chord (a texel of slack each side; beyond it the kernel is 0, so
+/// the sums are the same bits as visiting every texel), counting them.
+fn add_blob(
+    dirty: &Dirty,
+    dims: UVec3,
+    [xs_c, ys_c, zs_c]: &[Vec<f32>; 3],
+    bx: (UVec3, UVec3),
+    work: &mut u64,
+    blob: &Blob,
+    values: &mut [f32],
+) {
+    let (x0, inv_h) = (
+        xs_c[0],
+        if dims.x > 1 {
+            1.0 / (xs_c[1] - xs_c[0])
+        } else {
+            1.0
+        },
+    );
+    dirty.each_row(dims, bx, |Row { at: row, j, k, xs }| {
+        let line = blob.row(ys_c[j], zs_c[k]);
+        let Some((lo, hi)) = line.reach() else {
+            return;
+        };
+        // Truncation is within a texel of floor and ceil: one more texel of slack each side
+        // (and no call to floorf on targets without SSE4.1).
+        let first = (((lo - x0) * inv_h) as i64 - 2).max(xs.start as i64);
+        let end = (((hi - x0) * inv_h) as i64 + 3).min(xs.end as i64);
+        if first >= end {
+            return;
+        }
+        let (first, end) = (first as usize, end as usize);
+        *work += (end - first) as u64;
+        let texels = &mut values[row + first..row + end];
+        for (v, &x) in texels.iter_mut().zip(&xs_c[first..end]) {
+            *v += line.value(x);
+        }
+    });
 }
 
 /// Evaluates `field` at the dirty texels of `values` (laid out on `grid`): clears them, sums the
@@ -288,13 +339,12 @@ fn splat(
 /// full bake bit for bit. Returns the kernel evaluations and clip tests done.
 fn evaluate(field: &Field, grid: &Grid, dirty: &Dirty, values: &mut [f32]) -> u64 {
     let dims = grid.dims;
-    let (nx, ny) = (dims.x as usize, dims.y as usize);
     let [xs, ys, zs] = grid.centers();
     let center = |i: usize, j: usize, k: usize| Vec3::new(xs[i], ys[j], zs[k]);
     let whole = (UVec3::ZERO, dims - 1);
-    for (row, xs) in dirty.rows(dims, whole) {
-        values[row + xs.start..row + xs.end].fill(0.0);
-    }
+    dirty.each_row(dims, whole, |Row { at: row, xs, .. }| {
+        values[row + xs.start..row + xs.end].fill(0.0)
+    });
     let mut work = 0u64;
     // The dirty texels' world box (a texel of slack): a primitive that misses it is skipped
     // before any texel arithmetic.
@@ -313,9 +363,7 @@ fn evaluate(field: &Field, grid: &Grid, dirty: &Dirty, values: &mut [f32]) -> u6
     let centers = grid.centers();
     for blob in &field.blobs {
         if let Some(bx) = reach(blob) {
-            splat(dirty, dims, &centers, bx, &mut work, |at, p| {
-                values[at] += blob.value(p)
-            });
+            add_blob(dirty, dims, &centers, bx, &mut work, blob, values);
         }
     }
     if !field.groups.is_empty() {
@@ -332,10 +380,10 @@ fn evaluate(field: &Field, grid: &Grid, dirty: &Dirty, values: &mut [f32]) -> u6
             else {
                 continue;
             };
-            for (row, xs) in dirty.rows(dims, bx) {
+            dirty.each_row(dims, bx, |Row { at: row, xs, .. }| {
                 first[row + xs.start..row + xs.end].fill(0.0);
                 second[row + xs.start..row + xs.end].fill(0.0);
-            }
+            });
             for blob in &group.blobs {
                 if let Some(bx) = reach(blob) {
                     splat(dirty, dims, &centers, bx, &mut work, |at, p| {
@@ -350,8 +398,7 @@ fn evaluate(field: &Field, grid: &Grid, dirty: &Dirty, values: &mut [f32]) -> u6
         }
     }
     if !field.clips.is_empty() {
-        for (row, xs) in dirty.rows(dims, whole) {
-            let (j, k) = ((row / nx) % ny, row / (nx * ny));
+        dirty.each_row(dims, whole, |Row { at: row, j, k, xs }| {
             for i in xs {
                 let v = &mut values[row + i];
                 // Empty texels need no clip test.
@@ -362,7 +409,7 @@ fn evaluate(field: &Field, grid: &Grid, dirty: &Dirty, values: &mut [f32]) -> u6
                     }
                 }
             }
-        }
+        });
     }
     work
 }
@@ -669,10 +716,10 @@ impl Baker {
                 (grid, extent, values, Dirty::all(&grid))
             }
         };
-        let texels = dirty
-            .rows(grid.dims, (UVec3::ZERO, grid.dims - 1))
-            .map(|(_, xs)| xs.len() as u64)
-            .sum();
+        let mut texels = 0;
+        dirty.each_row(grid.dims, (UVec3::ZERO, grid.dims - 1), |row| {
+            texels += row.xs.len() as u64
+        });
         let work = evaluate(field, &grid, &dirty, &mut values);
         let volume = Arc::new(volume_of(&grid, values));
         self.last = Some(LastBake {
