@@ -15,8 +15,13 @@
 //! levels, a table of words whose bits are 1 with that level's probability. A cell's
 //! probabilities (from the parcels) are rounded to a level when the parcels change; the
 //! random mask of a word is the OR over levels of (the cells at that level ∧ a word drawn from
-//! that level's table). [`Automaton::random_word`] is the one source of randomness, so the
-//! byte-per-cell reference in the tests reproduces a run bit for bit.
+//! that level's table). Each row keeps member words only for the levels its cells use, so a
+//! step reads a few words per cell row rather than one per level. [`Automaton::random_word`]
+//! is the one source of randomness, so the byte-per-cell reference in the tests reproduces a
+//! run bit for bit.
+//!
+//! A step writes into spare buffers (no allocation) and moves each row by its layer's wind
+//! while the row is still in cache.
 
 use crate::seeded::hash64;
 
@@ -24,6 +29,56 @@ use crate::seeded::hash64;
 pub const LEVELS: [f32; 8] = [0.0, 0.002, 0.01, 0.03, 0.08, 0.2, 0.45, 1.0];
 /// Random words per level table.
 const TABLE: usize = 1024;
+
+/// Per level, its table of random words.
+type Tables = [[u64; TABLE]; LEVELS.len()];
+
+/// The cells of one kind at each probability level, kept only where used: per word, the
+/// levels its cells use (bit `l`), and for each of them in ascending order one member word
+/// (bit set: the cell is at that level), stored word after word, row after row.
+#[derive(Clone, Debug, Default)]
+struct Membership {
+    /// Per row: the index of its first member word.
+    rows: Vec<usize>,
+    /// Per word: the levels its cells use.
+    levels: Vec<u8>,
+    /// The member words.
+    words: Vec<u64>,
+}
+
+impl Membership {
+    /// Row `row`'s words' used levels and the index of its first member word (none before
+    /// any level is set).
+    #[inline]
+    fn row(&self, row: usize, words: usize) -> (&[u8], usize) {
+        match self.rows.get(row) {
+            Some(&at) => (&self.levels[row * words..(row + 1) * words], at),
+            None => (&[], 0),
+        }
+    }
+}
+
+/// The random mask of word `i` and how many member words it read: the OR over its used
+/// `levels` of (its member word ∧ the word drawn from that level's table by `keys` and `i`),
+/// its member words starting at `members`.
+#[inline(always)]
+fn draw(
+    tables: &Tables,
+    keys: &[u64; LEVELS.len()],
+    levels: u8,
+    members: &[u64],
+    i: usize,
+) -> (u64, usize) {
+    let (mut mask, mut left, mut k) = (0, levels, 0);
+    while left != 0 {
+        let l = left.trailing_zeros() as usize & (LEVELS.len() - 1);
+        left &= left - 1;
+        let pick = ((keys[l] ^ i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 54) as usize;
+        mask |= members[k] & tables[l][pick % TABLE];
+        k += 1;
+    }
+    (mask, k)
+}
 
 /// The nearest level of a probability (on a log scale above the smallest).
 pub fn level_of(p: f32) -> u8 {
@@ -82,10 +137,14 @@ pub struct Automaton {
     pub act: Vec<u64>,
     /// See [`Automaton::hum`].
     pub cld: Vec<u64>,
-    /// Per kind and level (1..): the cells at that level, as words.
-    membership: [Vec<Vec<u64>>; 3],
+    /// Per kind: the cells at each level (1..) its rows use.
+    membership: [Membership; 3],
     /// Per level: its random words.
-    tables: Vec<Vec<u64>>,
+    tables: Box<Tables>,
+    /// The buffers a step writes (hum, act, cld), swapped with the state after it.
+    spare: [Vec<u64>; 3],
+    /// One row of zeros: the neighbour row of every cell past an edge.
+    zeros: Vec<u64>,
     /// Per kind and level: this step's key, which picks each word's draw from the table.
     keys: [[u64; LEVELS.len()]; 3],
     /// Threads a step may use (`None`: every core).
@@ -104,22 +163,16 @@ impl Automaton {
         let [nx, ny, nz] = dims;
         let words = nx.div_ceil(64).max(1);
         let n = words * ny * nz;
-        let tables = LEVELS
-            .iter()
-            .enumerate()
-            .map(|(k, &p)| {
-                (0..TABLE)
-                    .map(|i| {
-                        (0..64).fold(0u64, |w, b| {
-                            let h =
-                                hash64(seed ^ hash64(((k as u64) << 40) ^ ((i as u64) << 8) ^ b));
-                            let u = (h >> 11) as f64 / (1u64 << 53) as f64;
-                            w | (((u < p as f64) as u64) << b)
-                        })
-                    })
-                    .collect()
-            })
-            .collect();
+        let mut tables = Box::new([[0u64; TABLE]; LEVELS.len()]);
+        for (k, (table, &p)) in tables.iter_mut().zip(&LEVELS).enumerate() {
+            for (i, word) in table.iter_mut().enumerate() {
+                *word = (0..64).fold(0u64, |w, b| {
+                    let h = hash64(seed ^ hash64(((k as u64) << 40) ^ ((i as u64) << 8) ^ b));
+                    let u = (h >> 11) as f64 / (1u64 << 53) as f64;
+                    w | (((u < p as f64) as u64) << b)
+                });
+            }
+        }
         let mut automaton = Self {
             dims,
             words,
@@ -128,8 +181,10 @@ impl Automaton {
             hum: vec![0; n],
             act: vec![0; n],
             cld: vec![0; n],
-            membership: std::array::from_fn(|_| vec![Vec::new(); LEVELS.len()]),
+            membership: Default::default(),
             tables,
+            spare: Default::default(),
+            zeros: vec![0; words],
             wind: vec![0.0; ny],
             carry: vec![0.0; ny],
             seed,
@@ -170,23 +225,32 @@ impl Automaton {
     /// order), from `level(x, y, z)`.
     pub fn set_levels(&mut self, kind: Kind, level: impl Fn(usize, usize, usize) -> u8) {
         let [nx, ny, nz] = self.dims;
-        let n = self.words * ny * nz;
-        let mut m = vec![vec![0u64; n]; LEVELS.len()];
+        let words = self.words;
+        let mut m = Membership {
+            rows: Vec::with_capacity(ny * nz),
+            levels: Vec::with_capacity(ny * nz * words),
+            words: Vec::new(),
+        };
+        let mut row = vec![[0u64; LEVELS.len()]; words];
         for y in 0..ny {
             for z in 0..nz {
+                row.iter_mut().for_each(|w| *w = [0; LEVELS.len()]);
                 for x in 0..nx {
                     let l = level(x, y, z).min(LEVELS.len() as u8 - 1) as usize;
                     if l > 0 {
-                        let (w, b) = self.at(x, y, z);
-                        m[l][w] |= 1 << b;
+                        row[x / 64][l] |= 1 << (x % 64);
                     }
                 }
-            }
-        }
-        // Levels no cell uses keep no words.
-        for v in &mut m {
-            if v.iter().all(|&w| w == 0) {
-                v.clear();
+                m.rows.push(m.words.len());
+                for w in &row {
+                    // Only the levels some cell of the word uses keep a member word.
+                    let used = (1..LEVELS.len())
+                        .filter(|&l| w[l] != 0)
+                        .fold(0u8, |u, l| u | 1 << l);
+                    m.levels.push(used);
+                    m.words
+                        .extend((1..LEVELS.len()).filter(|&l| w[l] != 0).map(|l| w[l]));
+                }
             }
         }
         self.membership[kind as usize] = m;
@@ -203,19 +267,24 @@ impl Automaton {
     /// draw far-apart entries).
     #[inline]
     pub fn random_word(&self, kind: Kind, w: usize) -> u64 {
-        let mut mask = 0;
-        let keys = &self.keys[kind as usize];
-        for (l, members) in self.membership[kind as usize].iter().enumerate().skip(1) {
-            let Some(&m) = members.get(w) else {
-                continue;
-            };
-            if m == 0 {
-                continue;
-            }
-            let pick = ((keys[l] ^ w as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 54) as usize;
-            mask |= m & self.tables[l][pick % TABLE];
-        }
-        mask
+        let m = &self.membership[kind as usize];
+        let Some(&levels) = m.levels.get(w) else {
+            return 0;
+        };
+        let first = w - w % self.words;
+        let at = m.rows[w / self.words]
+            + m.levels[first..w]
+                .iter()
+                .map(|l| l.count_ones() as usize)
+                .sum::<usize>();
+        draw(
+            &self.tables,
+            &self.keys[kind as usize],
+            levels,
+            &m.words[at..],
+            w,
+        )
+        .0
     }
 
     /// The bits of the last word of a row that are cells (the rest stay 0).
@@ -229,7 +298,10 @@ impl Automaton {
     /// Threads a step may use: the machine's cores (1 where threads are not available, as in
     /// the browser), or what [`Automaton::set_threads`] asked for.
     fn threads(&self) -> usize {
-        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+        // Asked once: on Linux the answer reads cgroup files (tens of µs, a few % of a step).
+        static CORES: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
+        let cores =
+            *CORES.get_or_init(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
         self.threads
             .unwrap_or(cores)
             .clamp(1, cores.min(self.dims[1]))
@@ -247,19 +319,25 @@ impl Automaton {
         let [_, ny, nz] = self.dims;
         let words = self.words;
         let n = self.act.len();
-        let (mut hum, mut act, mut cld) = (vec![0u64; n], vec![0u64; n], vec![0u64; n]);
-        // `act` with one row of zeros after it: the neighbour of every cell past an edge.
-        let mut a = Vec::with_capacity(n + words);
-        a.extend_from_slice(&self.act);
-        a.resize(n + words, 0);
+        // Each layer's whole cells of wind this step; the fraction is carried.
+        let shifts: Vec<i64> = (0..ny)
+            .map(|y| {
+                let total = self.carry[y] + self.wind[y];
+                let cells = total.trunc();
+                self.carry[y] = total - cells;
+                cells as i64
+            })
+            .collect();
+        let mut out = std::mem::take(&mut self.spare);
+        out.iter_mut().for_each(|v| v.resize(n, 0));
         let threads = self.threads();
+        let [hum, act, cld] = &mut out;
         if threads <= 1 || n < (1 << 14) {
-            self.step_layers(&a, 0, &mut hum, &mut act, &mut cld);
+            self.step_layers(&shifts, 0, hum, act, cld);
         } else {
             let layer = nz * words;
             let per = ny.div_ceil(threads) * layer;
-            let this = &*self;
-            let a = &a;
+            let (this, shifts) = (&*self, &shifts);
             std::thread::scope(|scope| {
                 for (i, ((h, ac), c)) in hum
                     .chunks_mut(per)
@@ -267,90 +345,113 @@ impl Automaton {
                     .zip(cld.chunks_mut(per))
                     .enumerate()
                 {
-                    scope.spawn(move || this.step_layers(a, i * per / layer, h, ac, c));
+                    scope.spawn(move || this.step_layers(shifts, i * per / layer, h, ac, c));
                 }
             });
         }
-        (self.hum, self.act, self.cld) = (hum, act, cld);
-        self.blow();
+        std::mem::swap(&mut self.hum, &mut out[0]);
+        std::mem::swap(&mut self.act, &mut out[1]);
+        std::mem::swap(&mut self.cld, &mut out[2]);
+        self.spare = out;
         self.step += 1;
         self.refresh_keys();
     }
 
-    /// The growth, extinction and re-supply of the layers from `y0` on that `hum`, `act` and
-    /// `cld` (whole layers) hold, reading `a`: this step's activation with a row of zeros after.
-    fn step_layers(&self, a: &[u64], y0: usize, hum: &mut [u64], act: &mut [u64], cld: &mut [u64]) {
+    /// The growth, extinction, re-supply and wind of the layers from `y0` on that `hum`, `act`
+    /// and `cld` (whole layers) hold; `shifts` is every layer's wind this step, in cells.
+    fn step_layers(
+        &self,
+        shifts: &[i64],
+        y0: usize,
+        hum: &mut [u64],
+        act: &mut [u64],
+        cld: &mut [u64],
+    ) {
         let [_, ny, nz] = self.dims;
         let words = self.words;
-        let n = self.act.len();
         let tail = self.tail_mask();
+        let a = &self.act[..];
+        let zeros = &self.zeros[..words];
+        let [key_h, key_a, key_e] = &self.keys;
+        let [mem_h, mem_a, mem_e] = &self.membership;
         let layers = hum.len() / (nz * words);
         for y in y0..y0 + layers {
             for z in 0..nz {
-                let r = (y * nz + z) * words;
-                let row = |dy: isize, dz: isize| {
+                let row = y * nz + z;
+                let r = row * words;
+                let near = |dy: isize, dz: isize| -> &[u64] {
                     let (y, z) = (y as isize + dy, z as isize + dz);
                     if y >= 0 && z >= 0 && (y as usize) < ny && (z as usize) < nz {
-                        (y as usize * nz + z as usize) * words
+                        let o = (y as usize * nz + z as usize) * words;
+                        &a[o..o + words]
                     } else {
-                        n
+                        zeros
                     }
                 };
                 let near = [
-                    row(0, 1),
-                    row(0, -1),
-                    row(0, 2),
-                    row(0, -2),
-                    row(1, 0),
-                    row(-1, 0),
-                    row(-2, 0),
+                    near(0, 1),
+                    near(0, -1),
+                    near(0, 2),
+                    near(0, -2),
+                    near(1, 0),
+                    near(-1, 0),
+                    near(-2, 0),
                 ];
+                // Per kind: the words' used levels and where the row's member words start.
+                let ((lh, mut at_h), (la, mut at_a), (le, mut at_e)) = (
+                    mem_h.row(row, words),
+                    mem_a.row(row, words),
+                    mem_e.row(row, words),
+                );
                 let out = r - y0 * nz * words;
+                let (ha, aa, ca) = (
+                    &self.hum[r..r + words],
+                    &a[r..r + words],
+                    &self.cld[r..r + words],
+                );
+                let (ho, ao, co) = (
+                    &mut hum[out..out + words],
+                    &mut act[out..out + words],
+                    &mut cld[out..out + words],
+                );
                 for w in 0..words {
                     let i = r + w;
-                    let prev = if w > 0 { a[i - 1] } else { 0 };
-                    let next = if w + 1 < words { a[i + 1] } else { 0 };
+                    let prev = if w > 0 { aa[w - 1] } else { 0 };
+                    let next = if w + 1 < words { aa[w + 1] } else { 0 };
+                    let (h, ac, c) = (ha[w], aa[w], ca[w]);
                     // Bit i holds cell i+k (>>) or cell i−k (<<).
-                    let mut f = (a[i] >> 1 | next << 63)
-                        | (a[i] >> 2 | next << 62)
-                        | (a[i] << 1 | prev >> 63)
-                        | (a[i] << 2 | prev >> 62);
-                    for o in near {
-                        f |= a[o + w];
+                    let mut f = (ac >> 1 | next << 63)
+                        | (ac >> 2 | next << 62)
+                        | (ac << 1 | prev >> 63)
+                        | (ac << 2 | prev >> 62);
+                    for o in &near {
+                        f |= o[w];
                     }
-                    let (h, ac, c) = (self.hum[i], a[i], self.cld[i]);
                     let keep = if w + 1 == words { tail } else { u64::MAX };
-                    hum[out + w] = ((h & !ac) | self.random_word(Kind::Hum, i)) & keep;
-                    cld[out + w] = ((c | ac) & !self.random_word(Kind::Ext, i)) & keep;
-                    act[out + w] = ((!ac & h & f) | self.random_word(Kind::Act, i)) & keep;
+                    let tables = &self.tables;
+                    let rnd = |m: &Membership, levels: &[u8], at: &mut usize, key| {
+                        let l = levels.get(w).copied().unwrap_or(0);
+                        if l == 0 {
+                            return 0;
+                        }
+                        let (mask, read) = draw(tables, key, l, &m.words[*at..], i);
+                        *at += read;
+                        mask
+                    };
+                    let r_h = rnd(mem_h, lh, &mut at_h, key_h);
+                    let r_e = rnd(mem_e, le, &mut at_e, key_e);
+                    let r_a = rnd(mem_a, la, &mut at_a, key_a);
+                    ho[w] = ((h & !ac) | r_h) & keep;
+                    co[w] = ((c | ac) & !r_e) & keep;
+                    ao[w] = ((!ac & h & f) | r_a) & keep;
                 }
-            }
-        }
-    }
-
-    /// Moves every layer along x by its wind, carrying the fraction.
-    fn blow(&mut self) {
-        let [_, ny, nz] = self.dims;
-        for y in 0..ny {
-            let total = self.carry[y] + self.wind[y];
-            let cells = total.trunc();
-            self.carry[y] = total - cells;
-            let s = cells as i64;
-            if s == 0 {
-                continue;
-            }
-            for z in 0..nz {
-                let r = (y * nz + z) * self.words;
-                for bits in [&mut self.hum, &mut self.act, &mut self.cld] {
-                    shift_row(&mut bits[r..r + self.words], s);
+                let s = shifts[y];
+                if s != 0 {
+                    for bits in [ho, ao, co] {
+                        shift_row(bits, s);
+                        bits[words - 1] &= tail;
+                    }
                 }
-            }
-        }
-        let tail = self.tail_mask();
-        let words = self.words;
-        for bits in [&mut self.hum, &mut self.act, &mut self.cld] {
-            for row in bits.chunks_mut(words) {
-                row[words - 1] &= tail;
             }
         }
     }
@@ -383,35 +484,40 @@ impl Automaton {
 }
 
 /// Moves a row's cells `s` places toward higher x (lower when negative); cells shifted in are 0.
+/// In place: words are rewritten in the order that reads each source before it is overwritten.
 pub fn shift_row(row: &mut [u64], s: i64) {
-    let n = row.len() as i64;
-    let (words, bits) = (s.unsigned_abs() / 64, (s.unsigned_abs() % 64) as u32);
-    let words = words as i64;
-    let old = row.to_vec();
-    let get = |i: i64| {
-        if (0..n).contains(&i) {
-            old[i as usize]
-        } else {
-            0
-        }
-    };
-    for i in 0..n {
-        row[i as usize] = if s > 0 {
-            let lo = get(i - words);
-            let below = get(i - words - 1);
-            if bits == 0 {
+    let n = row.len();
+    let (words, bits) = (
+        (s.unsigned_abs() / 64) as usize,
+        (s.unsigned_abs() % 64) as u32,
+    );
+    if words >= n {
+        row.fill(0);
+        return;
+    }
+    if s > 0 {
+        for i in (0..n).rev() {
+            let lo = if i >= words { row[i - words] } else { 0 };
+            let below = if i > words { row[i - words - 1] } else { 0 };
+            row[i] = if bits == 0 {
                 lo
             } else {
                 (lo << bits) | (below >> (64 - bits))
-            }
-        } else {
-            let hi = get(i + words);
-            let above = get(i + words + 1);
-            if bits == 0 {
+            };
+        }
+    } else {
+        for i in 0..n {
+            let hi = if i + words < n { row[i + words] } else { 0 };
+            let above = if i + words + 1 < n {
+                row[i + words + 1]
+            } else {
+                0
+            };
+            row[i] = if bits == 0 {
                 hi
             } else {
                 (hi >> bits) | (above << (64 - bits))
-            }
-        };
+            };
+        }
     }
 }
