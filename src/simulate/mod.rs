@@ -300,15 +300,15 @@ impl Simulation {
     /// The density volume of the current step (`previous`: the last step's smoothed values,
     /// blended with weight `1 − t`, so playback between steps is smooth).
     pub fn density(&self, previous: Option<&[f32]>, t: f32) -> DensityVolume {
-        let now = self.smoothed();
-        let values = match previous {
-            Some(p) if p.len() == now.len() => p
-                .iter()
-                .zip(&now)
-                .map(|(a, b)| a + (b - a) * t.clamp(0.0, 1.0))
-                .collect(),
-            _ => now,
-        };
+        let mut values = self.smoothed();
+        if let Some(p) = previous.filter(|p| p.len() == values.len()) {
+            let t = t.clamp(0.0, 1.0);
+            // In place: the blend writes no second volume.
+            values
+                .iter_mut()
+                .zip(p)
+                .for_each(|(b, &a)| *b = a + (*b - a) * t);
+        }
         volume(&self.settings, self.automaton.dims, values)
     }
 }
