@@ -58,26 +58,27 @@ impl Membership {
     }
 }
 
-/// The random mask of word `i` and how many member words it read: the OR over its used
-/// `levels` of (its member word ∧ the word drawn from that level's table by `keys` and `i`),
-/// its member words starting at `members`.
+/// The random mask of word `i`: the OR over its used `levels` of (its member word ∧ the word
+/// drawn from that level's table by `keys` and `i`), its member words read from `members` at
+/// `*at` on (which moves past them).
 #[inline(always)]
 fn draw(
     tables: &Tables,
     keys: &[u64; LEVELS.len()],
     levels: u8,
     members: &[u64],
+    at: &mut usize,
     i: usize,
-) -> (u64, usize) {
-    let (mut mask, mut left, mut k) = (0, levels, 0);
+) -> u64 {
+    let (mut mask, mut left) = (0, levels);
     while left != 0 {
         let l = left.trailing_zeros() as usize & (LEVELS.len() - 1);
         left &= left - 1;
         let pick = ((keys[l] ^ i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 54) as usize;
-        mask |= members[k] & tables[l][pick % TABLE];
-        k += 1;
+        mask |= members[*at] & tables[l][pick % TABLE];
+        *at += 1;
     }
-    (mask, k)
+    mask
 }
 
 /// The nearest level of a probability (on a log scale above the smallest).
@@ -272,19 +273,13 @@ impl Automaton {
             return 0;
         };
         let first = w - w % self.words;
-        let at = m.rows[w / self.words]
+        let mut at = m.rows[w / self.words]
             + m.levels[first..w]
                 .iter()
                 .map(|l| l.count_ones() as usize)
                 .sum::<usize>();
-        draw(
-            &self.tables,
-            &self.keys[kind as usize],
-            levels,
-            &m.words[at..],
-            w,
-        )
-        .0
+        let keys = &self.keys[kind as usize];
+        draw(&self.tables, keys, levels, &m.words, &mut at, w)
     }
 
     /// The bits of the last word of a row that are cells (the rest stay 0).
@@ -429,18 +424,31 @@ impl Automaton {
                     }
                     let keep = if w + 1 == words { tail } else { u64::MAX };
                     let tables = &self.tables;
-                    let rnd = |m: &Membership, levels: &[u8], at: &mut usize, key| {
-                        let l = levels.get(w).copied().unwrap_or(0);
-                        if l == 0 {
-                            return 0;
-                        }
-                        let (mask, read) = draw(tables, key, l, &m.words[*at..], i);
-                        *at += read;
-                        mask
-                    };
-                    let r_h = rnd(mem_h, lh, &mut at_h, key_h);
-                    let r_e = rnd(mem_e, le, &mut at_e, key_e);
-                    let r_a = rnd(mem_a, la, &mut at_a, key_a);
+                    let (words_h, words_a, words_e) = (&mem_h.words, &mem_a.words, &mem_e.words);
+                    let r_h = draw(
+                        tables,
+                        key_h,
+                        lh.get(w).map_or(0, |&l| l),
+                        words_h,
+                        &mut at_h,
+                        i,
+                    );
+                    let r_e = draw(
+                        tables,
+                        key_e,
+                        le.get(w).map_or(0, |&l| l),
+                        words_e,
+                        &mut at_e,
+                        i,
+                    );
+                    let r_a = draw(
+                        tables,
+                        key_a,
+                        la.get(w).map_or(0, |&l| l),
+                        words_a,
+                        &mut at_a,
+                        i,
+                    );
                     ho[w] = ((h & !ac) | r_h) & keep;
                     co[w] = ((c | ac) & !r_e) & keep;
                     ao[w] = ((!ac & h & f) | r_a) & keep;

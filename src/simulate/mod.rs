@@ -230,10 +230,10 @@ impl Simulation {
             let z0 = i * per / plane;
             let span = 2 * r + 1;
             let mut window = vec![0u16; span * plane];
-            let (mut lines, mut sum) = (vec![0u16; plane], vec![0u16; plane]);
+            let (mut lines, mut sum, mut bits) = (vec![0u16; plane], vec![0u16; plane], Vec::new());
             // The box sums across x and y of layer `z` into its slot of the window.
             let mut make = |z: usize, window: &mut [u16]| {
-                self.sum_x(z, &mut lines, r);
+                self.sum_x(z, &mut lines, r, &mut bits);
                 let slot = &mut window[(z % span) * plane..][..plane];
                 box_sum_rows(&lines, slot, nx, ny, r);
             };
@@ -271,19 +271,17 @@ impl Simulation {
 
     /// The box sums of half-width `r` along x of the cloud bits, for the lines of layer `z`
     /// (`out`: `ny` lines of `nx` counts).
-    fn sum_x(&self, z: usize, out: &mut [u16], r: usize) {
+    /// `bits` is scratch space.
+    fn sum_x(&self, z: usize, out: &mut [u16], r: usize, bits: &mut Vec<u16>) {
         let a = &self.automaton;
         let [nx, ny, nz] = a.dims;
         let words = a.words();
-        // Each byte of cloud bits as eight 0/1 counts, looked up rather than shifted out.
-        let unpack: [[u16; 8]; 256] =
-            std::array::from_fn(|b| std::array::from_fn(|i| (b >> i) as u16 & 1));
-        let mut bits = vec![0u16; words * 64 + 2 * r];
+        bits.resize(words * 64 + 2 * r, 0);
         for (y, line) in out.chunks_exact_mut(nx).take(ny).enumerate() {
             let row = &a.cld[(y * nz + z) * words..][..words];
             for (w, &word) in row.iter().enumerate() {
                 for (k, byte) in word.to_le_bytes().into_iter().enumerate() {
-                    bits[r + w * 64 + 8 * k..][..8].copy_from_slice(&unpack[byte as usize]);
+                    bits[r + w * 64 + 8 * k..][..8].copy_from_slice(&UNPACK[byte as usize]);
                 }
             }
             // Cells past the grid's edge count as empty.
@@ -323,19 +321,45 @@ fn box_sum_rows(src: &[u16], dst: &mut [u16], len: usize, n: usize, r: usize) {
     let mut previous = &*first;
     for (i, out) in (1..n).zip(rest.chunks_exact_mut(len)) {
         // Row i's sum is row i − 1's, plus the row entering the window, less the one leaving.
+        // Zipped, not indexed: no bounds test per value where the page's size-optimised
+        // build would keep one.
         let (p, o) = (&previous[..len], &mut out[..len]);
         match (
             (i + r < n).then(|| row(i + r)),
             (i > r).then(|| row(i - r - 1)),
         ) {
-            (Some(e), Some(l)) => (0..len).for_each(|k| o[k] = p[k] + e[k] - l[k]),
-            (Some(e), None) => (0..len).for_each(|k| o[k] = p[k] + e[k]),
-            (None, Some(l)) => (0..len).for_each(|k| o[k] = p[k] - l[k]),
+            (Some(e), Some(l)) => o
+                .iter_mut()
+                .zip(p.iter().zip(e).zip(l))
+                .for_each(|(o, ((&p, &e), &l))| *o = p + e - l),
+            (Some(e), None) => o
+                .iter_mut()
+                .zip(p.iter().zip(e))
+                .for_each(|(o, (&p, &e))| *o = p + e),
+            (None, Some(l)) => o
+                .iter_mut()
+                .zip(p.iter().zip(l))
+                .for_each(|(o, (&p, &l))| *o = p - l),
             (None, None) => o.copy_from_slice(p),
         }
         previous = out;
     }
 }
+
+/// Each byte of cloud bits as eight 0/1 counts, looked up rather than shifted out.
+const UNPACK: [[u16; 8]; 256] = {
+    let mut table = [[0; 8]; 256];
+    let mut b = 0;
+    while b < 256 {
+        let mut i = 0;
+        while i < 8 {
+            table[b][i] = (b >> i) as u16 & 1;
+            i += 1;
+        }
+        b += 1;
+    }
+    table
+};
 
 /// Adds `b` to `a`, value by value.
 fn add(a: &mut [u16], b: &[u16]) {
