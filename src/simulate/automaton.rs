@@ -15,8 +15,8 @@
 //! levels, a table of words whose bits are 1 with that level's probability. A cell's
 //! probabilities (from the parcels) are rounded to a level when the parcels change; the
 //! random mask of a word is the OR over levels of (the cells at that level ∧ a word drawn from
-//! that level's table). Each row keeps member words only for the levels its cells use, so a
-//! step reads a few words per cell row rather than one per level. [`Automaton::random_word`]
+//! that level's table). Each word keeps member words only for the levels its cells use, so a
+//! step draws once per level a word holds rather than once per level. [`Automaton::random_word`]
 //! is the one source of randomness, so the byte-per-cell reference in the tests reproduces a
 //! run bit for bit.
 //!
@@ -55,6 +55,22 @@ impl Membership {
             Some(&at) => (&self.levels[row * words..(row + 1) * words], at),
             None => (&[], 0),
         }
+    }
+
+    /// The random mask of word `w` of a row whose words use `levels` (from [`Membership::row`]),
+    /// word `i` of the grid, its member words read at `*at` on.
+    #[inline(always)]
+    fn draw(
+        &self,
+        tables: &Tables,
+        keys: &[u64; LEVELS.len()],
+        levels: &[u8],
+        w: usize,
+        at: &mut usize,
+        i: usize,
+    ) -> u64 {
+        let used = levels.get(w).map_or(0, |&l| l);
+        draw(tables, keys, used, &self.words, at, i)
     }
 }
 
@@ -138,7 +154,7 @@ pub struct Automaton {
     pub act: Vec<u64>,
     /// See [`Automaton::hum`].
     pub cld: Vec<u64>,
-    /// Per kind: the cells at each level (1..) its rows use.
+    /// Per kind: the cells at each level (1..) its words use.
     membership: [Membership; 3],
     /// Per level: its random words.
     tables: Box<Tables>,
@@ -424,31 +440,9 @@ impl Automaton {
                     }
                     let keep = if w + 1 == words { tail } else { u64::MAX };
                     let tables = &self.tables;
-                    let (words_h, words_a, words_e) = (&mem_h.words, &mem_a.words, &mem_e.words);
-                    let r_h = draw(
-                        tables,
-                        key_h,
-                        lh.get(w).map_or(0, |&l| l),
-                        words_h,
-                        &mut at_h,
-                        i,
-                    );
-                    let r_e = draw(
-                        tables,
-                        key_e,
-                        le.get(w).map_or(0, |&l| l),
-                        words_e,
-                        &mut at_e,
-                        i,
-                    );
-                    let r_a = draw(
-                        tables,
-                        key_a,
-                        la.get(w).map_or(0, |&l| l),
-                        words_a,
-                        &mut at_a,
-                        i,
-                    );
+                    let r_h = mem_h.draw(tables, key_h, lh, w, &mut at_h, i);
+                    let r_e = mem_e.draw(tables, key_e, le, w, &mut at_e, i);
+                    let r_a = mem_a.draw(tables, key_a, la, w, &mut at_a, i);
                     ho[w] = ((h & !ac) | r_h) & keep;
                     co[w] = ((c | ac) & !r_e) & keep;
                     ao[w] = ((!ac & h & f) | r_a) & keep;
