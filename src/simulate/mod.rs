@@ -218,7 +218,7 @@ impl Simulation {
         // Slabs of z are shared out among the cores, each warming its own window.
         let plane = nx * ny;
         // Written once, by the slabs, without first being cleared (16 MB at the benchmark's
-        // size: clearing it costs a third of the smoothing).
+        // size: clearing it cost about a quarter of the smoothing).
         let mut out: Vec<f32> = Vec::with_capacity(plane * nz);
         let threads = std::thread::available_parallelism()
             .map_or(1, |n| n.get())
@@ -270,8 +270,7 @@ impl Simulation {
     }
 
     /// The box sums of half-width `r` along x of the cloud bits, for the lines of layer `z`
-    /// (`out`: `ny` lines of `nx` counts).
-    /// `bits` is scratch space.
+    /// (`out`: `ny` lines of `nx` counts; `bits`: scratch space).
     fn sum_x(&self, z: usize, out: &mut [u16], r: usize, bits: &mut Vec<u16>) {
         let a = &self.automaton;
         let [nx, ny, nz] = a.dims;
