@@ -95,25 +95,32 @@ impl Blob {
     pub fn row(&self, y: f32, z: f32) -> BlobRow {
         let m = &self.to_unit;
         let (dy, dz) = (y - self.center.y, z - self.center.z);
-        let across = m.y_axis * dy + m.z_axis * dz;
+        // In unit space the line is `along·dx + across` (dx = x − center.x). Its point
+        // nearest the centre, at dx = −(along·across)/|along|², and its squared distance there
+        // (from the perpendicular part of `across`, not as a difference of large terms, which
+        // would cancel for thin, turned ellipsoids) give the quadratic in completed-square form.
+        let (along, across) = (m.x_axis, m.y_axis * dy + m.z_axis * dz);
+        let a = along.length_squared();
+        let t = if a > 0.0 { -along.dot(across) / a } else { 0.0 };
         BlobRow {
             center_x: self.center.x,
-            a: m.x_axis.length_squared(),
-            b: m.x_axis.dot(across),
-            c: across.length_squared(),
+            t,
+            a,
+            c: (across + along * t).length_squared(),
             strength: self.strength,
         }
     }
 }
 
-/// A primitive along one line parallel to x ([`Blob::row`]). In the primitive's unit space the
-/// point at `x` is `along·dx + across` (dx = x − center_x), whose squared length is the
-/// quadratic a·dx² + 2b·dx + c: two multiply-adds per texel of a row.
+/// A primitive along one line parallel to x ([`Blob::row`]): in the primitive's unit space the
+/// point at `x` lies at squared distance a·(x − center_x − t)² + c from the centre, the line's
+/// point nearest it at `center_x + t` (kept apart: far from the origin their rounded sum would
+/// cost the precision that `x − center_x` keeps).
 #[derive(Clone, Copy, Debug)]
 pub struct BlobRow {
     center_x: f32,
+    t: f32,
     a: f32,
-    b: f32,
     c: f32,
     strength: f32,
 }
@@ -122,25 +129,21 @@ impl BlobRow {
     /// The primitive's contribution at `x`.
     #[inline]
     pub fn value(&self, x: f32) -> f32 {
-        let dx = x - self.center_x;
-        self.strength * wyvill((self.a * dx + 2.0 * self.b) * dx + self.c)
+        let dx = (x - self.center_x) - self.t;
+        self.strength * wyvill(self.a * dx * dx + self.c)
     }
 
     /// The open interval of x where the contribution can be non-zero (the line's chord through
     /// the unit ball of influence), if the line meets it; rounding may widen the true chord by
     /// a few ulps, so callers add slack.
     pub fn reach(&self) -> Option<(f32, f32)> {
-        // a·dx² + 2b·dx + c < 1.
-        let (a, b, c) = (self.a, self.b, self.c);
-        let disc = b * b - a * (c - 1.0);
-        if a <= 0.0 || disc <= 0.0 {
+        // a·(x − center_x − t)² + c < 1.
+        if self.a <= 0.0 || self.c >= 1.0 {
             return None;
         }
-        let (root, inv) = (disc.sqrt(), 1.0 / a);
-        Some((
-            self.center_x - (b + root) * inv,
-            self.center_x + (root - b) * inv,
-        ))
+        let half = ((1.0 - self.c) / self.a).sqrt();
+        let mid = self.center_x + self.t;
+        Some((mid - half, mid + half))
     }
 }
 
