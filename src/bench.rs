@@ -535,9 +535,7 @@ pub fn run(json: bool, only: Option<&str>) -> Result<(), String> {
     let mut offscreen = Offscreen::new().map_err(|e| e.to_string())?;
     let machine = format!(
         "{} cores, {} {}; adapter {}",
-        std::thread::available_parallelism()
-            .map(|n| n.get())
-            .unwrap_or(1),
+        crate::cores(),
         std::env::consts::OS,
         std::env::consts::ARCH,
         offscreen.adapter_name()

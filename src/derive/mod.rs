@@ -51,7 +51,7 @@ pub struct Work {
     pub interpretations: u64,
     /// Fields assembled and baked into a density volume.
     pub bakes: u64,
-    /// Kernel evaluations and clip tests of all bakes ([`bake_work`] for a full one; a
+    /// Kernel evaluations and clip tests of all bakes (at most [`bake_work`] for a full one; a
     /// partial update counts what it re-evaluated).
     pub bake_work: u64,
     /// Texels re-evaluated by all bakes (a partial update copies the others).

@@ -410,8 +410,9 @@ fn evaluate(field: &Field, grid: &Grid, dirty: &Dirty, values: &mut [f32]) -> u6
     work
 }
 
-/// The work a full bake of `field` on `grid` does: kernel evaluations (each primitive over the
-/// texels its influence reaches) plus clip tests (each cut over every texel, at most).
+/// The most work a full bake of `field` on `grid` does: kernel evaluations (each primitive over
+/// the box of texels its influence reaches; the bake visits only the chords of its rows, fewer)
+/// plus clip tests (each cut over every texel, at most).
 fn work_on(field: &Field, grid: &Grid) -> u64 {
     let kernel: u64 = field
         .all_blobs()
@@ -421,8 +422,8 @@ fn work_on(field: &Field, grid: &Grid) -> u64 {
     kernel + field.clips.len() as u64 * grid.texels()
 }
 
-/// The work [`bake`] does for `field` at `resolution` (see `work_on`). Cheap to compute (one
-/// box per primitive), so callers check it before baking.
+/// The most work [`bake`] does for `field` at `resolution` (see `work_on`). Cheap to compute
+/// (one box per primitive), so callers check it before baking.
 pub fn bake_work(field: &Field, resolution: u32) -> u64 {
     Grid::of(field, resolution).map_or(0, |grid| work_on(field, &grid))
 }
@@ -474,10 +475,7 @@ pub fn bake_fine(field: &Field, resolution: u32) -> DensityVolume {
     let Some(grid) = Grid::capped(field, resolution, cap) else {
         return DensityVolume::default();
     };
-    let threads = std::thread::available_parallelism()
-        .map_or(1, |n| n.get())
-        .min(grid.dims.z as usize / 8)
-        .max(1);
+    let threads = crate::cores().min(grid.dims.z as usize / 8).max(1);
     if threads == 1 {
         return bake_on(field, &grid);
     }

@@ -16,9 +16,9 @@
 //! probabilities (from the parcels) are rounded to a level when the parcels change; the
 //! random mask of a word is the OR over levels of (the cells at that level ∧ a word drawn from
 //! that level's table). Each word keeps member words only for the levels its cells use, so a
-//! step draws once per level a word holds rather than once per level. [`Automaton::random_word`]
-//! is the one source of randomness, so the byte-per-cell reference in the tests reproduces a
-//! run bit for bit.
+//! step draws once per level a word holds rather than once per level. The step and
+//! [`Automaton::random_word`] (which the byte-per-cell reference in the tests calls per word)
+//! both draw through one function, so the reference reproduces a run bit for bit.
 //!
 //! A step writes into spare buffers (no allocation) and moves each row by its layer's wind
 //! while the row is still in cache.
@@ -29,6 +29,8 @@ use crate::seeded::hash64;
 pub const LEVELS: [f32; 8] = [0.0, 0.002, 0.01, 0.03, 0.08, 0.2, 0.45, 1.0];
 /// Random words per level table.
 const TABLE: usize = 1024;
+// A word's used levels are a `u8` of bits, one per level.
+const _: () = assert!(LEVELS.len() == 8);
 
 /// Per level, its table of random words.
 type Tables = [[u64; TABLE]; LEVELS.len()];
@@ -261,12 +263,12 @@ impl Automaton {
                 m.rows.push(m.words.len());
                 for w in &row {
                     // Only the levels some cell of the word uses keep a member word.
-                    let used = (1..LEVELS.len())
-                        .filter(|&l| w[l] != 0)
-                        .fold(0u8, |u, l| u | 1 << l);
+                    let mut used = 0u8;
+                    for l in (1..LEVELS.len()).filter(|&l| w[l] != 0) {
+                        used |= 1 << l;
+                        m.words.push(w[l]);
+                    }
                     m.levels.push(used);
-                    m.words
-                        .extend((1..LEVELS.len()).filter(|&l| w[l] != 0).map(|l| w[l]));
                 }
             }
         }
@@ -309,10 +311,7 @@ impl Automaton {
     /// Threads a step may use: the machine's cores (1 where threads are not available, as in
     /// the browser), or what [`Automaton::set_threads`] asked for.
     fn threads(&self) -> usize {
-        // Asked once: on Linux the answer reads cgroup files (tens of µs, a few % of a step).
-        static CORES: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
-        let cores =
-            *CORES.get_or_init(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+        let cores = crate::cores();
         self.threads
             .unwrap_or(cores)
             .clamp(1, cores.min(self.dims[1]))
@@ -489,10 +488,10 @@ impl Automaton {
 /// In place: words are rewritten in the order that reads each source before it is overwritten.
 pub fn shift_row(row: &mut [u64], s: i64) {
     let n = row.len();
-    let (words, bits) = (
-        (s.unsigned_abs() / 64) as usize,
-        (s.unsigned_abs() % 64) as u32,
-    );
+    // Whole words capped at the row's length before the cast (which would wrap on 32-bit
+    // targets).
+    let words = (s.unsigned_abs() / 64).min(n as u64) as usize;
+    let bits = (s.unsigned_abs() % 64) as u32;
     if words >= n {
         row.fill(0);
         return;

@@ -62,6 +62,28 @@ fn rows_shift_across_words_and_lose_what_leaves() {
     assert_eq!(row, vec![0, 0, 1 << 1 | 1]);
     shift_row(&mut row, -130);
     assert_eq!(row, vec![0, 0, 0]);
+    // Every shift, whole words with and without a remainder, either way, against the cells
+    // moved one by one.
+    let start = [
+        0x8000_0000_0000_0001u64,
+        0xdead_beef_0123_4567,
+        0x0f0f_f0f0_1234_8765,
+    ];
+    let cells = 3 * 64;
+    for s in (-200i64..=200).chain([i64::MIN / 2, i64::MAX / 2, 1 << 40, -(1 << 40)]) {
+        let mut row = start.to_vec();
+        shift_row(&mut row, s);
+        for x in 0..cells {
+            let from = x as i64 - s;
+            let want = (0..cells as i64).contains(&from)
+                && start[from as usize / 64] >> (from as usize % 64) & 1 == 1;
+            assert_eq!(
+                row[x / 64] >> (x % 64) & 1 == 1,
+                want,
+                "shift {s}, cell {x}"
+            );
+        }
+    }
 }
 
 #[test]
@@ -301,6 +323,27 @@ fn the_smoothed_density_is_the_share_of_cloud_around_each_cell() {
         "no cloud in the big grid"
     );
     assert!(same(&big.smoothed(), &brute(&big, 1)));
+    // Each radius the settings allow on the small grid (one slab), and 0 and 2 on the big one
+    // (several slabs, each warming its window).
+    for r in 0..=4 {
+        let at_r = |s: &Simulation| Simulation {
+            settings: Settings {
+                smoothing: r,
+                ..s.settings.clone()
+            },
+            automaton: s.automaton.clone(),
+        };
+        assert!(
+            same(&at_r(&sim).smoothed(), &brute(&sim, r as i32)),
+            "radius {r}"
+        );
+        if r % 2 == 0 && r < 4 {
+            assert!(
+                same(&at_r(&big).smoothed(), &brute(&big, r as i32)),
+                "radius {r}, big"
+            );
+        }
+    }
     let (x, y, z) = (20, 7, 16);
     // Halfway between two steps: the mean of both.
     let before = sim.smoothed();
