@@ -385,7 +385,7 @@ impl Automaton {
         let [key_h, key_a, key_e] = &self.keys;
         let [mem_h, mem_a, mem_e] = &self.membership;
         let layers = hum.len() / (nz * words);
-        for y in y0..y0 + layers {
+        for (y, &s) in shifts.iter().enumerate().skip(y0).take(layers) {
             for z in 0..nz {
                 let row = y * nz + z;
                 let r = row * words;
@@ -446,7 +446,6 @@ impl Automaton {
                     co[w] = ((c | ac) & !r_e) & keep;
                     ao[w] = ((!ac & h & f) | r_a) & keep;
                 }
-                let s = shifts[y];
                 if s != 0 {
                     for bits in [ho, ao, co] {
                         shift_row(bits, s);
