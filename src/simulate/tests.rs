@@ -51,6 +51,16 @@ fn the_bit_parallel_step_equals_the_plain_one_bit_for_bit() {
         }
         assert!(a.cloud_cells() > 0);
     }
+    // Wind of more than a word a step, both ways, across a row of three words.
+    let mut a = random_automaton([150, 4, 3], 5);
+    let wind = |y: usize| 70.5 - 47.0 * y as f32;
+    a.set_wind(wind);
+    let mut r = Reference::of(&a);
+    for step in 0..6 {
+        r.step(&a, &wind);
+        a.advance();
+        assert!(r.same_as(&a), "strong wind: differs after step {}", step + 1);
+    }
 }
 
 #[test]
