@@ -426,6 +426,7 @@ impl CloudApp {
             "sun": [self.doc.scene().light.sun_azimuth_deg, self.doc.scene().light.sun_elevation_deg],
             "export": {
                 "format": self.panels.export.format.name(),
+                "transparent": self.panels.export.transparent,
                 "progress": self.panels.export.progress(),
                 "last": self.panels.export.last.as_ref().map(|r| match r {
                     Ok(names) => serde_json::json!({ "files": names }),

@@ -24,8 +24,12 @@ function parseGlb(bytes) {
   return { json, binLength };
 }
 
+// A full-quality 1920-px capture takes 50–100 s on SwiftShader (a CI machine: more); the
+// limits only catch a download that never comes.
+const DOWNLOAD_WAIT = 240_000;
+
 for (const backend of ['webgpu', 'webgl2']) {
-  test(`a glb and PNGs of the view download from the Export group (${backend})`, { timeout: 300_000 }, async () => {
+  test(`a glb and PNGs of the view download from the Export group (${backend})`, { timeout: 600_000 }, async () => {
     await withApp({ base: server.url, webgpu: backend === 'webgpu', viewport: { width: 1280, height: 800 } }, async (page) => {
       let s = await state(page);
       const [vw, vh] = s.view.viewport;
@@ -48,7 +52,7 @@ for (const backend of ['webgpu', 'webgl2']) {
 
       // The glb: a closed mesh's accessors, its binary chunk as long as its buffer.
       await click('export:glb');
-      const [glb] = await Promise.all([page.waitForEvent('download', { timeout: 120_000 }), click('export:run')]);
+      const [glb] = await Promise.all([page.waitForEvent('download', { timeout: DOWNLOAD_WAIT }), click('export:run')]);
       assert.equal(glb.suggestedFilename(), 'untitled.glb');
       const { json, binLength } = parseGlb(new Uint8Array(fs.readFileSync(await glb.path())));
       const [pos, nor, idx] = json.accessors;
@@ -62,7 +66,7 @@ for (const backend of ['webgpu', 'webgl2']) {
       // The PNG of the view at 1920 px wide, the view's shape: sky in the corner, cloud in the
       // middle; then over a transparent background.
       await click('export:png');
-      const [png] = await Promise.all([page.waitForEvent('download', { timeout: 120_000 }), click('export:run')]);
+      const [png] = await Promise.all([page.waitForEvent('download', { timeout: DOWNLOAD_WAIT }), click('export:run')]);
       assert.equal(png.suggestedFilename(), 'untitled.png');
       const img = PNG.sync.read(fs.readFileSync(await png.path()));
       assert.equal(img.width, 1920);
@@ -74,9 +78,13 @@ for (const backend of ['webgpu', 'webgl2']) {
       const middle = at(img, img.width / 2, img.height / 2);
       assert.ok(middle.slice(0, 3).some((v, i) => Math.abs(v - bg[i]) > 30), `cloud in the middle: ${middle}`);
       fs.copyFileSync(await png.path(), `test-results/screenshots/export-view-${backend}.png`);
+      // The capture is done and reported before the next clicks (a click while the job still
+      // runs would land on a disabled button or a panel about to reflow).
+      await until(page, (s) => s.view.export.progress == null && s.view.export.last?.files?.[0] === 'untitled.png (a download)', 'the PNG is reported');
 
       await click('export:transparent');
-      const [clear] = await Promise.all([page.waitForEvent('download', { timeout: 120_000 }), click('export:run')]);
+      await until(page, (s) => s.view.export.transparent === true, 'transparent background ticked');
+      const [clear] = await Promise.all([page.waitForEvent('download', { timeout: DOWNLOAD_WAIT }), click('export:run')]);
       const t = PNG.sync.read(fs.readFileSync(await clear.path()));
       assert.equal(at(t, 3, 3)[3], 0, 'a transparent corner');
       assert.equal(at(t, t.width / 2, t.height / 2)[3], 255, 'an opaque middle');
