@@ -59,7 +59,11 @@ fn the_bit_parallel_step_equals_the_plain_one_bit_for_bit() {
     for step in 0..6 {
         r.step(&a, &wind);
         a.advance();
-        assert!(r.same_as(&a), "strong wind: differs after step {}", step + 1);
+        assert!(
+            r.same_as(&a),
+            "strong wind: differs after step {}",
+            step + 1
+        );
     }
 }
 
