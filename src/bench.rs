@@ -535,7 +535,7 @@ pub fn run(json: bool, only: Option<&str>) -> Result<(), String> {
     let mut offscreen = Offscreen::new().map_err(|e| e.to_string())?;
     let machine = format!(
         "{} cores, {} {}; adapter {}",
-        crate::cores(),
+        crate::limits::cores(),
         std::env::consts::OS,
         std::env::consts::ARCH,
         offscreen.adapter_name()

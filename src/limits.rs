@@ -358,6 +358,14 @@ pub const BLEND: Param = Param::linear(
     0.4,
 );
 
+/// The cores work may be shared out among: the machine's (1 where threads are not available,
+/// as in the browser). Asked once: on Linux the answer reads cgroup files, tens of µs, which
+/// is a few percent of an automaton step.
+pub fn cores() -> usize {
+    static CORES: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
+    *CORES.get_or_init(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

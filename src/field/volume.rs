@@ -475,7 +475,7 @@ pub fn bake_fine(field: &Field, resolution: u32) -> DensityVolume {
     let Some(grid) = Grid::capped(field, resolution, cap) else {
         return DensityVolume::default();
     };
-    let threads = crate::cores().min(grid.dims.z as usize / 8).max(1);
+    let threads = crate::limits::cores().min(grid.dims.z as usize / 8).max(1);
     if threads == 1 {
         return bake_on(field, &grid);
     }

@@ -311,7 +311,7 @@ impl Automaton {
     /// Threads a step may use: the machine's cores (1 where threads are not available, as in
     /// the browser), or what [`Automaton::set_threads`] asked for.
     fn threads(&self) -> usize {
-        let cores = crate::cores();
+        let cores = crate::limits::cores();
         self.threads
             .unwrap_or(cores)
             .clamp(1, cores.min(self.dims[1]))

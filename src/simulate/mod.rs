@@ -220,7 +220,7 @@ impl Simulation {
         // Written once, by the slabs, without first being cleared (16 MB at the benchmark's
         // size: clearing it cost about a quarter of the smoothing).
         let mut out: Vec<f32> = Vec::with_capacity(plane * nz);
-        let threads = crate::cores()
+        let threads = crate::limits::cores()
             .min(nz)
             .min(if plane * nz < 1 << 18 { 1 } else { 8 });
         let per = nz.div_ceil(threads) * plane;
