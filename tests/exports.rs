@@ -107,6 +107,33 @@ fn the_glb_is_closed_consistently_oriented_and_holds_the_fields_volume() {
     assert!((volume(&pz, &tz) - 8.0 * got).abs() < 1e-3 * got);
 }
 
+/// A mesh of the plain field samples only the bricks its surface can cross: the mesh (and so
+/// the file) is the one marching cubes makes from the whole grid's field.
+#[test]
+fn a_plain_mesh_is_the_whole_grids_mesh() {
+    use cloudsketch::export::{sample, surface};
+    for scene in [
+        Scene::default(),
+        Scene::preset(cloudsketch::scene::Preset::Cumulonimbus),
+    ] {
+        let options = Options {
+            resolution: 112,
+            noise: false,
+            ..Options::default()
+        };
+        let near = sample(&scene, Format::Glb, &options).unwrap();
+        let whole = sample(&scene, Format::Vdb, &options).unwrap();
+        assert!(near.values.is_empty() && !whole.values.is_empty());
+        let mesh = surface(&near, false);
+        assert!(
+            mesh.triangles.len() > 1000,
+            "{} triangles",
+            mesh.triangles.len()
+        );
+        assert!(mesh == surface(&whole, false), "the meshes differ");
+    }
+}
+
 #[test]
 fn obj_and_ply_hold_the_same_mesh() {
     let scene = Scene::default();
@@ -179,7 +206,7 @@ fn vdb_grids_and_probes_for_openvdbs_own_reader() {
         std::fs::write(out_dir().join(&files[0].name), &files[0].bytes).unwrap();
         // Probes at the grid's texel centres (where the file's voxels sit), with the value
         // the field and media give there, evaluated directly; and points far outside.
-        let grid = cloudsketch::export::sample(&scene, 64, noise).unwrap();
+        let grid = cloudsketch::export::sample(&scene, Format::Vdb, &options).unwrap();
         let axes = Axes { up, scale: 0.5 };
         let mut probes = Vec::new();
         let mut rng = 0x9e37_79b9_u64;

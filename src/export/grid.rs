@@ -1,15 +1,17 @@
 //! The cloud sampled for export: the field baked on a grid of the chosen resolution, turned
 //! into density in [0, 1] — through the noise media as shown (the scene's time included), or
-//! the plain soft iso-surface step without them.
+//! the plain soft iso-surface step without them. A mesh of the plain field needs neither the
+//! density nor the field away from its surface, so for it only the bricks the surface can
+//! cross are evaluated ([`bake_for_surface`]).
 
 use glam::{UVec3, Vec3};
 
 use crate::field::media::Media;
-use crate::field::{DensityVolume, bake_fine, bake_fine_work, density};
+use crate::field::{DensityVolume, ISO, bake_fine, bake_fine_work, bake_for_surface, density};
 use crate::limits::{MAX_EXPORT_RESOLUTION, MAX_EXPORT_WORK};
 use crate::scene::Scene;
 
-use super::ExportError;
+use super::{ExportError, Format, Options};
 
 /// Density on a regular grid: texel `(x, y, z)` is centred at `min + (x, y, z)·h`, x fastest.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -20,9 +22,11 @@ pub struct DensityGrid {
     pub min: Vec3,
     /// Texel side in world units.
     pub h: f32,
-    /// Density in [0, 1] per texel.
+    /// Density in [0, 1] per texel (empty where the export reads only the surface).
     pub values: Vec<f32>,
-    /// The field's values (iso-surface at [`crate::field::ISO`]) on the same texels.
+    /// The field's values (iso-surface at [`crate::field::ISO`]) on the same texels; where the
+    /// export reads only the surface, exact at the corners of the cells it crosses and
+    /// elsewhere only on the right side of the level.
     pub field: Vec<f32>,
 }
 
@@ -49,9 +53,12 @@ pub struct Sampling {
 }
 
 impl Sampling {
-    /// Bakes `scene`'s field on a grid of `resolution` texels along its longest side (at most
-    /// [`MAX_EXPORT_RESOLUTION`]); the density follows with [`Sampling::step`].
-    pub fn start(scene: &Scene, resolution: u32, noise: bool) -> Result<Self, ExportError> {
+    /// Bakes `scene`'s field for `format` on a grid of `options.resolution` texels along its
+    /// longest side (at most [`MAX_EXPORT_RESOLUTION`]); the density follows with
+    /// [`Sampling::step`] (none for a mesh of the plain field, which reads only its surface).
+    pub fn start(scene: &Scene, format: Format, options: &Options) -> Result<Self, ExportError> {
+        let (resolution, noise) = (options.resolution, options.noise);
+        let surface_only = format.is_mesh() && !noise && scene.simulation.is_none();
         let volume = match &scene.simulation {
             // A simulated cloud: the run's smoothed cloud at the scene's time, on its own grid.
             Some(settings) => {
@@ -75,7 +82,11 @@ impl Sampling {
                         MAX_EXPORT_WORK as f64 / 1e6
                     )));
                 }
-                bake_fine(&field, resolution)
+                if surface_only {
+                    bake_for_surface(&field, resolution, ISO).0
+                } else {
+                    bake_fine(&field, resolution)
+                }
             }
         };
         if volume.is_empty() || volume.values.iter().all(|&v| v <= 0.0) {
@@ -85,21 +96,21 @@ impl Sampling {
             dims: volume.dims,
             min: volume.center(0, 0, 0),
             h: volume.texel_size().x,
-            values: Vec::with_capacity(volume.values.len()),
+            values: Vec::with_capacity(if surface_only { 0 } else { volume.values.len() }),
             field: Vec::new(),
         };
         Ok(Self {
+            next_z: if surface_only { grid.dims.z } else { 0 },
             volume,
             grid,
             media: noise.then(|| Media::new(scene)),
             softness: scene.render.softness,
-            next_z: 0,
         })
     }
 
     /// Fills the density of up to `slabs` more z-slabs; returns whether all are done.
     pub fn step(&mut self, slabs: u32) -> bool {
-        let end = (self.next_z + slabs).min(self.grid.dims.z);
+        let end = self.next_z.saturating_add(slabs).min(self.grid.dims.z);
         let g = &mut self.grid;
         for z in self.next_z..end {
             for y in 0..g.dims.y {
@@ -132,8 +143,11 @@ impl Sampling {
     }
 }
 
-/// Samples `scene` on a grid of `resolution` texels along its longest side (at most
-/// [`MAX_EXPORT_RESOLUTION`]), with or without the noise media, in one go.
-pub fn sample(scene: &Scene, resolution: u32, noise: bool) -> Result<DensityGrid, ExportError> {
-    Ok(Sampling::start(scene, resolution, noise)?.finish())
+/// Samples `scene` for `format` as `options` say ([`Sampling::start`]), in one go.
+pub fn sample(
+    scene: &Scene,
+    format: Format,
+    options: &Options,
+) -> Result<DensityGrid, ExportError> {
+    Ok(Sampling::start(scene, format, options)?.finish())
 }

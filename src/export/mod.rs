@@ -165,7 +165,7 @@ pub fn export(
     if format == Format::Png {
         return Err(ExportError::NeedsRenderer);
     }
-    let grid = sample(scene, options.resolution, options.noise)?;
+    let grid = sample(scene, format, options)?;
     Ok(write(scene, &grid, format, options, stem))
 }
 

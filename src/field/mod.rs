@@ -16,7 +16,7 @@ pub use inside::{InsideMap, PlacedInside};
 
 pub use volume::{
     Baked, Baker, DensityVolume, MAX_RESOLUTION, bake, bake_brute_force, bake_fine, bake_fine_work,
-    bake_work, density, lattice, resolution_within,
+    bake_for_surface, bake_work, density, lattice, resolution_within,
 };
 
 use glam::{Mat3, Vec2, Vec3};
@@ -89,30 +89,65 @@ impl Blob {
         self.strength * wyvill((self.to_unit * (p - self.center)).length_squared())
     }
 
-    /// The primitive along the line of points `(x, y, z)` for every x: what a bake needs once
-    /// per texel row (the same values as [`Blob::value`] up to float rounding).
-    #[inline]
-    pub fn row(&self, y: f32, z: f32) -> BlobRow {
+    /// What the primitive's lines parallel to x share ([`BlobRows::at`] gives each line), found
+    /// once per primitive for a bake's texel rows.
+    pub fn rows(&self) -> BlobRows {
         let m = &self.to_unit;
-        let (dy, dz) = (y - self.center.y, z - self.center.z);
-        // In unit space the line is `along·dx + across` (dx = x − center.x). Its point
-        // nearest the centre, at dx = −(along·across)/|along|², and its squared distance there
-        // (from the perpendicular part of `across`, not as a difference of large terms, which
-        // would cancel for thin, turned ellipsoids) give the quadratic in completed-square form.
-        let (along, across) = (m.x_axis, m.y_axis * dy + m.z_axis * dz);
+        // In unit space the line through (·, y, z) is `along·dx + across` (dx = x − center.x),
+        // across = y_axis·dy + z_axis·dz. Its point nearest the centre is at dx = t, where
+        // t = −(along·across)/|along|² = ty·dy + tz·dz, and its squared distance there is
+        // |across + along·t|² = |py·dy + pz·dz|², with py and pz the parts of the y and z
+        // columns perpendicular to `along`: the quadratic in completed-square form, from
+        // perpendicular parts (not as a difference of large terms, which would cancel for
+        // thin, turned ellipsoids).
+        let along = m.x_axis;
         let a = along.length_squared();
-        let t = if a > 0.0 { -along.dot(across) / a } else { 0.0 };
-        BlobRow {
-            center_x: self.center.x,
-            t,
+        let (ty, tz) = if a > 0.0 {
+            (-along.dot(m.y_axis) / a, -along.dot(m.z_axis) / a)
+        } else {
+            (0.0, 0.0)
+        };
+        BlobRows {
+            center: self.center,
             a,
-            c: (across + along * t).length_squared(),
+            ty,
+            tz,
+            py: m.y_axis + along * ty,
+            pz: m.z_axis + along * tz,
             strength: self.strength,
         }
     }
 }
 
-/// A primitive along one line parallel to x ([`Blob::row`]): in the primitive's unit space the
+/// What a primitive's lines parallel to x share ([`Blob::rows`]).
+#[derive(Clone, Copy, Debug)]
+pub struct BlobRows {
+    center: Vec3,
+    a: f32,
+    ty: f32,
+    tz: f32,
+    py: Vec3,
+    pz: Vec3,
+    strength: f32,
+}
+
+impl BlobRows {
+    /// The primitive along the line of points `(x, y, z)` for every x (the same values as
+    /// [`Blob::value`] up to float rounding).
+    #[inline]
+    pub fn at(&self, y: f32, z: f32) -> BlobRow {
+        let (dy, dz) = (y - self.center.y, z - self.center.z);
+        BlobRow {
+            center_x: self.center.x,
+            t: self.ty * dy + self.tz * dz,
+            a: self.a,
+            c: (self.py * dy + self.pz * dz).length_squared(),
+            strength: self.strength,
+        }
+    }
+}
+
+/// A primitive along one line parallel to x ([`BlobRows::at`]): in the primitive's unit space the
 /// point at `x` lies at squared distance a·(x − center_x − t)² + c from the centre, the line's
 /// point nearest it at `center_x + t` (kept apart: far from the origin their rounded sum would
 /// cost the precision that `x − center_x` keeps).

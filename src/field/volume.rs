@@ -13,7 +13,10 @@ use std::sync::Arc;
 
 use glam::{I64Vec3, UVec3, Vec3};
 
-use super::{Blob, Field, ISO, SUPPORT};
+use super::{Blob, BlobRow, Field, ISO, SUPPORT};
+
+mod surface;
+pub use surface::bake_for_surface;
 
 pub use crate::limits::MAX_GRID_RESOLUTION as MAX_RESOLUTION;
 /// Fewest texels along one side.
@@ -167,12 +170,19 @@ impl Grid {
     }
 
     fn bricks(&self) -> UVec3 {
-        (self.dims + BRICK - 1) / BRICK
+        self.bricks_of(BRICK)
+    }
+
+    /// Bricks of `size`³ texels per axis.
+    fn bricks_of(&self, size: u32) -> UVec3 {
+        (self.dims + size - 1) / size
     }
 }
 
 /// The bricks of a grid that an update re-evaluates, as runs of texels along x per brick row.
 struct Dirty {
+    /// Brick side (texels): [`BRICK`] for updates.
+    size: u32,
     bricks: UVec3,
     /// Per brick row (`by + bricks.y · bz`): merged texel ranges along x.
     runs: Vec<Vec<std::ops::Range<u32>>>,
@@ -186,6 +196,7 @@ impl Dirty {
     fn all(grid: &Grid) -> Self {
         let bricks = grid.bricks();
         Self {
+            size: BRICK,
             bricks,
             runs: vec![vec![0..grid.dims.x]; (bricks.y * bricks.z) as usize],
             bounds: Some((UVec3::ZERO, grid.dims - 1)),
@@ -194,16 +205,18 @@ impl Dirty {
 
     /// The bricks flagged in `mask` (x fastest, then y, then z).
     fn of_mask(grid: &Grid, mask: &[bool]) -> Self {
-        let bricks = grid.bricks();
+        Self::of_mask_sized(grid, mask, BRICK)
+    }
+
+    /// [`Dirty::of_mask`] for bricks of `size`³ texels.
+    fn of_mask_sized(grid: &Grid, mask: &[bool], size: u32) -> Self {
+        let bricks = grid.bricks_of(size);
         let runs = (0..(bricks.y * bricks.z) as usize)
             .map(|row| {
                 let flags = &mask[row * bricks.x as usize..][..bricks.x as usize];
                 let mut runs: Vec<std::ops::Range<u32>> = Vec::new();
                 for (bx, _) in flags.iter().enumerate().filter(|(_, f)| **f) {
-                    let (a, b) = (
-                        bx as u32 * BRICK,
-                        ((bx as u32 + 1) * BRICK).min(grid.dims.x),
-                    );
+                    let (a, b) = (bx as u32 * size, ((bx as u32 + 1) * size).min(grid.dims.x));
                     match runs.last_mut() {
                         Some(r) if r.end == a => r.end = b,
                         _ => runs.push(a..b),
@@ -219,10 +232,11 @@ impl Dirty {
                 (i as u32 / bricks.x) % bricks.y,
                 i as u32 / (bricks.x * bricks.y),
             );
-            let (lo, hi) = (b * BRICK, ((b + 1) * BRICK).min(grid.dims) - 1);
+            let (lo, hi) = (b * size, ((b + 1) * size).min(grid.dims) - 1);
             bounds = Some(bounds.map_or((lo, hi), |(a, c)| (a.min(lo), c.max(hi))));
         }
         Self {
+            size,
             bricks,
             runs,
             bounds,
@@ -244,7 +258,7 @@ impl Dirty {
         }
         for k in a.z..=b.z {
             for j in a.y..=b.y {
-                let brick_row = (j / BRICK + self.bricks.y * (k / BRICK)) as usize;
+                let brick_row = (j / self.size + self.bricks.y * (k / self.size)) as usize;
                 let at = (k as usize * ny + j as usize) * nx;
                 for r in &self.runs[brick_row] {
                     let (lo, hi) = (r.start.max(a.x), r.end.min(b.x + 1));
@@ -308,15 +322,31 @@ fn add_blob(
     // centres, which is off by several texels far from the origin).
     let (inv_h, offset) = (1.0 / grid.h as f64, grid.origin.x as f64 + 0.5);
     let index = |x: f32| x as f64 * inv_h - offset;
-    dirty.each_row(grid.dims, bx, |Row { at: row, j, k, xs }| {
-        let line = blob.row(ys_c[j], zs_c[k]);
-        let Some((lo, hi)) = line.reach() else {
-            return;
-        };
+    // The row's chord (texel indices with slack, unclamped), found once per row and kept for
+    // the row's further dirty runs.
+    let rows = blob.rows();
+    let chord = |j: usize, k: usize| {
+        let line = rows.at(ys_c[j], zs_c[k]);
+        let (lo, hi) = line.reach()?;
         // Truncation is within a texel of floor and ceil: one more texel of slack each side
         // (and no call to floor on targets without SSE4.1). The casts saturate.
-        let first = (index(lo) as i64).saturating_sub(2).max(xs.start as i64);
-        let end = (index(hi) as i64).saturating_add(3).min(xs.end as i64);
+        Some((
+            line,
+            (index(lo) as i64).saturating_sub(2),
+            (index(hi) as i64).saturating_add(3),
+        ))
+    };
+    let mut last: Option<(usize, Option<(BlobRow, i64, i64)>)> = None;
+    dirty.each_row(grid.dims, bx, |Row { at: row, j, k, xs }| {
+        let found = match last {
+            Some((at, found)) if at == row => found,
+            _ => last.insert((row, chord(j, k))).1,
+        };
+        let Some((line, first, end)) = found else {
+            return;
+        };
+        let first = first.max(xs.start as i64);
+        let end = end.min(xs.end as i64);
         if first >= end {
             return;
         }

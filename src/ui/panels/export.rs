@@ -196,7 +196,7 @@ impl ExportPanel {
             };
         }
         let scene = doc.scene().clone();
-        match Sampling::start(&scene, self.options.resolution, self.options.noise) {
+        match Sampling::start(&scene, self.format, &self.options) {
             Ok(sampling) => {
                 self.job = Some(Job::Sampling {
                     sampling,
