@@ -727,8 +727,9 @@ mod plain_mc {
 /// The cellular automaton (Dobashi et al. 2000): one step of the benchmarks' 256×64×256
 /// simulation (three parcels, random terms), bit-parallel on every core and on one (as the
 /// page runs it), against the plain byte-per-cell step with the same random words built into
-/// the same binary; the step's rate in cells per second; and the smoothing into a density
-/// volume against the step.
+/// the same binary; the step's rate in cells per second; the smoothing of a step into cloud
+/// counts and a frame's blend of two smoothed steps into the density volume, against the
+/// step.
 fn simulation() -> Vec<BenchResult> {
     use crate::simulate::{bench_simulation, reference::Reference, time_steps};
     let mut sim = bench_simulation();
@@ -744,8 +745,18 @@ fn simulation() -> Vec<BenchResult> {
     let mut plain = Reference::of(sim.automaton());
     let automaton = sim.automaton().clone();
     let reference = time_median(3, &mut || plain.step(&automaton, &wind));
+    // Each step is smoothed once (whole counts); each frame blends two smoothed steps into the
+    // density volume the renderer uploads.
     let smooth = time_median(5, &mut || {
-        std::hint::black_box(sim.density(None, 1.0));
+        std::hint::black_box(sim.smoothed());
+    });
+    let (a, b) = (sim.smoothed(), {
+        let mut next = sim.clone();
+        next.advance(1);
+        next.smoothed()
+    });
+    let blend = time_median(5, &mut || {
+        std::hint::black_box(a.blend(&b, 0.5));
     });
     vec![
         result(
@@ -775,6 +786,13 @@ fn simulation() -> Vec<BenchResult> {
         result(
             "ca_smoothing_256x64x256",
             smooth * 1e3,
+            "ms",
+            "ca_step_256x64x256",
+            step * 1e3,
+        ),
+        result(
+            "ca_frame_blend_256x64x256",
+            blend * 1e3,
             "ms",
             "ca_step_256x64x256",
             step * 1e3,

@@ -122,7 +122,7 @@ fn bench_automaton() {
     let mut smoothing: Vec<f64> = (0..5)
         .map(|_| {
             let t = now();
-            std::hint::black_box(sim.density(None, 1.0));
+            std::hint::black_box(sim.smoothed());
             now() - t
         })
         .collect();

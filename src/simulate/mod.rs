@@ -204,9 +204,9 @@ impl Simulation {
     }
 
     /// The cloud bits smoothed by a box kernel of half-width `smoothing` cells: each cell's
-    /// share of cloud around it, in [0, 1], in a density volume's order (x fastest, then y,
-    /// then z).
-    pub fn smoothed(&self) -> Vec<f32> {
+    /// count of cloud cells around it ([`Smoothed::shares`] gives the share in [0, 1]), in a
+    /// density volume's order (x fastest, then y, then z).
+    pub fn smoothed(&self) -> Smoothed {
         let a = &self.automaton;
         let [nx, ny, nz] = a.dims;
         let r = self.settings.smoothing.min(4) as usize;
@@ -217,15 +217,15 @@ impl Simulation {
         // step is a contiguous sweep of one plane, held in cache; the volume is written once.
         // Slabs of z are shared out among the cores, each warming its own window.
         let plane = nx * ny;
-        // Written once, by the slabs, without first being cleared (16 MB at the benchmark's
-        // size: clearing it cost about a quarter of the smoothing).
-        let mut out: Vec<f32> = Vec::with_capacity(plane * nz);
+        // Written once, by the slabs, without first being cleared (8 MB at the benchmark's
+        // size), in whole counts: half the bytes of shares as floats, which a frame's blend of
+        // two steps makes anyway.
+        let mut out: Vec<u16> = Vec::with_capacity(plane * nz);
         let threads = crate::limits::cores()
             .min(nz)
             .min(if plane * nz < 1 << 18 { 1 } else { 8 });
         let per = nz.div_ceil(threads) * plane;
-        let scale = 1.0 / ((2 * r + 1) as f32).powi(3);
-        let slab = |i: usize, chunk: &mut [MaybeUninit<f32>]| {
+        let slab = |i: usize, chunk: &mut [MaybeUninit<u16>]| {
             let z0 = i * per / plane;
             let span = 2 * r + 1;
             let mut window = vec![0u16; span * plane];
@@ -246,7 +246,7 @@ impl Simulation {
                     add(&mut sum, &window[((z + r) % span) * plane..][..plane]);
                 }
                 values.iter_mut().zip(&sum).for_each(|(v, &c)| {
-                    v.write(c as f32 * scale);
+                    v.write(c);
                 });
                 // The oldest plane leaves the window (its slot is the next one made).
                 if z >= r {
@@ -265,7 +265,10 @@ impl Simulation {
         // whole planes), and each slab writes every value of each of its planes (the plane's
         // `values` zipped with the equally long `sum`), so all of them are initialised.
         unsafe { out.set_len(cells) };
-        out
+        Smoothed {
+            counts: out,
+            scale: 1.0 / ((2 * r + 1) as f32).powi(3),
+        }
     }
 
     /// The box sums of half-width `r` along x of the cloud bits, for the lines of layer `z`
@@ -293,19 +296,51 @@ impl Simulation {
         }
     }
 
-    /// The density volume of the current step (`previous`: the last step's smoothed values,
+    /// The density volume of the current step (`previous`: the last step's smoothed cloud,
     /// blended with weight `1 − t`, so playback between steps is smooth).
-    pub fn density(&self, previous: Option<&[f32]>, t: f32) -> DensityVolume {
-        let mut values = self.smoothed();
-        if let Some(p) = previous.filter(|p| p.len() == values.len()) {
-            let t = t.clamp(0.0, 1.0);
-            // In place: the blend writes no second volume.
-            values
-                .iter_mut()
-                .zip(p)
-                .for_each(|(b, &a)| *b = a + (*b - a) * t);
-        }
+    pub fn density(&self, previous: Option<&Smoothed>, t: f32) -> DensityVolume {
+        let now = self.smoothed();
+        let values = match previous.filter(|p| p.counts.len() == now.counts.len()) {
+            Some(p) => p.blend(&now, t),
+            None => now.shares(),
+        };
         volume(&self.settings, self.automaton.dims, values)
+    }
+}
+
+/// One step's cloud smoothed ([`Simulation::smoothed`]): each cell's count of cloud cells in
+/// the box around it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Smoothed {
+    /// Counts per cell (at most 9³), x fastest, then y, then z.
+    pub counts: Vec<u16>,
+    /// One over the box's cells: a count's share of cloud.
+    pub scale: f32,
+}
+
+impl Smoothed {
+    /// Each cell's share of cloud around it, in [0, 1].
+    pub fn shares(&self) -> Vec<f32> {
+        self.counts.iter().map(|&c| c as f32 * self.scale).collect()
+    }
+
+    /// The shares blended toward `next`'s by `t` in [0, 1] (a frame between two steps).
+    pub fn blend(&self, next: &Smoothed, t: f32) -> Vec<f32> {
+        let t = t.clamp(0.0, 1.0);
+        let (sa, sb) = (self.scale, next.scale);
+        self.counts
+            .iter()
+            .zip(&next.counts)
+            .map(|(&a, &b)| {
+                let (x, y) = (a as f32 * sa, b as f32 * sb);
+                x + (y - x) * t
+            })
+            .collect()
+    }
+
+    /// Bytes held.
+    pub fn bytes(&self) -> usize {
+        self.counts.len() * std::mem::size_of::<u16>()
     }
 }
 
@@ -457,7 +492,7 @@ pub struct Player {
     snapshots: Vec<State>,
     /// Bytes the snapshots may hold.
     snapshot_bytes: usize,
-    smoothed: Vec<(u64, std::sync::Arc<Vec<f32>>)>,
+    smoothed: Vec<(u64, std::sync::Arc<Smoothed>)>,
 }
 
 impl Player {
@@ -491,7 +526,7 @@ impl Player {
     }
 
     /// The smoothed cloud at step `n`, or at the nearest step this call could reach.
-    fn smoothed_at(&mut self, n: u64) -> (u64, std::sync::Arc<Vec<f32>>) {
+    fn smoothed_at(&mut self, n: u64) -> (u64, std::sync::Arc<Smoothed>) {
         if let Some((s, v)) = self.smoothed.iter().find(|(s, _)| *s == n) {
             return (*s, v.clone());
         }
@@ -538,15 +573,10 @@ impl Player {
         let t = (target - n as f64) as f32;
         let (a, qa) = self.smoothed_at(n);
         if a < n {
-            return (self.volume((*qa).clone()), true);
+            return (self.volume(qa.shares()), true);
         }
         let (_, qb) = self.smoothed_at(n + 1);
-        let values = qa
-            .iter()
-            .zip(qb.iter())
-            .map(|(x, y)| x + (y - x) * t)
-            .collect();
-        (self.volume(values), false)
+        (self.volume(qa.blend(&qb, t)), false)
     }
 
     fn volume(&self, values: Vec<f32>) -> DensityVolume {
