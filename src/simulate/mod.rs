@@ -337,11 +337,6 @@ impl Smoothed {
             })
             .collect()
     }
-
-    /// Bytes held.
-    pub fn bytes(&self) -> usize {
-        self.counts.len() * std::mem::size_of::<u16>()
-    }
 }
 
 /// Writes into `dst` the sums of each of `src`'s `n` rows of `len` values with its `2r + 1`
