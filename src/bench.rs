@@ -745,7 +745,7 @@ fn simulation() -> Vec<BenchResult> {
     let mut plain = Reference::of(sim.automaton());
     let automaton = sim.automaton().clone();
     let reference = time_median(3, &mut || plain.step(&automaton, &wind));
-    // Each step is smoothed once (whole counts); each frame blends two smoothed steps into the
+    // Each step is smoothed once (byte counts); each frame blends two smoothed steps into the
     // density volume the renderer uploads.
     let smooth = time_median(5, &mut || {
         std::hint::black_box(sim.smoothed());

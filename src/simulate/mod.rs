@@ -4,15 +4,15 @@
 //!
 //! - `automaton`: the state, the growth rules, the random masks, the wind;
 //! - `reference`: the same rules one byte per cell (the tests' reference, the bench's baseline);
+//! - `smoothing`: the box counts of the cloud bits, summed bit-sliced, 64 cells at a time;
 //! - here: [`Settings`] → [`Simulation`] (parcels → per-cell probability levels), stepping,
 //!   and [`Simulation::density`] (a box kernel over the cloud bits, interpolated between steps).
 
 mod automaton;
 pub mod reference;
+mod smoothing;
 
 pub use automaton::{Automaton, Kind, LEVELS, State, level_of, shift_row};
-
-use std::mem::MaybeUninit;
 
 use glam::{Quat, UVec3, Vec3};
 
@@ -207,93 +207,7 @@ impl Simulation {
     /// count of cloud cells around it ([`Smoothed::shares`] gives the share in [0, 1]), in a
     /// density volume's order (x fastest, then y, then z).
     pub fn smoothed(&self) -> Smoothed {
-        let a = &self.automaton;
-        let [nx, ny, nz] = a.dims;
-        let r = self.settings.smoothing.min(4) as usize;
-        // One pass along z with a window of planes: each plane's box sums across x (from the
-        // bits, line by line) and then y, in whole cell counts (at most 9³: u16), are made
-        // once, kept while the window holds them, and added to / taken from a running sum
-        // whose value, scaled, is the output plane. Cells past the edge count as empty. Every
-        // step is a contiguous sweep of one plane, held in cache; the volume is written once.
-        // Slabs of z are shared out among the cores, each warming its own window.
-        let plane = nx * ny;
-        // Written once, by the slabs, without first being cleared (8 MB at the benchmark's
-        // size), in whole counts: half the bytes of shares as floats, which a frame's blend of
-        // two steps makes anyway.
-        let mut out: Vec<u16> = Vec::with_capacity(plane * nz);
-        let threads = crate::limits::cores()
-            .min(nz)
-            .min(if plane * nz < 1 << 18 { 1 } else { 8 });
-        let per = nz.div_ceil(threads) * plane;
-        let slab = |i: usize, chunk: &mut [MaybeUninit<u16>]| {
-            let z0 = i * per / plane;
-            let span = 2 * r + 1;
-            let mut window = vec![0u16; span * plane];
-            let (mut lines, mut sum, mut bits) = (vec![0u16; plane], vec![0u16; plane], Vec::new());
-            // The box sums across x and y of layer `z` into its slot of the window.
-            let mut make = |z: usize, window: &mut [u16]| {
-                self.sum_x(z, &mut lines, r, &mut bits);
-                let slot = &mut window[(z % span) * plane..][..plane];
-                box_sum_rows(&lines, slot, nx, ny, r);
-            };
-            for z in z0.saturating_sub(r)..(z0 + r).min(nz) {
-                make(z, &mut window);
-                add(&mut sum, &window[(z % span) * plane..][..plane]);
-            }
-            for (z, values) in (z0..).zip(chunk.chunks_exact_mut(plane)) {
-                if z + r < nz {
-                    make(z + r, &mut window);
-                    add(&mut sum, &window[((z + r) % span) * plane..][..plane]);
-                }
-                values.iter_mut().zip(&sum).for_each(|(v, &c)| {
-                    v.write(c);
-                });
-                // The oldest plane leaves the window (its slot is the next one made).
-                if z >= r {
-                    let old = &window[((z - r) % span) * plane..][..plane];
-                    sum.iter_mut().zip(old).for_each(|(s, &x)| *s -= x);
-                }
-            }
-        };
-        let cells = plane * nz;
-        run_parts(
-            threads,
-            out.spare_capacity_mut()[..cells].chunks_mut(per).collect(),
-            &slab,
-        );
-        // SAFETY: the slabs cover the first `cells` values of the spare capacity (chunks of
-        // whole planes), and each slab writes every value of each of its planes (the plane's
-        // `values` zipped with the equally long `sum`), so all of them are initialised.
-        unsafe { out.set_len(cells) };
-        Smoothed {
-            counts: out,
-            scale: 1.0 / ((2 * r + 1) as f32).powi(3),
-        }
-    }
-
-    /// The box sums of half-width `r` along x of the cloud bits, for the lines of layer `z`
-    /// (`out`: `ny` lines of `nx` counts; `bits`: scratch space).
-    fn sum_x(&self, z: usize, out: &mut [u16], r: usize, bits: &mut Vec<u16>) {
-        let a = &self.automaton;
-        let [nx, ny, nz] = a.dims;
-        let words = a.words();
-        bits.resize(words * 64 + 2 * r, 0);
-        for (y, line) in out.chunks_exact_mut(nx).take(ny).enumerate() {
-            let row = &a.cld[(y * nz + z) * words..][..words];
-            for (w, &word) in row.iter().enumerate() {
-                for (k, byte) in word.to_le_bytes().into_iter().enumerate() {
-                    bits[r + w * 64 + 8 * k..][..8].copy_from_slice(&UNPACK[byte as usize]);
-                }
-            }
-            // Cells past the grid's edge count as empty.
-            bits[r + nx..].fill(0);
-            line.copy_from_slice(&bits[..nx]);
-            for d in 1..=2 * r {
-                line.iter_mut()
-                    .zip(&bits[d..d + nx])
-                    .for_each(|(c, &b)| *c += b);
-            }
-        }
+        smoothing::smooth(&self.automaton, self.settings.smoothing as usize)
     }
 
     /// The density volume of the current step (`previous`: the last step's smoothed cloud,
@@ -312,9 +226,10 @@ impl Simulation {
 /// the box around it.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Smoothed {
-    /// Counts per cell (at most 9³), x fastest, then y, then z.
-    pub counts: Vec<u16>,
-    /// One over the box's cells: a count's share of cloud.
+    /// Counts per cell, x fastest, then y, then z, brought into a byte where the box holds
+    /// more than 255 cells (half-widths 3 and 4: halved or quartered, rounded).
+    pub counts: Vec<u8>,
+    /// A count's share of cloud: one over the box's cells (times the count's divisor).
     pub scale: f32,
 }
 
@@ -337,74 +252,6 @@ impl Smoothed {
             })
             .collect()
     }
-}
-
-/// Writes into `dst` the sums of each of `src`'s `n` rows of `len` values with its `2r + 1`
-/// neighbouring rows (rows past the ends count as zero).
-fn box_sum_rows(src: &[u16], dst: &mut [u16], len: usize, n: usize, r: usize) {
-    let row = |i: usize| &src[i * len..][..len];
-    let (first, rest) = dst.split_at_mut(len.min(dst.len()));
-    first.fill(0);
-    (0..(r + 1).min(n)).for_each(|i| add(first, row(i)));
-    let mut previous = &*first;
-    for (i, out) in (1..n).zip(rest.chunks_exact_mut(len)) {
-        // Row i's sum is row i − 1's, plus the row entering the window, less the one leaving.
-        // Zipped, not indexed: no bounds test per value where the page's size-optimised
-        // build would keep one.
-        let (p, o) = (&previous[..len], &mut out[..len]);
-        match (
-            (i + r < n).then(|| row(i + r)),
-            (i > r).then(|| row(i - r - 1)),
-        ) {
-            (Some(e), Some(l)) => o
-                .iter_mut()
-                .zip(p.iter().zip(e).zip(l))
-                .for_each(|(o, ((&p, &e), &l))| *o = p + e - l),
-            (Some(e), None) => o
-                .iter_mut()
-                .zip(p.iter().zip(e))
-                .for_each(|(o, (&p, &e))| *o = p + e),
-            (None, Some(l)) => o
-                .iter_mut()
-                .zip(p.iter().zip(l))
-                .for_each(|(o, (&p, &l))| *o = p - l),
-            (None, None) => o.copy_from_slice(p),
-        }
-        previous = out;
-    }
-}
-
-/// Each byte of cloud bits as eight 0/1 counts, looked up rather than shifted out.
-const UNPACK: [[u16; 8]; 256] = {
-    let mut table = [[0; 8]; 256];
-    let mut b = 0;
-    while b < 256 {
-        let mut i = 0;
-        while i < 8 {
-            table[b][i] = (b >> i) as u16 & 1;
-            i += 1;
-        }
-        b += 1;
-    }
-    table
-};
-
-/// Adds `b` to `a`, value by value.
-fn add(a: &mut [u16], b: &[u16]) {
-    a.iter_mut().zip(b).for_each(|(s, &x)| *s += x);
-}
-
-/// Runs `work(i, part)` for every part, on up to `threads` scoped threads (inline for one).
-fn run_parts<T: Send>(threads: usize, parts: Vec<T>, work: &(dyn Fn(usize, T) + Sync)) {
-    if threads <= 1 {
-        parts.into_iter().enumerate().for_each(|(i, p)| work(i, p));
-        return;
-    }
-    std::thread::scope(|scope| {
-        for (i, p) in parts.into_iter().enumerate() {
-            scope.spawn(move || work(i, p));
-        }
-    });
 }
 
 /// The density volume of `values` on a run's grid of `dims` cells.

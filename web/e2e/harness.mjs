@@ -147,12 +147,19 @@ export function recordTiming(entry) {
  */
 export async function reveal(page, name) {
   const [vw, vh] = (await state(page)).view.viewport;
-  for (let i = 0; i < 20; i++) {
+  let last = null;
+  for (let i = 0; i < 30; i++) {
     const r = (await state(page)).view.widgets[name];
     if (!r) throw new Error(`${name} is not drawn`);
-    if (r[1] >= 10 && r[1] + r[3] <= vh - 10) return r;
-    await page.mouse.move(vw + 100, vh / 2);
-    await page.mouse.wheel(0, r[1] < 10 ? -200 : 200);
+    const inView = r[1] >= 10 && r[1] + r[3] <= vh - 10;
+    // egui animates a wheel scroll over several frames: only a box that stayed put since the
+    // last look (150 ms earlier) is where a click will land.
+    if (inView && last && r.every((v, k) => v === last[k])) return r;
+    last = r;
+    if (!inView) {
+      await page.mouse.move(vw + 100, vh / 2);
+      await page.mouse.wheel(0, r[1] < 10 ? -200 : 200);
+    }
     await page.waitForTimeout(150);
   }
   throw new Error(`${name} never came into view`);
