@@ -20,8 +20,8 @@
 //! [`Automaton::random_word`] (which the byte-per-cell reference in the tests calls per word)
 //! both draw through one function, so the reference reproduces a run bit for bit.
 //!
-//! A step writes into spare buffers (no allocation) and moves each row by its layer's wind
-//! while the row is still in cache.
+//! A step writes into spare buffers (no allocation), a layer of y (its rows contiguous) as one
+//! run of words, and moves each row by its layer's wind while the layer is still in cache.
 
 use crate::seeded::hash64;
 
@@ -49,18 +49,18 @@ struct Membership {
 }
 
 impl Membership {
-    /// Row `row`'s words' used levels and the index of its first member word (none before
-    /// any level is set).
+    /// The used levels of the `n` words from row `row` on (which starts at word `first`), and
+    /// the index of their first member word (none before any level is set).
     #[inline]
-    fn row(&self, row: usize, words: usize) -> (&[u8], usize) {
+    fn words_from(&self, row: usize, first: usize, n: usize) -> (&[u8], usize) {
         match self.rows.get(row) {
-            Some(&at) => (&self.levels[row * words..(row + 1) * words], at),
+            Some(&at) => (&self.levels[first..first + n], at),
             None => (&[], 0),
         }
     }
 
-    /// The random mask of word `w` of a row whose words use `levels` (from [`Membership::row`]),
-    /// word `i` of the grid, its member words read at `*at` on.
+    /// The random mask of word `w` of a run of words that use `levels` (from
+    /// [`Membership::words_from`]), word `i` of the grid, its member words read at `*at` on.
     #[inline(always)]
     fn draw(
         &self,
@@ -162,7 +162,7 @@ pub struct Automaton {
     tables: Box<Tables>,
     /// The buffers a step writes (hum, act, cld), swapped with the state after it.
     spare: [Vec<u64>; 3],
-    /// One row of zeros: the neighbour row of every cell past an edge.
+    /// One layer of zeros: the neighbour layer of every cell past the bottom or top.
     zeros: Vec<u64>,
     /// Per kind and level: this step's key, which picks each word's draw from the table.
     keys: [[u64; LEVELS.len()]; 3],
@@ -203,7 +203,7 @@ impl Automaton {
             membership: Default::default(),
             tables,
             spare: Default::default(),
-            zeros: vec![0; words],
+            zeros: vec![0; words * nz],
             wind: vec![0.0; ny],
             carry: vec![0.0; ny],
             seed,
@@ -369,6 +369,10 @@ impl Automaton {
 
     /// The growth, extinction, re-supply and wind of the layers from `y0` on that `hum`, `act`
     /// and `cld` (whole layers) hold; `shifts` is every layer's wind this step, in cells.
+    ///
+    /// A layer's rows are contiguous, so each layer is one run of words: the neighbours along z
+    /// are `words` and `2·words` away in it (none past its ends: past the grid's edge), the
+    /// layers above and below at the same place in theirs.
     fn step_layers(
         &self,
         shifts: &[i64],
@@ -379,77 +383,87 @@ impl Automaton {
     ) {
         let [_, ny, nz] = self.dims;
         let words = self.words;
+        let layer = nz * words;
         let tail = self.tail_mask();
         let a = &self.act[..];
-        let zeros = &self.zeros[..words];
+        let zeros = &self.zeros[..layer];
         let [key_h, key_a, key_e] = &self.keys;
         let [mem_h, mem_a, mem_e] = &self.membership;
-        let layers = hum.len() / (nz * words);
-        for (y, &s) in shifts.iter().enumerate().skip(y0).take(layers) {
-            for z in 0..nz {
-                let row = y * nz + z;
-                let r = row * words;
-                let near = |dy: isize, dz: isize| -> &[u64] {
-                    let (y, z) = (y as isize + dy, z as isize + dz);
-                    if y >= 0 && z >= 0 && (y as usize) < ny && (z as usize) < nz {
-                        let o = (y as usize * nz + z as usize) * words;
-                        &a[o..o + words]
-                    } else {
-                        zeros
-                    }
-                };
-                let near = [
-                    near(0, 1),
-                    near(0, -1),
-                    near(0, 2),
-                    near(0, -2),
-                    near(1, 0),
-                    near(-1, 0),
-                    near(-2, 0),
-                ];
-                // Per kind: the words' used levels and where the row's member words start.
-                let ((lh, mut at_h), (la, mut at_a), (le, mut at_e)) = (
-                    mem_h.row(row, words),
-                    mem_a.row(row, words),
-                    mem_e.row(row, words),
-                );
-                let out = r - y0 * nz * words;
-                let (ha, aa, ca) = (
-                    &self.hum[r..r + words],
-                    &a[r..r + words],
-                    &self.cld[r..r + words],
-                );
-                let (ho, ao, co) = (
-                    &mut hum[out..out + words],
-                    &mut act[out..out + words],
-                    &mut cld[out..out + words],
-                );
-                for w in 0..words {
-                    let i = r + w;
-                    let prev = if w > 0 { aa[w - 1] } else { 0 };
-                    let next = if w + 1 < words { aa[w + 1] } else { 0 };
-                    let (h, ac, c) = (ha[w], aa[w], ca[w]);
-                    // Bit i holds cell i+k (>>) or cell i−k (<<).
-                    let mut f = (ac >> 1 | next << 63)
-                        | (ac >> 2 | next << 62)
-                        | (ac << 1 | prev >> 63)
-                        | (ac << 2 | prev >> 62);
-                    for o in &near {
-                        f |= o[w];
-                    }
-                    let keep = if w + 1 == words { tail } else { u64::MAX };
-                    let tables = &self.tables;
-                    let r_h = mem_h.draw(tables, key_h, lh, w, &mut at_h, i);
-                    let r_e = mem_e.draw(tables, key_e, le, w, &mut at_e, i);
-                    let r_a = mem_a.draw(tables, key_a, la, w, &mut at_a, i);
-                    ho[w] = ((h & !ac) | r_h) & keep;
-                    co[w] = ((c | ac) & !r_e) & keep;
-                    ao[w] = ((!ac & h & f) | r_a) & keep;
+        let tables = &self.tables;
+        let layers = hum.len() / layer;
+        let outputs = hum
+            .chunks_exact_mut(layer)
+            .zip(act.chunks_exact_mut(layer))
+            .zip(cld.chunks_exact_mut(layer));
+        for ((y, &s), ((ho, ao), co)) in shifts.iter().enumerate().skip(y0).zip(outputs) {
+            debug_assert!(y < y0 + layers);
+            let base = y * layer;
+            let near = |dy: isize| -> &[u64] {
+                let y = y as isize + dy;
+                if (0..ny as isize).contains(&y) {
+                    &a[y as usize * layer..][..layer]
+                } else {
+                    zeros
                 }
-                if s != 0 {
-                    for bits in [ho, ao, co] {
-                        shift_row(bits, s);
-                        bits[words - 1] &= tail;
+            };
+            let (above, below, below2) = (near(1), near(-1), near(-2));
+            // Per kind: the layer's words' used levels and where its member words start.
+            let ((lh, mut at_h), (la, mut at_a), (le, mut at_e)) = (
+                mem_h.words_from(y * nz, base, layer),
+                mem_a.words_from(y * nz, base, layer),
+                mem_e.words_from(y * nz, base, layer),
+            );
+            let (ha, aa, ca) = (
+                &self.hum[base..base + layer],
+                &a[base..base + layer],
+                &self.cld[base..base + layer],
+            );
+            let at = |j: Option<usize>| j.and_then(|j| aa.get(j)).copied().unwrap_or(0);
+            // Zipped, not indexed: no bounds test per word where the page's size-optimised
+            // build would keep one.
+            let words_in = ha
+                .iter()
+                .zip(aa)
+                .zip(ca)
+                .zip(above.iter().zip(below).zip(below2));
+            let words_out = ho.iter_mut().zip(ao.iter_mut()).zip(co.iter_mut());
+            // The word's place in its row.
+            let mut w = 0;
+            for (k, ((((&h, &ac), &c), ((&up, &down), &down2)), ((ho, ao), co))) in
+                words_in.zip(words_out).enumerate()
+            {
+                let i = base + k;
+                let prev = if w > 0 { aa[k - 1] } else { 0 };
+                let next = if w + 1 < words { aa[k + 1] } else { 0 };
+                // Bit i holds cell i+k (>>) or cell i−k (<<).
+                let f = (ac >> 1 | next << 63)
+                    | (ac >> 2 | next << 62)
+                    | (ac << 1 | prev >> 63)
+                    | (ac << 2 | prev >> 62)
+                    | at(k.checked_add(words))
+                    | at(k.checked_sub(words))
+                    | at(k.checked_add(2 * words))
+                    | at(k.checked_sub(2 * words))
+                    | up
+                    | down
+                    | down2;
+                let keep = if w + 1 == words { tail } else { u64::MAX };
+                let r_h = mem_h.draw(tables, key_h, lh, k, &mut at_h, i);
+                let r_e = mem_e.draw(tables, key_e, le, k, &mut at_e, i);
+                let r_a = mem_a.draw(tables, key_a, la, k, &mut at_a, i);
+                *ho = ((h & !ac) | r_h) & keep;
+                *co = ((c | ac) & !r_e) & keep;
+                *ao = ((!ac & h & f) | r_a) & keep;
+                w += 1;
+                if w == words {
+                    w = 0;
+                }
+            }
+            if s != 0 {
+                for bits in [ho, ao, co] {
+                    for row in bits.chunks_exact_mut(words) {
+                        shift_row(row, s);
+                        row[words - 1] &= tail;
                     }
                 }
             }
