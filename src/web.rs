@@ -118,7 +118,7 @@ fn bench_automaton() {
     let now = move || performance.as_ref().map_or(0.0, |p| p.now() / 1000.0);
     let mut sim = bench_simulation();
     sim.advance(1);
-    let step = time_steps(&mut sim, 9, &now);
+    let step = time_steps(&mut sim, 5, 4, &now);
     let mut smoothing: Vec<f64> = (0..5)
         .map(|_| {
             let t = now();

@@ -287,14 +287,21 @@ pub fn bench_simulation() -> Simulation {
     sim
 }
 
-/// Median seconds of one step over `runs` steps of `sim`, timed by `now` (seconds; the
-/// platform's clock: the bench's and the page's differ).
-pub fn time_steps(sim: &mut Simulation, runs: usize, now: &dyn Fn() -> f64) -> f64 {
-    let mut times: Vec<f64> = (0..runs.max(1))
+/// Seconds per step of `sim`: the median over `blocks` runs of `per_block` steps each, timed by
+/// `now` (seconds; the platform's clock: the bench's and the page's differ, and the page's
+/// ticks only every 0.1 ms, so a block spans several steps).
+pub fn time_steps(
+    sim: &mut Simulation,
+    blocks: usize,
+    per_block: usize,
+    now: &dyn Fn() -> f64,
+) -> f64 {
+    let per_block = per_block.max(1);
+    let mut times: Vec<f64> = (0..blocks.max(1))
         .map(|_| {
             let t = now();
-            sim.advance(1);
-            now() - t
+            sim.advance(per_block as u64);
+            (now() - t) / per_block as f64
         })
         .collect();
     times.sort_by(f64::total_cmp);
