@@ -47,10 +47,9 @@ fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
 
 // The cloud as fs_main draws it with the shafts' light added on top, over the cloud and the
 // sky behind it alike (alpha stays the cloud's).
-@fragment
-fn fs_shafts(in: VsOut) -> @location(0) vec4<f32> {
-    let p = textureSampleLevel(src, src_smp, in.uv, 0.0);
-    let shafts = textureSampleLevel(shafts_tex, src_smp, in.uv, 0.0).rgb;
+fn with_shafts(uv: vec2<f32>) -> vec4<f32> {
+    let p = textureSampleLevel(src, src_smp, uv, 0.0);
+    let shafts = textureSampleLevel(shafts_tex, src_smp, uv, 0.0).rgb;
     var out = vec4<f32>(0.0);
     if p.a > 1e-4 {
         out = cloud(p);
@@ -58,4 +57,19 @@ fn fs_shafts(in: VsOut) -> @location(0) vec4<f32> {
     // Added as is (not sRGB-encoded): about what adding that light to mid-tones does, where
     // encoding would brighten faint light five-fold.
     return vec4<f32>(out.rgb + (1.0 - exp(-shafts)), out.a);
+}
+
+@fragment
+fn fs_shafts(in: VsOut) -> @location(0) vec4<f32> {
+    return with_shafts(in.uv);
+}
+
+// The same over no background (a transparent image): light added to nothing has no alpha,
+// and a straight-alpha PNG would lose it, so the shafts' light covers the pixel as much as
+// its brightest channel (a glow: over a background B it gives light + (1 − a)·B).
+@fragment
+fn fs_shafts_transparent(in: VsOut) -> @location(0) vec4<f32> {
+    let c = with_shafts(in.uv);
+    let a = clamp(max(c.a, max(c.r, max(c.g, c.b))), 0.0, 1.0);
+    return vec4<f32>(min(c.rgb, vec3<f32>(a)), a);
 }

@@ -10,16 +10,17 @@ use cloudsketch::scene::{Preset, Scene, set_by_pointer};
 const W: u32 = 200;
 const H: u32 = 150;
 
-fn render(scene: &Scene) -> Image {
+/// The tests' one offscreen device (lavapipe on CPU-only machines).
+fn offscreen() -> std::sync::MutexGuard<'static, Offscreen> {
     static DEVICE: OnceLock<Mutex<Offscreen>> = OnceLock::new();
-    let device = DEVICE.get_or_init(|| {
-        Mutex::new(Offscreen::new().expect("an offscreen wgpu adapter (lavapipe)"))
-    });
-    device
+    DEVICE
+        .get_or_init(|| Mutex::new(Offscreen::new().expect("an offscreen wgpu adapter (lavapipe)")))
         .lock()
         .unwrap_or_else(|e| e.into_inner())
-        .render(scene, W, H)
-        .expect("render")
+}
+
+fn render(scene: &Scene) -> Image {
+    offscreen().render(scene, W, H).expect("render")
 }
 
 fn with(scene: &Scene, sets: &[&str]) -> Scene {
@@ -947,6 +948,42 @@ fn shafts_of_light_brighten_the_air_in_the_gaps_and_add_nothing_when_off() {
     assert!(
         crossings >= 4,
         "{crossings} changes between shaft and shadow"
+    );
+}
+
+#[test]
+fn a_transparent_image_keeps_the_shafts_light() {
+    // Over no background the shafts' light has nothing to be added to: it needs alpha of its
+    // own, or a straight-alpha image drops it (as this renderer did). Open air, transparent
+    // without shafts, carries with them about the light the opaque image adds there.
+    let layer = broken_layer();
+    let on_sets = ["/light/shafts=true", "/light/shaft_density=0.003"];
+    let transparent = |s: &Scene| offscreen().render_transparent(s, W, H).expect("render");
+    let clear = transparent(&layer);
+    let glowing = transparent(&with(&layer, &on_sets));
+    let opaque_on = render(&with(&layer, &on_sets));
+    let term = added_light(&opaque_on, &render(&layer));
+    let air: Vec<usize> = (0..(W * H) as usize)
+        .filter(|&i| clear.rgba[4 * i + 3] == 0 && term[i] > 10.0)
+        .filter(|&i| opaque_on.rgba[4 * i..4 * i + 3].iter().all(|&c| c < 250))
+        .collect();
+    assert!(
+        air.len() > (W * H / 4) as usize,
+        "{} pixels of lit air",
+        air.len()
+    );
+    let kept = air
+        .iter()
+        .filter(|&&i| {
+            let p = &glowing.rgba[4 * i..4 * i + 4];
+            let light = luminance([p[0], p[1], p[2], 255]) * p[3] as f64 / 255.0;
+            (light - term[i]).abs() < 3.0 + 0.1 * term[i]
+        })
+        .count();
+    assert!(
+        kept * 10 > air.len() * 9,
+        "{kept} of {} pixels of lit air keep the shafts' light",
+        air.len()
     );
 }
 

@@ -255,7 +255,10 @@ pub struct CompositePass {
     pub layout: wgpu::BindGroupLayout,
     /// The composite of a target with its shafts of light added (`fs_shafts`).
     pub shafts_pipeline: wgpu::RenderPipeline,
-    /// Layout of its bind group (source texture, sampler, shafts texture).
+    /// The same over a transparent background: the shafts' light with alpha of its own
+    /// (`fs_shafts_transparent`).
+    pub shafts_transparent_pipeline: wgpu::RenderPipeline,
+    /// Layout of their bind group (source texture, sampler, shafts texture).
     pub shafts_layout: wgpu::BindGroupLayout,
 }
 
@@ -292,6 +295,15 @@ impl CompositePass {
                 shaders::COMPOSITE,
                 &[&shafts_layout],
                 "fs_shafts",
+                &[output_format],
+                Some(PREMULTIPLIED_OVER),
+            ),
+            shafts_transparent_pipeline: targets_pipeline(
+                device,
+                "volume composite with shafts, transparent",
+                shaders::COMPOSITE,
+                &[&shafts_layout],
+                "fs_shafts_transparent",
                 &[output_format],
                 Some(PREMULTIPLIED_OVER),
             ),

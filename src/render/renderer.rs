@@ -502,7 +502,7 @@ impl VolumeRenderer {
         if sky {
             self.draw_sky(&mut pass);
         }
-        self.composite(&mut pass, job.plan.target);
+        self.composite(&mut pass, job.plan.target, background.is_none());
         drop(pass);
         output
     }
@@ -524,14 +524,19 @@ impl VolumeRenderer {
         self.sky.draw(pass);
     }
 
-    /// Draws accumulation target `index` over the current render pass's viewport.
-    pub fn composite(&self, pass: &mut wgpu::RenderPass<'_>, index: usize) {
+    /// Draws accumulation target `index` over the current render pass's viewport; over a
+    /// `transparent` one the shafts of light get alpha of their own.
+    pub fn composite(&self, pass: &mut wgpu::RenderPass<'_>, index: usize, transparent: bool) {
         let Some(target) = self.targets.get(index).and_then(|t| t.as_ref()) else {
             return;
         };
         match &target.shafts {
             Some((_, group)) if target.has_shafts => {
-                pass.set_pipeline(&self.composite.shafts_pipeline);
+                pass.set_pipeline(if transparent {
+                    &self.composite.shafts_transparent_pipeline
+                } else {
+                    &self.composite.shafts_pipeline
+                });
                 pass.set_bind_group(0, group, &[]);
             }
             _ => {

@@ -50,7 +50,7 @@ impl egui_wgpu::CallbackTrait for ViewportPaint {
         resources: &egui_wgpu::CallbackResources,
     ) {
         if let (Some(renderer), Some(target)) = (resources.get::<VolumeRenderer>(), self.display) {
-            renderer.composite(pass, target);
+            renderer.composite(pass, target, false);
         }
     }
 }
