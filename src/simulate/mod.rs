@@ -4,7 +4,8 @@
 //!
 //! - `automaton`: the state, the growth rules, the random masks, the wind;
 //! - `reference`: the same rules one byte per cell (the tests' reference, the bench's baseline);
-//! - `smoothing`: the box counts of the cloud bits, summed bit-sliced, 64 cells at a time;
+//! - `smoothing`: the box counts of the cloud bits, eight cells a word in byte lanes (summed
+//!   bit-sliced, 64 cells at a time, for boxes whose counts pass a byte);
 //! - here: [`Settings`] → [`Simulation`] (parcels → per-cell probability levels), stepping,
 //!   and [`Simulation::density`] (a box kernel over the cloud bits, interpolated between steps).
 

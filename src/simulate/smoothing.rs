@@ -1,13 +1,18 @@
 //! The smoothing of the automaton's cloud bits: each cell's count of cloud cells in the box of
-//! half-width `r` around it, counted 64 cells at a time.
+//! half-width `r` around it.
 //!
-//! A count is kept bit-sliced while it is summed: plane `p` is a `u64` whose bit `i` is bit `p`
-//! of cell `i`'s count, so adding two counts of 64 cells is a ripple of bitwise full adders,
-//! one per plane, instead of 64 additions. A z-plane of the grid is summed across x (the row's
-//! bits shifted by −r..r) and then across y (neighbouring rows' x-sums); a window of the last
-//! `2r + 1` such planes is summed across z for each output plane. Only then is each count
-//! written out, in a byte, eight cells per lookup and plane (a byte of a plane → eight 0/1
-//! lanes). Cells past the grid's edges count as empty.
+//! Up to half-width 2 (the box's 125 cells fit a byte) counts are summed eight cells at a
+//! time, a byte each in a `u64` (lanes that never carry into each other): a row's x-sums of
+//! eight cells are one lookup of the `8 + 2r` bits around them in a table, and the y- and
+//! z-sums are additions of those words, rows of them at a time (which the compiler
+//! vectorises). A window of the last `2r + 1` z-planes' xy-sums is summed for each output
+//! plane.
+//!
+//! Wider boxes are counted bit-sliced: plane `p` is a `u64` whose bit `i` is bit `p` of cell
+//! `i`'s count, so adding two counts of 64 cells is a ripple of bitwise full adders, one per
+//! plane. Only then is each count written out, in a byte (a byte of a plane → eight 0/1
+//! lanes, one lookup per plane), halved or quartered to fit. Cells past the grid's edges count
+//! as empty.
 
 use std::mem::MaybeUninit;
 
@@ -38,20 +43,32 @@ fn add<const N: usize, const M: usize>(acc: &mut [u64; N], x: &[u64; M]) {
     }
 }
 
-/// Each byte of a plane spread into the eight bytes of a `u64`: byte j holds bit j.
-const SPREAD: [u64; 256] = {
-    let mut table = [0; 256];
-    let mut b = 0;
-    while b < 256 {
+/// For each window of `8 + 2r` bits of a row (`N` = 2^(8 + 2r) of them), the counts of the
+/// set bits at `j..=j + 2r` for j in 0..8, byte j of the entry: the x-sums of the eight cells
+/// at the window's middle.
+const fn x_sums<const N: usize>(r: usize) -> [u64; N] {
+    assert!(N == 1 << (8 + 2 * r));
+    let mut table = [0; N];
+    let mut v = 0;
+    while v < N {
         let mut j = 0;
         while j < 8 {
-            table[b] |= ((b as u64 >> j) & 1) << (8 * j);
+            let count = ((v >> j) & ((1 << (2 * r + 1)) - 1)).count_ones() as u64;
+            table[v] |= count << (8 * j);
             j += 1;
         }
-        b += 1;
+        v += 1;
     }
     table
-};
+}
+
+/// Each byte of a plane spread into the eight bytes of a `u64`: byte j holds bit j (the
+/// x-sums of half-width 0).
+static SPREAD: [u64; 256] = x_sums(0);
+/// The x-sums of half-width 1 (8 kB).
+static X_SUMS_1: [u64; 1 << 10] = x_sums(1);
+/// The x-sums of half-width 2 (32 kB).
+static X_SUMS_2: [u64; 1 << 12] = x_sums(2);
 
 /// The planes (bits) counts up to `max` need.
 const fn planes_for(max: usize) -> usize {
@@ -93,12 +110,12 @@ pub(super) fn smooth(a: &Automaton, r: usize) -> Smoothed {
     let slab = |i: usize, chunk: &mut [MaybeUninit<u8>]| {
         let z0 = i * per / plane;
         let zs = z0..z0 + chunk.len() / plane;
-        // The planes of an x-sum, an xy-sum and an xyz-sum: enough for (2r + 1), (2r + 1)² and
-        // (2r + 1)³ ([`planes_for`]).
+        // Up to half-width 2 in byte lanes; then bit-sliced, the planes of an x-sum, an xy-sum
+        // and an xyz-sum enough for (2r + 1), (2r + 1)² and (2r + 1)³ ([`planes_for`]).
         match r {
-            0 => Slab::<1, 1, 1>::new(a, r).write(zs, chunk),
-            1 => Slab::<2, 4, 5>::new(a, r).write(zs, chunk),
-            2 => Slab::<3, 5, 7>::new(a, r).write(zs, chunk),
+            0 => Lanes::new(a, &SPREAD).write(zs, chunk),
+            1 => Lanes::new(a, &X_SUMS_1).write(zs, chunk),
+            2 => Lanes::new(a, &X_SUMS_2).write(zs, chunk),
             3 => Slab::<3, 6, 9>::new(a, r).write(zs, chunk),
             _ => Slab::<4, 7, 10>::new(a, r).write(zs, chunk),
         }
@@ -116,6 +133,135 @@ pub(super) fn smooth(a: &Automaton, r: usize) -> Smoothed {
         counts: out,
         scale: (1u32 << byte_shift(planes_for((2 * r + 1).pow(3)))) as f32
             / ((2 * r + 1) as f32).powi(3),
+    }
+}
+
+/// `dst[l]` = the sum over `rows` of `row[l]` (each row as long as `dst`; one to five rows).
+#[inline(always)]
+fn sum_rows(dst: &mut [u64], rows: &[&[u64]]) {
+    let n = dst.len();
+    let row = |k: usize| &rows[k][..n];
+    match rows.len() {
+        1 => dst.copy_from_slice(row(0)),
+        2 => {
+            for ((d, a), b) in dst.iter_mut().zip(row(0)).zip(row(1)) {
+                *d = a + b;
+            }
+        }
+        3 => {
+            for (((d, a), b), c) in dst.iter_mut().zip(row(0)).zip(row(1)).zip(row(2)) {
+                *d = a + b + c;
+            }
+        }
+        _ => {
+            sum_rows(dst, &rows[..3]);
+            for r in &rows[3..] {
+                for (d, x) in dst.iter_mut().zip(&r[..n]) {
+                    *d += x;
+                }
+            }
+        }
+    }
+}
+
+/// One thread's sums for half-widths up to 2, eight cells' counts a byte each in a `u64`:
+/// the x-sums of a z-plane's rows and a window of the last z-planes' xy-sums.
+struct Lanes<'a, const N: usize> {
+    a: &'a Automaton,
+    /// The x-sums of each window of `8 + 2r` bits ([`x_sums`]; N = 2^(8 + 2r)).
+    table: &'static [u64; N],
+    /// Lanes of eight cells per row (eight per word).
+    lanes: usize,
+    /// A z-plane's x-sums: row y's lane l at `y·lanes + l`.
+    xs: Vec<u64>,
+    /// `2r + 1` slots of xy-sums (plane z in slot z mod 2r+1), laid out as `xs`.
+    window: Vec<u64>,
+    /// One output row's sums.
+    line: Vec<u64>,
+}
+
+impl<'a, const N: usize> Lanes<'a, N> {
+    /// The half-width (a constant, so the row's bits shift by constants).
+    const R: usize = (N.trailing_zeros() as usize - 8) / 2;
+
+    fn new(a: &'a Automaton, table: &'static [u64; N]) -> Self {
+        let r = Self::R;
+        debug_assert!(r <= 2 && N == 1 << (8 + 2 * r));
+        let [_, ny, _] = a.dims;
+        let lanes = 8 * a.words();
+        Self {
+            a,
+            table,
+            lanes,
+            xs: vec![0; ny * lanes],
+            window: vec![0; (2 * r + 1) * ny * lanes],
+            line: vec![0; lanes],
+        }
+    }
+
+    /// The xy-sums of z-plane `z` into its slot of the window.
+    fn make(&mut self, z: usize) {
+        let a = self.a;
+        let [_, ny, nz] = a.dims;
+        let (r, words, lanes) = (Self::R, a.words(), self.lanes);
+        for (y, sums) in self.xs.chunks_exact_mut(lanes).enumerate() {
+            let row = &a.cld[(y * nz + z) * words..][..words];
+            for (w, eight) in sums.as_chunks_mut::<8>().0.iter_mut().enumerate() {
+                let prev = if w > 0 { row[w - 1] } else { 0 };
+                let next = if w + 1 < words { row[w + 1] } else { 0 };
+                // Bit k is cell 64w − r + k (cells past the row's ends are 0 bits).
+                let wide =
+                    ((next as u128) << 64 | row[w] as u128) << r | (prev as u128) >> (64 - r);
+                for (b, sum) in eight.iter_mut().enumerate() {
+                    *sum = self.table[(wide >> (8 * b)) as usize & (N - 1)];
+                }
+            }
+        }
+        let layer = ny * lanes;
+        let slot = &mut self.window[(z % (2 * r + 1)) * layer..][..layer];
+        for (y, sums) in slot.chunks_exact_mut(lanes).enumerate() {
+            let mut rows: [&[u64]; 5] = [&[]; 5];
+            let near = y.saturating_sub(r)..(y + r + 1).min(ny);
+            let n = near.len();
+            for (row, k) in rows.iter_mut().zip(near) {
+                *row = &self.xs[k * lanes..][..lanes];
+            }
+            sum_rows(sums, &rows[..n]);
+        }
+    }
+
+    /// Writes the counts of z-planes `zs` into `out` (their planes, in order).
+    fn write(mut self, zs: std::ops::Range<usize>, out: &mut [MaybeUninit<u8>]) {
+        let [nx, ny, nz] = self.a.dims;
+        let (r, lanes) = (Self::R, self.lanes);
+        let span = 2 * r + 1;
+        let layer = ny * lanes;
+        for z in zs.start.saturating_sub(r)..(zs.start + r).min(nz) {
+            self.make(z);
+        }
+        for (z, values) in zs.zip(out.chunks_exact_mut(nx * ny)) {
+            if z + r < nz {
+                self.make(z + r);
+            }
+            let near = z.saturating_sub(r)..(z + r + 1).min(nz);
+            let n = near.len();
+            for (y, cells) in values.chunks_exact_mut(nx).enumerate() {
+                let mut rows: [&[u64]; 5] = [&[]; 5];
+                for (row, k) in rows.iter_mut().zip(near.clone()) {
+                    *row = &self.window[(k % span) * layer + y * lanes..][..lanes];
+                }
+                let line = &mut self.line;
+                sum_rows(line, &rows[..n]);
+                // Byte j of lane l is cell 8l + j (in memory order once little-endian).
+                if cfg!(target_endian = "big") {
+                    line.iter_mut().for_each(|l| *l = l.to_le());
+                }
+                let counts: &[u8] = bytemuck::cast_slice(line);
+                for (cell, &count) in cells.iter_mut().zip(counts) {
+                    cell.write(count);
+                }
+            }
+        }
     }
 }
 
