@@ -180,6 +180,20 @@ struct Lanes<'a, const N: usize> {
     line: Vec<u64>,
 }
 
+impl<const N: usize> Window for Lanes<'_, N> {
+    fn automaton(&self) -> &Automaton {
+        self.a
+    }
+
+    fn half_width(&self) -> usize {
+        Self::R
+    }
+
+    fn make(&mut self, z: usize) {
+        self.make_plane(z);
+    }
+}
+
 impl<'a, const N: usize> Lanes<'a, N> {
     /// The half-width (a constant, so the row's bits shift by constants).
     const R: usize = (N.trailing_zeros() as usize - 8) / 2;
@@ -200,7 +214,7 @@ impl<'a, const N: usize> Lanes<'a, N> {
     }
 
     /// The xy-sums of z-plane `z` into its slot of the window.
-    fn make(&mut self, z: usize) {
+    fn make_plane(&mut self, z: usize) {
         let a = self.a;
         let [_, ny, nz] = a.dims;
         let (r, words, lanes) = (Self::R, a.words(), self.lanes);
@@ -231,26 +245,18 @@ impl<'a, const N: usize> Lanes<'a, N> {
     }
 
     /// Writes the counts of z-planes `zs` into `out` (their planes, in order).
-    fn write(mut self, zs: std::ops::Range<usize>, out: &mut [MaybeUninit<u8>]) {
-        let [nx, ny, nz] = self.a.dims;
-        let (r, lanes) = (Self::R, self.lanes);
-        let span = 2 * r + 1;
-        let layer = ny * lanes;
-        for z in zs.start.saturating_sub(r)..(zs.start + r).min(nz) {
-            self.make(z);
-        }
-        for (z, values) in zs.zip(out.chunks_exact_mut(nx * ny)) {
-            if z + r < nz {
-                self.make(z + r);
-            }
-            let near = z.saturating_sub(r)..(z + r + 1).min(nz);
+    fn write(self, zs: std::ops::Range<usize>, out: &mut [MaybeUninit<u8>]) {
+        let [nx, ny, _] = self.a.dims;
+        let lanes = self.lanes;
+        let (span, layer) = (2 * Self::R + 1, ny * lanes);
+        self.slide(zs, out, |this, near, values| {
             let n = near.len();
             for (y, cells) in values.chunks_exact_mut(nx).enumerate() {
                 let mut rows: [&[u64]; 5] = [&[]; 5];
                 for (row, k) in rows.iter_mut().zip(near.clone()) {
-                    *row = &self.window[(k % span) * layer + y * lanes..][..lanes];
+                    *row = &this.window[(k % span) * layer + y * lanes..][..lanes];
                 }
-                let line = &mut self.line;
+                let line = &mut this.line;
                 sum_rows(line, &rows[..n]);
                 // Byte j of lane l is cell 8l + j (in memory order once little-endian).
                 if cfg!(target_endian = "big") {
@@ -261,6 +267,37 @@ impl<'a, const N: usize> Lanes<'a, N> {
                     cell.write(count);
                 }
             }
+        });
+    }
+}
+
+/// A thread's sums over a window of z-planes: what [`Window::slide`] walks.
+trait Window: Sized {
+    /// The automaton summed.
+    fn automaton(&self) -> &Automaton;
+    /// The window's half-width.
+    fn half_width(&self) -> usize;
+    /// Sums plane z into its slot of the window.
+    fn make(&mut self, z: usize);
+
+    /// Walks z-planes `zs`: [`Window::make`] once for every plane the window needs, in order,
+    /// each before the first `emit(self, near, values)` whose planes `near` hold it, which
+    /// writes plane z's `values` (`out` holds the planes of `zs` in order).
+    fn slide(
+        mut self,
+        zs: std::ops::Range<usize>,
+        out: &mut [MaybeUninit<u8>],
+        mut emit: impl FnMut(&mut Self, std::ops::Range<usize>, &mut [MaybeUninit<u8>]),
+    ) {
+        let ([nx, ny, nz], r) = (self.automaton().dims, self.half_width());
+        for z in zs.start.saturating_sub(r)..(zs.start + r).min(nz) {
+            self.make(z);
+        }
+        for (z, values) in zs.zip(out.chunks_exact_mut(nx * ny)) {
+            if z + r < nz {
+                self.make(z + r);
+            }
+            emit(&mut self, z.saturating_sub(r)..(z + r + 1).min(nz), values);
         }
     }
 }
@@ -274,6 +311,20 @@ struct Slab<'a, const PX: usize, const PY: usize, const PZ: usize> {
     xs: Vec<[u64; PX]>,
     /// `2r + 1` slots of xy-sums (plane z in slot z mod 2r+1), laid out as `xs`.
     window: Vec<[u64; PY]>,
+}
+
+impl<const PX: usize, const PY: usize, const PZ: usize> Window for Slab<'_, PX, PY, PZ> {
+    fn automaton(&self) -> &Automaton {
+        self.a
+    }
+
+    fn half_width(&self) -> usize {
+        self.r
+    }
+
+    fn make(&mut self, z: usize) {
+        self.make_plane(z);
+    }
 }
 
 impl<'a, const PX: usize, const PY: usize, const PZ: usize> Slab<'a, PX, PY, PZ> {
@@ -294,7 +345,7 @@ impl<'a, const PX: usize, const PY: usize, const PZ: usize> Slab<'a, PX, PY, PZ>
     }
 
     /// The xy-sums of z-plane `z` into its slot of the window.
-    fn make(&mut self, z: usize) {
+    fn make_plane(&mut self, z: usize) {
         let a = self.a;
         let [_, ny, nz] = a.dims;
         let (r, words) = (self.r, a.words());
@@ -327,21 +378,13 @@ impl<'a, const PX: usize, const PY: usize, const PZ: usize> Slab<'a, PX, PY, PZ>
     }
 
     /// Writes the counts of z-planes `zs` into `out` (their planes, in order).
-    fn write(mut self, zs: std::ops::Range<usize>, out: &mut [MaybeUninit<u8>]) {
-        let [nx, ny, nz] = self.a.dims;
-        let (r, words) = (self.r, self.a.words());
-        let span = 2 * r + 1;
-        let layer = ny * words;
-        for z in zs.start.saturating_sub(r)..(zs.start + r).min(nz) {
-            self.make(z);
-        }
-        for (z, values) in zs.zip(out.chunks_exact_mut(nx * ny)) {
-            if z + r < nz {
-                self.make(z + r);
-            }
+    fn write(self, zs: std::ops::Range<usize>, out: &mut [MaybeUninit<u8>]) {
+        let [nx, ny, _] = self.a.dims;
+        let words = self.a.words();
+        let (span, layer) = (2 * self.r + 1, ny * words);
+        self.slide(zs, out, |this, near, values| {
             // The window's slots of the planes around z.
             let mut slots = [0; 9];
-            let near = z.saturating_sub(r)..(z + r + 1).min(nz);
             let slots = &mut slots[..near.len()];
             for (slot, k) in slots.iter_mut().zip(near) {
                 *slot = (k % span) * layer;
@@ -350,7 +393,7 @@ impl<'a, const PX: usize, const PY: usize, const PZ: usize> Slab<'a, PX, PY, PZ>
                 for (w, cells) in line.chunks_mut(64).enumerate() {
                     let mut acc = [0u64; PZ];
                     for &slot in &*slots {
-                        add(&mut acc, &self.window[slot + y * words + w]);
+                        add(&mut acc, &this.window[slot + y * words + w]);
                     }
                     // Counts over a byte (r = 3, 4) are rounded: half of the lowest kept
                     // plane added, the planes below dropped.
@@ -382,7 +425,7 @@ impl<'a, const PX: usize, const PY: usize, const PZ: usize> Slab<'a, PX, PY, PZ>
                     }
                 }
             }
-        }
+        });
     }
 }
 
