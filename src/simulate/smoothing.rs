@@ -258,13 +258,15 @@ impl<'a, const N: usize> Lanes<'a, N> {
                 }
                 let line = &mut this.line;
                 sum_rows(line, &rows[..n]);
-                // Byte j of lane l is cell 8l + j (in memory order once little-endian).
-                if cfg!(target_endian = "big") {
-                    line.iter_mut().for_each(|l| *l = l.to_le());
+                // Byte j of lane l is cell 8l + j.
+                let (eights, rest) = cells.as_chunks_mut::<8>();
+                for (eight, l) in eights.iter_mut().zip(line.iter()) {
+                    *eight = l.to_le_bytes().map(MaybeUninit::new);
                 }
-                let counts: &[u8] = bytemuck::cast_slice(line);
-                for (cell, &count) in cells.iter_mut().zip(counts) {
-                    cell.write(count);
+                if let Some(l) = line.get(eights.len()) {
+                    for (cell, count) in rest.iter_mut().zip(l.to_le_bytes()) {
+                        cell.write(count);
+                    }
                 }
             }
         });
