@@ -258,15 +258,22 @@ impl<'a, const N: usize> Lanes<'a, N> {
                 }
                 let line = &mut this.line;
                 sum_rows(line, &rows[..n]);
-                // Byte j of lane l is cell 8l + j.
-                let (eights, rest) = cells.as_chunks_mut::<8>();
-                for (eight, l) in eights.iter_mut().zip(line.iter()) {
-                    *eight = l.to_le_bytes().map(MaybeUninit::new);
+                // Byte j of lane l is cell 8l + j, in memory order once little-endian: the
+                // row's counts are the line's first nx bytes, copied at once (the page's
+                // size-optimised build would otherwise store them lane by lane, or byte by
+                // byte).
+                if cfg!(target_endian = "big") {
+                    line.iter_mut().for_each(|l| *l = l.to_le());
                 }
-                if let Some(l) = line.get(eights.len()) {
-                    for (cell, count) in rest.iter_mut().zip(l.to_le_bytes()) {
-                        cell.write(count);
-                    }
+                debug_assert!(8 * line.len() >= cells.len());
+                // SAFETY: `line` holds 8·lanes ≥ nx bytes, `cells` is nx writable bytes
+                // (`MaybeUninit<u8>` is laid out as `u8`), and the two do not overlap.
+                unsafe {
+                    std::ptr::copy_nonoverlapping(
+                        line.as_ptr().cast::<u8>(),
+                        cells.as_mut_ptr().cast::<u8>(),
+                        cells.len(),
+                    );
                 }
             }
         });
