@@ -126,8 +126,8 @@ pub(super) fn smooth(a: &Automaton, r: usize) -> Smoothed {
         &slab,
     );
     // SAFETY: the slabs cover the first `cells` values of the spare capacity (chunks of whole
-    // planes), and `Slab::write` writes every value of each of its planes, so all of them are
-    // initialised.
+    // planes), and `Lanes::write` and `Slab::write` write every value of each of their planes,
+    // so all of them are initialised.
     unsafe { out.set_len(cells) };
     Smoothed {
         counts: out,
@@ -190,31 +190,6 @@ impl<const N: usize> Window for Lanes<'_, N> {
     }
 
     fn make(&mut self, z: usize) {
-        self.make_plane(z);
-    }
-}
-
-impl<'a, const N: usize> Lanes<'a, N> {
-    /// The half-width (a constant, so the row's bits shift by constants).
-    const R: usize = (N.trailing_zeros() as usize - 8) / 2;
-
-    fn new(a: &'a Automaton, table: &'static [u64; N]) -> Self {
-        let r = Self::R;
-        debug_assert!(r <= 2 && N == 1 << (8 + 2 * r));
-        let [_, ny, _] = a.dims;
-        let lanes = 8 * a.words();
-        Self {
-            a,
-            table,
-            lanes,
-            xs: vec![0; ny * lanes],
-            window: vec![0; (2 * r + 1) * ny * lanes],
-            line: vec![0; lanes],
-        }
-    }
-
-    /// The xy-sums of z-plane `z` into its slot of the window.
-    fn make_plane(&mut self, z: usize) {
         let a = self.a;
         let [_, ny, nz] = a.dims;
         let (r, words, lanes) = (Self::R, a.words(), self.lanes);
@@ -241,6 +216,26 @@ impl<'a, const N: usize> Lanes<'a, N> {
                 *row = &self.xs[k * lanes..][..lanes];
             }
             sum_rows(sums, &rows[..n]);
+        }
+    }
+}
+
+impl<'a, const N: usize> Lanes<'a, N> {
+    /// The half-width (a constant, so the row's bits shift by constants).
+    const R: usize = (N.trailing_zeros() as usize - 8) / 2;
+
+    fn new(a: &'a Automaton, table: &'static [u64; N]) -> Self {
+        let r = Self::R;
+        debug_assert!(r <= 2 && N == 1 << (8 + 2 * r));
+        let [_, ny, _] = a.dims;
+        let lanes = 8 * a.words();
+        Self {
+            a,
+            table,
+            lanes,
+            xs: vec![0; ny * lanes],
+            window: vec![0; (2 * r + 1) * ny * lanes],
+            line: vec![0; lanes],
         }
     }
 
@@ -332,29 +327,6 @@ impl<const PX: usize, const PY: usize, const PZ: usize> Window for Slab<'_, PX, 
     }
 
     fn make(&mut self, z: usize) {
-        self.make_plane(z);
-    }
-}
-
-impl<'a, const PX: usize, const PY: usize, const PZ: usize> Slab<'a, PX, PY, PZ> {
-    fn new(a: &'a Automaton, r: usize) -> Self {
-        let [_, ny, _] = a.dims;
-        let layer = ny * a.words();
-        let span = 2 * r + 1;
-        debug_assert_eq!(
-            [PX, PY, PZ],
-            [span, span * span, span.pow(3)].map(planes_for)
-        );
-        Self {
-            a,
-            r,
-            xs: vec![[0; PX]; layer],
-            window: vec![[0; PY]; (2 * r + 1) * layer],
-        }
-    }
-
-    /// The xy-sums of z-plane `z` into its slot of the window.
-    fn make_plane(&mut self, z: usize) {
         let a = self.a;
         let [_, ny, nz] = a.dims;
         let (r, words) = (self.r, a.words());
@@ -383,6 +355,24 @@ impl<'a, const PX: usize, const PY: usize, const PZ: usize> Slab<'a, PX, PY, PZ>
                     add(acc, &self.xs[y * words + w]);
                 }
             }
+        }
+    }
+}
+
+impl<'a, const PX: usize, const PY: usize, const PZ: usize> Slab<'a, PX, PY, PZ> {
+    fn new(a: &'a Automaton, r: usize) -> Self {
+        let [_, ny, _] = a.dims;
+        let layer = ny * a.words();
+        let span = 2 * r + 1;
+        debug_assert_eq!(
+            [PX, PY, PZ],
+            [span, span * span, span.pow(3)].map(planes_for)
+        );
+        Self {
+            a,
+            r,
+            xs: vec![[0; PX]; layer],
+            window: vec![[0; PY]; (2 * r + 1) * layer],
         }
     }
 
