@@ -40,6 +40,41 @@ fn slice_position(j: i32) -> i32 {
     return j + beyond - first;
 }
 
+// The rectangle, along the image's right and up from `centre` (min xy, max zw), around the
+// polygon where the plane through `centre` facing the view cuts the grid's box: the crossings
+// of its twelve edges. Empty (all zero) where the plane misses the box. Fragments of the
+// rectangle outside the box are still discarded; most of those of the bounding sphere's
+// square, which the slices covered before, are no longer drawn.
+fn slice_bounds(centre: vec3<f32>) -> vec4<f32> {
+    let n = u.forward.xyz;
+    let lo = u.grid_min.xyz;
+    let size = 1.0 / u.grid_inv_size.xyz;
+    var axes = array<vec3<f32>, 3>(
+        vec3<f32>(size.x, 0.0, 0.0), vec3<f32>(0.0, size.y, 0.0), vec3<f32>(0.0, 0.0, size.z),
+    );
+    var bounds = vec4<f32>(1e30, 1e30, -1e30, -1e30);
+    for (var e = 0u; e < 12u; e = e + 1u) {
+        // Edge e runs along axis e / 4 from the corner the bits of e % 4 pick on the others.
+        let axis = e / 4u;
+        let bits = e % 4u;
+        let a = lo + f32(bits & 1u) * axes[(axis + 1u) % 3u] + f32(bits >> 1u) * axes[(axis + 2u) % 3u];
+        let b = a + axes[axis];
+        let da = dot(n, a - centre);
+        let db = dot(n, b - centre);
+        if (da <= 0.0) != (db <= 0.0) {
+            let p = mix(a, b, da / (da - db)) - centre;
+            let q = vec2<f32>(dot(p, u.right.xyz), dot(p, u.up.xyz));
+            bounds = vec4<f32>(min(bounds.xy, q), max(bounds.zw, q));
+        }
+    }
+    if bounds.x > bounds.z {
+        return vec4<f32>(0.0);
+    }
+    // A margin of a thousandth of the box, so rounding loses no pixel at its rim.
+    let margin = 1e-3 * length(size);
+    return bounds + vec4<f32>(-margin, -margin, margin, margin);
+}
+
 @vertex
 fn vs_main(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> VsOut {
     var out: VsOut;
@@ -76,17 +111,18 @@ fn vs_main(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> 
         slice_in_draw = lo - 1;
     }
     // Slice 0 is the farthest; slices span the grid box's depth along the view (from
-    // grid_min.w toward the eye), and each quad covers the bounding sphere's cross-section.
+    // grid_min.w toward the eye), and each quad is the rectangle (along the image's right and
+    // up) around the polygon where the slice's plane cuts the box.
     let slice = f32(slice_in_draw) + u.slicing.y;
-    let r = u.sphere.w;
     let d = u.grid_min.w - (slice + 0.5) * u.slicing.z;
-    let half = sqrt(max(r * r - d * d, 0.0));
+    let centre = u.sphere.xyz + u.forward.xyz * d;
+    let bounds = slice_bounds(centre);
     var corners = array<vec2<f32>, 6>(
-        vec2<f32>(-1.0, -1.0), vec2<f32>(1.0, -1.0), vec2<f32>(1.0, 1.0),
-        vec2<f32>(-1.0, -1.0), vec2<f32>(1.0, 1.0), vec2<f32>(-1.0, 1.0),
+        bounds.xy, bounds.zy, bounds.zw,
+        bounds.xy, bounds.zw, bounds.xw,
     );
-    let c = corners[vi % 6u] * half;
-    let world = u.sphere.xyz + u.forward.xyz * d + u.right.xyz * c.x + u.up.xyz * c.y;
+    let c = corners[vi % 6u];
+    let world = centre + u.right.xyz * c.x + u.up.xyz * c.y;
     out.clip = u.view_proj * vec4<f32>(world, 1.0);
     out.world = world;
     return out;
@@ -131,6 +167,66 @@ fn sun_light(s: f32, cos_theta: f32) -> f32 {
     return light;
 }
 
+// The field perturbed by the noise, `field + amount · (noise − 0.5)`, with its octaves looked
+// up coarse to fine only while they can still matter: once the octaves left (each filtered
+// into [0, 1]) cannot bring the value back inside the soft edge [iso − soft, iso + soft], the
+// density is exactly 0 or exactly 1 whatever they hold, and the look-ups stop. Deep inside
+// the cloud and in the air around it that is after none or a few of them; where the value ends
+// inside the edge, every octave is summed as `fbm` sums it. (Tiers blend several sums: they
+// take every octave.)
+fn noisy_field(field: f32, p: vec3<f32>) -> f32 {
+    let amount = u.media.w;
+    let octaves = i32(u.noise.y);
+    let lo = u.media.y - u.media.z;
+    let hi = u.media.y + u.media.z;
+    if amount <= 0.0 || octaves == 0 {
+        return field;
+    }
+    if i32(u.tiers.w) > 0 {
+        // Nothing noise could lift above the surface: skip the look-ups.
+        if field + 0.5 * amount < lo {
+            return field + 0.5 * amount;
+        }
+        return field + amount * (tiered_noise(p, octaves) - 0.5);
+    }
+    let worley = u.noise.w > 0.5;
+    let kind = u.noise.z;
+    let gain = u.noise.x;
+    var norm = 0.0;
+    var a = 1.0;
+    for (var i = 0; i < MAX_OCTAVES; i = i + 1) {
+        if i >= octaves {
+            break;
+        }
+        norm = norm + a;
+        a = a * gain;
+    }
+    let scale = amount / norm;
+    var amp = 1.0;
+    var sum = 0.0;
+    var left = norm;
+    for (var i = 0; i < MAX_OCTAVES; i = i + 1) {
+        // The value if every octave left held 0 (the least) and if each held 1 (the most).
+        let least = field + scale * sum - 0.5 * amount;
+        let most = least + scale * left;
+        if most < lo {
+            return most;
+        }
+        if least > hi {
+            return least;
+        }
+        if i >= octaves {
+            break;
+        }
+        let q = (u.octaves[i] * vec4<f32>(p, 1.0)).xyz;
+        let s = textureSampleLevel(noise_tex, repeat_smp, q, 0.0);
+        sum = sum + amp * filtered(select(s.r, s.g, worley), kind);
+        left = left - amp;
+        amp = amp * gain;
+    }
+    return field + amount * (sum / norm - 0.5);
+}
+
 // One slice's light and opacity at a fragment, premultiplied (discards where it adds nothing).
 fn cloud(in: VsOut) -> vec4<f32> {
     let uvw = (in.world - u.grid_min.xyz) * u.grid_inv_size.xyz;
@@ -142,11 +238,7 @@ fn cloud(in: VsOut) -> vec4<f32> {
     let iso = u.media.y;
     let soft = u.media.z;
     let amount = u.media.w;
-    // Nothing noise could lift above the surface: skip the noise look-ups.
-    if field < iso - soft - 0.5 * amount {
-        discard;
-    }
-    let v = field + amount * (tiered_noise(in.world, i32(u.noise.y)) - 0.5);
+    let v = noisy_field(field, in.world);
     let density = smoothstep(iso - soft, iso + soft, v);
     if density <= 0.0 {
         discard;

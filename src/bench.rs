@@ -477,6 +477,89 @@ fn light_volume(offscreen: &mut Offscreen) -> Result<Vec<BenchResult>, String> {
     Ok(out)
 }
 
+/// Frames and passes timed by the device's own clock (timestamp queries): the 1080p frame
+/// at 128 slices and 4 octaves (issue 11's GPU figure), other qualities, the ground and shafts,
+/// and the light volume, each against its baseline on the same device. Empty, with a note on
+/// stderr, where the adapter has no timestamp queries.
+fn device_timed(offscreen: &mut Offscreen) -> Result<Vec<BenchResult>, String> {
+    // A software adapter (lavapipe) takes seconds a frame at these sizes: fewer frames, and
+    // only the 1080p row of issue 11.
+    let cpu = offscreen.on_cpu();
+    let frames = if cpu { 2 } else { 9 };
+    let skipped = || {
+        eprintln!("gpu: the adapter has no timestamp queries; its rows are left out");
+        Ok(Vec::new())
+    };
+    let mut out = Vec::new();
+    let mut frame = |scene: &Scene, (w, h): (u32, u32), plain: bool| {
+        // The first frame compiles and uploads; the median of the rest.
+        offscreen
+            .time_frames_on_gpu(scene, w, h, frames + 1, plain)
+            .map(|t| t.map(|mut t| median(t.split_off(1))))
+            .map_err(|e| e.to_string())
+    };
+    let sizes = [
+        ((1920, 1080), 128, 4),
+        ((1920, 1080), 256, 8),
+        ((1280, 720), 64, 4),
+        ((3840, 2160), 128, 4),
+    ];
+    for ((w, h), slices, octaves) in sizes.into_iter().take(if cpu { 1 } else { sizes.len() }) {
+        let mut scene = Scene::default();
+        scene.render.slices = slices;
+        scene.render.noise_octaves = octaves;
+        let (Some(ours), Some(plain)) =
+            (frame(&scene, (w, h), false)?, frame(&scene, (w, h), true)?)
+        else {
+            return skipped();
+        };
+        out.push(result(
+            &format!("gpu_frame_{w}x{h}_{slices}_slices_{octaves}_octaves"),
+            ours * 1e3,
+            "ms",
+            &format!("gpu_plain_slice_shader_{w}x{h}_{slices}_slices"),
+            plain * 1e3,
+        ));
+    }
+    let mut bare = Scene::default();
+    bare.render.slices = 128;
+    bare.render.noise_octaves = 4;
+    let mut shafts = bare.clone();
+    shafts.light.ground = true;
+    shafts.light.ground_height = -2.0;
+    shafts.light.shafts = true;
+    if let (Some(with), Some(without)) = (
+        frame(&shafts, (1920, 1080), false)?,
+        frame(&bare, (1920, 1080), false)?,
+    ) {
+        out.push(result(
+            "gpu_ground_and_shafts_frame_1920x1080",
+            with * 1e3,
+            "ms",
+            "gpu_frame_1920x1080_128_slices_4_octaves",
+            without * 1e3,
+        ));
+    }
+    let mut light = |octaves: u32| {
+        let mut s = Scene::default();
+        s.render.light_octaves = octaves;
+        offscreen
+            .time_light_volume_on_gpu(&s, frames + 1)
+            .map(|t| t.map(|mut t| median(t.split_off(1))))
+            .map_err(|e| e.to_string())
+    };
+    if let (Some(noisy), Some(plain)) = (light(4)?, light(0)?) {
+        out.push(result(
+            "gpu_light_volume_4_octaves",
+            noisy * 1e3,
+            "ms",
+            "gpu_light_volume_no_noise",
+            plain * 1e3,
+        ));
+    }
+    Ok(out)
+}
+
 /// Share links for every preset and for five hand-drawn strokes: the URL's length against the
 /// scene file's, and encoding and opening times against writing and opening the scene file
 /// (opening either includes the cost check that derives the field).
@@ -579,6 +662,9 @@ pub fn run(json: bool, only: Option<&str>) -> Result<(), String> {
     }
     if wanted("light") {
         results.extend(light_volume(&mut offscreen)?);
+    }
+    if wanted("gpu") {
+        results.extend(device_timed(&mut offscreen)?);
     }
     let report = BenchReport { machine, results };
     if json {

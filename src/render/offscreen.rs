@@ -86,6 +86,53 @@ pub struct Offscreen {
     derived: Derived,
     /// The GPU field evaluation (the bench's baseline), made on first use.
     field_evaluator: Option<FieldEvaluator>,
+    /// Timestamp queries around recorded work, where the adapter has them.
+    stamps: Option<Stamps>,
+}
+
+/// Two GPU timestamps (before and after a piece of recorded work) and the buffers that bring
+/// them back: the device's own clock, so a frame's time excludes submission and waiting.
+#[derive(Clone)]
+struct Stamps {
+    set: wgpu::QuerySet,
+    resolve: wgpu::Buffer,
+    read: wgpu::Buffer,
+    /// Nanoseconds per tick.
+    period: f32,
+}
+
+impl Stamps {
+    /// The features timestamps around whole command encoders need.
+    const FEATURES: wgpu::Features =
+        wgpu::Features::TIMESTAMP_QUERY.union(wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS);
+    const BYTES: u64 = 2 * std::mem::size_of::<u64>() as u64;
+
+    fn new(device: &wgpu::Device, queue: &wgpu::Queue) -> Self {
+        let buffer = |label, usage| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: Self::BYTES,
+                usage,
+                mapped_at_creation: false,
+            })
+        };
+        Self {
+            set: device.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some("frame timestamps"),
+                ty: wgpu::QueryType::Timestamp,
+                count: 2,
+            }),
+            resolve: buffer(
+                "timestamps (resolved)",
+                wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+            ),
+            read: buffer(
+                "timestamps (read back)",
+                wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            ),
+            period: queue.get_timestamp_period(),
+        }
+    }
 }
 
 impl Offscreen {
@@ -121,14 +168,17 @@ impl Offscreen {
         };
         let info = adapter.get_info();
         let limits = wgpu::Limits::downlevel_defaults().using_resolution(adapter.limits());
+        let features = adapter.features() & Stamps::FEATURES;
         let (device, queue) = adapter
             .request_device(&wgpu::DeviceDescriptor {
                 label: Some("cloudsketch offscreen"),
+                required_features: features,
                 required_limits: limits,
                 ..Default::default()
             })
             .await
             .map_err(|e| OffscreenError::Device(e.to_string()))?;
+        let stamps = (features == Stamps::FEATURES).then(|| Stamps::new(&device, &queue));
         let renderer = VolumeRenderer::new(
             &device,
             &queue,
@@ -142,12 +192,18 @@ impl Offscreen {
             renderer,
             derived: Derived::default(),
             field_evaluator: None,
+            stamps,
         })
     }
 
     /// Name and backend of the adapter, e.g. "llvmpipe (LLVM 15.0.6, 256 bits) (Vulkan)".
     pub fn adapter_name(&self) -> String {
         format!("{} ({:?})", self.info.name, self.info.backend)
+    }
+
+    /// Whether the adapter is a software one (lavapipe, SwiftShader): the CPU draws.
+    pub fn on_cpu(&self) -> bool {
+        self.info.device_type == wgpu::DeviceType::Cpu
     }
 
     /// Renders `scene` from its camera at full quality.
@@ -200,6 +256,108 @@ impl Offscreen {
             times.push(start.elapsed().as_secs_f64());
         }
         Ok(times)
+    }
+
+    /// Like [`Offscreen::time_frames`], timed by the device's own clock (timestamps before
+    /// and after each frame's commands); `None` where the adapter has no timestamp queries.
+    pub fn time_frames_on_gpu(
+        &mut self,
+        scene: &Scene,
+        width: u32,
+        height: u32,
+        frames: usize,
+        baseline: bool,
+    ) -> Result<Option<Vec<f64>>, OffscreenError> {
+        check_size(width, height)?;
+        let job = self.full_job(scene, width, height);
+        let pipeline = baseline.then(|| self.renderer.baseline_pipeline(&self.device));
+        let background = Some(scene.light.background);
+        let mut times = Vec::with_capacity(frames);
+        for _ in 0..frames {
+            self.renderer.begin_frame();
+            let stamped = self.stamped(|o, encoder| {
+                o.renderer.render_image(
+                    &o.device,
+                    &o.queue,
+                    encoder,
+                    &job,
+                    background,
+                    pipeline.as_ref(),
+                );
+            })?;
+            match stamped {
+                Some(t) => times.push(t),
+                None => return Ok(None),
+            }
+        }
+        Ok(Some(times))
+    }
+
+    /// Like [`Offscreen::time_light_volume`], timed by the device's own clock; `None` where
+    /// the adapter has no timestamp queries.
+    pub fn time_light_volume_on_gpu(
+        &mut self,
+        scene: &Scene,
+        runs: usize,
+    ) -> Result<Option<Vec<f64>>, OffscreenError> {
+        let job = self.full_job(scene, 64, 64);
+        let mut times = Vec::with_capacity(runs);
+        for _ in 0..runs {
+            self.renderer.invalidate_light();
+            self.renderer.begin_frame();
+            let stamped = self.stamped(|o, encoder| {
+                o.renderer
+                    .update_light(&o.device, &o.queue, encoder, &job.view);
+            })?;
+            match stamped {
+                Some(t) => times.push(t),
+                None => return Ok(None),
+            }
+        }
+        Ok(Some(times))
+    }
+
+    /// Records `record` between two timestamps, submits it, waits and returns the seconds the
+    /// device spent between them; `None` where the adapter has no timestamp queries.
+    fn stamped(
+        &mut self,
+        record: impl FnOnce(&mut Self, &mut wgpu::CommandEncoder),
+    ) -> Result<Option<f64>, OffscreenError> {
+        let Some(stamps) = self.stamps.clone() else {
+            return Ok(None);
+        };
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("timed"),
+            });
+        encoder.write_timestamp(&stamps.set, 0);
+        record(self, &mut encoder);
+        encoder.write_timestamp(&stamps.set, 1);
+        encoder.resolve_query_set(&stamps.set, 0..2, &stamps.resolve, 0);
+        encoder.copy_buffer_to_buffer(&stamps.resolve, 0, &stamps.read, 0, Stamps::BYTES);
+        self.submit_and_wait(encoder)?;
+        let (tx, rx) = std::sync::mpsc::channel();
+        let slice = stamps.read.slice(..);
+        slice.map_async(wgpu::MapMode::Read, move |r| {
+            let _ = tx.send(r);
+        });
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| OffscreenError::Readback(e.to_string()))?;
+        rx.recv()
+            .map_err(|e| OffscreenError::Readback(e.to_string()))?
+            .map_err(|e| OffscreenError::Readback(e.to_string()))?;
+        let ticks = {
+            let bytes = slice
+                .get_mapped_range()
+                .map_err(|e| OffscreenError::Readback(e.to_string()))?;
+            let t =
+                |i: usize| u64::from_le_bytes(bytes[8 * i..8 * i + 8].try_into().unwrap_or([0; 8]));
+            t(1).saturating_sub(t(0))
+        };
+        stamps.read.unmap();
+        Ok(Some(ticks as f64 * f64::from(stamps.period) * 1e-9))
     }
 
     /// `field` evaluated on the GPU on the grid the CPU bake uses at `resolution`, read back.
