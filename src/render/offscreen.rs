@@ -90,6 +90,15 @@ pub struct Offscreen {
     stamps: Option<Stamps>,
 }
 
+/// Which clock times the bench's GPU work.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Clock {
+    /// The host's, from recording to the device being done (submission and waiting included).
+    Wall,
+    /// The device's own (timestamp queries).
+    Device,
+}
+
 /// Two GPU timestamps (before and after a piece of recorded work) and the buffers that bring
 /// them back: the device's own clock, so a frame's time excludes submission and waiting.
 #[derive(Clone)]
@@ -243,19 +252,8 @@ impl Offscreen {
         frames: usize,
         baseline: bool,
     ) -> Result<Vec<f64>, OffscreenError> {
-        check_size(width, height)?;
-        let job = self.full_job(scene, width, height);
-        let pipeline = baseline.then(|| self.renderer.baseline_pipeline(&self.device));
-        let mut times = Vec::with_capacity(frames);
-        for _ in 0..frames {
-            let start = std::time::Instant::now();
-            self.renderer.begin_frame();
-            let (encoder, _output) =
-                self.encode(&job, Some(scene.light.background), pipeline.as_ref());
-            self.submit_and_wait(encoder)?;
-            times.push(start.elapsed().as_secs_f64());
-        }
-        Ok(times)
+        self.frame_times(scene, [width, height], frames, baseline, Clock::Wall)
+            .map(Option::unwrap_or_default)
     }
 
     /// Like [`Offscreen::time_frames`], timed by the device's own clock (timestamps before
@@ -268,29 +266,47 @@ impl Offscreen {
         frames: usize,
         baseline: bool,
     ) -> Result<Option<Vec<f64>>, OffscreenError> {
+        self.frame_times(scene, [width, height], frames, baseline, Clock::Device)
+    }
+
+    fn frame_times(
+        &mut self,
+        scene: &Scene,
+        [width, height]: [u32; 2],
+        frames: usize,
+        baseline: bool,
+        clock: Clock,
+    ) -> Result<Option<Vec<f64>>, OffscreenError> {
         check_size(width, height)?;
         let job = self.full_job(scene, width, height);
         let pipeline = baseline.then(|| self.renderer.baseline_pipeline(&self.device));
         let background = Some(scene.light.background);
-        let mut times = Vec::with_capacity(frames);
-        for _ in 0..frames {
-            self.renderer.begin_frame();
-            let stamped = self.stamped(|o, encoder| {
-                o.renderer.render_image(
-                    &o.device,
-                    &o.queue,
-                    encoder,
-                    &job,
-                    background,
-                    pipeline.as_ref(),
-                );
-            })?;
-            match stamped {
-                Some(t) => times.push(t),
-                None => return Ok(None),
-            }
-        }
-        Ok(Some(times))
+        (0..frames)
+            .map(|_| {
+                self.renderer.begin_frame();
+                self.timed(clock, |o, encoder| {
+                    o.renderer.render_image(
+                        &o.device,
+                        &o.queue,
+                        encoder,
+                        &job,
+                        background,
+                        pipeline.as_ref(),
+                    );
+                })
+            })
+            .collect()
+    }
+
+    /// Times `runs` computations of `scene`'s light volume on the GPU (every slice marched
+    /// toward the sun through the field and its noise), each waited for on the device.
+    pub fn time_light_volume(
+        &mut self,
+        scene: &Scene,
+        runs: usize,
+    ) -> Result<Vec<f64>, OffscreenError> {
+        self.light_volume_times(scene, runs, Clock::Wall)
+            .map(Option::unwrap_or_default)
     }
 
     /// Like [`Offscreen::time_light_volume`], timed by the device's own clock; `None` where
@@ -300,21 +316,47 @@ impl Offscreen {
         scene: &Scene,
         runs: usize,
     ) -> Result<Option<Vec<f64>>, OffscreenError> {
+        self.light_volume_times(scene, runs, Clock::Device)
+    }
+
+    fn light_volume_times(
+        &mut self,
+        scene: &Scene,
+        runs: usize,
+        clock: Clock,
+    ) -> Result<Option<Vec<f64>>, OffscreenError> {
         let job = self.full_job(scene, 64, 64);
-        let mut times = Vec::with_capacity(runs);
-        for _ in 0..runs {
-            self.renderer.invalidate_light();
-            self.renderer.begin_frame();
-            let stamped = self.stamped(|o, encoder| {
-                o.renderer
-                    .update_light(&o.device, &o.queue, encoder, &job.view);
-            })?;
-            match stamped {
-                Some(t) => times.push(t),
-                None => return Ok(None),
-            }
+        (0..runs)
+            .map(|_| {
+                self.renderer.invalidate_light();
+                self.renderer.begin_frame();
+                self.timed(clock, |o, encoder| {
+                    o.renderer
+                        .update_light(&o.device, &o.queue, encoder, &job.view);
+                })
+            })
+            .collect()
+    }
+
+    /// Records `record`, submits it, waits for the device and returns the seconds it took by
+    /// `clock`; `None` for the device's clock where the adapter has no timestamp queries.
+    fn timed(
+        &mut self,
+        clock: Clock,
+        record: impl FnOnce(&mut Self, &mut wgpu::CommandEncoder),
+    ) -> Result<Option<f64>, OffscreenError> {
+        if clock == Clock::Device {
+            return self.stamped(record);
         }
-        Ok(Some(times))
+        let start = std::time::Instant::now();
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("timed"),
+            });
+        record(self, &mut encoder);
+        self.submit_and_wait(encoder)?;
+        Ok(Some(start.elapsed().as_secs_f64()))
     }
 
     /// Records `record` between two timestamps, submits it, waits and returns the seconds the
@@ -336,20 +378,12 @@ impl Offscreen {
         encoder.write_timestamp(&stamps.set, 1);
         encoder.resolve_query_set(&stamps.set, 0..2, &stamps.resolve, 0);
         encoder.copy_buffer_to_buffer(&stamps.resolve, 0, &stamps.read, 0, Stamps::BYTES);
-        self.submit_and_wait(encoder)?;
-        let (tx, rx) = std::sync::mpsc::channel();
-        let slice = stamps.read.slice(..);
-        slice.map_async(wgpu::MapMode::Read, move |r| {
-            let _ = tx.send(r);
-        });
-        self.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| OffscreenError::Readback(e.to_string()))?;
-        rx.recv()
-            .map_err(|e| OffscreenError::Readback(e.to_string()))?
-            .map_err(|e| OffscreenError::Readback(e.to_string()))?;
+        self.queue.submit([encoder.finish()]);
+        self.map_for_reading(&stamps.read)?;
         let ticks = {
-            let bytes = slice
+            let bytes = stamps
+                .read
+                .slice(..)
                 .get_mapped_range()
                 .map_err(|e| OffscreenError::Readback(e.to_string()))?;
             let t =
@@ -400,30 +434,18 @@ impl Offscreen {
         Ok(times)
     }
 
-    /// Times `runs` computations of `scene`'s light volume on the GPU (every slice marched
-    /// toward the sun through the field and its noise), each waited for on the device.
-    pub fn time_light_volume(
-        &mut self,
-        scene: &Scene,
-        runs: usize,
-    ) -> Result<Vec<f64>, OffscreenError> {
-        let job = self.full_job(scene, 64, 64);
-        let mut times = Vec::with_capacity(runs);
-        for _ in 0..runs {
-            self.renderer.invalidate_light();
-            self.renderer.begin_frame();
-            let start = std::time::Instant::now();
-            let mut encoder = self
-                .device
-                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                    label: Some("light volume (bench)"),
-                });
-            self.renderer
-                .update_light(&self.device, &self.queue, &mut encoder, &job.view);
-            self.submit_and_wait(encoder)?;
-            times.push(start.elapsed().as_secs_f64());
-        }
-        Ok(times)
+    /// Maps all of `buffer` for reading, waiting for the device to finish what was submitted.
+    fn map_for_reading(&self, buffer: &wgpu::Buffer) -> Result<(), OffscreenError> {
+        let (tx, rx) = std::sync::mpsc::channel();
+        buffer.slice(..).map_async(wgpu::MapMode::Read, move |r| {
+            let _ = tx.send(r);
+        });
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| OffscreenError::Readback(e.to_string()))?;
+        rx.recv()
+            .map_err(|e| OffscreenError::Readback(e.to_string()))?
+            .map_err(|e| OffscreenError::Readback(e.to_string()))
     }
 
     /// Submits `encoder` and waits for the device to finish it.
@@ -505,16 +527,7 @@ impl Offscreen {
         let (mut encoder, output) = self.encode(job, background, None);
         let (readback, row) = copy_for_readback(&self.device, &mut encoder, &output, size);
         self.queue.submit([encoder.finish()]);
-        let (tx, rx) = std::sync::mpsc::channel();
-        readback.slice(..).map_async(wgpu::MapMode::Read, move |r| {
-            let _ = tx.send(r);
-        });
-        self.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| OffscreenError::Readback(e.to_string()))?;
-        rx.recv()
-            .map_err(|e| OffscreenError::Readback(e.to_string()))?
-            .map_err(|e| OffscreenError::Readback(e.to_string()))?;
+        self.map_for_reading(&readback)?;
         let rgba = read_rows(&readback, size, row).map_err(OffscreenError::Readback)?;
         Ok(Image {
             width: size[0],
