@@ -47,8 +47,13 @@ fn fs_main(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
     let h = ls.dims.w;
     let octaves = i32(ls.slice.z);
     var tau = 0.0;
-    // Half a step in, then whole steps, until the ray leaves the box.
-    var p = start + dir * (0.5 * h);
+    // A share of a step in, then whole steps, until the ray leaves the box. The share differs
+    // from texel to texel (interleaved gradient noise over x, y and the slice): with one
+    // share for all, a layer thinner than a few steps falls between a varying number of them
+    // as the texels move along it, and its shadow shows bands; varied, the bands become grain
+    // finer than a texel, which the slices' trilinear look-ups smooth.
+    let grain = dot(floor(pos.xy) + 5.588238 * f32(ls.slice.x), vec2<f32>(0.06711056, 0.00583715));
+    var p = start + dir * (fract(52.9829189 * fract(grain)) * h);
     for (var i = 0u; i < ls.slice.y; i = i + 1u) {
         let uvw = (p - u.grid_min.xyz) * u.grid_inv_size.xyz;
         if any(uvw < vec3<f32>(0.0)) || any(uvw > vec3<f32>(1.0)) {

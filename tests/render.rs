@@ -1024,3 +1024,71 @@ fn a_cloud_hides_the_shafts_behind_it_and_not_those_in_front() {
         "an opaque pixel gets {core:.1} of the air's light, the open sky {sky:.1}"
     );
 }
+
+#[test]
+fn a_thin_layer_above_casts_a_shadow_without_bands() {
+    // A thin, wide layer high above (out of view) between a high sun and the cloud in view,
+    // the noise off so only the march shows: when the layer falls between a
+    // number of march steps that changes with height, its shadow on the cloud shows bands.
+    let scene = with(
+        &Scene::preset(Preset::Empty),
+        &[
+            "/ellipsoids=[{\"center\":[0,2,0],\"radii\":[4.0,2.0,3.0]},{\"center\":[0,9.5,0],\"radii\":[7.0,0.6,7.0]}]",
+            "/camera/target=[0,2,0]",
+            "/camera/pitch_deg=0",
+            "/camera/yaw_deg=0",
+            "/camera/distance=10",
+            "/light/sun_azimuth_deg=30",
+            "/light/sun_elevation_deg=75",
+            "/light/multiple_scattering=0",
+            "/render/noise_octaves=0",
+            "/render/light_octaves=0",
+            "/render/light_resolution=96",
+        ],
+    );
+    let bg = background(&scene);
+    let lit = render(&with(&scene, &["/ellipsoids/1/hidden=true"]));
+    let shadowed = render(&scene);
+    // Rows through the middle of the cloud in view: each row's mean over its middle half.
+    let cloud = |x: u32, y: u32| differs(lit.pixel(x, y), bg);
+    let rows: Vec<u32> = (0..H)
+        .filter(|&y| (W / 4..3 * W / 4).all(|x| cloud(x, y)))
+        .collect();
+    assert!(rows.len() > 20, "{} rows through the cloud", rows.len());
+    let means = |img: &Image| -> Vec<f64> {
+        rows.iter()
+            .map(|&y| {
+                (W / 4..3 * W / 4)
+                    .map(|x| luminance(img.pixel(x, y)))
+                    .sum::<f64>()
+                    / (W / 2) as f64
+            })
+            .collect()
+    };
+    // Bands: the rows' means bending up and down from row to row (second differences).
+    let banding = |m: &[f64]| {
+        let d: Vec<f64> = m
+            .windows(3)
+            .map(|w| (w[0] - 2.0 * w[1] + w[2]).powi(2))
+            .collect();
+        d.iter().sum::<f64>() / d.len() as f64
+    };
+    let (dark, bright) = (means(&shadowed), means(&lit));
+    let avg = |m: &[f64]| m.iter().sum::<f64>() / m.len() as f64;
+    let (b_shadow, b_sun) = (banding(&dark), banding(&bright));
+    eprintln!(
+        "mean {:.1} in the shadow, {:.1} in the sun; banding {b_shadow:.3} vs {b_sun:.3}",
+        avg(&dark),
+        avg(&bright)
+    );
+    assert!(
+        avg(&dark) < avg(&bright) - 15.0,
+        "the layer above casts no shadow"
+    );
+    // The shadow dims the rows' own variation, so without bands it bends no more than the
+    // sunlit cloud's rows do.
+    assert!(
+        b_shadow < 1.5 * b_sun,
+        "the rows in the shadow bend {b_shadow:.3} (squared second differences), in the sun {b_sun:.3}"
+    );
+}
