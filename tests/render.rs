@@ -1092,3 +1092,92 @@ fn a_thin_layer_above_casts_a_shadow_without_bands() {
         "the rows in the shadow bend {b_shadow:.3} (squared second differences), in the sun {b_sun:.3}"
     );
 }
+
+#[test]
+fn the_slices_cover_the_whole_cloud_from_every_side() {
+    // Each slice is drawn only over the rectangle around where its plane cuts the cloud's
+    // box: from views all round, every pixel onto which a texel deep inside the cloud projects
+    // (the CPU's bake of the same field, a brute-force reference) must show cloud.
+    let base = Scene::default();
+    let bg = background(&base);
+    let field = cloudsketch::derive::field_of(&base);
+    let volume = cloudsketch::field::bake(&field, 48);
+    let texel = volume.size / volume.dims.as_vec3();
+    let deep: Vec<glam::Vec3> = (0..volume.values.len())
+        .filter(|&i| volume.values[i] > 0.85)
+        .map(|i| {
+            let (nx, ny) = (volume.dims.x as usize, volume.dims.y as usize);
+            let at = glam::UVec3::new(
+                (i % nx) as u32,
+                ((i / nx) % ny) as u32,
+                (i / (nx * ny)) as u32,
+            );
+            volume.min + (at.as_vec3() + 0.5) * texel
+        })
+        .collect();
+    assert!(deep.len() > 100, "{} texels deep inside", deep.len());
+    for (yaw, pitch, distance) in [
+        (0.0, 0.0, 14.0),
+        (35.0, 50.0, 12.0),
+        (120.0, -30.0, 10.0),
+        (200.0, 15.0, 9.0),
+        (290.0, 80.0, 14.0),
+        (60.0, -75.0, 12.0),
+    ] {
+        let scene = with(
+            &base,
+            &[
+                &format!("/camera/yaw_deg={yaw}"),
+                &format!("/camera/pitch_deg={pitch}"),
+                &format!("/camera/distance={distance}"),
+            ],
+        );
+        let image = render(&scene);
+        let view_proj = scene.camera.view_projection(W as f32 / H as f32);
+        let (mut seen, mut shown) = (0usize, 0usize);
+        for p in &deep {
+            let clip = view_proj * p.extend(1.0);
+            if clip.w <= 0.0 {
+                continue;
+            }
+            let (x, y) = (clip.x / clip.w, clip.y / clip.w);
+            let (px, py) = ((x + 1.0) * 0.5 * W as f32, (1.0 - y) * 0.5 * H as f32);
+            if (1.0..W as f32 - 1.0).contains(&px) && (1.0..H as f32 - 1.0).contains(&py) {
+                seen += 1;
+                shown += differs(image.pixel(px as u32, py as u32), bg) as usize;
+            }
+        }
+        assert!(
+            seen > 100,
+            "yaw {yaw}, pitch {pitch}: {seen} deep texels in view"
+        );
+        assert!(
+            shown == seen,
+            "yaw {yaw}, pitch {pitch}: {} of {seen} deep texels project onto sky",
+            seen - shown
+        );
+    }
+}
+
+#[test]
+fn the_noise_octaves_stop_early_only_where_the_rest_cannot_matter() {
+    // The slices stop summing noise octaves once the ones left cannot move the value across
+    // the soft edge. A tier far above the cloud takes the other path, which sums every octave
+    // (its weight there is 0): the two images must be the same to the bit.
+    for preset in ["cumulus", "cumulonimbus", "stratus"] {
+        let scene = with(
+            &Scene::preset(Preset::from_name(preset).unwrap()),
+            &["/render/noise_octaves=6", "/render/tiers=[]"],
+        );
+        let tiered = with(
+            &scene,
+            &["/render/tiers=[{\"floor\":1000,\"filter\":\"wispy\",\"wind\":[3,0],\"torque\":0}]"],
+        );
+        let (early, every) = (render(&scene), render(&tiered));
+        let (mean, max) = image_difference(&early, &every);
+        assert!(
+            max == 0,
+            "{preset}: the early stop changed the image (mean {mean:.4}, max {max})"
+        );
+    }
+}
