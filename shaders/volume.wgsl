@@ -132,8 +132,7 @@ fn vs_main(@builtin(vertex_index) vi: u32, @builtin(instance_index) ii: u32) -> 
 // the image keeps today's brightness at g = 0.
 fn hg(cos_theta: f32, g: f32) -> f32 {
     let d = 1.0 + g * g - 2.0 * g * cos_theta;
-    // d^(−3/2) from one inverse square root (a division and a square root cost two of the
-    // special-function units' slots a fragment spends most of its time on a GPU).
+    // d^(−3/2) from one inverse square root instead of a square root and a division.
     let r = inverseSqrt(d);
     return (1.0 - g * g) * r * r * r;
 }
