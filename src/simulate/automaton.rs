@@ -391,6 +391,9 @@ impl Automaton {
         let [mem_h, mem_a, mem_e] = &self.membership;
         let tables = &self.tables;
         let layers = hum.len() / layer;
+        // A layer's act words between two rows of zeros each side: word k's neighbours along
+        // z (±1, ±2 rows) and along x (±1 word) all lie within it.
+        let mut padded = vec![0u64; layer + 4 * words];
         let outputs = hum
             .chunks_exact_mut(layer)
             .zip(act.chunks_exact_mut(layer))
@@ -418,7 +421,8 @@ impl Automaton {
                 &a[base..base + layer],
                 &self.cld[base..base + layer],
             );
-            let at = |j: Option<usize>| j.and_then(|j| aa.get(j)).copied().unwrap_or(0);
+            padded[2 * words..2 * words + layer].copy_from_slice(aa);
+            let shifted = |d: usize| &padded[d..d + layer];
             // Zipped, not indexed: no bounds test per word where the page's size-optimised
             // build would keep one.
             let words_in = ha
@@ -426,24 +430,38 @@ impl Automaton {
                 .zip(aa)
                 .zip(ca)
                 .zip(above.iter().zip(below).zip(below2));
+            let z_near = shifted(0)
+                .iter()
+                .zip(shifted(words))
+                .zip(shifted(3 * words).iter().zip(shifted(4 * words)));
+            let x_near = shifted(2 * words - 1).iter().zip(shifted(2 * words + 1));
             let words_out = ho.iter_mut().zip(ao.iter_mut()).zip(co.iter_mut());
             // The word's place in its row.
             let mut w = 0;
-            for (k, ((((&h, &ac), &c), ((&up, &down), &down2)), ((ho, ao), co))) in
-                words_in.zip(words_out).enumerate()
+            for (
+                k,
+                (
+                    (
+                        (((&h, &ac), &c), ((&up, &down), &down2)),
+                        (((&z2, &z1), (&z3, &z4)), (&prev, &next)),
+                    ),
+                    ((ho, ao), co),
+                ),
+            ) in words_in.zip(z_near.zip(x_near)).zip(words_out).enumerate()
             {
                 let i = base + k;
-                let prev = if w > 0 { aa[k - 1] } else { 0 };
-                let next = if w + 1 < words { aa[k + 1] } else { 0 };
+                // The words before and after in the row (none past its ends).
+                let prev = if w > 0 { prev } else { 0 };
+                let next = if w + 1 < words { next } else { 0 };
                 // Bit i holds cell i+k (>>) or cell i−k (<<).
                 let f = (ac >> 1 | next << 63)
                     | (ac >> 2 | next << 62)
                     | (ac << 1 | prev >> 63)
                     | (ac << 2 | prev >> 62)
-                    | at(k.checked_add(words))
-                    | at(k.checked_sub(words))
-                    | at(k.checked_add(2 * words))
-                    | at(k.checked_sub(2 * words))
+                    | z1
+                    | z2
+                    | z3
+                    | z4
                     | up
                     | down
                     | down2;
