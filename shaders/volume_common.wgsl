@@ -19,7 +19,8 @@ struct Volume {
     // boundary along the view from the bounding sphere's centre.
     grid_min: vec4<f32>,
     grid_inv_size: vec4<f32>,
-    // Bounding sphere: centre (xyz), radius (w).
+    // Bounding sphere: centre (xyz), radius (w; unread: the slices cover their cut through the
+    // box, not the sphere's cross-section).
     sphere: vec4<f32>,
     // x: total slices, y: first slice of this draw (0 = farthest), z: slice spacing (world),
     // w: Sharpness (the alpha cut-off as a share of the slice's full opacity).

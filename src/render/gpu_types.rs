@@ -36,7 +36,8 @@ pub struct VolumeUniforms {
     pub grid_min: [f32; 4],
     /// 1 / density grid size (xyz).
     pub grid_inv_size: [f32; 4],
-    /// Bounding sphere of the volume: centre (xyz), radius (w).
+    /// Bounding sphere of the volume: centre (xyz), radius (w; no shader reads it since each
+    /// slice covers only its plane's cut through the box, not the sphere's cross-section).
     pub sphere: [f32; 4],
     /// x: total slices, y: index of the first slice of this draw (0 = farthest),
     /// z: spacing between slices in world units, w: Sharpness (the alpha cut-off as a share of
