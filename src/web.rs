@@ -1,5 +1,7 @@
 //! Everything wasm-only: start-up in the page, URL options, the page's test contract and the
-//! on-page error box. Gated as a whole module (with `ui/platform_web.rs`, the browser's file
+//! on-page error box. The page holds two builds of this crate (index.html loads one): without
+//! feature `webgl` it draws with WebGPU, and hands over to the other build when WebGPU fails to
+//! start (`fall_back_to_webgl`); with it, with WebGL2. Gated as a whole module (with `ui/platform_web.rs`, the browser's file
 //! reading), so wasm-only code stays out of the rest of the crate.
 //!
 //! Test contract: `<body>` carries `data-ready` (first full-quality image shown),
@@ -48,8 +50,14 @@ pub fn start() {
     wasm_bindgen_futures::spawn_local(async move {
         if let Err(message) = run(options).await {
             log::error!("{message}");
-            show_error(&message);
-        } else if bench.as_deref() == Some("ca") {
+            // The link or preset stays in the address bar for the WebGL2 build.
+            if !fall_back_to_webgl() {
+                show_error(&message);
+            }
+            return;
+        }
+        crate::ui::forget_opening_in_url();
+        if bench.as_deref() == Some("ca") {
             bench_automaton();
         }
     });
@@ -65,7 +73,7 @@ async fn run(options: StartOptions) -> Result<(), String> {
         .ok_or("the page has no <canvas id=\"cloudsketch_canvas\">")?;
     let runner = eframe::WebRunner::new();
     runner
-        .start(canvas, eframe::WebOptions::default(), Box::new(move |cc| Ok(Box::new(CloudApp::new(cc, options)))))
+        .start(canvas, web_options(), Box::new(move |cc| Ok(Box::new(CloudApp::new(cc, options)))))
         .await
         .map_err(|e| {
             format!(
@@ -80,10 +88,38 @@ async fn run(options: StartOptions) -> Result<(), String> {
     Ok(())
 }
 
+/// The page's wgpu set-up. Of the page's two builds (index.html), the one without feature
+/// `webgl` draws with WebGPU; the one with it only with WebGL2, as the page loads it where
+/// WebGPU is missing or failed to start, or where `?backend=webgl` asks for it.
+fn web_options() -> eframe::WebOptions {
+    let mut options = eframe::WebOptions::default();
+    if let egui_wgpu::WgpuSetup::CreateNew(setup) = &mut options.wgpu_options.wgpu_setup {
+        setup.instance_descriptor.backends = if cfg!(feature = "webgl") {
+            wgpu::Backends::GL
+        } else {
+            wgpu::Backends::BROWSER_WEBGPU
+        };
+    }
+    options
+}
+
+/// Asks the page to start its WebGL2 build instead (index.html defines
+/// `window.cloudsketchFallback` only while this is the WebGPU-only build); whether it will.
+fn fall_back_to_webgl() -> bool {
+    let Some(window) = web_sys::window() else {
+        return false;
+    };
+    js_sys::Reflect::get(&window, &JsValue::from_str("cloudsketchFallback"))
+        .ok()
+        .and_then(|f| f.dyn_into::<js_sys::Function>().ok())
+        .and_then(|f| f.call0(&window).ok())
+        .is_some_and(|answer| answer.is_truthy())
+}
+
 /// The starting document: a share link (`#s=…`) or `?preset=NAME` opens that (keeping the
 /// last session aside), a plain visit continues the last session (see
-/// [`crate::ui::start_session`]). The link or preset then leaves the address bar, so a reload
-/// continues the session instead of opening it again.
+/// [`crate::ui::start_session`]). Once the app runs, the link or preset leaves the address bar
+/// ([`start`]), so a reload continues the session instead of opening it again.
 fn scene_from_url() -> Start {
     let location = web_sys::window().map(|w| w.location());
     let hash = location
@@ -91,15 +127,13 @@ fn scene_from_url() -> Start {
         .and_then(|l| l.hash().ok())
         .unwrap_or_default();
     let preset = url_param("preset");
-    let start = if hash.starts_with("#s=") {
+    if hash.starts_with("#s=") {
         crate::ui::start_session(Opening::Link(&hash))
     } else if let Some(name) = &preset {
         crate::ui::start_session(Opening::Preset(name))
     } else {
         crate::ui::start_session(Opening::Nothing)
-    };
-    crate::ui::forget_opening_in_url();
-    start
+    }
 }
 
 /// The page address's query parameter `name` (`?name=value`).

@@ -1,11 +1,13 @@
-// The app in the browser: the default cloud is drawn (WebGPU, then the WebGL2 fallback), a
-// drag orbits the camera and changes the image, nothing logs an error, ?preset=empty opens an
-// empty scene, and a browser with neither WebGPU nor WebGL2 gets a plain message.
+// The app in the browser: the default cloud is drawn (WebGPU, then the WebGL2 fallback), each
+// browser fetches only the build it needs (the WebGPU build, or the one with the WebGL2
+// fallback, also where a WebGPU device fails to start or `?backend=webgl` asks for it), a drag
+// orbits the camera and changes the image, nothing logs an error, ?preset=empty opens an empty
+// scene, and a browser with neither WebGPU nor WebGL2 gets a plain message.
 // Screenshots: web/test-results/screenshots/.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import {
-  serve, launch, openApp, waitForBody, waitForFullQuality, state, screenshot, countDiffering, countChanged, recordTiming, sunHandleBox,
+  serve, launch, openApp, fetchedBuilds, waitForBody, waitForFullQuality, state, screenshot, countDiffering, countChanged, recordTiming, sunHandleBox,
 } from './harness.mjs';
 
 let server;
@@ -39,6 +41,8 @@ for (const backend of ['webgpu', 'webgl2']) {
         await waitForBody(page, 'data-ready', (v) => v === 'true');
         const readySeconds = (Date.now() - started) / 1000;
         assert.equal(await page.getAttribute('body', 'data-backend'), backend, 'active backend');
+        const builds = await fetchedBuilds(page);
+        assert.deepEqual(builds.map((b) => b.build), [backend === 'webgpu' ? 'webgpu' : 'webgl'], 'the one build fetched');
         const adapter = await page.getAttribute('body', 'data-adapter');
         const before = await state(page);
         const [vw, vh] = before.view.viewport;
@@ -66,7 +70,7 @@ for (const backend of ['webgpu', 'webgl2']) {
         assert.ok(countDiffering(second, rect, bg) > 0.03 * vw * vh, 'cloud still drawn after orbiting');
 
         assert.deepEqual(errors, [], `errors logged:\n${errors.join('\n')}`);
-        recordTiming({ test: 'orbit', backend, adapter, firstImageSeconds, readySeconds, dragSeconds, refineSeconds, quality: afterDrag.view.quality });
+        recordTiming({ test: 'orbit', backend, adapter, wasmBytes: builds[0].bytes, wasmGzipBytes: builds[0].gzipBytes, firstImageSeconds, readySeconds, dragSeconds, refineSeconds, quality: afterDrag.view.quality });
       } catch (e) {
         console.error(log.slice(-40).join('\n'));
         await screenshot(page, `${backend}-failure`).catch(() => {});
@@ -77,6 +81,44 @@ for (const backend of ['webgpu', 'webgl2']) {
     }
   });
 }
+
+test('a WebGPU device that fails to start falls back to the WebGL2 build; ?backend=webgl asks for it', { timeout: 240_000 }, async () => {
+  const { browser, close } = await launch({ webgpu: true });
+  try {
+    // The browser offers a WebGPU adapter, but no device: the WebGPU build starts, fails, and
+    // hands over to the WebGL2 build, which opens the preset the address asked for.
+    const failing = await browser.newPage({ viewport: { width: 1280, height: 800 } });
+    const log = [];
+    failing.on('console', (m) => log.push(`[${m.type()}] ${m.text()}`));
+    await failing.addInitScript(() => {
+      GPUAdapter.prototype.requestDevice = () => Promise.reject(new Error('no device (test)'));
+    });
+    await failing.goto(`${server.url}?preset=empty`);
+    try {
+      await waitForBody(failing, 'data-ready', (v) => v === 'true');
+    } catch (e) {
+      console.error(log.slice(-40).join('\n'));
+      throw e;
+    }
+    assert.equal(await failing.getAttribute('body', 'data-backend'), 'webgl2');
+    assert.deepEqual((await fetchedBuilds(failing)).map((b) => b.build), ['webgpu', 'webgl']);
+    const s = await state(failing);
+    assert.equal(s.scene.ellipsoids.length, 0, 'the preset survived the hand-over');
+    assert.ok(!failing.url().includes('preset='), `the preset left the address once the app ran (${failing.url()})`);
+    assert.equal(await failing.$('#error[style*="display:block"]'), null, 'no error box');
+    await screenshot(failing, 'fallback-after-failed-device');
+    await failing.close();
+
+    // A working WebGPU, and the address asks for WebGL2.
+    const { page, errors } = await openApp(browser, server.url, '?backend=webgl');
+    await waitForBody(page, 'data-ready', (v) => v === 'true');
+    assert.equal(await page.getAttribute('body', 'data-backend'), 'webgl2');
+    assert.deepEqual((await fetchedBuilds(page)).map((b) => b.build), ['webgl']);
+    assert.deepEqual(errors, []);
+  } finally {
+    await close();
+  }
+});
 
 test('?preset=empty opens an empty scene', { timeout: 180_000 }, async () => {
   const { browser, close } = await launch({ webgpu: true });

@@ -6,6 +6,7 @@ import http from 'node:http';
 import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
+import zlib from 'node:zlib';
 import { fileURLToPath } from 'node:url';
 import { chromium } from 'playwright-core';
 import { PNG } from 'pngjs';
@@ -70,6 +71,22 @@ export async function openApp(browser, base, query = '', viewport = { width: 900
   const started = Date.now();
   await page.goto(base + query);
   return { page, errors, log, started };
+}
+
+/**
+ * The builds of the app (index.html: `webgpu`, `webgl`) whose wasm the page fetched, in order,
+ * each with the file's size raw and gzipped (`gzip -9`, as a server would send it).
+ */
+export async function fetchedBuilds(page) {
+  const urls = await page.evaluate(() => performance.getEntriesByType('resource').map((e) => e.name));
+  return urls
+    .map((u) => new URL(u).pathname)
+    .filter((p) => p.endsWith('_bg.wasm'))
+    .map((p) => {
+      const rel = decodeURIComponent(p.slice(p.indexOf(SUB_PATH) + SUB_PATH.length));
+      const bytes = fs.readFileSync(path.join(DIST, rel));
+      return { build: rel.split('/')[0], bytes: bytes.length, gzipBytes: zlib.gzipSync(bytes, { level: 9 }).length };
+    });
 }
 
 /** Waits for the body attribute `name` to satisfy `pred` (string → bool); returns its value. */
