@@ -88,18 +88,14 @@ async fn run(options: StartOptions) -> Result<(), String> {
     Ok(())
 }
 
-/// The page's wgpu set-up. Of the page's two builds (index.html), the one without feature
-/// `webgl` draws with WebGPU; the one with it only with WebGL2, as the page loads it where
-/// WebGPU is missing or failed to start, or where `?backend=webgl` asks for it.
+/// The page's options: the wgpu set-up of this build (see
+/// [`crate::render::viewport::choose_web_backends`]).
 fn web_options() -> eframe::WebOptions {
     let mut options = eframe::WebOptions::default();
-    if let egui_wgpu::WgpuSetup::CreateNew(setup) = &mut options.wgpu_options.wgpu_setup {
-        setup.instance_descriptor.backends = if cfg!(feature = "webgl") {
-            wgpu::Backends::GL
-        } else {
-            wgpu::Backends::BROWSER_WEBGPU
-        };
-    }
+    crate::render::viewport::choose_web_backends(
+        &mut options.wgpu_options,
+        cfg!(feature = "webgl"),
+    );
     options
 }
 

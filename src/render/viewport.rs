@@ -97,6 +97,19 @@ pub struct BackendInfo {
     pub adapter: String,
 }
 
+/// Sets the backends of the page's builds (index.html holds two): the WebGPU build draws with
+/// WebGPU; the build with the WebGL2 fallback (`webgl_build`) only with WebGL2, as the page
+/// loads it where WebGPU is missing or failed to start, or where `?backend=webgl` asks for it.
+pub fn choose_web_backends(config: &mut egui_wgpu::WgpuConfiguration, webgl_build: bool) {
+    if let egui_wgpu::WgpuSetup::CreateNew(setup) = &mut config.wgpu_setup {
+        setup.instance_descriptor.backends = if webgl_build {
+            wgpu::Backends::GL
+        } else {
+            wgpu::Backends::BROWSER_WEBGPU
+        };
+    }
+}
+
 /// Creates the renderer in egui-wgpu's callback resources; returns what is in use. `gl_name`
 /// is what the GL backend is called on this platform (`webgl2` in the browser).
 pub fn install(render_state: &egui_wgpu::RenderState, gl_name: &'static str) -> BackendInfo {
