@@ -1,8 +1,9 @@
 //! Everything wasm-only: start-up in the page, URL options, the page's test contract and the
 //! on-page error box. The page holds two builds of this crate (index.html loads one): without
 //! feature `webgl` it draws with WebGPU, and hands over to the other build when WebGPU fails to
-//! start (`fall_back_to_webgl`); with it, with WebGL2. Gated as a whole module (with `ui/platform_web.rs`, the browser's file
-//! reading), so wasm-only code stays out of the rest of the crate.
+//! start (`fall_back_to_webgl`); with it, with WebGL2. Gated as a whole module (with
+//! `ui/platform_web.rs`, the browser's file reading), so wasm-only code stays out of the rest
+//! of the crate.
 //!
 //! Test contract: `<body>` carries `data-ready` (first full-quality image shown),
 //! `data-backend` (`webgpu` | `webgl2`), `data-adapter` and `data-quality`
