@@ -4,13 +4,18 @@
 //! copied into a buffer and read back once the GPU is done — a frame or more later, which the
 //! browser requires (its buffers map asynchronously).
 
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicU8, Ordering};
 use std::sync::{Arc, Mutex};
 
 use super::progressive::JobPlan;
 use super::renderer::{SliceJob, VolumeRenderer};
 use super::resources::{CAPTURE_TARGET, copy_for_readback, read_rows, unpremultiply};
 use super::{FULL_VIEW, View};
+
+/// The read-back buffer's mapping: under way, done, failed.
+const MAPPING: u8 = 0;
+const MAPPED: u8 = 1;
+const MAP_FAILED: u8 = 2;
 
 /// Where a capture stands; shared by the UI (which polls it) and the paint callback.
 enum State {
@@ -20,7 +25,7 @@ enum State {
     Reading {
         buffer: wgpu::Buffer,
         row: u32,
-        mapped: Arc<AtomicBool>,
+        mapped: Arc<AtomicU8>,
         bgra: bool,
     },
     /// The straight-alpha RGBA pixels, or why there are none.
@@ -81,7 +86,13 @@ impl Capture {
             State::Reading { mapped, .. } => {
                 // Native backends map during a poll; the browser maps on its own.
                 let _ = device.poll(wgpu::PollType::Poll);
-                if mapped.load(Ordering::Acquire)
+                let outcome = mapped.load(Ordering::Acquire);
+                if outcome == MAP_FAILED {
+                    // The device was lost, say: an error to show, never a wait without end.
+                    *state = State::Done(Err(
+                        "the GPU could not hand the image back (its device was lost?)".into(),
+                    ));
+                } else if outcome == MAPPED
                     && let State::Reading {
                         buffer, row, bgra, ..
                     } = std::mem::replace(&mut *state, State::Taken)
@@ -121,12 +132,15 @@ impl Capture {
         let output = renderer.render_image(device, queue, &mut encoder, &job, background, None);
         let (buffer, row) = copy_for_readback(device, &mut encoder, &output, self.size);
         queue.submit([encoder.finish()]);
-        let mapped = Arc::new(AtomicBool::new(false));
+        let mapped = Arc::new(AtomicU8::new(MAPPING));
         let flag = mapped.clone();
         buffer.slice(..).map_async(wgpu::MapMode::Read, move |r| {
             // A failed map leaves the flag down (the capture then never completes; the
             // export's Cancel remains).
-            flag.store(r.is_ok(), Ordering::Release);
+            flag.store(
+                if r.is_ok() { MAPPED } else { MAP_FAILED },
+                Ordering::Release,
+            );
         });
         State::Reading {
             buffer,
