@@ -170,7 +170,105 @@ pub fn table() -> &'static [Case] {
 
 /// Meshes the surface `value = iso` of `values` (on `dims` texels, x fastest) whose texel
 /// `(x, y, z)` is at `min + (x, y, z)·h`; outside the grid the value is below `iso`.
+///
+/// The layers of cubes are cut into one run per core, meshed at once and joined: a run's
+/// vertices on its first plane are the ones the run before made on its last, so the joined
+/// mesh is the one a single pass makes (the same vertices in the same order, the same
+/// triangles).
 pub fn mesh(dims: UVec3, min: Vec3, h: f32, values: &[f32], iso: f32) -> Mesh {
+    // Runs of at least 16 layers: a smaller grid is not worth a thread.
+    let runs = crate::limits::cores().min(dims.z as usize / 16).max(1);
+    mesh_in_runs(dims, min, h, values, iso, runs)
+}
+
+/// [`mesh`] with its layers cut into `runs` runs.
+fn mesh_in_runs(dims: UVec3, min: Vec3, h: f32, values: &[f32], iso: f32, runs: usize) -> Mesh {
+    let layers = dims.z as i32 + 1;
+    let threads = (runs as i32).clamp(1, layers);
+    let per = (layers + threads - 1) / threads;
+    let ranges: Vec<std::ops::Range<i32>> = (0..threads)
+        .map(|t| (-1 + t * per)..(-1 + (t + 1) * per).min(dims.z as i32))
+        .filter(|r| !r.is_empty())
+        .collect();
+    let run = |z: std::ops::Range<i32>| mesh_layers(dims, min, h, values, iso, z);
+    let runs: Vec<Run> = if ranges.len() == 1 {
+        ranges.into_iter().map(run).collect()
+    } else {
+        std::thread::scope(|scope| {
+            let handles: Vec<_> = ranges
+                .iter()
+                .map(|z| scope.spawn(move || run(z.clone())))
+                .collect();
+            handles
+                .into_iter()
+                .zip(&ranges)
+                // A run whose thread failed is done again here.
+                .map(|(h, z)| h.join().unwrap_or_else(|_| run(z.clone())))
+                .collect()
+        })
+    };
+    let mut mesh = Mesh::default();
+    // The last plane's vertex ids (of the mesh so far) of the run before.
+    let mut last: Vec<u32> = Vec::new();
+    for run in runs {
+        // A vertex of this run's first plane is the run before's; the others follow on.
+        let mut ids = vec![u32::MAX; run.positions.len()];
+        for (slot, &own) in run.first.iter().enumerate() {
+            if let (Some(id), Some(&earlier)) = (ids.get_mut(own as usize), last.get(slot))
+                && earlier != u32::MAX
+            {
+                *id = earlier;
+            }
+        }
+        for (id, p) in ids.iter_mut().zip(&run.positions) {
+            if *id == u32::MAX {
+                *id = mesh.positions.len() as u32;
+                mesh.positions.push(*p);
+            }
+        }
+        mesh.triangles
+            .extend(run.triangles.iter().map(|t| t.map(|v| ids[v as usize])));
+        last = run
+            .last
+            .iter()
+            .map(|&v| ids.get(v as usize).copied().unwrap_or(u32::MAX))
+            .collect();
+    }
+    // Area-weighted normals.
+    mesh.normals = vec![Vec3::ZERO; mesh.positions.len()];
+    for t in &mesh.triangles {
+        let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
+        let n = (b - a).cross(c - a);
+        for &i in t {
+            mesh.normals[i as usize] += n;
+        }
+    }
+    for n in &mut mesh.normals {
+        *n = n.normalize_or(Vec3::Y);
+    }
+    mesh
+}
+
+/// The surface in a run of cube layers ([`mesh_layers`]): its vertices and triangles (ids of
+/// its own vertices), and the vertex ids of the x and y grid edges of its first and last
+/// planes (`u32::MAX` where none).
+struct Run {
+    positions: Vec<Vec3>,
+    triangles: Vec<[u32; 3]>,
+    first: Vec<u32>,
+    last: Vec<u32>,
+}
+
+/// Meshes the cube layers `zs` (layer `z` lies between texel planes `z` and `z + 1`; `-1` and
+/// `dims.z − 1` touch the padding).
+fn mesh_layers(
+    dims: UVec3,
+    min: Vec3,
+    h: f32,
+    values: &[f32],
+    iso: f32,
+    layers: std::ops::Range<i32>,
+) -> Run {
     let table = table();
     let d = dims.as_ivec3();
     let outside = iso - 1.0;
@@ -199,13 +297,14 @@ pub fn mesh(dims: UVec3, min: Vec3, h: f32, values: &[f32], iso: f32) -> Mesh {
     let mut xy = [vec![u32::MAX; 2 * layer], vec![u32::MAX; 2 * layer]];
     let mut zs = vec![u32::MAX; layer];
     let mut mesh = Mesh::default();
-    for z in -1..d.z {
+    let mut first = Vec::new();
+    for z in layers.clone() {
         xy[1].fill(u32::MAX);
         zs.fill(u32::MAX);
         {
             let [p0, p1] = &mut planes;
             let [i0, i1] = &mut inside;
-            if z == -1 {
+            if z == layers.start {
                 fill(z, p0, i0);
             } else {
                 std::mem::swap(p0, p1);
@@ -214,10 +313,29 @@ pub fn mesh(dims: UVec3, min: Vec3, h: f32, values: &[f32], iso: f32) -> Mesh {
             fill(z + 1, p1, i1);
         }
         let (in0, in1) = (&inside[0], &inside[1]);
+        // Eight bytes of insideness from `at` (0 past the end).
+        let word = |v: &[u8], at: usize| {
+            v.get(at..at + 8)
+                .map_or(0, |b| u64::from_le_bytes(b.try_into().unwrap_or_default()))
+        };
         for y in -1..d.y {
             let row = (y + 1) as usize * w;
-            for x in -1..d.x {
+            let mut x = -1;
+            while x < d.x {
                 let i = row + (x + 1) as usize;
+                // Eight cubes at once whose corners are all outside or all inside: no surface.
+                if x + 8 <= d.x && i + w + 9 <= layer {
+                    let words =
+                        [i, i + 1, i + w, i + w + 1].map(|at| (word(in0, at), word(in1, at)));
+                    let any = words.iter().fold(0, |acc, (a, b)| acc | a | b);
+                    let all = words.iter().fold(u64::MAX, |acc, (a, b)| acc & a & b);
+                    if any == 0 || all == 0x0101_0101_0101_0101 {
+                        x += 8;
+                        continue;
+                    }
+                }
+                let cube_x = x;
+                x += 1;
                 let case = (in0[i]
                     | in0[i + 1] << 1
                     | in0[i + w] << 2
@@ -229,7 +347,7 @@ pub fn mesh(dims: UVec3, min: Vec3, h: f32, values: &[f32], iso: f32) -> Mesh {
                 if case == 0 || case == 255 {
                     continue;
                 }
-                let base = IVec3::new(x, y, z);
+                let base = IVec3::new(cube_x, y, z);
                 let v: [f32; 8] =
                     std::array::from_fn(|c| planes[c >> 2][i + (c & 1) + ((c >> 1) & 1) * w]);
                 let case = &table[case];
@@ -278,21 +396,18 @@ pub fn mesh(dims: UVec3, min: Vec3, h: f32, values: &[f32], iso: f32) -> Mesh {
                 }
             }
         }
+        if z == layers.start {
+            first = xy[0].clone();
+        }
         xy.swap(0, 1);
     }
-    // Area-weighted normals.
-    mesh.normals = vec![Vec3::ZERO; mesh.positions.len()];
-    for t in &mesh.triangles {
-        let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
-        let n = (b - a).cross(c - a);
-        for &i in t {
-            mesh.normals[i as usize] += n;
-        }
+    let [last, _] = xy;
+    Run {
+        positions: mesh.positions,
+        triangles: mesh.triangles,
+        first,
+        last,
     }
-    for n in &mut mesh.normals {
-        *n = n.normalize_or(Vec3::Y);
-    }
-    mesh
 }
 
 #[cfg(test)]
@@ -348,6 +463,48 @@ mod tests {
         // Normals point away from the centre.
         for (p, n) in m.positions.iter().zip(&m.normals) {
             assert!(p.normalize().dot(*n) > 0.9);
+        }
+    }
+
+    /// Runs meshed at once and joined give the single pass's mesh, vertex for vertex, on a
+    /// lumpy field with wide empty and full stretches (the eight-cube skip) and noise.
+    #[test]
+    fn runs_joined_give_the_single_pass_mesh() {
+        let dims = UVec3::new(37, 21, 45);
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut u = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state % 10_000) as f32 / 10_000.0
+        };
+        let blobs: Vec<(Vec3, f32)> = (0..12)
+            .map(|_| {
+                (
+                    Vec3::new(u() * 36.0, u() * 20.0, u() * 44.0),
+                    3.0 + u() * 6.0,
+                )
+            })
+            .collect();
+        let mut values = Vec::new();
+        for z in 0..dims.z {
+            for y in 0..dims.y {
+                for x in 0..dims.x {
+                    let p = UVec3::new(x, y, z).as_vec3();
+                    let near = blobs
+                        .iter()
+                        .map(|(c, r)| r - p.distance(*c))
+                        .fold(f32::MIN, f32::max);
+                    values.push(near + (u() - 0.5) * 0.8);
+                }
+            }
+        }
+        let one = mesh_in_runs(dims, Vec3::ZERO, 1.0, &values, 0.0, 1);
+        assert!(one.triangles.len() > 1000, "{}", one.triangles.len());
+        assert_closed_and_oriented(&one);
+        for runs in [2, 3, 7, 46, 100] {
+            let joined = mesh_in_runs(dims, Vec3::ZERO, 1.0, &values, 0.0, runs);
+            assert!(joined == one, "{runs} runs differ from one");
         }
     }
 

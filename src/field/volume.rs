@@ -365,8 +365,6 @@ fn add_blob(
 /// full bake bit for bit. Returns the kernel evaluations and clip tests done.
 fn evaluate(field: &Field, grid: &Grid, dirty: &Dirty, values: &mut [f32]) -> u64 {
     let dims = grid.dims;
-    let [xs, ys, zs] = grid.centers();
-    let center = |i: usize, j: usize, k: usize| Vec3::new(xs[i], ys[j], zs[k]);
     let whole = (UVec3::ZERO, dims - 1);
     dirty.each_row(dims, whole, |Row { at: row, xs, .. }| {
         values[row + xs.start..row + xs.end].fill(0.0)
@@ -392,6 +390,19 @@ fn evaluate(field: &Field, grid: &Grid, dirty: &Dirty, values: &mut [f32]) -> u6
             add_blob(dirty, grid, &centers, bx, &mut work, blob, values);
         }
     }
+    work + add_groups_and_clip(field, grid, dirty, values)
+}
+
+/// The rest of [`evaluate`] once the primitives are summed into the dirty texels: adds each
+/// group's maximum and applies the clips. Returns the kernel evaluations and clip tests done.
+fn add_groups_and_clip(field: &Field, grid: &Grid, dirty: &Dirty, values: &mut [f32]) -> u64 {
+    let dims = grid.dims;
+    let centers = grid.centers();
+    let [xs, ys, zs] = &centers;
+    let center = |i: usize, j: usize, k: usize| Vec3::new(xs[i], ys[j], zs[k]);
+    let whole = (UVec3::ZERO, dims - 1);
+    let reach = |blob: &Blob| grid.texel_box(blob);
+    let mut work = 0u64;
     if !field.groups.is_empty() {
         // Scratch grids of each group's two largest values; each group clears and adds back
         // only the box it reaches.

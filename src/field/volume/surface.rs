@@ -4,10 +4,10 @@
 //! one side of the level; its texels then get a value on that side. Marching cubes reads a
 //! texel's value only in cells the level crosses, so the mesh is the full bake's, to the bit.
 
-use glam::{UVec3, Vec3};
+use glam::{UVec3, Vec3, Vec3A, Vec4};
 
-use super::{DensityVolume, Dirty, Grid, evaluate, volume_of};
-use crate::field::{Blob, Clip, Field, wyvill};
+use super::{DensityVolume, Dirty, Grid, add_groups_and_clip, volume_of};
+use crate::field::{Blob, BlobRow, Clip, Field, wyvill};
 
 /// How far (field units) a bound must clear the level before a brick is skipped: far more than
 /// the rounding of a sum of thousands of kernel values, so float error never decides a side.
@@ -106,13 +106,84 @@ fn near_surface(
         }
         mask[i] = true;
     }
-    evaluate(
+    // The values start at 0, the primitives go in brick by brick, the rest as a bake does it.
+    let centers = slab.centers();
+    for blob in &field.blobs {
+        add_blob_in_bricks(blob, slab, &centers, &mask, values);
+    }
+    add_groups_and_clip(
         field,
         slab,
         &Dirty::of_mask_sized(slab, &mask, BRICK),
         values,
     );
     (mask.iter().filter(|m| **m).count(), mask.len())
+}
+
+/// Adds `blob` into the texels of the flagged bricks (`mask`) within its texel box, by whole
+/// brick rows: no chord to find per row, only a test that the row meets the primitive's ball of
+/// influence. Texels of a row outside the ball get exactly 0 from the kernel (the chords of
+/// `super::add_blob` rely on it too), so every texel gets the bits of the whole bake.
+fn add_blob_in_bricks(
+    blob: &Blob,
+    grid: &Grid,
+    [xs, ys, zs]: &[Vec<f32>; 3],
+    mask: &[bool],
+    values: &mut [f32],
+) {
+    let Some((a, b)) = grid.texel_box(blob) else {
+        return;
+    };
+    let bricks = grid.bricks_of(BRICK);
+    let (nx, ny) = (grid.dims.x as usize, grid.dims.y as usize);
+    let rows = blob.rows();
+    // The part of brick `i` along axis `axis` inside the texel box.
+    let span = |axis: usize, i: u32| {
+        let lo = (i * BRICK).max(a[axis]) as usize;
+        let hi = ((i + 1) * BRICK).min(b[axis] + 1) as usize;
+        lo..hi
+    };
+    for bz in a.z / BRICK..=b.z / BRICK {
+        for by in a.y / BRICK..=b.y / BRICK {
+            let brick_row = ((bz * bricks.y + by) * bricks.x) as usize;
+            for bx in a.x / BRICK..=b.x / BRICK {
+                if !mask[brick_row + bx as usize] {
+                    continue;
+                }
+                let (x, y) = (span(0, bx), span(1, by));
+                let whole = x.len() == BRICK as usize;
+                let centres = &xs[x.clone()];
+                let mut add = |j: usize, k: usize, line: BlobRow| {
+                    if line.misses() {
+                        return;
+                    }
+                    let row = &mut values[(k * ny + j) * nx..][x.clone()];
+                    if whole {
+                        // A fixed width: four lanes of one vector.
+                        let sum = Vec4::from_slice(row) + line.value4(Vec4::from_slice(centres));
+                        sum.write_to_slice(row);
+                    } else {
+                        for (v, &c) in row.iter_mut().zip(centres) {
+                            *v += line.value(c);
+                        }
+                    }
+                };
+                for k in span(2, bz) {
+                    if y.len() == BRICK as usize {
+                        // The brick's four rows in this layer found at once.
+                        let lines = rows.at4(Vec4::from_slice(&ys[y.clone()]), zs[k]);
+                        for (j, line) in y.clone().zip(lines) {
+                            add(j, k, line);
+                        }
+                    } else {
+                        for j in y.clone() {
+                            add(j, k, rows.at(ys[j], zs[k]));
+                        }
+                    }
+                }
+            }
+        }
+    }
 }
 
 /// Brick `i`'s coordinates (x fastest, then y, then z).
@@ -156,7 +227,7 @@ fn brick_bounds(field: &Field, grid: &Grid) -> Vec<(f32, f32)> {
     let index = |b: UVec3| ((b.z * bricks.y + b.y) * bricks.x + b.x) as usize;
     let mut bounds = vec![(0f32, 0f32); bricks.element_product() as usize];
     for blob in &field.blobs {
-        blob_bounds(blob, grid, &extents, &mut |b, lo, hi| {
+        blob_bounds(blob, grid, &extents, |b, lo, hi| {
             let s = &mut bounds[index(b)];
             *s = (s.0 + lo, s.1 + hi);
         });
@@ -167,7 +238,7 @@ fn brick_bounds(field: &Field, grid: &Grid) -> Vec<(f32, f32)> {
         let lift = group.blend.max(0.0) * 0.25;
         let mut own: std::collections::HashMap<usize, (f32, f32)> = Default::default();
         for blob in &group.blobs {
-            blob_bounds(blob, grid, &extents, &mut |b, lo, hi| {
+            blob_bounds(blob, grid, &extents, |b, lo, hi| {
                 let s = own.entry(index(b)).or_insert((0.0, 0.0));
                 *s = (s.0.max(lo), s.1.max(hi));
             });
@@ -211,7 +282,7 @@ fn blob_bounds(
     blob: &Blob,
     grid: &Grid,
     extents: &[Vec<(f32, f32)>; 3],
-    sink: &mut dyn FnMut(UVec3, f32, f32),
+    mut sink: impl FnMut(UVec3, f32, f32),
 ) {
     // The bricks whose grown box meets the influence box: those holding a texel of that box
     // widened by one texel.
@@ -221,7 +292,9 @@ fn blob_bounds(
     };
     let (a, b) = (a / BRICK, b / BRICK);
     let m = &blob.to_unit;
-    let axis = |j: usize, col: Vec3| -> Vec<(Vec3, Vec3)> {
+    // (SIMD vectors where glam has them: this loop visits every brick a primitive reaches.)
+    let axis = |j: usize, col: Vec3| -> Vec<(Vec3A, Vec3A)> {
+        let col = Vec3A::from(col);
         (a[j]..=b[j])
             .map(|k| {
                 let (lo, hi) = extents[j][k as usize];
@@ -237,10 +310,10 @@ fn blob_bounds(
             for (kx, x) in xs.iter().enumerate() {
                 let (ulo, uhi) = (x.0 + lo_yz, x.1 + hi_yz);
                 let (lo2, hi2) = (ulo * ulo, uhi * uhi);
-                let straddles = ulo.cmple(Vec3::ZERO) & uhi.cmpge(Vec3::ZERO);
+                let straddles = ulo.cmple(Vec3A::ZERO) & uhi.cmpge(Vec3A::ZERO);
                 // Widened a little against the rounding of the bake's own arithmetic.
-                let qmin =
-                    Vec3::select(straddles, Vec3::ZERO, lo2.min(hi2)).element_sum() * (1.0 - 1e-4);
+                let qmin = Vec3A::select(straddles, Vec3A::ZERO, lo2.min(hi2)).element_sum()
+                    * (1.0 - 1e-4);
                 if qmin >= 1.0 {
                     continue;
                 }
