@@ -63,6 +63,30 @@ pub struct FramePlan {
     pub refining: Option<f32>,
     /// Whether another frame is needed soon (work is under way).
     pub repaint: bool,
+    /// Refinement waits for the GPU to finish its last chunk: the next frame is due when the
+    /// GPU's fence reports it (the fence wakes the UI), or after a short while where nothing
+    /// polls the GPU meanwhile (natively, callbacks run when a frame is submitted).
+    pub waiting_for_gpu: bool,
+    /// The job's number (jobs are numbered from 1 as planned), which the GPU's fence reports
+    /// back once the job is done (the `gpu_done` of [`Progressive::plan`]).
+    pub job_id: u64,
+}
+
+/// What the GPU has reported of the jobs the planner gave it ([`FramePlan::job_id`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct GpuReport {
+    /// The number of the last job finished (every job before it is finished too).
+    pub done: u64,
+    /// The last job finished whose own time is known: its number, and the seconds from its
+    /// submission to the GPU's report of it.
+    pub timed: Option<(u64, f64)>,
+}
+
+impl GpuReport {
+    /// Jobs up to `done` finished, none timed.
+    pub fn upto(done: u64) -> Self {
+        Self { done, timed: None }
+    }
 }
 
 /// Frame-time budgets in seconds.
@@ -94,6 +118,19 @@ struct Shown {
     quality: Quality,
 }
 
+/// A job not yet measured.
+#[derive(Clone, Debug)]
+struct Pending {
+    id: u64,
+    /// When it was planned (seconds).
+    then: f64,
+    /// Pixel·slices.
+    work: f64,
+    /// A refinement chunk: measured from its planning until the GPU reports it done (the next
+    /// chunk waits for that), where a preview is measured by the interval to the next frame.
+    chunk: bool,
+}
+
 #[derive(Clone, Debug)]
 struct Refine {
     key: u64,
@@ -111,7 +148,22 @@ pub struct Progressive {
     overhead: f64,
     /// Recent frames with volume work: (pixel·slices, seconds).
     samples: std::collections::VecDeque<(f64, f64)>,
-    pending: Option<(f64, f64)>,
+    /// Seconds a timed chunk takes besides its work, from its planning to the frame that sees
+    /// its report (the frame, the GPU's other work, the report's delay).
+    per_chunk: f64,
+    /// Since when the GPU has been behind the jobs planned (fenced refinement waits).
+    behind_since: Option<f64>,
+    /// Recent refinement chunks the GPU timed: (pixel·slices, seconds).
+    timed: std::collections::VecDeque<(f64, f64)>,
+    /// Seconds every timed chunk took besides its work (fitted through `timed`): on a CPU
+    /// adapter the GPU's report of a chunk comes a good while after the work is done.
+    delay: f64,
+    pending: Option<Pending>,
+    /// Jobs planned so far (the last job's number).
+    jobs: u64,
+    /// The GPU never reported a refinement chunk done within [`FENCE_PATIENCE`]: chunks are
+    /// no longer held back, and measured by frame intervals like previews.
+    fence_silent: bool,
     shown: Option<Shown>,
     refine: Option<Refine>,
     last_frame: Option<f64>,
@@ -125,6 +177,9 @@ const MIN_PREVIEW_SCALE: f64 = 0.15;
 pub const MIN_REFINE_SCALE: f64 = 0.25;
 /// Frames the overhead is fitted over.
 const SAMPLES: usize = 16;
+/// Seconds a refinement chunk may go unreported by the GPU's fence before the planner stops
+/// waiting for fences (a chunk is sized to a quarter second).
+pub const FENCE_PATIENCE: f64 = 5.0;
 
 impl Progressive {
     /// A planner starting from a guessed cost in seconds per pixel·slice.
@@ -134,11 +189,24 @@ impl Progressive {
             cost: initial_cost.max(1e-12),
             overhead: 0.0,
             samples: std::collections::VecDeque::new(),
+            timed: std::collections::VecDeque::new(),
+            delay: 0.0,
+            behind_since: None,
+            per_chunk: 0.0,
             pending: None,
+            jobs: 0,
+            fence_silent: false,
             shown: None,
             refine: None,
             last_frame: None,
         }
+    }
+
+    /// Whether a refinement chunk waits for the GPU's report of the one before it (see
+    /// [`Progressive::plan`]); without, chunks follow frame after frame.
+    pub fn fenced(mut self, on: bool) -> Self {
+        self.fence_silent = !on;
+        self
     }
 
     /// Current cost estimate in seconds per pixel·slice.
@@ -160,7 +228,10 @@ impl Progressive {
 
     /// Plans the frame at time `now` (seconds) for a view identified by `key` in a viewport of
     /// `viewport` pixels whose full quality is `full_slices`. While `interacting` (pointer held)
-    /// no refinement starts, so dragging stays responsive.
+    /// no refinement starts, so dragging stays responsive. `gpu_done` is the number of the last
+    /// job the GPU has finished (see [`FramePlan::job_id`]): a refinement chunk is planned only
+    /// once the one before it is done, so a drag that starts during refinement waits for one
+    /// chunk at most (a browser otherwise lets two or three queue up).
     pub fn plan(
         &mut self,
         now: f64,
@@ -168,8 +239,9 @@ impl Progressive {
         viewport: [u32; 2],
         full_slices: u32,
         interacting: bool,
+        gpu: GpuReport,
     ) -> FramePlan {
-        self.measure(now);
+        self.measure(now, gpu);
         let viewport = [viewport[0].max(1), viewport[1].max(1)];
         let full_slices = full_slices.max(1);
 
@@ -198,11 +270,13 @@ impl Progressive {
                 },
                 Some(0),
                 None,
+                false,
             );
         }
         let Some(shown) = self.shown.clone() else {
             unreachable!("set above")
         };
+        let chunk_on_gpu = self.pending.as_ref().is_some_and(|p| p.chunk);
         if shown.quality.full || interacting {
             return FramePlan {
                 job: None,
@@ -210,6 +284,36 @@ impl Progressive {
                 shown: Some(shown.quality),
                 refining: None,
                 repaint: false,
+                // The last chunk is measured when the GPU reports it, not at the next input.
+                waiting_for_gpu: chunk_on_gpu,
+                job_id: 0,
+            };
+        }
+        // The GPU has yet to report the last job (a chunk, or the preview before the first):
+        // a chunk now would queue behind it. Past the fence's patience, stop waiting for it.
+        let behind = !self.fence_silent && gpu.done < self.jobs;
+        if behind {
+            let since = *self.behind_since.get_or_insert(now);
+            if now - since > FENCE_PATIENCE {
+                self.fence_silent = true;
+            }
+        } else {
+            self.behind_since = None;
+        }
+        if chunk_on_gpu || (behind && !self.fence_silent) {
+            // The last job is still on the GPU: show what there is and look again.
+            return FramePlan {
+                job: None,
+                display: Some(shown.target),
+                shown: Some(shown.quality),
+                refining: self
+                    .refine
+                    .as_ref()
+                    .filter(|r| r.key == key)
+                    .map(|r| r.next as f32 / r.total as f32),
+                repaint: false,
+                waiting_for_gpu: true,
+                job_id: 0,
             };
         }
         let size = self.refine_size(viewport, full_slices);
@@ -224,7 +328,14 @@ impl Progressive {
             }),
         };
         let pixels = refine.size[0] as f64 * refine.size[1] as f64;
-        let per_chunk = (chunk_seconds / (self.cost * pixels))
+        // Chunks the GPU times alternate in size, so that their times tell the work's part
+        // from the fixed delay of the GPU's reports.
+        let vary = if !self.fence_silent && !self.timed.is_empty() && self.jobs % 2 == 1 {
+            0.7
+        } else {
+            1.0
+        };
+        let per_chunk = (vary * chunk_seconds / (self.cost * pixels))
             .floor()
             .clamp(1.0, u32::MAX as f64) as u32;
         let start = refine.next;
@@ -250,9 +361,9 @@ impl Progressive {
                 quality,
             });
             self.refine = None;
-            self.submit(now, job, Some(1), None)
+            self.submit(now, job, Some(1), None, true)
         } else {
-            self.submit(now, job, Some(shown.target), Some(progress))
+            self.submit(now, job, Some(shown.target), Some(progress), true)
         }
     }
 
@@ -262,27 +373,90 @@ impl Progressive {
         job: JobPlan,
         display: Option<usize>,
         refining: Option<f32>,
+        chunk: bool,
     ) -> FramePlan {
         let work =
             job.size[0] as f64 * job.size[1] as f64 * (job.range.end - job.range.start) as f64;
-        self.pending = Some((now, work));
+        self.jobs += 1;
+        // A chunk is followed by a frame only once the GPU reports it done: a frame drawn
+        // meanwhile would only queue more work behind it.
+        let fenced = chunk && !self.fence_silent;
+        self.pending = Some(Pending {
+            id: self.jobs,
+            then: now,
+            work,
+            chunk: fenced,
+        });
         FramePlan {
             job: Some(job),
             display,
             shown: self.shown.as_ref().map(|s| s.quality),
             refining,
-            repaint: true,
+            repaint: !fenced,
+            waiting_for_gpu: fenced,
+            job_id: self.jobs,
         }
     }
 
-    /// Learns the cost and the overhead from the interval since the last frame that carried
-    /// work: the overhead is the intercept of a line fitted through recent frames of different
-    /// sizes (previews and refinement chunks); the cost is what a frame took beyond it.
-    fn measure(&mut self, now: f64) {
-        let Some((then, work)) = self.pending.take() else {
+    /// Learns the cost and the overhead from the time the last job took: a preview's is the
+    /// interval to the next frame (while dragging, frames queue behind the GPU), a refinement
+    /// chunk's lasts until the GPU reports it done (`gpu_done`; the next chunk waits for
+    /// that). The overhead is the intercept of a line fitted through recent jobs of different
+    /// sizes (previews and refinement chunks); the cost is what a job took beyond it.
+    fn measure(&mut self, now: f64, gpu: GpuReport) {
+        let gpu_done = gpu.done;
+        let Some(pending) = self
+            .pending
+            .take_if(|p| !p.chunk || gpu_done >= p.id || now - p.then > FENCE_PATIENCE)
+        else {
             return;
         };
+        let Pending { then, work, .. } = pending;
+        if pending.chunk
+            && let Some((id, seconds)) = gpu.timed
+            && id == pending.id
+        {
+            // The GPU's own time for the chunk, from its submission to the report: no frame's
+            // other work in it, so it teaches the cost alone (not the overhead's line).
+            if seconds > 0.0 && work > 0.0 {
+                self.last_frame = Some(seconds);
+                if self.timed.len() == SAMPLES {
+                    self.timed.pop_front();
+                }
+                self.timed.push_back((work, seconds));
+                // The work's part: the line's slope once chunks of different sizes tell it from
+                // the fixed delay (chunks alternate in size for that), else the chunk's seconds
+                // less the delay known so far.
+                let (slope, intercept) = fit_line(&self.timed);
+                if let Some(intercept) = intercept {
+                    self.delay = 0.5 * self.delay + 0.5 * intercept;
+                }
+                let sample = slope
+                    .unwrap_or(((seconds - self.delay).max(0.25 * seconds)) / work)
+                    .min(self.cost * 20.0);
+                let w = if sample > self.cost { 0.6 } else { 0.25 };
+                self.cost = self.cost * (1.0 - w) + sample * w;
+                // What a chunk costs in time besides its work, from its planning until the
+                // frame that saw its report: what refining at a resolution must count per chunk.
+                let beyond = (now - then - self.cost * work).max(0.0);
+                self.per_chunk = if self.per_chunk > 0.0 {
+                    0.7 * self.per_chunk + 0.3 * beyond
+                } else {
+                    beyond
+                };
+            }
+            return;
+        }
         let dt = now - then;
+        if pending.chunk && gpu_done < pending.id {
+            // No word from the GPU: stop waiting for it from now on.
+            self.fence_silent = true;
+            return;
+        }
+        if pending.chunk && dt > FENCE_PATIENCE {
+            // Reported, but seen only now (no frame came meanwhile): not a measure of it.
+            return;
+        }
         if dt.is_nan() || dt <= 0.0 || work <= 0.0 {
             return;
         }
@@ -293,13 +467,18 @@ impl Progressive {
         self.samples.push_back((work, dt));
         self.fit_overhead();
         let sample = ((dt - self.overhead).max(0.5 * dt) / work).min(self.cost * 20.0);
+        if !self.timed.is_empty() && !pending.chunk && sample < self.cost {
+            // A quick frame after a preview says little while the GPU is not behind (frames
+            // then come at the display's pace); the GPU's timing of chunks says more.
+            return;
+        }
         // Rise fast (stay responsive), fall slowly (don't trust one quick frame).
         let w = if sample > self.cost { 0.6 } else { 0.25 };
         self.cost = self.cost * (1.0 - w) + sample * w;
     }
 
     /// Least squares of seconds on work over the recent frames, when their sizes differ enough
-    /// to tell a fixed part from a proportional one.
+    /// to tell a fixed part from a proportional one (see also `fit_line`).
     fn fit_overhead(&mut self) {
         let n = self.samples.len() as f64;
         if n < 4.0 {
@@ -330,7 +509,13 @@ impl Progressive {
     /// Seconds of volume work per refinement chunk: the chunk budget less the frame's
     /// overhead, so a refining frame stays near the budget.
     fn chunk_seconds(&self) -> f64 {
-        (self.budget.refine - self.overhead).max(0.5 * self.budget.refine)
+        if self.fence_silent {
+            (self.budget.refine - self.overhead).max(0.5 * self.budget.refine)
+        } else {
+            // Fenced: a drag starting now waits for this chunk and the frame queued before it.
+            (self.budget.refine - 2.0 * self.overhead)
+                .clamp(0.4 * self.budget.refine, 0.6 * self.budget.refine)
+        }
     }
 
     /// Resolution of the refined image: the viewport's, or less where the adapter could not
@@ -341,7 +526,13 @@ impl Progressive {
                 * (viewport[0] as f64 * scale).round().max(1.0)
                 * (viewport[1] as f64 * scale).round().max(1.0)
                 * full_slices as f64;
-            work + (work / self.chunk_seconds()).ceil() * self.overhead
+            // Each chunk also costs a frame's overhead; a timed one also waits for its report.
+            let fixed = if self.fence_silent {
+                self.overhead
+            } else {
+                self.overhead.max(self.per_chunk)
+            };
+            work + (work / self.chunk_seconds()).ceil() * fixed
         };
         let mut scale: f64 = 1.0;
         while scale > MIN_REFINE_SCALE && seconds(scale) > self.budget.refine_total {
@@ -370,6 +561,35 @@ impl Progressive {
     }
 }
 
+/// The line `seconds = slope · work + intercept` through `samples` (work, seconds) by least
+/// squares, where their work differs enough to tell the two apart and both come out positive:
+/// (slope, intercept); the slope alone where the intercept comes out negative (taken as 0).
+fn fit_line(samples: &std::collections::VecDeque<(f64, f64)>) -> (Option<f64>, Option<f64>) {
+    let n = samples.len() as f64;
+    if n < 3.0 {
+        return (None, None);
+    }
+    let (mw, ms) = samples
+        .iter()
+        .fold((0.0, 0.0), |(a, b), &(w, s)| (a + w / n, b + s / n));
+    let (var, cov) = samples.iter().fold((0.0, 0.0), |(v, c), &(w, s)| {
+        (v + (w - mw) * (w - mw), c + (w - mw) * (s - ms))
+    });
+    if var < (0.15 * mw).powi(2) * n || cov <= 0.0 {
+        return (None, None);
+    }
+    let slope = cov / var;
+    let intercept = ms - slope * mw;
+    if intercept < 0.0 {
+        // Through the origin instead.
+        let (ww, ws) = samples
+            .iter()
+            .fold((0.0, 0.0), |(a, b), &(w, s)| (a + w * w, b + w * s));
+        return ((ww > 0.0).then(|| ws / ww), Some(0.0));
+    }
+    (Some(slope), Some(intercept))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -392,8 +612,11 @@ mod tests {
         t: &mut f64,
     ) -> (usize, f64) {
         let mut longest: f64 = 0.0;
+        // Each frame's work is done when the next frame starts.
+        let mut done = 0;
         for frame in 1..1000 {
-            let plan = p.plan(*t, key, view, 128, false);
+            let plan = p.plan(*t, key, view, 128, false, GpuReport::upto(done));
+            done = done.max(plan.job_id);
             let work = plan.job.as_ref().map_or(0.0, |j| {
                 j.size[0] as f64 * j.size[1] as f64 * (j.range.end - j.range.start) as f64
             });
@@ -437,7 +660,8 @@ mod tests {
         let view = [1200, 860];
         let true_cost = 12.0 / (1200.0 * 860.0 * 128.0);
         let overhead = 0.1;
-        let mut p = Progressive::new(true_cost / 3.0, Budget::default());
+        // Frames measured by their intervals (as natively, and as before fences).
+        let mut p = Progressive::new(true_cost / 3.0, Budget::default()).fenced(false);
         let mut t = 0.0;
         // A few views (drags and refinements) to learn from.
         for key in 1..4 {
@@ -468,7 +692,7 @@ mod tests {
     fn fast_adapter_shows_full_quality_at_once() {
         let true_cost = 1e-10;
         let mut p = Progressive::new(true_cost, Budget::default());
-        let plan = p.plan(0.0, 1, VIEW, 128, false);
+        let plan = p.plan(0.0, 1, VIEW, 128, false, GpuReport::upto(u64::MAX));
         assert_eq!(
             plan.shown,
             Some(Quality {
@@ -477,7 +701,7 @@ mod tests {
                 full: true
             })
         );
-        let plan = p.plan(0.02, 1, VIEW, 128, false);
+        let plan = p.plan(0.02, 1, VIEW, 128, false, GpuReport::upto(u64::MAX));
         assert!(plan.job.is_none() && !plan.repaint);
     }
 
@@ -485,11 +709,11 @@ mod tests {
     fn chunks_cover_every_slice_exactly_once() {
         let mut p = Progressive::new(1e-7, Budget::default());
         let mut t = 0.0;
-        p.plan(t, 9, VIEW, 100, false);
+        p.plan(t, 9, VIEW, 100, false, GpuReport::upto(u64::MAX));
         let mut covered = Vec::new();
         loop {
             t += 0.1;
-            let plan = p.plan(t, 9, VIEW, 100, false);
+            let plan = p.plan(t, 9, VIEW, 100, false, GpuReport::upto(u64::MAX));
             match plan.job {
                 Some(j) => {
                     assert_eq!(j.target, 1);
@@ -505,16 +729,194 @@ mod tests {
     #[test]
     fn view_change_restarts_and_interaction_defers_refinement() {
         let mut p = Progressive::new(1e-7, Budget::default());
-        let a = p.plan(0.0, 1, VIEW, 128, false);
+        let a = p.plan(0.0, 1, VIEW, 128, false, GpuReport::upto(u64::MAX));
         assert_eq!(a.job.as_ref().unwrap().target, 0);
         assert!(!a.shown.unwrap().full);
-        let held = p.plan(0.1, 1, VIEW, 128, true);
+        let held = p.plan(0.1, 1, VIEW, 128, true, GpuReport::upto(u64::MAX));
         assert!(held.job.is_none() && !held.repaint);
-        let r = p.plan(0.2, 1, VIEW, 128, false);
+        let r = p.plan(0.2, 1, VIEW, 128, false, GpuReport::upto(u64::MAX));
         assert_eq!(r.job.as_ref().unwrap().target, 1);
-        let moved = p.plan(0.3, 2, VIEW, 128, false);
+        let moved = p.plan(0.3, 2, VIEW, 128, false, GpuReport::upto(u64::MAX));
         assert_eq!(moved.job.unwrap().target, 0);
         assert_eq!(moved.display, Some(0));
+    }
+
+    #[test]
+    fn a_chunk_waits_until_the_gpu_has_done_the_one_before() {
+        let mut p = Progressive::new(1e-8, Budget::default());
+        let preview = p.plan(0.0, 1, VIEW, 128, false, GpuReport::upto(0));
+        let first = p.plan(0.1, 1, VIEW, 128, false, GpuReport::upto(preview.job_id));
+        let range = first.job.as_ref().unwrap().range.clone();
+        assert!(
+            range.end < 128,
+            "the refinement takes several chunks: {range:?}"
+        );
+        // The GPU is still on that chunk: nothing more is queued, the image shown stays, and
+        // the fence is to wake the next frame.
+        for t in [0.2, 0.3, 0.4] {
+            let waiting = p.plan(t, 1, VIEW, 128, false, GpuReport::upto(preview.job_id));
+            assert!(waiting.job.is_none() && waiting.waiting_for_gpu);
+            assert_eq!(waiting.display, first.display);
+            assert_eq!(waiting.refining, first.refining);
+        }
+        // Done: the next chunk follows on from the first.
+        let next = p.plan(0.5, 1, VIEW, 128, false, GpuReport::upto(first.job_id));
+        assert_eq!(next.job.as_ref().unwrap().range.start, range.end);
+        // A view change is drawn at once, whatever the GPU is doing.
+        let moved = p.plan(0.6, 2, VIEW, 128, false, GpuReport::upto(first.job_id));
+        assert_eq!(moved.job.unwrap().target, 0);
+    }
+
+    #[test]
+    fn a_silent_fence_holds_refinement_back_no_longer_than_its_patience() {
+        // Six seconds of refinement: many chunks.
+        let mut p = Progressive::new(1e-7, Budget::default());
+        p.plan(0.0, 1, VIEW, 128, false, GpuReport::upto(0));
+        // The GPU never reports anything done: not even the preview, so no chunk follows it.
+        assert!(
+            p.plan(0.1, 1, VIEW, 128, false, GpuReport::upto(0))
+                .waiting_for_gpu
+        );
+        let t = 0.1 + 0.5 * FENCE_PATIENCE;
+        assert!(
+            p.plan(t, 1, VIEW, 128, false, GpuReport::upto(0))
+                .waiting_for_gpu
+        );
+        let mut t = 0.2 + FENCE_PATIENCE;
+        // From then on chunks follow each other as frames come, as before fences.
+        for _ in 0..3 {
+            let plan = p.plan(t, 1, VIEW, 128, false, GpuReport::upto(0));
+            assert!(plan.job.is_some() && !plan.waiting_for_gpu, "{plan:?}");
+            t += 0.1;
+        }
+    }
+
+    /// A browser over a CPU adapter: the page's frames run ahead of the GPU (up to `ahead`
+    /// frames wait on it, else frames come every 1/60 s), the GPU runs the frames in order,
+    /// each taking `overhead` plus its volume work at `cost`, and its fence reports a job done
+    /// once the GPU has finished it (waking the page if refinement waits for it).
+    struct Browser {
+        cost: f64,
+        overhead: f64,
+        ahead: usize,
+        /// Fences off: the planner is told every job is done (as before fences).
+        unfenced: bool,
+        /// Seconds from a job's end on the GPU to its report, which are also in the GPU's
+        /// time of the job (as measured in SwiftShader's WebGPU: about 0.16 s at 1920×1080).
+        delay: f64,
+        t: f64,
+        gpu_free: f64,
+        /// GPU end times of the frames not yet finished, oldest first.
+        queued: std::collections::VecDeque<f64>,
+        /// (end, job, the job's own GPU seconds) of every job.
+        jobs: Vec<(f64, u64, f64)>,
+    }
+
+    impl Browser {
+        fn new(cost: f64, overhead: f64, unfenced: bool, delay: f64) -> Self {
+            Self {
+                cost,
+                overhead,
+                ahead: 3,
+                unfenced,
+                delay,
+                t: 0.0,
+                gpu_free: 0.0,
+                queued: Default::default(),
+                jobs: Vec::new(),
+            }
+        }
+
+        /// Frames of view `key` until full quality is shown: the longest a drag starting right
+        /// after one of them would wait for the GPU, and the seconds to full quality.
+        fn refine(&mut self, p: &mut Progressive, key: u64, view: [u32; 2]) -> (f64, f64) {
+            let (t0, mut stall) = (self.t, 0.0f64);
+            for _ in 0..10_000 {
+                let t = self.t;
+                let report = if self.unfenced {
+                    GpuReport::upto(u64::MAX)
+                } else {
+                    let reported = self.jobs.iter().filter(|(end, ..)| end + self.delay <= t);
+                    let last = reported.max_by(|a, b| a.1.cmp(&b.1));
+                    GpuReport {
+                        done: last.map_or(0, |j| j.1),
+                        timed: last.map(|&(_, id, seconds)| (id, seconds + self.delay)),
+                    }
+                };
+                let plan = p.plan(t, key, view, 128, false, report);
+                if plan.shown.is_some_and(|q| q.full) && plan.job.is_none() && !plan.repaint {
+                    return (stall, t - t0);
+                }
+                let work = plan.job.as_ref().map_or(0.0, |j| {
+                    j.size[0] as f64 * j.size[1] as f64 * (j.range.end - j.range.start) as f64
+                });
+                let end = self.gpu_free.max(t) + self.overhead + work * self.cost;
+                // A drag starting right after this frame waits until the GPU is through.
+                stall = stall.max(end - t);
+                self.gpu_free = end;
+                if plan.job.is_some() {
+                    self.jobs.push((end, plan.job_id, work * self.cost));
+                }
+                self.queued.push_back(end);
+                let mut next = t + 1.0 / 60.0;
+                if plan.waiting_for_gpu {
+                    // No frame until the fence wakes the page.
+                    let chunk = self.jobs.last().map_or(next, |&(end, ..)| end + self.delay);
+                    next = next.max(chunk);
+                }
+                self.queued.retain(|&e| e > next);
+                while self.queued.len() >= self.ahead {
+                    next = self.queued.pop_front().unwrap_or(next);
+                    self.queued.retain(|&e| e > next);
+                }
+                self.t = next;
+            }
+            panic!("never reached full quality");
+        }
+    }
+
+    #[test]
+    fn a_drag_during_refinement_waits_for_one_chunk_not_the_frames_queued_ahead() {
+        // SwiftShader at 1280×800 in the headless browser: the cloud's box 800×600 px, 6 s at
+        // full resolution in one go, 67 ms of compositing in every frame; the GPU's reports
+        // come at once, or 0.16 s late (as SwiftShader's WebGPU at 1920×1080).
+        let cost = 6.0 / (800.0 * 600.0 * 128.0);
+        let run = |unfenced: bool, delay: f64| {
+            let mut b = Browser::new(cost, 0.067, unfenced, delay);
+            let mut p = Progressive::new(cost / 3.0, Budget::default()).fenced(!unfenced);
+            for key in 1..4 {
+                b.refine(&mut p, key, VIEW);
+            }
+            let (stall, seconds) = b.refine(&mut p, 9, VIEW);
+            (stall, seconds, p.cost() / cost, p.refine_size(VIEW, 128))
+        };
+        let pace = |seconds: f64, size: [u32; 2]| size[0] as f64 * size[1] as f64 / seconds;
+        let (stall_before, seconds_before, _, size_before) = run(true, 0.0);
+        // Before fences, frames of a quarter second each queued up behind each other.
+        assert!(stall_before > 0.45, "unfenced: {stall_before:.2} s");
+        // (With the delay counted as work, chunks shrink until each is mostly delay: 0.1 of
+        // the pace.)
+        for (delay, kept) in [(0.0, 0.6), (0.16, 0.3)] {
+            let (stall, seconds, learnt, size) = run(false, delay);
+            assert!(
+                stall < 0.3,
+                "fenced, reports {delay} s late: {stall:.2} s (unfenced {stall_before:.2} s)"
+            );
+            // The cost is still learnt (chunks timed by the GPU, their reports' delay told
+            // apart, not frame intervals, which are short while no chunk queues), and
+            // refinement keeps much of its pace: a chunk waits for the report of the one before.
+            assert!(
+                (learnt - 1.0).abs() < 0.3,
+                "reports {delay} s late: learnt {learnt:.2} of the true cost"
+            );
+            assert!(
+                pace(seconds, size) > kept * pace(seconds_before, size_before)
+                    && size[0] as f64 >= 0.8 * size_before[0] as f64
+                    && seconds < 2.5,
+                "fenced, reports {delay} s late: {seconds:.2} s at {size:?}, unfenced \
+                 {seconds_before:.2} s at {size_before:?}"
+            );
+        }
     }
 
     #[test]

@@ -4,9 +4,84 @@
 //! the app hands over a plain `Send + Sync` snapshot: the derived volumes, the job (with its
 //! view) and which target to show. Uniforms are built here, from the snapshot.
 
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, Mutex};
+
+use super::progressive::GpuReport;
 use super::renderer::{SliceJob, VolumeRenderer};
 use super::resources::accumulation_format;
 use crate::derive::Volumes;
+
+/// The GPU's reports of the viewport's volume jobs (see
+/// [`super::progressive::Progressive::plan`]), shared by the app and the paint callback. The
+/// callback submits each job on its own, asking the queue for two reports: one when the work
+/// before the job is done (the GPU is free to start it) and one when the job is done. Their
+/// difference is the GPU's time for the job without the frames queued before it; it still
+/// holds a fixed delay of the reports themselves (about 0.16 s in SwiftShader's WebGPU at
+/// 1920×1080), which the planner tells apart from the work by fitting a line through chunks
+/// of different sizes. The last report also wakes the app, so refinement waiting for it goes
+/// on at once.
+#[derive(Clone)]
+pub struct JobFence(Arc<FenceState>);
+
+struct FenceState {
+    done: AtomicU64,
+    times: Mutex<Times>,
+    clock: fn() -> f64,
+    wake: Box<dyn Fn() + Send + Sync>,
+}
+
+/// What a [`JobFence`] knows of the jobs' times.
+#[derive(Default)]
+struct Times {
+    /// The job the GPU last became free for, and when.
+    free: Option<(u64, f64)>,
+    /// The last job timed, and its seconds.
+    timed: Option<(u64, f64)>,
+}
+
+impl JobFence {
+    /// A fence that calls `wake` whenever a job is reported done, timing jobs by `clock`
+    /// (seconds).
+    pub fn new(wake: impl Fn() + Send + Sync + 'static, clock: fn() -> f64) -> Self {
+        Self(Arc::new(FenceState {
+            done: AtomicU64::new(0),
+            times: Mutex::new(Times::default()),
+            clock,
+            wake: Box::new(wake),
+        }))
+    }
+
+    /// What the GPU has reported so far.
+    pub fn report(&self) -> GpuReport {
+        let timed = self.0.times.lock().map_or(None, |t| t.timed);
+        GpuReport {
+            done: self.0.done.load(Ordering::Acquire),
+            timed,
+        }
+    }
+
+    /// The work submitted before job `job` is done: the GPU can start it.
+    fn free_for(&self, job: u64) {
+        let now = (self.0.clock)();
+        if let Ok(mut t) = self.0.times.lock() {
+            t.free = Some((job, now));
+        }
+    }
+
+    /// Reports job `job` (and every job before it) done.
+    pub fn finished(&self, job: u64) {
+        let now = (self.0.clock)();
+        if let Ok(mut t) = self.0.times.lock()
+            && let Some((id, at)) = t.free
+            && id == job
+        {
+            t.timed = Some((job, (now - at).max(0.0)));
+        }
+        self.0.done.fetch_max(job, Ordering::AcqRel);
+        (self.0.wake)();
+    }
+}
 
 /// What one frame of the viewport draws.
 pub struct ViewportPaint {
@@ -18,6 +93,8 @@ pub struct ViewportPaint {
     pub display: Option<usize>,
     /// A capture of the view for export, advanced every frame until read back.
     pub capture: Option<super::capture::Capture>,
+    /// The job's number and the fence to report it done through.
+    pub fence: Option<(JobFence, u64)>,
 }
 
 impl egui_wgpu::CallbackTrait for ViewportPaint {
@@ -26,15 +103,28 @@ impl egui_wgpu::CallbackTrait for ViewportPaint {
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         _screen: &egui_wgpu::ScreenDescriptor,
-        encoder: &mut wgpu::CommandEncoder,
+        _encoder: &mut wgpu::CommandEncoder,
         resources: &mut egui_wgpu::CallbackResources,
     ) -> Vec<wgpu::CommandBuffer> {
         if let Some(renderer) = resources.get_mut::<VolumeRenderer>() {
             renderer.begin_frame();
             renderer.upload(device, queue, &self.volumes);
             if let Some(job) = &self.job {
-                renderer.update_light(device, queue, encoder, &job.view);
-                renderer.draw_slices(device, queue, encoder, job, None);
+                // The job goes to the GPU now, in a submission of its own (before the frame's,
+                // which composites it), so that the queue can report it done at once: a report
+                // asked for here covers only what is already submitted.
+                let mut own = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                    label: Some("volume job"),
+                });
+                renderer.update_light(device, queue, &mut own, &job.view);
+                renderer.draw_slices(device, queue, &mut own, job, None);
+                if let Some((fence, id)) = self.fence.clone() {
+                    queue.on_submitted_work_done(move || fence.free_for(id));
+                }
+                queue.submit([own.finish()]);
+                if let Some((fence, id)) = self.fence.clone() {
+                    queue.on_submitted_work_done(move || fence.finished(id));
+                }
             }
             if let Some(capture) = &self.capture {
                 capture.advance(renderer, device, queue);

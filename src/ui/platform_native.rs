@@ -11,6 +11,10 @@ pub const GL_BACKEND_NAME: &str = "gl";
 /// Whether this platform has a file picker button (the browser's file input).
 pub const HAS_PICKER: bool = false;
 
+/// Whether refinement waits for the GPU's report of each chunk before the next: not natively,
+/// where the queue reports only when it is next polled or given work (a frame later at best).
+pub const FENCED_REFINEMENT: bool = false;
+
 /// Reads a dropped file at once.
 pub fn read_dropped(file: egui::DroppedFileHandle, _ctx: &egui::Context) -> Option<Loaded> {
     let name = file.path().display().to_string();

@@ -19,6 +19,11 @@ pub const GL_BACKEND_NAME: &str = "webgl2";
 /// Whether this platform has a file picker button.
 pub const HAS_PICKER: bool = true;
 
+/// Whether refinement waits for the GPU's report of each chunk before the next (with WebGPU,
+/// whose reports come as soon as the work is done): a browser runs frames ahead of the GPU,
+/// so chunks queued there would hold up the first frame of a drag.
+pub const FENCED_REFINEMENT: bool = true;
+
 /// Largest file read.
 const MAX_BYTES: f64 = MAX_FILE_BYTES as f64;
 

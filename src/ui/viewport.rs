@@ -13,12 +13,19 @@ use crate::render::SliceJob;
 use crate::render::View;
 use crate::render::capture::Capture;
 use crate::render::progressive::{Budget, Progressive};
+use crate::render::viewport::JobFence;
 use crate::render::viewport::{SkyPaint, ViewportPaint};
 use crate::scene::Document;
+
+/// How often a viewport whose refinement waits for the GPU looks again without word from it.
+const FENCE_POLL: std::time::Duration = std::time::Duration::from_millis(100);
 
 /// The viewport's own state.
 pub struct Viewport {
     progressive: Progressive,
+    /// The GPU's reports of the jobs this viewport gave it (made with the first frame, as it
+    /// wakes the UI).
+    fence: Option<JobFence>,
     /// What it reports (backend, quality, frame time, size).
     pub stats: ViewStats,
     /// The first full-quality image has been shown.
@@ -50,8 +57,16 @@ pub struct ViewportContext<'a> {
 impl Viewport {
     /// A viewport whose planner starts from a guessed cost (seconds per pixel·slice).
     pub fn new(initial_cost: f64, stats: ViewStats) -> Self {
+        // WebGPU reports finished work by itself; WebGL2's reports come only when work is next
+        // submitted, a frame or more late, which would make every chunk look slow.
+        let webgpu = stats
+            .backend
+            .as_ref()
+            .is_some_and(|b| b.backend == "webgpu");
         Self {
-            progressive: Progressive::new(initial_cost, Budget::default()),
+            progressive: Progressive::new(initial_cost, Budget::default())
+                .fenced(super::platform::FENCED_REFINEMENT && webgpu),
+            fence: None,
             stats,
             ready: false,
             frame_request: false,
@@ -175,12 +190,20 @@ impl Viewport {
         let key = view_key(cx.doc, px, crop.map(|c| c.px));
         let now = ui.input(|i| i.time);
         let crop_size = crop.map_or([1, 1], |c| c.size());
+        let fence = self
+            .fence
+            .get_or_insert_with(|| {
+                let ctx = ui.ctx().clone();
+                JobFence::new(move || ctx.request_repaint(), super::platform::now)
+            })
+            .clone();
         let plan = self.progressive.plan(
             now,
             key,
             crop_size,
             scene.render.slices,
             response.is_pointer_button_down_on(),
+            fence.report(),
         );
         self.stats.shown = plan.shown;
         self.stats.refining = plan.refining;
@@ -209,9 +232,16 @@ impl Viewport {
                     job: None,
                     display: None,
                     capture: capture.clone(),
+                    fence: None,
                 },
             ));
         }
+        // A job the GPU never gets counts as done at once.
+        let drawn = crop.is_some() && self.stats.backend.is_some();
+        if plan.job.is_some() && !drawn {
+            fence.finished(plan.job_id);
+        }
+        let job_fence = plan.job.is_some().then(|| (fence.clone(), plan.job_id));
         if let Some(crop) = crop {
             let job = plan.job.map(|plan| SliceJob {
                 plan,
@@ -233,12 +263,16 @@ impl Viewport {
                         job,
                         display: plan.display,
                         capture,
+                        fence: job_fence,
                     },
                 ));
             }
         }
         if plan.repaint {
             ui.ctx().request_repaint();
+        } else if plan.waiting_for_gpu {
+            // The GPU's report wakes the UI; this is in case it never comes.
+            ui.ctx().request_repaint_after(FENCE_POLL);
         }
         guide.paint(&ui.painter_at(rect), rect, cx.doc, true);
         self.status_line(ui, rect, cx.doc, cx.notices, now);
