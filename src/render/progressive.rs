@@ -68,7 +68,7 @@ pub struct FramePlan {
     /// polls the GPU meanwhile (natively, callbacks run when a frame is submitted).
     pub waiting_for_gpu: bool,
     /// The job's number (jobs are numbered from 1 as planned), which the GPU's fence reports
-    /// back once the job is done (the `gpu_done` of [`Progressive::plan`]).
+    /// back once the job is done ([`GpuReport::done`]).
     pub job_id: u64,
 }
 
@@ -77,8 +77,8 @@ pub struct FramePlan {
 pub struct GpuReport {
     /// The number of the last job finished (every job before it is finished too).
     pub done: u64,
-    /// The last job finished whose own time is known: its number, and the seconds from its
-    /// submission to the GPU's report of it.
+    /// The last job finished whose own time is known: its number, and the seconds from the
+    /// GPU's report that it was free for the job to its report of the job done.
     pub timed: Option<(u64, f64)>,
 }
 
@@ -126,8 +126,9 @@ struct Pending {
     then: f64,
     /// Pixel·slices.
     work: f64,
-    /// A refinement chunk: measured from its planning until the GPU reports it done (the next
-    /// chunk waits for that), where a preview is measured by the interval to the next frame.
+    /// A refinement chunk the next one waits for: measured by the GPU's time for it (or, where
+    /// untimed, from its planning until its report is seen), where a preview is measured by
+    /// the interval to the next frame.
     chunk: bool,
 }
 
@@ -161,8 +162,9 @@ pub struct Progressive {
     pending: Option<Pending>,
     /// Jobs planned so far (the last job's number).
     jobs: u64,
-    /// The GPU never reported a refinement chunk done within [`FENCE_PATIENCE`]: chunks are
-    /// no longer held back, and measured by frame intervals like previews.
+    /// Fences off ([`Progressive::fenced`]), or the GPU never reported a job within
+    /// [`FENCE_PATIENCE`]: chunks are not held back, and measured by frame intervals like
+    /// previews.
     fence_silent: bool,
     shown: Option<Shown>,
     refine: Option<Refine>,
@@ -228,10 +230,10 @@ impl Progressive {
 
     /// Plans the frame at time `now` (seconds) for a view identified by `key` in a viewport of
     /// `viewport` pixels whose full quality is `full_slices`. While `interacting` (pointer held)
-    /// no refinement starts, so dragging stays responsive. `gpu_done` is the number of the last
-    /// job the GPU has finished (see [`FramePlan::job_id`]): a refinement chunk is planned only
-    /// once the one before it is done, so a drag that starts during refinement waits for one
-    /// chunk at most (a browser otherwise lets two or three queue up).
+    /// no refinement starts, so dragging stays responsive. `gpu` is what the GPU has reported
+    /// of the jobs (see [`FramePlan::job_id`]): with fences on, a refinement chunk is planned
+    /// only once every job before it is done, so a drag that starts during refinement waits
+    /// for one chunk at most (a browser otherwise lets two or three queue up).
     pub fn plan(
         &mut self,
         now: f64,
@@ -399,10 +401,11 @@ impl Progressive {
     }
 
     /// Learns the cost and the overhead from the time the last job took: a preview's is the
-    /// interval to the next frame (while dragging, frames queue behind the GPU), a refinement
-    /// chunk's lasts until the GPU reports it done (`gpu_done`; the next chunk waits for
-    /// that). The overhead is the intercept of a line fitted through recent jobs of different
-    /// sizes (previews and refinement chunks); the cost is what a job took beyond it.
+    /// interval to the next frame (while dragging, frames queue behind the GPU); a fenced
+    /// refinement chunk's is the GPU's own time for it (`gpu.timed`), less the reports' fixed
+    /// delay, or where untimed the time until its report is seen. The overhead is the
+    /// intercept of a line fitted through recent frames of different sizes; the cost is what a
+    /// frame took beyond it.
     fn measure(&mut self, now: f64, gpu: GpuReport) {
         let gpu_done = gpu.done;
         let Some(pending) = self
@@ -416,8 +419,8 @@ impl Progressive {
             && let Some((id, seconds)) = gpu.timed
             && id == pending.id
         {
-            // The GPU's own time for the chunk, from its submission to the report: no frame's
-            // other work in it, so it teaches the cost alone (not the overhead's line).
+            // The GPU's own time for the chunk, between its two reports: no frame's other work
+            // in it, so it teaches the cost (and the reports' delay), not the overhead's line.
             if seconds > 0.0 && work > 0.0 {
                 self.last_frame = Some(seconds);
                 if self.timed.len() == SAMPLES {
