@@ -390,15 +390,20 @@ fn evaluate(field: &Field, grid: &Grid, dirty: &Dirty, values: &mut [f32]) -> u6
             add_blob(dirty, grid, &centers, bx, &mut work, blob, values);
         }
     }
-    work + add_groups_and_clip(field, grid, dirty, values)
+    work + add_groups_and_clip(field, grid, &centers, dirty, values)
 }
 
 /// The rest of [`evaluate`] once the primitives are summed into the dirty texels: adds each
 /// group's maximum and applies the clips. Returns the kernel evaluations and clip tests done.
-fn add_groups_and_clip(field: &Field, grid: &Grid, dirty: &Dirty, values: &mut [f32]) -> u64 {
+fn add_groups_and_clip(
+    field: &Field,
+    grid: &Grid,
+    centers: &[Vec<f32>; 3],
+    dirty: &Dirty,
+    values: &mut [f32],
+) -> u64 {
     let dims = grid.dims;
-    let centers = grid.centers();
-    let [xs, ys, zs] = &centers;
+    let [xs, ys, zs] = centers;
     let center = |i: usize, j: usize, k: usize| Vec3::new(xs[i], ys[j], zs[k]);
     let whole = (UVec3::ZERO, dims - 1);
     let reach = |blob: &Blob| grid.texel_box(blob);

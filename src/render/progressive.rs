@@ -483,21 +483,12 @@ impl Progressive {
     /// Least squares of seconds on work over the recent frames, when their sizes differ enough
     /// to tell a fixed part from a proportional one (see also `fit_line`).
     fn fit_overhead(&mut self) {
-        let n = self.samples.len() as f64;
-        if n < 4.0 {
+        if self.samples.len() < 4 {
             return;
         }
-        let (mw, md) = self
-            .samples
-            .iter()
-            .fold((0.0, 0.0), |(a, b), &(w, d)| (a + w / n, b + d / n));
-        let (var, cov) = self.samples.iter().fold((0.0, 0.0), |(v, c), &(w, d)| {
-            (v + (w - mw) * (w - mw), c + (w - mw) * (d - md))
-        });
-        if var < (0.3 * mw).powi(2) * n || cov <= 0.0 {
+        let Some((_, intercept)) = least_squares(&self.samples, 0.3) else {
             return;
-        }
-        let slope = cov / var;
+        };
         // Never more than half the quickest recent frame: a wrong fit must not make the cost
         // look small (the next chunk would then take seconds).
         let quickest = self
@@ -505,7 +496,7 @@ impl Progressive {
             .iter()
             .map(|&(_, d)| d)
             .fold(f64::MAX, f64::min);
-        let intercept = (md - slope * mw).clamp(0.0, 0.5 * quickest);
+        let intercept = intercept.clamp(0.0, 0.5 * quickest);
         self.overhead = 0.5 * self.overhead + 0.5 * intercept;
     }
 
@@ -568,21 +559,12 @@ impl Progressive {
 /// squares, where their work differs enough to tell the two apart and both come out positive:
 /// (slope, intercept); the slope alone where the intercept comes out negative (taken as 0).
 fn fit_line(samples: &std::collections::VecDeque<(f64, f64)>) -> (Option<f64>, Option<f64>) {
-    let n = samples.len() as f64;
-    if n < 3.0 {
+    if samples.len() < 3 {
         return (None, None);
     }
-    let (mw, ms) = samples
-        .iter()
-        .fold((0.0, 0.0), |(a, b), &(w, s)| (a + w / n, b + s / n));
-    let (var, cov) = samples.iter().fold((0.0, 0.0), |(v, c), &(w, s)| {
-        (v + (w - mw) * (w - mw), c + (w - mw) * (s - ms))
-    });
-    if var < (0.15 * mw).powi(2) * n || cov <= 0.0 {
+    let Some((slope, intercept)) = least_squares(samples, 0.15) else {
         return (None, None);
-    }
-    let slope = cov / var;
-    let intercept = ms - slope * mw;
+    };
     if intercept < 0.0 {
         // Through the origin instead.
         let (ww, ws) = samples
@@ -591,6 +573,30 @@ fn fit_line(samples: &std::collections::VecDeque<(f64, f64)>) -> (Option<f64>, O
         return ((ww > 0.0).then(|| ws / ww), Some(0.0));
     }
     (Some(slope), Some(intercept))
+}
+
+/// The least-squares line of seconds on work through `samples` (work, seconds): (slope,
+/// intercept), where the work's spread (standard deviation) is at least `spread` of its mean
+/// and seconds grow with it; else none.
+fn least_squares(
+    samples: &std::collections::VecDeque<(f64, f64)>,
+    spread: f64,
+) -> Option<(f64, f64)> {
+    let n = samples.len() as f64;
+    if n == 0.0 {
+        return None;
+    }
+    let (mw, ms) = samples
+        .iter()
+        .fold((0.0, 0.0), |(a, b), &(w, s)| (a + w / n, b + s / n));
+    let (var, cov) = samples.iter().fold((0.0, 0.0), |(v, c), &(w, s)| {
+        (v + (w - mw) * (w - mw), c + (w - mw) * (s - ms))
+    });
+    if var < (spread * mw).powi(2) * n || cov <= 0.0 {
+        return None;
+    }
+    let slope = cov / var;
+    Some((slope, ms - slope * mw))
 }
 
 #[cfg(test)]

@@ -114,6 +114,7 @@ fn near_surface(
     add_groups_and_clip(
         field,
         slab,
+        &centers,
         &Dirty::of_mask_sized(slab, &mask, BRICK),
         values,
     );
