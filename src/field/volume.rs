@@ -428,13 +428,13 @@ fn add_groups_and_clip(
             });
             for blob in &group.blobs {
                 if let Some(bx) = reach(blob) {
-                    splat(dirty, dims, &centers, bx, &mut work, |at, p| {
+                    splat(dirty, dims, centers, bx, &mut work, |at, p| {
                         (first[at], second[at]) =
                             super::top_two((first[at], second[at]), blob.value(p));
                     });
                 }
             }
-            splat(dirty, dims, &centers, bx, &mut work, |at, p| {
+            splat(dirty, dims, centers, bx, &mut work, |at, p| {
                 values[at] += group.combine(first[at], second[at], p)
             });
         }
