@@ -142,18 +142,27 @@ fn url_param(name: &str) -> Option<String> {
 }
 
 /// `?bench=ca`: the automaton's step and smoothing on the benchmarks' grid, timed by the page's
-/// clock (medians; the page's state shows them as `bench`).
+/// clock (medians; the page's state shows them as `bench`). The step runs on pairs of words
+/// (SIMD); the same step a word at a time is its baseline, and both must give the same bits.
 fn bench_automaton() {
     use crate::simulate::{bench_simulation, time_steps};
     let performance = web_sys::window().and_then(|w| w.performance());
     let now = move || performance.as_ref().map_or(0.0, |p| p.now() / 1000.0);
     let mut sim = bench_simulation();
     sim.advance(1);
+    let mut words = sim.clone();
+    words.set_paired(false);
+    let word_step = time_steps(&mut words, 5, 4, &now);
     let step = time_steps(&mut sim, 5, 4, &now);
+    let a = (sim.automaton(), words.automaton());
+    let pairs_match =
+        a.0.step == a.1.step && a.0.hum == a.1.hum && a.0.act == a.1.act && a.0.cld == a.1.cld;
+    // Over a dropped step's counts, as the player smooths.
+    let mut old = sim.smoothed();
     let mut smoothing: Vec<f64> = (0..5)
         .map(|_| {
             let t = now();
-            std::hint::black_box(sim.smoothed());
+            old = std::hint::black_box(sim.smoothed_over(std::mem::take(&mut old)));
             now() - t
         })
         .collect();
@@ -161,6 +170,8 @@ fn bench_automaton() {
     let cells = sim.automaton().dims.iter().product::<usize>();
     let figures = serde_json::json!({
         "ca_step_ms": step * 1e3,
+        "ca_word_step_ms": word_step * 1e3,
+        "ca_pairs_match": pairs_match,
         "ca_smoothing_ms": smoothing[2] * 1e3,
         "cells": cells,
         "gcells_per_s": cells as f64 / step / 1e9,

@@ -15,88 +15,168 @@
 //! levels, a table of words whose bits are 1 with that level's probability. A cell's
 //! probabilities (from the parcels) are rounded to a level when the parcels change; the
 //! random mask of a word is the OR over levels of (the cells at that level ∧ a word drawn from
-//! that level's table). Each word keeps member words only for the levels its cells use, so a
-//! step draws once per level a word holds rather than once per level. The step and
+//! that level's table). Each level keeps a list of the words with cells at it, so a step draws
+//! once per word a level holds, in a loop without branches. The step and
 //! [`Automaton::random_word`] (which the byte-per-cell reference in the tests calls per word)
 //! both draw through one function, so the reference reproduces a run bit for bit.
 //!
-//! A step writes into spare buffers (no allocation), a layer of y (its rows contiguous) as one
-//! run of words, and moves each row by its layer's wind while the layer is still in cache.
+//! A step writes into spare buffers, a layer of y (its rows contiguous) at a time, in three
+//! passes while the layer is in cache: the rule without its random terms (a word, or on the
+//! web build two words in one SIMD register, at a time), the random terms level by level, then
+//! each row moved by its layer's wind.
 
+use super::lanes::{Lanes, PAIRED, Pair};
+use super::smoothing::run_parts;
 use crate::seeded::hash64;
 
 /// The probability levels a cell's probabilities are rounded to (level 0 never fires).
 pub const LEVELS: [f32; 8] = [0.0, 0.002, 0.01, 0.03, 0.08, 0.2, 0.45, 1.0];
 /// Random words per level table.
 const TABLE: usize = 1024;
-// A word's used levels are a `u8` of bits, one per level.
-const _: () = assert!(LEVELS.len() == 8);
 
 /// Per level, its table of random words.
 type Tables = [[u64; TABLE]; LEVELS.len()];
 
-/// The cells of one kind at each probability level, kept only where used: per word, the
-/// levels its cells use (bit `l`), and for each of them in ascending order one member word
-/// (bit set: the cell is at that level), stored word after word, row after row.
+/// The cells of one kind at one probability level: the words that have any, in ascending
+/// order, each with its member word (bit set: the cell is at that level).
 #[derive(Clone, Debug, Default)]
-struct Membership {
-    /// Per row: the index of its first member word.
-    rows: Vec<usize>,
-    /// Per word: the levels its cells use.
-    levels: Vec<u8>,
-    /// The member words.
-    words: Vec<u64>,
+struct Level {
+    /// Per word with cells at this level: its index in the grid.
+    at: Vec<u32>,
+    /// Per such word: its cells at this level.
+    members: Vec<u64>,
+    /// Per layer y, the first of its words (and one past the last layer's).
+    layers: Vec<usize>,
 }
 
-impl Membership {
-    /// The used levels of the `n` words from row `row` on (which starts at word `first`), and
-    /// the index of their first member word (none before any level is set).
-    #[inline]
-    fn words_from(&self, row: usize, first: usize, n: usize) -> (&[u8], usize) {
-        match self.rows.get(row) {
-            Some(&at) => (&self.levels[first..first + n], at),
-            None => (&[], 0),
-        }
-    }
+/// The cells of one kind at each probability level (1..).
+type Membership = [Level; LEVELS.len()];
 
-    /// The random mask of word `w` of a run of words that use `levels` (from
-    /// [`Membership::words_from`]), word `i` of the grid, its member words read at `*at` on.
-    #[inline(always)]
-    fn draw(
-        &self,
-        tables: &Tables,
-        keys: &[u64; LEVELS.len()],
-        levels: &[u8],
-        w: usize,
-        at: &mut usize,
-        i: usize,
-    ) -> u64 {
-        let used = levels.get(w).map_or(0, |&l| l);
-        draw(tables, keys, used, &self.words, at, i)
-    }
-}
-
-/// The random mask of word `i`: the OR over its used `levels` of (its member word ∧ the word
-/// drawn from that level's table by `keys` and `i`), its member words read from `members` at
-/// `*at` on (which moves past them).
+/// The word level `l` draws for word `i`: picked from its table by the step's key and `i` (a
+/// Fibonacci hash: neighbouring words draw far-apart entries).
 #[inline(always)]
-fn draw(
-    tables: &Tables,
-    keys: &[u64; LEVELS.len()],
-    levels: u8,
-    members: &[u64],
-    at: &mut usize,
-    i: usize,
-) -> u64 {
-    let (mut mask, mut left) = (0, levels);
-    while left != 0 {
-        let l = left.trailing_zeros() as usize & (LEVELS.len() - 1);
-        left &= left - 1;
-        let pick = ((keys[l] ^ i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 54) as usize;
-        mask |= members[*at] & tables[l][pick % TABLE];
-        *at += 1;
+fn pick(tables: &Tables, keys: &[u64; LEVELS.len()], l: usize, i: u64) -> u64 {
+    let p = ((keys[l] ^ i).wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 54) as usize;
+    tables[l][p % TABLE]
+}
+
+/// The rule without its random terms, on a word or a pair: the new `[hum, cld, act]` from
+/// `[hum, act, cld]`, the act words before and after in the row (0 past its ends) and the
+/// word's cells, and the act words of its other neighbours.
+#[inline(always)]
+fn grow<B: Lanes>([h, ac, c]: [B; 3], [prev, next, cells]: [B; 3], near: [B; 7]) -> [B; 3] {
+    // Bit i holds cell i+k (>>) or cell i−k (<<).
+    let along_x = (ac >> 1 | next << 63)
+        | (ac >> 2 | next << 62)
+        | (ac << 1 | prev >> 63)
+        | (ac << 2 | prev >> 62);
+    let [z1, z2, z3, z4, up, down, down2] = near;
+    let f = along_x | z1 | z2 | z3 | z4 | up | down | down2;
+    [h & !ac, c | ac, !ac & h & f & cells]
+}
+
+/// A word (or pair) moved `b` cells (0 < b < 64) toward higher x (`up`) or lower, taking the
+/// bits shifted out of `from`, its neighbour on that side; `cells` keeps the row's cells.
+#[inline(always)]
+fn wind<B: Lanes>(up: bool, b: u32, word: B, from: B, cells: B) -> B {
+    let moved = if up {
+        word << b | from >> (64 - b)
+    } else {
+        word >> b | from << (64 - b)
+    };
+    moved & cells
+}
+
+/// One layer's inputs to the rule, word k of each at k (all one layer long).
+struct Layer<'a> {
+    hum: &'a [u64],
+    act: &'a [u64],
+    cld: &'a [u64],
+    /// The act words before and after in the row (masked by `edges`).
+    prev: &'a [u64],
+    next: &'a [u64],
+    /// Whether `prev` and `next` lie in the row, and the word's cells.
+    edges: [&'a [u64]; 3],
+    /// The act words along z (±1, ±2 rows) and y (above, below, two below).
+    near: [&'a [u64]; 7],
+}
+
+impl Layer<'_> {
+    /// The rule without its random terms from word `k` on, `B::WIDTH` words at a time, into
+    /// `hum`, `cld` and `act`, while whole `B`s fit; returns the first word not done.
+    #[inline(always)]
+    fn grow<B: Lanes>(
+        &self,
+        mut k: usize,
+        hum: &mut [u64],
+        cld: &mut [u64],
+        act: &mut [u64],
+    ) -> usize {
+        let n = self.act.len();
+        while k + B::WIDTH <= n {
+            let [prev_in, next_in, cells] = self.edges;
+            let [z1, z2, z3, z4, up, down, down2] = self.near;
+            let [h, c, a] = grow::<B>(
+                [
+                    B::load(self.hum, k),
+                    B::load(self.act, k),
+                    B::load(self.cld, k),
+                ],
+                [
+                    B::load(self.prev, k) & B::load(prev_in, k),
+                    B::load(self.next, k) & B::load(next_in, k),
+                    B::load(cells, k),
+                ],
+                [
+                    B::load(z1, k),
+                    B::load(z2, k),
+                    B::load(z3, k),
+                    B::load(z4, k),
+                    B::load(up, k),
+                    B::load(down, k),
+                    B::load(down2, k),
+                ],
+            );
+            h.store(hum, k);
+            c.store(cld, k);
+            a.store(act, k);
+            k += B::WIDTH;
+        }
+        k
     }
-    mask
+}
+
+/// One layer's words moved by its wind: `here` moved `b` cells (0 < b < 64) up x or down,
+/// taking the bits shifted out of `from` (the neighbour on the upwind side; `from_in`: whether
+/// it lies in the row).
+struct Moved<'a> {
+    up: bool,
+    b: u32,
+    here: &'a [u64],
+    from: &'a [u64],
+    from_in: &'a [u64],
+    cells: &'a [u64],
+}
+
+impl Moved<'_> {
+    /// Writes the moved words from word `k` on into `out`, `B::WIDTH` at a time, while whole
+    /// `B`s fit; returns the first word not written.
+    #[inline(always)]
+    fn write<B: Lanes>(&self, mut k: usize, out: &mut [u64]) -> usize {
+        while k + B::WIDTH <= self.here.len() {
+            let from = B::load(self.from, k) & B::load(self.from_in, k);
+            wind::<B>(
+                self.up,
+                self.b,
+                B::load(self.here, k),
+                from,
+                B::load(self.cells, k),
+            )
+            .store(out, k);
+            k += B::WIDTH;
+        }
+        k
+    }
 }
 
 /// The nearest level of a probability (on a log scale above the smallest).
@@ -164,6 +244,11 @@ pub struct Automaton {
     spare: [Vec<u64>; 3],
     /// One layer of zeros: the neighbour layer of every cell past the bottom or top.
     zeros: Vec<u64>,
+    /// Per word of a layer: whether the words before and after it in its row lie in the row
+    /// (all ones or zero), and which of its bits are cells (the last word's tail is not).
+    edges: [Vec<u64>; 3],
+    /// Whether the rule runs on pairs of words ([`PAIRED`]: on the web build).
+    paired: bool,
     /// Per kind and level: this step's key, which picks each word's draw from the table.
     keys: [[u64; LEVELS.len()]; 3],
     /// Threads a step may use (`None`: every core).
@@ -204,6 +289,20 @@ impl Automaton {
             tables,
             spare: Default::default(),
             zeros: vec![0; words * nz],
+            edges: {
+                let tail = match nx % 64 {
+                    0 => u64::MAX,
+                    r => (1u64 << r) - 1,
+                };
+                let per_word =
+                    |f: &dyn Fn(usize) -> u64| (0..words * nz).map(|k| f(k % words)).collect();
+                [
+                    per_word(&|w| if w > 0 { u64::MAX } else { 0 }),
+                    per_word(&|w| if w + 1 < words { u64::MAX } else { 0 }),
+                    per_word(&|w| if w + 1 < words { u64::MAX } else { tail }),
+                ]
+            },
+            paired: PAIRED,
             wind: vec![0.0; ny],
             carry: vec![0.0; ny],
             seed,
@@ -245,13 +344,12 @@ impl Automaton {
     pub fn set_levels(&mut self, kind: Kind, level: impl Fn(usize, usize, usize) -> u8) {
         let [nx, ny, nz] = self.dims;
         let words = self.words;
-        let mut m = Membership {
-            rows: Vec::with_capacity(ny * nz),
-            levels: Vec::with_capacity(ny * nz * words),
-            words: Vec::new(),
-        };
+        let mut m = Membership::default();
         let mut row = vec![[0u64; LEVELS.len()]; words];
         for y in 0..ny {
+            for l in &mut m {
+                l.layers.push(l.at.len());
+            }
             for z in 0..nz {
                 row.iter_mut().for_each(|w| *w = [0; LEVELS.len()]);
                 for x in 0..nx {
@@ -260,17 +358,17 @@ impl Automaton {
                         row[x / 64][l] |= 1 << (x % 64);
                     }
                 }
-                m.rows.push(m.words.len());
-                for w in &row {
-                    // Only the levels some cell of the word uses keep a member word.
-                    let mut used = 0u8;
-                    for l in (1..LEVELS.len()).filter(|&l| w[l] != 0) {
-                        used |= 1 << l;
-                        m.words.push(w[l]);
+                let first = (y * nz + z) * words;
+                for (w, bits) in row.iter().enumerate() {
+                    for (l, &b) in m.iter_mut().zip(bits).filter(|(_, b)| **b != 0) {
+                        l.at.push((first + w) as u32);
+                        l.members.push(b);
                     }
-                    m.levels.push(used);
                 }
             }
+        }
+        for l in &mut m {
+            l.layers.push(l.at.len());
         }
         self.membership[kind as usize] = m;
     }
@@ -284,28 +382,26 @@ impl Automaton {
     /// probability of cell i's level. The word drawn from a level's table is picked by the
     /// step's key for that kind and level mixed with `w` (a Fibonacci hash: neighbouring words
     /// draw far-apart entries).
-    #[inline]
     pub fn random_word(&self, kind: Kind, w: usize) -> u64 {
-        let m = &self.membership[kind as usize];
-        let Some(&levels) = m.levels.get(w) else {
-            return 0;
-        };
-        let first = w - w % self.words;
-        let mut at = m.rows[w / self.words]
-            + m.levels[first..w]
-                .iter()
-                .map(|l| l.count_ones() as usize)
-                .sum::<usize>();
         let keys = &self.keys[kind as usize];
-        draw(&self.tables, keys, levels, &m.words, &mut at, w)
+        let mut mask = 0;
+        for (l, level) in self.membership[kind as usize].iter().enumerate() {
+            if let Ok(k) = level.at.binary_search(&(w as u32)) {
+                mask |= level.members[k] & pick(&self.tables, keys, l, w as u64);
+            }
+        }
+        mask
     }
 
     /// The bits of the last word of a row that are cells (the rest stay 0).
     fn tail_mask(&self) -> u64 {
-        match self.dims[0] % 64 {
-            0 => u64::MAX,
-            r => (1u64 << r) - 1,
-        }
+        self.edges[2][self.words - 1]
+    }
+
+    /// Runs the rule on pairs of words or one word at a time (the tests compare the two; both
+    /// give the same bits).
+    pub fn set_paired(&mut self, paired: bool) {
+        self.paired = paired;
     }
 
     /// Threads a step may use: the machine's cores (1 where threads are not available, as in
@@ -347,16 +443,12 @@ impl Automaton {
         } else {
             let layer = nz * words;
             let per = ny.div_ceil(threads) * layer;
-            let (this, shifts) = (&*self, &shifts);
-            std::thread::scope(|scope| {
-                for (i, ((h, ac), c)) in hum
-                    .chunks_mut(per)
-                    .zip(act.chunks_mut(per))
-                    .zip(cld.chunks_mut(per))
-                    .enumerate()
-                {
-                    scope.spawn(move || this.step_layers(shifts, i * per / layer, h, ac, c));
-                }
+            let parts = hum
+                .chunks_mut(per)
+                .zip(act.chunks_mut(per))
+                .zip(cld.chunks_mut(per));
+            run_parts(threads, parts, &|i, ((h, ac), c)| {
+                self.step_layers(&shifts, i * per / layer, h, ac, c)
             });
         }
         std::mem::swap(&mut self.hum, &mut out[0]);
@@ -383,101 +475,111 @@ impl Automaton {
     ) {
         let [_, ny, nz] = self.dims;
         let words = self.words;
-        let layer = nz * words;
-        let tail = self.tail_mask();
+        let n = nz * words;
         let a = &self.act[..];
-        let zeros = &self.zeros[..layer];
-        let [key_h, key_a, key_e] = &self.keys;
-        let [mem_h, mem_a, mem_e] = &self.membership;
-        let tables = &self.tables;
-        let layers = hum.len() / layer;
+        let [prev_in, next_in, cells] = self.edges.each_ref().map(|e| &e[..n]);
         // A layer's act words between two rows of zeros each side: word k's neighbours along
-        // z (±1, ±2 rows) and along x (±1 word) all lie within it.
-        let mut padded = vec![0u64; layer + 4 * words];
+        // z (±1, ±2 rows) and along x (±1 word) all lie within it. The wind pass reuses it.
+        let mut padded = vec![0u64; n + 4 * words];
+        let layers = hum.len() / n;
         let outputs = hum
-            .chunks_exact_mut(layer)
-            .zip(act.chunks_exact_mut(layer))
-            .zip(cld.chunks_exact_mut(layer));
+            .chunks_exact_mut(n)
+            .zip(act.chunks_exact_mut(n))
+            .zip(cld.chunks_exact_mut(n));
         for ((y, &s), ((ho, ao), co)) in shifts.iter().enumerate().skip(y0).zip(outputs) {
             debug_assert!(y < y0 + layers);
-            let base = y * layer;
+            let base = y * n;
             let near = |dy: isize| -> &[u64] {
                 let y = y as isize + dy;
                 if (0..ny as isize).contains(&y) {
-                    &a[y as usize * layer..][..layer]
+                    &a[y as usize * n..][..n]
                 } else {
-                    zeros
+                    &self.zeros[..n]
                 }
             };
-            let (above, below, below2) = (near(1), near(-1), near(-2));
-            // Per kind: the layer's words' used levels and where its member words start.
-            let ((lh, mut at_h), (la, mut at_a), (le, mut at_e)) = (
-                mem_h.words_from(y * nz, base, layer),
-                mem_a.words_from(y * nz, base, layer),
-                mem_e.words_from(y * nz, base, layer),
-            );
-            let (ha, aa, ca) = (
-                &self.hum[base..base + layer],
-                &a[base..base + layer],
-                &self.cld[base..base + layer],
-            );
-            padded[2 * words..2 * words + layer].copy_from_slice(aa);
-            let shifted = |d: usize| &padded[d..d + layer];
-            // Zipped, not indexed: no bounds test per word where the page's size-optimised
-            // build would keep one.
-            let words_in = ha
-                .iter()
-                .zip(aa)
-                .zip(ca)
-                .zip(above.iter().zip(below).zip(below2));
-            let z_near = shifted(0)
-                .iter()
-                .zip(shifted(words))
-                .zip(shifted(3 * words).iter().zip(shifted(4 * words)));
-            let x_near = shifted(2 * words - 1).iter().zip(shifted(2 * words + 1));
-            let words_out = ho.iter_mut().zip(ao.iter_mut()).zip(co.iter_mut());
-            // The word's place in its row.
-            let mut w = 0;
-            for (
-                k,
-                (
-                    (
-                        (((&h, &ac), &c), ((&up, &down), &down2)),
-                        (((&z2, &z1), (&z3, &z4)), (&prev, &next)),
-                    ),
-                    ((ho, ao), co),
-                ),
-            ) in words_in.zip(z_near.zip(x_near)).zip(words_out).enumerate()
-            {
-                let i = base + k;
-                // The words before and after in the row (none past its ends).
-                let prev = if w > 0 { prev } else { 0 };
-                let next = if w + 1 < words { next } else { 0 };
-                // Bit i holds cell i+k (>>) or cell i−k (<<).
-                let f = (ac >> 1 | next << 63)
-                    | (ac >> 2 | next << 62)
-                    | (ac << 1 | prev >> 63)
-                    | (ac << 2 | prev >> 62)
-                    | z1
-                    | z2
-                    | z3
-                    | z4
-                    | up
-                    | down
-                    | down2;
-                let keep = if w + 1 == words { tail } else { u64::MAX };
-                let r_h = mem_h.draw(tables, key_h, lh, k, &mut at_h, i);
-                let r_e = mem_e.draw(tables, key_e, le, k, &mut at_e, i);
-                let r_a = mem_a.draw(tables, key_a, la, k, &mut at_a, i);
-                *ho = ((h & !ac) | r_h) & keep;
-                *co = ((c | ac) & !r_e) & keep;
-                *ao = ((!ac & h & f) | r_a) & keep;
-                w += 1;
-                if w == words {
-                    w = 0;
+            padded[2 * words..2 * words + n].copy_from_slice(&a[base..][..n]);
+            let at = |d: usize| &padded[d..][..n];
+            let layer = Layer {
+                hum: &self.hum[base..][..n],
+                act: at(2 * words),
+                cld: &self.cld[base..][..n],
+                prev: at(2 * words - 1),
+                next: at(2 * words + 1),
+                edges: [prev_in, next_in, cells],
+                near: [
+                    at(words),
+                    at(0),
+                    at(3 * words),
+                    at(4 * words),
+                    near(1),
+                    near(-1),
+                    near(-2),
+                ],
+            };
+            let (ho, co, ao) = (&mut ho[..n], &mut co[..n], &mut ao[..n]);
+            let k = if self.paired {
+                layer.grow::<Pair>(0, ho, co, ao)
+            } else {
+                0
+            };
+            layer.grow::<u64>(k, ho, co, ao);
+            // The random terms, level by level: one draw per word with cells at the level.
+            for (kind, out) in [
+                (Kind::Hum, &mut *ho),
+                (Kind::Ext, &mut *co),
+                (Kind::Act, &mut *ao),
+            ] {
+                let keys = &self.keys[kind as usize];
+                for (l, level) in self.membership[kind as usize].iter().enumerate() {
+                    let Some(&[from, to]) =
+                        level.layers.get(y..y + 2).and_then(|r| r.first_chunk())
+                    else {
+                        continue;
+                    };
+                    let (at, members) = (&level.at[from..to], &level.members[from..to]);
+                    // (Written out per kind: the web build's size-optimised code keeps the
+                    // test of the kind inside the loop otherwise.)
+                    if kind == Kind::Ext {
+                        for j in 0..at.len().min(members.len()) {
+                            let draw = members[j] & pick(&self.tables, keys, l, at[j] as u64);
+                            out[at[j] as usize - base] &= !draw;
+                        }
+                    } else {
+                        for j in 0..at.len().min(members.len()) {
+                            let draw = members[j] & pick(&self.tables, keys, l, at[j] as u64);
+                            out[at[j] as usize - base] |= draw;
+                        }
+                    }
                 }
             }
-            if s != 0 {
+            if s != 0 && s.unsigned_abs() < 64 {
+                // Within a word: each word takes the bits shifted out of its neighbour on the
+                // wind's upwind side in the row (none past the row's ends).
+                let b = s.unsigned_abs() as u32;
+                let (d, from_in) = if s > 0 {
+                    (2 * words - 1, prev_in)
+                } else {
+                    (2 * words + 1, next_in)
+                };
+                for bits in [ho, ao, co] {
+                    padded[2 * words..2 * words + n].copy_from_slice(bits);
+                    let moved = Moved {
+                        up: s > 0,
+                        b,
+                        here: &padded[2 * words..][..n],
+                        from: &padded[d..][..n],
+                        from_in,
+                        cells,
+                    };
+                    let k = if self.paired {
+                        moved.write::<Pair>(0, bits)
+                    } else {
+                        0
+                    };
+                    moved.write::<u64>(k, bits);
+                }
+            } else if s != 0 {
+                let tail = self.tail_mask();
                 for bits in [ho, ao, co] {
                     for row in bits.chunks_exact_mut(words) {
                         shift_row(row, s);

@@ -3,6 +3,8 @@
 //! bits into a density volume the renderer and the exporters take like any other.
 //!
 //! - `automaton`: the state, the growth rules, the random masks, the wind;
+//! - `lanes`: a word of cells or two side by side (one SIMD register on the web build), as
+//!   the rule takes them;
 //! - `reference`: the same rules one byte per cell (the tests' reference, the bench's baseline);
 //! - `smoothing`: the box counts of the cloud bits, eight cells a word in byte lanes (summed
 //!   bit-sliced, 64 cells at a time, for boxes whose counts pass a byte);
@@ -10,6 +12,7 @@
 //!   and [`Simulation::density`] (a box kernel over the cloud bits, interpolated between steps).
 
 mod automaton;
+mod lanes;
 pub mod reference;
 mod smoothing;
 
@@ -187,6 +190,11 @@ impl Simulation {
         self.automaton.set_threads(n);
     }
 
+    /// Runs the rule on pairs of words or a word at a time (see [`Automaton::set_paired`]).
+    pub fn set_paired(&mut self, paired: bool) {
+        self.automaton.set_paired(paired);
+    }
+
     /// The automaton.
     pub fn automaton(&self) -> &Automaton {
         &self.automaton
@@ -208,7 +216,16 @@ impl Simulation {
     /// count of cloud cells around it ([`Smoothed::shares`] gives the share in [0, 1]), in a
     /// density volume's order (x fastest, then y, then z).
     pub fn smoothed(&self) -> Smoothed {
-        smoothing::smooth(&self.automaton, self.settings.smoothing as usize)
+        self.smoothed_over(Smoothed::default())
+    }
+
+    /// The same, written over `old` (a smoothed step no longer needed, whose memory it reuses).
+    pub fn smoothed_over(&self, old: Smoothed) -> Smoothed {
+        smoothing::smooth(
+            &self.automaton,
+            self.settings.smoothing as usize,
+            old.counts,
+        )
     }
 
     /// The density volume of the current step (`previous`: the last step's smoothed cloud,
@@ -225,7 +242,7 @@ impl Simulation {
 
 /// One step's cloud smoothed ([`Simulation::smoothed`]): each cell's count of cloud cells in
 /// the box around it.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Smoothed {
     /// Counts per cell, x fastest, then y, then z, brought into a byte where the box holds
     /// more than 255 cells (half-widths 3 and 4: halved or quartered, rounded).
@@ -343,6 +360,9 @@ pub struct Player {
     /// Bytes the snapshots may hold.
     snapshot_bytes: usize,
     smoothed: Vec<(u64, std::sync::Arc<Smoothed>)>,
+    /// The last step dropped from `smoothed`, if nothing else held it: the next one is
+    /// written over it.
+    spare: Smoothed,
 }
 
 impl Player {
@@ -356,6 +376,7 @@ impl Player {
             snapshots,
             snapshot_bytes: SNAPSHOT_BYTES,
             smoothed: Vec::new(),
+            spare: Smoothed::default(),
         }
     }
 
@@ -407,10 +428,11 @@ impl Player {
             }
         }
         let step = self.run.step();
-        let v = std::sync::Arc::new(self.run.smoothed());
+        let v = std::sync::Arc::new(self.run.smoothed_over(std::mem::take(&mut self.spare)));
         self.smoothed.push((step, v.clone()));
         if self.smoothed.len() > 3 {
-            self.smoothed.remove(0);
+            let (_, dropped) = self.smoothed.remove(0);
+            self.spare = std::sync::Arc::try_unwrap(dropped).unwrap_or_default();
         }
         (step, v)
     }

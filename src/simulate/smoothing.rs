@@ -95,14 +95,18 @@ fn byte_counts(planes: &[u64], shift: u32) -> u64 {
 
 /// Each cell's count of cloud cells in the box of half-width `r` (at most 4) around it, x
 /// fastest, then y, then z, in a byte: halved and rounded for r = 3, quartered for r = 4 (the
-/// box's 343 or 729 cells). Slabs of z are shared out among the cores.
-pub(super) fn smooth(a: &Automaton, r: usize) -> Smoothed {
+/// box's 343 or 729 cells). Slabs of z are shared out among the cores. The counts are written
+/// into `reuse`'s memory where it has room (a smoothed step no longer needed: its pages are
+/// already mapped, where fresh memory would be faulted in on first touch, page by page).
+pub(super) fn smooth(a: &Automaton, r: usize, reuse: Vec<u8>) -> Smoothed {
     let [nx, ny, nz] = a.dims;
     let r = r.min(4);
     let plane = nx * ny;
     let cells = plane * nz;
     // Written once, by the slabs, without first being cleared (4 MB at the benchmark's size).
-    let mut out: Vec<u8> = Vec::with_capacity(cells);
+    let mut out = reuse;
+    out.clear();
+    out.reserve_exact(cells);
     let threads = crate::limits::cores()
         .min(nz)
         .min(if cells < 1 << 18 { 1 } else { 8 });
@@ -122,7 +126,7 @@ pub(super) fn smooth(a: &Automaton, r: usize) -> Smoothed {
     };
     run_parts(
         threads,
-        out.spare_capacity_mut()[..cells].chunks_mut(per).collect(),
+        out.spare_capacity_mut()[..cells].chunks_mut(per),
         &slab,
     );
     // SAFETY: the slabs cover the first `cells` values of the spare capacity (chunks of whole
@@ -176,7 +180,7 @@ struct Lanes<'a, const N: usize> {
     xs: Vec<u64>,
     /// `2r + 1` slots of xy-sums (plane z in slot z mod 2r+1), laid out as `xs`.
     window: Vec<u64>,
-    /// One output row's sums.
+    /// One output plane's sums, laid out as `xs`.
     line: Vec<u64>,
 }
 
@@ -208,7 +212,23 @@ impl<const N: usize> Window for Lanes<'_, N> {
         }
         let layer = ny * lanes;
         let slot = &mut self.window[(z % (2 * r + 1)) * layer..][..layer];
+        // Rows with all 2r + 1 neighbours in the plane: summed as one run, each of the 2r + 1
+        // rows of sums a run of x-sums `lanes` further on; the rows at the edges one by one.
+        let inner = r..ny.saturating_sub(r).max(r);
+        if !inner.is_empty() {
+            let mut rows: [&[u64]; 5] = [&[]; 5];
+            for (k, row) in rows.iter_mut().enumerate().take(2 * r + 1) {
+                *row = &self.xs[k * lanes..];
+            }
+            sum_rows(
+                &mut slot[inner.start * lanes..inner.end * lanes],
+                &rows[..2 * r + 1],
+            );
+        }
         for (y, sums) in slot.chunks_exact_mut(lanes).enumerate() {
+            if inner.contains(&y) {
+                continue;
+            }
             let mut rows: [&[u64]; 5] = [&[]; 5];
             let near = y.saturating_sub(r)..(y + r + 1).min(ny);
             let n = near.len();
@@ -235,7 +255,7 @@ impl<'a, const N: usize> Lanes<'a, N> {
             lanes,
             xs: vec![0; ny * lanes],
             window: vec![0; (2 * r + 1) * ny * lanes],
-            line: vec![0; lanes],
+            line: vec![0; ny * lanes],
         }
     }
 
@@ -245,27 +265,33 @@ impl<'a, const N: usize> Lanes<'a, N> {
         let lanes = self.lanes;
         let (span, layer) = (2 * Self::R + 1, ny * lanes);
         self.slide(zs, out, |this, near, values| {
+            // The plane's sums at once: the xy-sums of its near planes added lane by lane.
+            let mut rows: [&[u64]; 5] = [&[]; 5];
             let n = near.len();
-            for (y, cells) in values.chunks_exact_mut(nx).enumerate() {
-                let mut rows: [&[u64]; 5] = [&[]; 5];
-                for (row, k) in rows.iter_mut().zip(near.clone()) {
-                    *row = &this.window[(k % span) * layer + y * lanes..][..lanes];
-                }
-                let line = &mut this.line;
-                sum_rows(line, &rows[..n]);
-                // Byte j of lane l is cell 8l + j, in memory order once little-endian: the
-                // row's counts are the line's first nx bytes, copied at once (the page's
-                // size-optimised build would otherwise store them lane by lane, or byte by
-                // byte).
-                if cfg!(target_endian = "big") {
-                    line.iter_mut().for_each(|l| *l = l.to_le());
-                }
-                debug_assert!(8 * line.len() >= cells.len());
-                // SAFETY: `line` holds 8·lanes ≥ nx bytes, `cells` is nx writable bytes
+            for (row, k) in rows.iter_mut().zip(near) {
+                *row = &this.window[(k % span) * layer..][..layer];
+            }
+            let plane = &mut this.line;
+            sum_rows(plane, &rows[..n]);
+            // Byte j of lane l is cell 8l + j, in memory order once little-endian: a row's
+            // counts are its lanes' first nx bytes, copied at once (the page's size-optimised
+            // build would otherwise store them lane by lane, or byte by byte).
+            if cfg!(target_endian = "big") {
+                plane.iter_mut().for_each(|l| *l = l.to_le());
+            }
+            // (Rows without spare bytes, as where nx is a multiple of 64: the plane at once.)
+            let (per, row) = if 8 * lanes == nx {
+                (layer, nx * ny)
+            } else {
+                (lanes, nx)
+            };
+            for (sums, cells) in plane.chunks_exact(per).zip(values.chunks_exact_mut(row)) {
+                debug_assert!(8 * sums.len() >= cells.len());
+                // SAFETY: `sums` holds at least as many bytes as `cells`, which is writable
                 // (`MaybeUninit<u8>` is laid out as `u8`), and the two do not overlap.
                 unsafe {
                     std::ptr::copy_nonoverlapping(
-                        line.as_ptr().cast::<u8>(),
+                        sums.as_ptr().cast::<u8>(),
                         cells.as_mut_ptr().cast::<u8>(),
                         cells.len(),
                     );
@@ -428,15 +454,25 @@ impl<'a, const PX: usize, const PY: usize, const PZ: usize> Slab<'a, PX, PY, PZ>
     }
 }
 
-/// Runs `work(i, part)` for every part, on up to `threads` scoped threads (inline for one).
-fn run_parts<T: Send>(threads: usize, parts: Vec<T>, work: &(dyn Fn(usize, T) + Sync)) {
+/// Runs `work(i, part)` for every part: with `threads` above one, each part but the first on
+/// a scoped thread of its own and the first on this one (one spawn fewer); else all here.
+pub(super) fn run_parts<T: Send>(
+    threads: usize,
+    parts: impl IntoIterator<Item = T>,
+    work: &(dyn Fn(usize, T) + Sync),
+) {
+    let mut parts = parts.into_iter().enumerate();
     if threads <= 1 {
-        parts.into_iter().enumerate().for_each(|(i, p)| work(i, p));
+        parts.for_each(|(i, p)| work(i, p));
         return;
     }
     std::thread::scope(|scope| {
-        for (i, p) in parts.into_iter().enumerate() {
+        let first = parts.next();
+        for (i, p) in parts {
             scope.spawn(move || work(i, p));
+        }
+        if let Some((i, p)) = first {
+            work(i, p);
         }
     });
 }
