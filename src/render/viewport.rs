@@ -25,6 +25,8 @@ use crate::derive::Volumes;
 pub struct JobFence(Arc<FenceState>);
 
 struct FenceState {
+    /// The last job handed to the GPU.
+    sent: AtomicU64,
     done: AtomicU64,
     times: Mutex<Times>,
     clock: fn() -> f64,
@@ -45,6 +47,7 @@ impl JobFence {
     /// (seconds).
     pub fn new(wake: impl Fn() + Send + Sync + 'static, clock: fn() -> f64) -> Self {
         Self(Arc::new(FenceState {
+            sent: AtomicU64::new(0),
             done: AtomicU64::new(0),
             times: Mutex::new(Times::default()),
             clock,
@@ -59,6 +62,16 @@ impl JobFence {
             done: self.0.done.load(Ordering::Acquire),
             timed,
         }
+    }
+
+    /// Whether a job handed to the GPU is not yet reported done.
+    pub fn outstanding(&self) -> bool {
+        self.0.sent.load(Ordering::Acquire) > self.0.done.load(Ordering::Acquire)
+    }
+
+    /// Job `job` is handed to the GPU.
+    fn sent(&self, job: u64) {
+        self.0.sent.fetch_max(job, Ordering::AcqRel);
     }
 
     /// The work submitted before job `job` is done: the GPU can start it.
@@ -119,6 +132,7 @@ impl egui_wgpu::CallbackTrait for ViewportPaint {
                 renderer.update_light(device, queue, &mut own, &job.view);
                 renderer.draw_slices(device, queue, &mut own, job, None);
                 if let Some((fence, id)) = self.fence.clone() {
+                    fence.sent(id);
                     queue.on_submitted_work_done(move || fence.free_for(id));
                 }
                 queue.submit([own.finish()]);
@@ -185,6 +199,35 @@ pub struct BackendInfo {
     pub backend: &'static str,
     /// Adapter name as the driver reports it.
     pub adapter: String,
+}
+
+/// Makes the queue's reports of finished work arrive without new work: wgpu's GL backend
+/// (WebGL2 in the page) runs them only when the device is polled or given work, a frame or more
+/// late; WebGPU runs them by itself.
+#[derive(Clone)]
+pub struct ReportPoll(Option<wgpu::Device>);
+
+impl ReportPoll {
+    /// The poll for `render_state`'s device (none where reports come by themselves).
+    pub fn new(render_state: &egui_wgpu::RenderState) -> Self {
+        let reports_itself =
+            render_state.adapter.get_info().backend == wgpu::Backend::BrowserWebGpu;
+        Self((!reports_itself).then(|| render_state.device.clone()))
+    }
+
+    /// Whether reports need polling.
+    pub fn needed(&self) -> bool {
+        self.0.is_some()
+    }
+
+    /// Runs the reports of work finished so far, without waiting.
+    pub fn poll(&self) {
+        if let Some(device) = &self.0
+            && let Err(e) = device.poll(wgpu::PollType::Poll)
+        {
+            log::warn!("polling the GPU for finished work: {e}");
+        }
+    }
 }
 
 /// Sets the backends of the page's builds (index.html holds two): the WebGPU build draws with

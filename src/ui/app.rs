@@ -12,7 +12,7 @@ use super::selection::Selection;
 use super::sketch_tool::{Axis, SketchTool, ToolContext};
 use super::viewport::{Viewport, ViewportContext};
 use crate::derive::Derived;
-use crate::render::viewport::{BackendInfo, install};
+use crate::render::viewport::{BackendInfo, ReportPoll, install};
 use crate::scene::{Document, Edit, Scene};
 
 /// What the page (or any embedder) is told after each frame.
@@ -116,6 +116,7 @@ impl CloudApp {
             .wgpu_render_state
             .as_ref()
             .map(|rs| install(rs, super::platform::GL_BACKEND_NAME));
+        let reports = cc.wgpu_render_state.as_ref().map(ReportPoll::new);
         if backend.is_none() {
             log::error!("no wgpu render state: the volume cannot be drawn");
         }
@@ -140,6 +141,7 @@ impl CloudApp {
                     backend,
                     ..Default::default()
                 },
+                reports,
             ),
             tool: SketchTool::default(),
             selection: Selection::default(),

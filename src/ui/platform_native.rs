@@ -11,9 +11,13 @@ pub const GL_BACKEND_NAME: &str = "gl";
 /// Whether this platform has a file picker button (the browser's file input).
 pub const HAS_PICKER: bool = false;
 
-/// Whether refinement waits for the GPU's report of each chunk before the next: not natively,
-/// where the queue reports only when it is next polled or given work (a frame later at best).
+/// Whether refinement waits for the GPU's report of each chunk before the next: not natively
+/// (the desktop window has no measure of its drags; the page does).
 pub const FENCED_REFINEMENT: bool = false;
+
+/// Keeps the GPU's reports of finished work coming for fenced refinement: natively refinement
+/// is not fenced ([`FENCED_REFINEMENT`]), so `poll` is not called.
+pub fn poll_reports(_poll: impl Fn() + 'static) {}
 
 /// Reads a dropped file at once.
 pub fn read_dropped(file: egui::DroppedFileHandle, _ctx: &egui::Context) -> Option<Loaded> {

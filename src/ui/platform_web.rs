@@ -19,10 +19,32 @@ pub const GL_BACKEND_NAME: &str = "webgl2";
 /// Whether this platform has a file picker button.
 pub const HAS_PICKER: bool = true;
 
-/// Whether refinement waits for the GPU's report of each chunk before the next (with WebGPU,
-/// whose reports come as soon as the work is done): a browser runs frames ahead of the GPU,
-/// so chunks queued there would hold up the first frame of a drag.
+/// Whether refinement waits for the GPU's report of each chunk before the next: a browser runs
+/// frames ahead of the GPU, so chunks queued there would hold up the first frame of a drag.
+/// WebGPU reports as soon as the work is done; WebGL2's reports come through [`poll_reports`].
 pub const FENCED_REFINEMENT: bool = true;
+
+/// How often [`poll_reports`] polls.
+const REPORT_POLL_MS: i32 = 8;
+
+/// Keeps the GPU's reports of finished work coming for fenced refinement where the device must
+/// be polled for them (WebGL2): calls `poll` every few milliseconds, between frames, for as
+/// long as the page is open (`poll` does nothing while no job is out).
+pub fn poll_reports(poll: impl Fn() + 'static) {
+    let Some(window) = web_sys::window() else {
+        return;
+    };
+    let tick = Closure::<dyn Fn()>::new(poll);
+    if let Err(e) = window.set_interval_with_callback_and_timeout_and_arguments_0(
+        tick.as_ref().unchecked_ref(),
+        REPORT_POLL_MS,
+    ) {
+        log::warn!("no timer to poll the GPU's reports: {e:?}");
+        return;
+    }
+    // The timer calls it for the page's life.
+    tick.forget();
+}
 
 /// Largest file read.
 const MAX_BYTES: f64 = MAX_FILE_BYTES as f64;

@@ -13,7 +13,7 @@ use crate::render::SliceJob;
 use crate::render::View;
 use crate::render::capture::Capture;
 use crate::render::progressive::{Budget, Progressive};
-use crate::render::viewport::JobFence;
+use crate::render::viewport::{JobFence, ReportPoll};
 use crate::render::viewport::{SkyPaint, ViewportPaint};
 use crate::scene::Document;
 
@@ -26,6 +26,8 @@ pub struct Viewport {
     /// The GPU's reports of the jobs this viewport gave it (made with the first frame, as it
     /// wakes the UI).
     fence: Option<JobFence>,
+    /// Polls the GPU for finished work where its reports do not come by themselves (WebGL2).
+    reports: Option<ReportPoll>,
     /// What it reports (backend, quality, frame time, size).
     pub stats: ViewStats,
     /// The first full-quality image has been shown.
@@ -55,18 +57,14 @@ pub struct ViewportContext<'a> {
 }
 
 impl Viewport {
-    /// A viewport whose planner starts from a guessed cost (seconds per pixel·slice).
-    pub fn new(initial_cost: f64, stats: ViewStats) -> Self {
-        // WebGPU reports finished work by itself; WebGL2's reports come only when work is next
-        // submitted, a frame or more late, which would make every chunk look slow.
-        let webgpu = stats
-            .backend
-            .as_ref()
-            .is_some_and(|b| b.backend == "webgpu");
+    /// A viewport whose planner starts from a guessed cost (seconds per pixel·slice);
+    /// `reports` makes the GPU's reports of finished work arrive where they need polling.
+    pub fn new(initial_cost: f64, stats: ViewStats, reports: Option<ReportPoll>) -> Self {
         Self {
             progressive: Progressive::new(initial_cost, Budget::default())
-                .fenced(super::platform::FENCED_REFINEMENT && webgpu),
+                .fenced(super::platform::FENCED_REFINEMENT),
             fence: None,
+            reports,
             stats,
             ready: false,
             frame_request: false,
@@ -194,7 +192,20 @@ impl Viewport {
             .fence
             .get_or_insert_with(|| {
                 let ctx = ui.ctx().clone();
-                JobFence::new(move || ctx.request_repaint(), super::platform::now)
+                let fence = JobFence::new(move || ctx.request_repaint(), super::platform::now);
+                // A fenced chunk waits for the report of the one before: where reports need
+                // polling, poll while a job is out, between frames (a report wakes the app).
+                if let Some(reports) = self.reports.clone().filter(ReportPoll::needed)
+                    && super::platform::FENCED_REFINEMENT
+                {
+                    let fence = fence.clone();
+                    super::platform::poll_reports(move || {
+                        if fence.outstanding() {
+                            reports.poll();
+                        }
+                    });
+                }
+                fence
             })
             .clone();
         let plan = self.progressive.plan(
