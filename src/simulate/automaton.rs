@@ -26,7 +26,7 @@
 //! each row moved by its layer's wind.
 
 use super::lanes::{Lanes, PAIRED, Pair};
-use super::smoothing::run_parts;
+use super::run_parts;
 use crate::seeded::hash64;
 
 /// The probability levels a cell's probabilities are rounded to (level 0 never fires).

@@ -9,7 +9,8 @@
 //! - `smoothing`: the box counts of the cloud bits, eight cells a word in byte lanes (summed
 //!   bit-sliced, 64 cells at a time, for boxes whose counts pass a byte);
 //! - here: [`Settings`] → [`Simulation`] (parcels → per-cell probability levels), stepping,
-//!   and [`Simulation::density`] (a box kernel over the cloud bits, interpolated between steps).
+//!   and [`Simulation::density`] (a box kernel over the cloud bits, interpolated between steps);
+//!   the sharing of a step's or a smoothing's parts among threads.
 
 mod automaton;
 mod lanes;
@@ -281,6 +282,29 @@ fn volume(settings: &Settings, dims: [usize; 3], values: Vec<f32>) -> DensityVol
         size: Vec3::new(nx as f32, ny as f32, nz as f32) * settings.cell_size.max(1e-3),
         values,
     }
+}
+
+/// Runs `work(i, part)` for every part: with `threads` above one, each part but the first on
+/// a scoped thread of its own and the first on this one (one spawn fewer); else all here.
+fn run_parts<T: Send>(
+    threads: usize,
+    parts: impl IntoIterator<Item = T>,
+    work: &(dyn Fn(usize, T) + Sync),
+) {
+    let mut parts = parts.into_iter().enumerate();
+    if threads <= 1 {
+        parts.for_each(|(i, p)| work(i, p));
+        return;
+    }
+    std::thread::scope(|scope| {
+        let first = parts.next();
+        for (i, p) in parts {
+            scope.spawn(move || work(i, p));
+        }
+        if let Some((i, p)) = first {
+            work(i, p);
+        }
+    });
 }
 
 /// The benchmarks' simulation (`cloudsketch bench`'s `ca_` entries and the page's

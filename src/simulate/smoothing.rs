@@ -16,7 +16,7 @@
 
 use std::mem::MaybeUninit;
 
-use super::{Automaton, Smoothed};
+use super::{Automaton, Smoothed, run_parts};
 
 /// Adds the one-bit count `bit` into `acc` (which must hold the sum).
 #[inline(always)]
@@ -452,27 +452,4 @@ impl<'a, const PX: usize, const PY: usize, const PZ: usize> Slab<'a, PX, PY, PZ>
             }
         });
     }
-}
-
-/// Runs `work(i, part)` for every part: with `threads` above one, each part but the first on
-/// a scoped thread of its own and the first on this one (one spawn fewer); else all here.
-pub(super) fn run_parts<T: Send>(
-    threads: usize,
-    parts: impl IntoIterator<Item = T>,
-    work: &(dyn Fn(usize, T) + Sync),
-) {
-    let mut parts = parts.into_iter().enumerate();
-    if threads <= 1 {
-        parts.for_each(|(i, p)| work(i, p));
-        return;
-    }
-    std::thread::scope(|scope| {
-        let first = parts.next();
-        for (i, p) in parts {
-            scope.spawn(move || work(i, p));
-        }
-        if let Some((i, p)) = first {
-            work(i, p);
-        }
-    });
 }
