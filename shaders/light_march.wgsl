@@ -21,23 +21,6 @@ fn vs_main(@builtin(vertex_index) vi: u32) -> @builtin(position) vec4<f32> {
     return vec4<f32>(xy * 2.0 - 1.0, 0.0, 1.0);
 }
 
-// The slices' density at world point `p` (the same field, iso-level, softness and noise).
-fn density_at(p: vec3<f32>, octaves: i32) -> f32 {
-    let uvw = (p - u.grid_min.xyz) * u.grid_inv_size.xyz;
-    let field = textureSampleLevel(volume_tex, clamp_smp, uvw, 0.0).r;
-    let iso = u.media.y;
-    let soft = u.media.z;
-    let amount = u.media.w;
-    if field < iso - soft - 0.5 * amount {
-        return 0.0;
-    }
-    var v = field;
-    if octaves > 0 {
-        v = field + amount * (tiered_noise(p, octaves) - 0.5);
-    }
-    return smoothstep(iso - soft, iso + soft, v);
-}
-
 @fragment
 fn fs_main(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
     let texel = vec3<f32>(floor(pos.xy), f32(ls.slice.x)) + 0.5;

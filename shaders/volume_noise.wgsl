@@ -74,3 +74,70 @@ fn tiered_noise(p: vec3<f32>, octaves: i32) -> f32 {
     return total;
 }
 
+// The field perturbed by `octaves` of the noise, `field + amount · (noise − 0.5)`, with them looked
+// up coarse to fine only while they can still matter: once the octaves left (each filtered
+// into [0, 1]) cannot bring the value back inside the soft edge [iso − soft, iso + soft], the
+// density is exactly 0 or exactly 1 whatever they hold, and the look-ups stop. Deep inside
+// the cloud and in the air around it that is after none or a few of them; where the value ends
+// inside the edge, every octave is summed as `fbm` sums it. (Tiers blend several sums: they
+// take every octave.)
+fn noisy_field(field: f32, p: vec3<f32>, octaves: i32) -> f32 {
+    let amount = u.media.w;
+    let lo = u.media.y - u.media.z;
+    let hi = u.media.y + u.media.z;
+    if amount <= 0.0 || octaves == 0 {
+        return field;
+    }
+    if i32(u.tiers.w) > 0 {
+        // Nothing noise could lift above the surface: skip the look-ups.
+        if field + 0.5 * amount < lo {
+            return field + 0.5 * amount;
+        }
+        return field + amount * (tiered_noise(p, octaves) - 0.5);
+    }
+    let worley = u.noise.w > 0.5;
+    let kind = u.noise.z;
+    let gain = u.noise.x;
+    var norm = 0.0;
+    var a = 1.0;
+    for (var i = 0; i < MAX_OCTAVES; i = i + 1) {
+        if i >= octaves {
+            break;
+        }
+        norm = norm + a;
+        a = a * gain;
+    }
+    let scale = amount / norm;
+    var amp = 1.0;
+    var sum = 0.0;
+    var left = norm;
+    for (var i = 0; i < MAX_OCTAVES; i = i + 1) {
+        // The value if every octave left held 0 (the least) and if each held 1 (the most).
+        let least = field + scale * sum - 0.5 * amount;
+        let most = least + scale * left;
+        if most < lo {
+            return most;
+        }
+        if least > hi {
+            return least;
+        }
+        if i >= octaves {
+            break;
+        }
+        let q = (u.octaves[i] * vec4<f32>(p, 1.0)).xyz;
+        let s = textureSampleLevel(noise_tex, repeat_smp, q, 0.0);
+        sum = sum + amp * filtered(select(s.r, s.g, worley), kind);
+        left = left - amp;
+        amp = amp * gain;
+    }
+    return field + amount * (sum / norm - 0.5);
+}
+
+// The slices' density at world point `p` seen with `octaves` of the noise: the field, the
+// noise, the iso-level and the soft edge as the slices take them.
+fn density_at(p: vec3<f32>, octaves: i32) -> f32 {
+    let uvw = (p - u.grid_min.xyz) * u.grid_inv_size.xyz;
+    let field = textureSampleLevel(volume_tex, clamp_smp, uvw, 0.0).r;
+    let v = noisy_field(field, p, octaves);
+    return smoothstep(u.media.y - u.media.z, u.media.y + u.media.z, v);
+}
