@@ -52,12 +52,12 @@ struct Level {
 /// The cells of one kind at each probability level (1..).
 type Membership = [Level; LEVELS.len()];
 
-/// The word level `l` draws for word `i`: picked from its table by the step's key and `i` (a
-/// Fibonacci hash: neighbouring words draw far-apart entries).
+/// The word a level draws for word `i`: picked from the level's table by its key this step
+/// and `i` (a Fibonacci hash: neighbouring words draw far-apart entries).
 #[inline(always)]
-fn pick(tables: &Tables, keys: &[u64; LEVELS.len()], l: usize, i: u64) -> u64 {
-    let p = ((keys[l] ^ i).wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 54) as usize;
-    tables[l][p % TABLE]
+fn pick(table: &[u64; TABLE], key: u64, i: u64) -> u64 {
+    let p = ((key ^ i).wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 54) as usize;
+    table[p % TABLE]
 }
 
 /// The rule without its random terms, on a word or a pair: the new `[hum, cld, act]` from
@@ -113,33 +113,45 @@ impl Layer<'_> {
         act: &mut [u64],
     ) -> usize {
         let n = self.act.len();
-        while k + B::WIDTH <= n {
-            let [prev_in, next_in, cells] = self.edges;
-            let [z1, z2, z3, z4, up, down, down2] = self.near;
-            let [h, c, a] = grow::<B>(
-                [
-                    B::load(self.hum, k),
-                    B::load(self.act, k),
-                    B::load(self.cld, k),
-                ],
-                [
-                    B::load(self.prev, k) & B::load(prev_in, k),
-                    B::load(self.next, k) & B::load(next_in, k),
-                    B::load(cells, k),
-                ],
-                [
-                    B::load(z1, k),
-                    B::load(z2, k),
-                    B::load(z3, k),
-                    B::load(z4, k),
-                    B::load(up, k),
-                    B::load(down, k),
-                    B::load(down2, k),
-                ],
-            );
-            h.store(hum, k);
-            c.store(cld, k);
-            a.store(act, k);
+        let [prev_in, next_in, cells] = self.edges;
+        let [z1, z2, z3, z4, up, down, down2] = self.near;
+        let ins = [
+            self.hum, self.cld, self.prev, self.next, prev_in, next_in, cells, z1, z2, z3, z4, up,
+            down, down2,
+        ];
+        assert!(k <= n && ins.iter().all(|s| s.len() >= n));
+        assert!(hum.len() >= n && cld.len() >= n && act.len() >= n);
+        while n - k >= B::WIDTH {
+            // SAFETY: k + WIDTH <= n, and every run holds n words or more (checked above).
+            let [h, c, a] = unsafe {
+                grow::<B>(
+                    [
+                        B::load(self.hum, k),
+                        B::load(self.act, k),
+                        B::load(self.cld, k),
+                    ],
+                    [
+                        B::load(self.prev, k) & B::load(prev_in, k),
+                        B::load(self.next, k) & B::load(next_in, k),
+                        B::load(cells, k),
+                    ],
+                    [
+                        B::load(z1, k),
+                        B::load(z2, k),
+                        B::load(z3, k),
+                        B::load(z4, k),
+                        B::load(up, k),
+                        B::load(down, k),
+                        B::load(down2, k),
+                    ],
+                )
+            };
+            // SAFETY: as above.
+            unsafe {
+                h.store(hum, k);
+                c.store(cld, k);
+                a.store(act, k);
+            }
             k += B::WIDTH;
         }
         k
@@ -163,16 +175,22 @@ impl Moved<'_> {
     /// `B`s fit; returns the first word not written.
     #[inline(always)]
     fn write<B: Lanes>(&self, mut k: usize, out: &mut [u64]) -> usize {
-        while k + B::WIDTH <= self.here.len() {
-            let from = B::load(self.from, k) & B::load(self.from_in, k);
-            wind::<B>(
-                self.up,
-                self.b,
-                B::load(self.here, k),
-                from,
-                B::load(self.cells, k),
-            )
-            .store(out, k);
+        let n = self.here.len();
+        let ins = [self.from, self.from_in, self.cells, out];
+        assert!(k <= n && ins.iter().all(|s| s.len() >= n));
+        while n - k >= B::WIDTH {
+            // SAFETY: k + WIDTH <= n, and every run holds n words or more (checked above).
+            unsafe {
+                let from = B::load(self.from, k) & B::load(self.from_in, k);
+                wind::<B>(
+                    self.up,
+                    self.b,
+                    B::load(self.here, k),
+                    from,
+                    B::load(self.cells, k),
+                )
+                .store(out, k);
+            }
             k += B::WIDTH;
         }
         k
@@ -387,7 +405,7 @@ impl Automaton {
         let mut mask = 0;
         for (l, level) in self.membership[kind as usize].iter().enumerate() {
             if let Ok(k) = level.at.binary_search(&(w as u32)) {
-                mask |= level.members[k] & pick(&self.tables, keys, l, w as u64);
+                mask |= level.members[k] & pick(&self.tables[l], keys[l], w as u64);
             }
         }
         mask
@@ -537,16 +555,18 @@ impl Automaton {
                         continue;
                     };
                     let (at, members) = (&level.at[from..to], &level.members[from..to]);
-                    // (Written out per kind: the web build's size-optimised code keeps the
-                    // test of the kind inside the loop otherwise.)
+                    // (The level's key and table, and the loops per kind, are written out:
+                    // the web build's size-optimised code reloads and re-checks them for
+                    // every word otherwise.)
+                    let (key, table) = (keys[l], &self.tables[l]);
                     if kind == Kind::Ext {
                         for j in 0..at.len().min(members.len()) {
-                            let draw = members[j] & pick(&self.tables, keys, l, at[j] as u64);
+                            let draw = members[j] & pick(table, key, at[j] as u64);
                             out[at[j] as usize - base] &= !draw;
                         }
                     } else {
                         for j in 0..at.len().min(members.len()) {
-                            let draw = members[j] & pick(&self.tables, keys, l, at[j] as u64);
+                            let draw = members[j] & pick(table, key, at[j] as u64);
                             out[at[j] as usize - base] |= draw;
                         }
                     }
