@@ -822,10 +822,10 @@ fn simulation() -> Vec<BenchResult> {
     let clock = Instant::now();
     let now = || clock.elapsed().as_secs_f64();
     sim.advance(1);
-    let step = time_steps(&mut sim, 5, 4, &now);
+    let step = time_steps(&mut sim, &now);
     let cells = sim.automaton().dims.iter().product::<usize>() as f64;
     sim.set_threads(Some(1));
-    let one_thread = time_steps(&mut sim, 5, 4, &now);
+    let one_thread = time_steps(&mut sim, &now);
     sim.set_threads(None);
     let wind = |_y: usize| 0.0;
     let mut plain = Reference::of(sim.automaton());

@@ -152,8 +152,8 @@ fn bench_automaton() {
     sim.advance(1);
     let mut words = sim.clone();
     words.set_paired(false);
-    let word_step = time_steps(&mut words, 5, 4, &now);
-    let step = time_steps(&mut sim, 5, 4, &now);
+    let word_step = time_steps(&mut words, &now);
+    let step = time_steps(&mut sim, &now);
     let a = (sim.automaton(), words.automaton());
     let pairs_match =
         a.0.step == a.1.step && a.0.hum == a.1.hum && a.0.act == a.1.act && a.0.cld == a.1.cld;

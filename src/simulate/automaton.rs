@@ -25,7 +25,7 @@
 //! web build two words in one SIMD register, at a time), the random terms level by level, then
 //! each row moved by its layer's wind.
 
-use super::lanes::{Lanes, PAIRED, Pair};
+use super::lanes::{Lanes, Pair};
 use super::run_parts;
 use crate::seeded::hash64;
 
@@ -60,21 +60,6 @@ fn pick(table: &[u64; TABLE], key: u64, i: u64) -> u64 {
     table[p % TABLE]
 }
 
-/// The rule without its random terms, on a word or a pair: the new `[hum, cld, act]` from
-/// `[hum, act, cld]`, the act words before and after in the row (0 past its ends) and the
-/// word's cells, and the act words of its other neighbours.
-#[inline(always)]
-fn grow<B: Lanes>([h, ac, c]: [B; 3], [prev, next, cells]: [B; 3], near: [B; 7]) -> [B; 3] {
-    // Bit i holds cell i+k (>>) or cell i−k (<<).
-    let along_x = (ac >> 1 | next << 63)
-        | (ac >> 2 | next << 62)
-        | (ac << 1 | prev >> 63)
-        | (ac << 2 | prev >> 62);
-    let [z1, z2, z3, z4, up, down, down2] = near;
-    let f = along_x | z1 | z2 | z3 | z4 | up | down | down2;
-    [h & !ac, c | ac, !ac & h & f & cells]
-}
-
 /// A word (or pair) moved `b` cells (0 < b < 64) toward higher x (`up`) or lower, taking the
 /// bits shifted out of `from`, its neighbour on that side; `cells` keeps the row's cells.
 #[inline(always)]
@@ -90,71 +75,104 @@ fn wind<B: Lanes>(up: bool, b: u32, word: B, from: B, cells: B) -> B {
 /// One layer's inputs to the rule, word k of each at k (all one layer long).
 struct Layer<'a> {
     hum: &'a [u64],
-    act: &'a [u64],
     cld: &'a [u64],
-    /// The act words before and after in the row (masked by `edges`).
-    prev: &'a [u64],
-    next: &'a [u64],
-    /// Whether `prev` and `next` lie in the row, and the word's cells.
-    edges: [&'a [u64]; 3],
-    /// The act words along z (±1, ±2 rows) and y (above, below, two below).
-    near: [&'a [u64]; 7],
+    /// The layer's act words from `2·words` on, between two rows of zeros each side: word
+    /// k's neighbours along z (±1, ±2 rows) and along x (±1 word) all lie in it, at fixed
+    /// distances from `padded[k]`.
+    padded: &'a [u64],
+    /// Per place in a row, twice over (so a pair may start at any place): whether the words
+    /// before and after it lie in the row (all ones or zero), then which of its bits are cells
+    /// (the last word's tail is not); `2·words` of each.
+    edges: &'a [u64],
+    /// The act words of the layers above, below and two below.
+    ys: [&'a [u64]; 3],
 }
 
 impl Layer<'_> {
-    /// The rule without its random terms from word `k` on, `B::WIDTH` words at a time, into
-    /// `hum`, `cld` and `act`, while whole `B`s fit; returns the first word not done.
+    /// The rule without its random terms into `hum`, `cld` and `act`: `B::WIDTH` words at a
+    /// time, then a word at a time for what is left.
+    ///
+    /// The common row lengths (one to four words) get their own copies of the loop: with
+    /// `words` a constant, the seven act words a word needs lie at constant distances from one
+    /// address and its edges' place in the row is a mask of the index, so the web build's
+    /// loads take offsets from a few registers instead of spilling eighteen.
     #[inline(always)]
-    fn grow<B: Lanes>(
+    fn grow<B: Lanes>(&self, words: usize, hum: &mut [u64], cld: &mut [u64], act: &mut [u64]) {
+        match words {
+            1 => self.grow_words::<B, 1>(hum, cld, act),
+            2 => self.grow_words::<B, 2>(hum, cld, act),
+            3 => self.grow_words::<B, 3>(hum, cld, act),
+            4 => self.grow_words::<B, 4>(hum, cld, act),
+            _ => self.grow_words::<B, 0>(hum, cld, act),
+        }
+    }
+
+    /// [`Layer::grow`] for rows of `W` words (0: of any length, `edges.len() / 6`).
+    #[inline(always)]
+    fn grow_words<B: Lanes, const W: usize>(
         &self,
-        mut k: usize,
         hum: &mut [u64],
         cld: &mut [u64],
         act: &mut [u64],
-    ) -> usize {
-        let n = self.act.len();
-        let [prev_in, next_in, cells] = self.edges;
-        let [z1, z2, z3, z4, up, down, down2] = self.near;
-        let ins = [
-            self.hum, self.cld, self.prev, self.next, prev_in, next_in, cells, z1, z2, z3, z4, up,
-            down, down2,
-        ];
-        assert!(k <= n && ins.iter().all(|s| s.len() >= n));
-        assert!(hum.len() >= n && cld.len() >= n && act.len() >= n);
-        while n - k >= B::WIDTH {
-            // SAFETY: k + WIDTH <= n, and every run holds n words or more (checked above).
-            let [h, c, a] = unsafe {
-                grow::<B>(
-                    [
-                        B::load(self.hum, k),
-                        B::load(self.act, k),
-                        B::load(self.cld, k),
-                    ],
-                    [
-                        B::load(self.prev, k) & B::load(prev_in, k),
-                        B::load(self.next, k) & B::load(next_in, k),
-                        B::load(cells, k),
-                    ],
-                    [
-                        B::load(z1, k),
-                        B::load(z2, k),
-                        B::load(z3, k),
-                        B::load(z4, k),
-                        B::load(up, k),
-                        B::load(down, k),
-                        B::load(down2, k),
-                    ],
-                )
-            };
-            // SAFETY: as above.
-            unsafe {
-                h.store(hum, k);
-                c.store(cld, k);
-                a.store(act, k);
+    ) {
+        let words = if W == 0 { self.edges.len() / 6 } else { W };
+        let n = self.hum.len();
+        let ins = [self.cld, self.ys[0], self.ys[1], self.ys[2], hum, cld, act];
+        assert!(words > 0 && ins.iter().all(|s| s.len() >= n));
+        assert!(self.padded.len() >= n + 4 * words && self.edges.len() >= 6 * words);
+        let mut k = 0;
+        let k = loop {
+            if n - k < B::WIDTH {
+                break k;
             }
+            // SAFETY: k + WIDTH <= n, so every run holds the words (checked above).
+            unsafe { self.grow_at::<B>(words, k, [hum, cld, act]) };
             k += B::WIDTH;
+        };
+        for k in k..n {
+            // SAFETY: as above.
+            unsafe { self.grow_at::<u64>(words, k, [hum, cld, act]) };
         }
-        k
+    }
+
+    /// The rule at words `k..k + B::WIDTH`.
+    ///
+    /// # Safety
+    /// `k + B::WIDTH <= n`, and every run as [`Layer::grow_words`] checks it.
+    #[inline(always)]
+    unsafe fn grow_at<B: Lanes>(&self, words: usize, k: usize, [hum, cld, act]: [&mut [u64]; 3]) {
+        let (p, e) = (self.padded, self.edges);
+        let place = k % words;
+        let [up, down, down2] = self.ys;
+        // SAFETY: the caller's; `place + B::WIDTH <= 2·words`.
+        unsafe {
+            // The rule without its random terms: the new hum, cld and act from the word's
+            // own, its act neighbours' (f: any of the eleven) and its cells. Each neighbour is
+            // loaded as it is taken (the web build's compiler keeps that order, so few
+            // registers are live at once). Bit i holds cell i+k (>>) or cell i−k (<<).
+            let mut f = B::load(p, k + words);
+            f = f | B::load(p, k);
+            f = f | B::load(p, k + 3 * words);
+            f = f | B::load(p, k + 4 * words);
+            f = f | B::load(up, k);
+            f = f | B::load(down, k);
+            f = f | B::load(down2, k);
+            let ac = B::load(p, k + 2 * words);
+            let prev = B::load(p, k + 2 * words - 1) & B::load(e, place);
+            let next = B::load(p, k + 2 * words + 1) & B::load(e, place + 2 * words);
+            f = f
+                | (ac >> 1 | next << 63)
+                | (ac >> 2 | next << 62)
+                | (ac << 1 | prev >> 63)
+                | (ac << 2 | prev >> 62);
+            let h = B::load(self.hum, k);
+            let a = !ac & h & f & B::load(e, place + 4 * words);
+            let c = B::load(self.cld, k) | ac;
+            let h = h & !ac;
+            h.store(hum, k);
+            c.store(cld, k);
+            a.store(act, k);
+        }
     }
 }
 
@@ -265,7 +283,10 @@ pub struct Automaton {
     /// Per word of a layer: whether the words before and after it in its row lie in the row
     /// (all ones or zero), and which of its bits are cells (the last word's tail is not).
     edges: [Vec<u64>; 3],
-    /// Whether the rule runs on pairs of words ([`PAIRED`]: on the web build).
+    /// The same per place in a row, twice over ([`Layer::edges`]).
+    row_edges: Vec<u64>,
+    /// Whether the rule runs on pairs of words (as it does unless a test or the page's
+    /// benchmark asks for a word at a time).
     paired: bool,
     /// Per kind and level: this step's key, which picks each word's draw from the table.
     keys: [[u64; LEVELS.len()]; 3],
@@ -320,12 +341,18 @@ impl Automaton {
                     per_word(&|w| if w + 1 < words { u64::MAX } else { tail }),
                 ]
             },
-            paired: PAIRED,
+            row_edges: Vec::new(),
+            paired: true,
             wind: vec![0.0; ny],
             carry: vec![0.0; ny],
             seed,
             step: 0,
         };
+        automaton.row_edges = automaton
+            .edges
+            .iter()
+            .flat_map(|e| (0..2 * words).map(|k| e[k % words]))
+            .collect();
         automaton.refresh_keys();
         automaton
     }
@@ -516,31 +543,19 @@ impl Automaton {
                 }
             };
             padded[2 * words..2 * words + n].copy_from_slice(&a[base..][..n]);
-            let at = |d: usize| &padded[d..][..n];
             let layer = Layer {
                 hum: &self.hum[base..][..n],
-                act: at(2 * words),
                 cld: &self.cld[base..][..n],
-                prev: at(2 * words - 1),
-                next: at(2 * words + 1),
-                edges: [prev_in, next_in, cells],
-                near: [
-                    at(words),
-                    at(0),
-                    at(3 * words),
-                    at(4 * words),
-                    near(1),
-                    near(-1),
-                    near(-2),
-                ],
+                padded: &padded,
+                edges: &self.row_edges,
+                ys: [near(1), near(-1), near(-2)],
             };
             let (ho, co, ao) = (&mut ho[..n], &mut co[..n], &mut ao[..n]);
-            let k = if self.paired {
-                layer.grow::<Pair>(0, ho, co, ao)
+            if self.paired {
+                layer.grow::<Pair>(words, ho, co, ao);
             } else {
-                0
-            };
-            layer.grow::<u64>(k, ho, co, ao);
+                layer.grow::<u64>(words, ho, co, ao);
+            }
             // The random terms, level by level: one draw per word with cells at the level.
             for (kind, out) in [
                 (Kind::Hum, &mut *ho),

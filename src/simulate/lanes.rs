@@ -1,14 +1,14 @@
 //! Words of cells as the automaton's rule takes them: one `u64`, or a [`Pair`] of words side
 //! by side.
 //!
-//! On wasm32 with SIMD128 a pair is one `v128`: the page's size-optimised build vectorises no
-//! loop itself, and the rule on pairs is about twice as fast there. Elsewhere a pair is a
-//! `[u64; 2]` (the tests run the rule on it), and the step goes a word at a time, which the
-//! optimiser vectorises better.
+//! The step runs on pairs. On wasm32 with SIMD128 a pair is one `v128`: the page's
+//! size-optimised build vectorises no loop itself, and the rule on pairs is about twice as fast
+//! there. Elsewhere a pair is a `[u64; 2]`, which the optimiser puts in one SIMD register. A
+//! word at a time is the baseline the page's benchmark and the tests compare pairs with.
 
 use std::ops::{BitAnd, BitOr, Not, Shl, Shr};
 
-pub use imp::{PAIRED, Pair};
+pub use imp::Pair;
 
 /// A word or words of cells, loaded from and stored to runs of words.
 pub trait Lanes:
@@ -58,9 +58,6 @@ mod imp {
     use core::arch::wasm32::{
         i64x2_shl, u64x2_shr, v128, v128_and, v128_load, v128_not, v128_or, v128_store,
     };
-
-    /// The step runs the rule on pairs.
-    pub const PAIRED: bool = true;
 
     /// Two words in one SIMD register.
     #[derive(Clone, Copy)]
@@ -125,9 +122,6 @@ mod imp {
 
 #[cfg(not(all(target_arch = "wasm32", target_feature = "simd128")))]
 mod imp {
-    /// The step goes a word at a time.
-    pub const PAIRED: bool = false;
-
     /// Two words.
     #[derive(Clone, Copy)]
     pub struct Pair([u64; 2]);
