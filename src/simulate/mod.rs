@@ -311,9 +311,14 @@ fn run_parts<T: Send>(
 /// `?bench=ca`): 256×64×256 cells (x, y up, z; [`MAX_CELLS`]) at a 0.125 cell under three
 /// parcels, 30 steps in, so clouds have formed.
 pub fn bench_simulation() -> Simulation {
+    simulation_under_parcels([256, 64, 256], 0.125)
+}
+
+/// [`bench_simulation`]'s three parcels over `cells` of `cell_size`, 30 steps in.
+pub fn simulation_under_parcels(cells: [u32; 3], cell_size: f32) -> Simulation {
     let settings = Settings {
-        cells: [256, 64, 256],
-        cell_size: 0.125,
+        cells,
+        cell_size,
         ..Settings::default()
     };
     let parcels: Vec<Parcel> = [(-6.0, 3.0, 0.0), (4.0, 4.0, 3.0), (0.0, 3.5, -7.0)]
