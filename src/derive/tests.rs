@@ -374,3 +374,25 @@ fn the_soft_blend_fills_creases_and_keeps_the_silhouette_within_a_pixel() {
         );
     }
 }
+
+#[test]
+fn a_simulated_scene_played_frame_by_frame_shows_what_a_fresh_derivation_shows() {
+    // One run played on (each frame derived from the run's state at the last one, blended
+    // between two steps): every frame is what a fresh derivation at its time shows.
+    let mut doc = Document::new(Scene::preset(Preset::Simulated));
+    let mut derived = Derived::default();
+    let mut shown: Option<Arc<DensityVolume>> = None;
+    for frame in 0..30 {
+        let time = frame as f32 * 0.04;
+        doc.set_time(time);
+        let v = derived.update(doc.scene(), doc.revisions()).density.data;
+        if frame % 7 == 6 {
+            let mut fresh = Derived::default();
+            let want = fresh.update(doc.scene(), doc.revisions()).density.data;
+            assert!(!derived.catching_up && !fresh.catching_up);
+            assert_eq!(v.values, want.values, "frame {frame}");
+        }
+        shown = Some(v);
+    }
+    assert!(shown.is_some_and(|v| v.values.iter().any(|&d| d > 0.0)));
+}
