@@ -21,9 +21,9 @@
 //! both draw through one function, so the reference reproduces a run bit for bit.
 //!
 //! A step writes into spare buffers, a layer of y (its rows contiguous) at a time, in three
-//! passes while the layer is in cache: the rule without its random terms (a word, or on the
-//! web build two words in one SIMD register, at a time), the random terms level by level, then
-//! each row moved by its layer's wind.
+//! passes while the layer is in cache: the rule without its random terms (two words at a time,
+//! in one SIMD register), the random terms level by level, then each row moved by its layer's
+//! wind.
 
 use super::lanes::{Lanes, Pair};
 use super::run_parts;
