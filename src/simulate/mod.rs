@@ -336,7 +336,8 @@ pub fn simulation_under_parcels(cells: [u32; 3], cell_size: f32) -> Simulation {
 
 /// Seconds per step of `sim`: the median over 9 runs of 16 steps each, timed by `now`
 /// (seconds; the platform's clock: the bench's and the page's differ, and the page's ticks only
-/// every 0.1 ms, so a run spans enough steps (about 5 ms) for that to be 2% at most).
+/// every 0.1 ms, so a run spans enough steps, over 4 ms at the benchmarks' size, for that to be
+/// about 2%).
 pub fn time_steps(sim: &mut Simulation, now: &dyn Fn() -> f64) -> f64 {
     const RUNS: usize = 9;
     const STEPS: u64 = 16;
