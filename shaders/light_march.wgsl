@@ -16,9 +16,7 @@ struct LightSlice {
 
 @vertex
 fn vs_main(@builtin(vertex_index) vi: u32) -> @builtin(position) vec4<f32> {
-    // One triangle over the whole target.
-    let xy = vec2<f32>(f32((vi << 1u) & 2u), f32(vi & 2u));
-    return vec4<f32>(xy * 2.0 - 1.0, 0.0, 1.0);
+    return vec4<f32>(fullscreen_corner(vi), 0.0, 1.0);
 }
 
 @fragment

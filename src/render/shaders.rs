@@ -14,10 +14,12 @@ pub const VOLUME: &str = concat!(
     include_str!("../../shaders/volume.wgsl")
 );
 
-/// The light volume pass: `volume_common.wgsl` + `volume_noise.wgsl` + `light_march.wgsl`.
+/// The light volume pass: `volume_common.wgsl` + `volume_noise.wgsl` + `fullscreen.wgsl` +
+/// `light_march.wgsl`.
 pub const LIGHT_MARCH: &str = concat!(
     include_str!("../../shaders/volume_common.wgsl"),
     include_str!("../../shaders/volume_noise.wgsl"),
+    include_str!("../../shaders/fullscreen.wgsl"),
     include_str!("../../shaders/light_march.wgsl")
 );
 
@@ -27,15 +29,23 @@ pub const PLAIN_SLICES: &str = concat!(
     include_str!("../../shaders/plain_slices.wgsl")
 );
 
-/// `shaders/composite.wgsl`.
-pub const COMPOSITE: &str = include_str!("../../shaders/composite.wgsl");
+/// `fullscreen.wgsl` + `composite.wgsl`.
+pub const COMPOSITE: &str = concat!(
+    include_str!("../../shaders/fullscreen.wgsl"),
+    include_str!("../../shaders/composite.wgsl")
+);
 
-/// `shaders/field_eval.wgsl`: the field evaluated on the GPU (the bench's baseline).
-pub const FIELD_EVAL: &str = include_str!("../../shaders/field_eval.wgsl");
+/// `fullscreen.wgsl` + `field_eval.wgsl`: the field evaluated on the GPU (the bench's
+/// baseline).
+pub const FIELD_EVAL: &str = concat!(
+    include_str!("../../shaders/fullscreen.wgsl"),
+    include_str!("../../shaders/field_eval.wgsl")
+);
 
-/// The sky gradient behind the cloud: `sun_shadow.wgsl` + `sky.wgsl`.
+/// The sky gradient behind the cloud: `sun_shadow.wgsl` + `fullscreen.wgsl` + `sky.wgsl`.
 pub const SKY: &str = concat!(
     include_str!("../../shaders/sun_shadow.wgsl"),
+    include_str!("../../shaders/fullscreen.wgsl"),
     include_str!("../../shaders/sky.wgsl")
 );
 
@@ -56,6 +66,7 @@ pub const MODULES: [(&str, &[&str], &str); 6] = [
         &[
             "volume_common.wgsl",
             "volume_noise.wgsl",
+            "fullscreen.wgsl",
             "light_march.wgsl",
         ],
         LIGHT_MARCH,
@@ -65,7 +76,19 @@ pub const MODULES: [(&str, &[&str], &str); 6] = [
         &["volume_common.wgsl", "plain_slices.wgsl"],
         PLAIN_SLICES,
     ),
-    ("composite", &["composite.wgsl"], COMPOSITE),
-    ("field_eval", &["field_eval.wgsl"], FIELD_EVAL),
-    ("sky", &["sun_shadow.wgsl", "sky.wgsl"], SKY),
+    (
+        "composite",
+        &["fullscreen.wgsl", "composite.wgsl"],
+        COMPOSITE,
+    ),
+    (
+        "field_eval",
+        &["fullscreen.wgsl", "field_eval.wgsl"],
+        FIELD_EVAL,
+    ),
+    (
+        "sky",
+        &["sun_shadow.wgsl", "fullscreen.wgsl", "sky.wgsl"],
+        SKY,
+    ),
 ];
