@@ -42,8 +42,9 @@ fn random_automaton(dims: [usize; 3], seed: u64) -> Automaton {
 
 #[test]
 fn the_bit_parallel_step_equals_the_plain_one_bit_for_bit() {
-    // A word at a time (the native step) and two words at a time (the web build's, here on
-    // plain pairs); rows of an odd number of words end with a single word. The wind is
+    // A word at a time (the page benchmark's baseline) and two words at a time (the step on
+    // every target; here on plain pairs, as natively); rows of an odd number of words end with
+    // a single word. The wind is
     // `a·y + b` cells a step: within a word both ways, and (the last grid) more than a word a
     // step both ways across a row of three words.
     for paired in [false, true] {
