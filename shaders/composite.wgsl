@@ -8,18 +8,9 @@
 // fs_shafts only.
 @group(0) @binding(2) var shafts_tex: texture_2d<f32>;
 
-struct VsOut {
-    @builtin(position) clip: vec4<f32>,
-    @location(0) uv: vec2<f32>,
-};
-
 @vertex
-fn vs_main(@builtin(vertex_index) vi: u32) -> VsOut {
-    let c = fullscreen_corner(vi);
-    var out: VsOut;
-    out.clip = vec4<f32>(c, 0.0, 1.0);
-    out.uv = vec2<f32>(c.x * 0.5 + 0.5, 0.5 - c.y * 0.5);
-    return out;
+fn vs_main(@builtin(vertex_index) vi: u32) -> Fullscreen {
+    return fullscreen_vertex(vi);
 }
 
 fn linear_to_srgb(x: vec3<f32>) -> vec3<f32> {
@@ -35,7 +26,7 @@ fn cloud(p: vec4<f32>) -> vec4<f32> {
 }
 
 @fragment
-fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
+fn fs_main(in: Fullscreen) -> @location(0) vec4<f32> {
     let p = textureSampleLevel(src, src_smp, in.uv, 0.0);
     if p.a <= 1e-4 {
         discard;
@@ -58,7 +49,7 @@ fn with_shafts(uv: vec2<f32>) -> vec4<f32> {
 }
 
 @fragment
-fn fs_shafts(in: VsOut) -> @location(0) vec4<f32> {
+fn fs_shafts(in: Fullscreen) -> @location(0) vec4<f32> {
     return with_shafts(in.uv);
 }
 
@@ -66,7 +57,7 @@ fn fs_shafts(in: VsOut) -> @location(0) vec4<f32> {
 // and a straight-alpha PNG would lose it, so the shafts' light covers the pixel as much as
 // its brightest channel (a glow: over a background B it gives light + (1 − a)·B).
 @fragment
-fn fs_shafts_transparent(in: VsOut) -> @location(0) vec4<f32> {
+fn fs_shafts_transparent(in: Fullscreen) -> @location(0) vec4<f32> {
     let c = with_shafts(in.uv);
     let a = clamp(max(c.a, max(c.r, max(c.g, c.b))), 0.0, 1.0);
     return vec4<f32>(min(c.rgb, vec3<f32>(a)), a);

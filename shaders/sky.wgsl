@@ -46,22 +46,13 @@ fn ground_sun(p: vec3<f32>) -> f32 {
     );
 }
 
-struct VsOut {
-    @builtin(position) clip: vec4<f32>,
-    @location(0) ndc: vec2<f32>,
-};
-
 @vertex
-fn vs_main(@builtin(vertex_index) vi: u32) -> VsOut {
-    let c = fullscreen_corner(vi);
-    var out: VsOut;
-    out.clip = vec4<f32>(c, 0.0, 1.0);
-    out.ndc = c;
-    return out;
+fn vs_main(@builtin(vertex_index) vi: u32) -> Fullscreen {
+    return fullscreen_vertex(vi);
 }
 
 @fragment
-fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
+fn fs_main(in: Fullscreen) -> @location(0) vec4<f32> {
     let d = normalize(sky.forward.xyz + in.ndc.x * sky.right.xyz + in.ndc.y * sky.up.xyz);
     let e = d.y;
     var colour: vec3<f32>;

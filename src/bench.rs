@@ -7,7 +7,7 @@ use std::time::Instant;
 use serde::Serialize;
 
 use crate::derive::Derived;
-use crate::render::offscreen::Offscreen;
+use crate::render::offscreen::{Clock, Offscreen};
 use crate::scene::{Document, DrawingPlane, Edit, Preset, Scene};
 
 /// One measurement.
@@ -56,6 +56,21 @@ fn result(name: &str, value: f64, unit: &str, baseline: &str, baseline_value: f6
     }
 }
 
+/// `frames` full-quality frames of `scene` at `w` × `h` timed by the host's clock (which every
+/// adapter has), with the plain slice shader if `plain`.
+fn wall_frames(
+    offscreen: &mut Offscreen,
+    scene: &Scene,
+    (w, h): (u32, u32),
+    frames: usize,
+    plain: bool,
+) -> Result<Vec<f64>, String> {
+    offscreen
+        .time_frames(scene, [w, h], frames, plain, Clock::Wall)
+        .map(Option::unwrap_or_default)
+        .map_err(|e| e.to_string())
+}
+
 /// Offscreen frame time at 1280×720 with 128 slices (median of several frames), against the
 /// plain slice shader on the same adapter.
 fn render_frame(offscreen: &mut Offscreen) -> Result<BenchResult, String> {
@@ -64,18 +79,10 @@ fn render_frame(offscreen: &mut Offscreen) -> Result<BenchResult, String> {
     scene.render.slices = 128;
     let (w, h) = (1280, 720);
     // Warm up (pipeline compilation, uploads), then measure both alternately.
-    offscreen
-        .time_frames(&scene, w, h, 1, false)
-        .map_err(|e| e.to_string())?;
-    offscreen
-        .time_frames(&scene, w, h, 1, true)
-        .map_err(|e| e.to_string())?;
-    let ours = offscreen
-        .time_frames(&scene, w, h, FRAMES, false)
-        .map_err(|e| e.to_string())?;
-    let plain = offscreen
-        .time_frames(&scene, w, h, FRAMES, true)
-        .map_err(|e| e.to_string())?;
+    wall_frames(offscreen, &scene, (w, h), 1, false)?;
+    wall_frames(offscreen, &scene, (w, h), 1, true)?;
+    let ours = wall_frames(offscreen, &scene, (w, h), FRAMES, false)?;
+    let plain = wall_frames(offscreen, &scene, (w, h), FRAMES, true)?;
     Ok(result(
         "render_frame_1280x720_128_slices",
         median(ours) * 1e3,
@@ -95,11 +102,8 @@ fn render_frames_by_quality(offscreen: &mut Offscreen) -> Result<Vec<BenchResult
         let mut scene = Scene::default();
         scene.render.slices = slices;
         scene.render.noise_octaves = octaves;
-        let time = |o: &mut Offscreen, plain| {
-            o.time_frames(&scene, w, h, FRAMES, plain)
-                .map(median)
-                .map_err(|e| e.to_string())
-        };
+        let time =
+            |o: &mut Offscreen, plain| wall_frames(o, &scene, (w, h), FRAMES, plain).map(median);
         let ours = time(offscreen, false)?;
         let plain = time(offscreen, true)?;
         out.push(result(
@@ -458,8 +462,9 @@ fn light_volume(offscreen: &mut Offscreen) -> Result<Vec<BenchResult>, String> {
         s.render.light_octaves = octaves;
         Ok(median(
             offscreen
-                .time_light_volume(&s, 4)
+                .time_light_volume(&s, 4, Clock::Wall)
                 .map_err(|e| e.to_string())?
+                .unwrap_or_default()
                 .split_off(1),
         ))
     };
@@ -494,7 +499,7 @@ fn device_timed(offscreen: &mut Offscreen) -> Result<Vec<BenchResult>, String> {
     let mut frame = |scene: &Scene, (w, h): (u32, u32), plain: bool| {
         // The first frame compiles and uploads; the median of the rest.
         offscreen
-            .time_frames_on_gpu(scene, w, h, frames + 1, plain)
+            .time_frames(scene, [w, h], frames + 1, plain, Clock::Device)
             .map(|t| t.map(|mut t| median(t.split_off(1))))
             .map_err(|e| e.to_string())
     };
@@ -544,7 +549,7 @@ fn device_timed(offscreen: &mut Offscreen) -> Result<Vec<BenchResult>, String> {
         let mut s = Scene::default();
         s.render.light_octaves = octaves;
         offscreen
-            .time_light_volume_on_gpu(&s, frames + 1)
+            .time_light_volume(&s, frames + 1, Clock::Device)
             .map(|t| t.map(|mut t| median(t.split_off(1))))
             .map_err(|e| e.to_string())
     };
@@ -902,11 +907,8 @@ fn shadow_and_shaft_passes(offscreen: &mut Offscreen) -> Result<Vec<BenchResult>
     let mut shafts = ground.clone();
     shafts.light.shafts = true;
     let mut time = |scene: &Scene| {
-        offscreen
-            .time_frames(scene, w, h, 1, false)
-            .and_then(|_| offscreen.time_frames(scene, w, h, FRAMES, false))
-            .map(median)
-            .map_err(|e| e.to_string())
+        wall_frames(offscreen, scene, (w, h), 1, false)?;
+        wall_frames(offscreen, scene, (w, h), FRAMES, false).map(median)
     };
     let (with_ground, without, with_shafts) = (time(&ground)?, time(&bare)?, time(&shafts)?);
     Ok(vec![

@@ -12,7 +12,7 @@ use std::path::PathBuf;
 use cloudsketch::export::{Axes, Format, Options, Up, export};
 use cloudsketch::field::media::Media;
 use cloudsketch::field::{ISO, bake_fine, density};
-use cloudsketch::render::offscreen::Offscreen;
+use cloudsketch::render::offscreen::{Backdrop, Offscreen};
 use cloudsketch::scene::Scene;
 use glam::Vec3;
 
@@ -268,7 +268,9 @@ fn mitsuba_scenes_and_the_apps_render_of_their_view() {
         assert!(xml.contains(&format!("value=\"{stem}.vol\"")));
     }
     let mut offscreen = Offscreen::new().expect("an offscreen adapter");
-    let image = offscreen.render(&scene, size[0], size[1]).unwrap();
+    let image = offscreen
+        .render(&scene, size[0], size[1], Backdrop::Sky)
+        .unwrap();
     std::fs::write(out_dir().join("app_view.png"), image.to_png().unwrap()).unwrap();
     // The same cloud seen through an orthographic camera (Mitsuba's orthographic sensor).
     let mut ortho = scene.clone();
@@ -282,7 +284,9 @@ fn mitsuba_scenes_and_the_apps_render_of_their_view() {
     for f in export(&ortho, Format::Mitsuba, &options, "mitsuba_ortho").unwrap() {
         std::fs::write(out_dir().join(&f.name), &f.bytes).unwrap();
     }
-    let image = offscreen.render(&ortho, size[0], size[1]).unwrap();
+    let image = offscreen
+        .render(&ortho, size[0], size[1], Backdrop::Sky)
+        .unwrap();
     std::fs::write(
         out_dir().join("app_view_ortho.png"),
         image.to_png().unwrap(),
@@ -300,8 +304,10 @@ fn mitsuba_scenes_and_the_apps_render_of_their_view() {
 fn a_transparent_png_has_the_clouds_alpha_and_no_sky() {
     let scene = Scene::default();
     let mut offscreen = Offscreen::new().expect("an offscreen adapter");
-    let clear = offscreen.render_transparent(&scene, 160, 90).unwrap();
-    let opaque = offscreen.render(&scene, 160, 90).unwrap();
+    let clear = offscreen
+        .render(&scene, 160, 90, Backdrop::Transparent)
+        .unwrap();
+    let opaque = offscreen.render(&scene, 160, 90, Backdrop::Sky).unwrap();
     let alpha: Vec<u8> = clear.rgba.chunks(4).map(|p| p[3]).collect();
     assert_eq!(alpha[0], 0, "the corner is sky: transparent");
     let covered = alpha.iter().filter(|&&a| a > 250).count();

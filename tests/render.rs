@@ -4,7 +4,7 @@
 
 use std::sync::{Mutex, OnceLock};
 
-use cloudsketch::render::offscreen::{Image, Offscreen};
+use cloudsketch::render::offscreen::{Backdrop, Image, Offscreen};
 use cloudsketch::scene::{Preset, Scene, set_by_pointer};
 
 const W: u32 = 200;
@@ -20,7 +20,9 @@ fn offscreen() -> std::sync::MutexGuard<'static, Offscreen> {
 }
 
 fn render(scene: &Scene) -> Image {
-    offscreen().render(scene, W, H).expect("render")
+    offscreen()
+        .render(scene, W, H, Backdrop::Sky)
+        .expect("render")
 }
 
 fn with(scene: &Scene, sets: &[&str]) -> Scene {
@@ -958,7 +960,11 @@ fn a_transparent_image_keeps_the_shafts_light() {
     // without shafts, carries with them about the light the opaque image adds there.
     let layer = broken_layer();
     let on_sets = ["/light/shafts=true", "/light/shaft_density=0.003"];
-    let transparent = |s: &Scene| offscreen().render_transparent(s, W, H).expect("render");
+    let transparent = |s: &Scene| {
+        offscreen()
+            .render(s, W, H, Backdrop::Transparent)
+            .expect("render")
+    };
     let clear = transparent(&layer);
     let glowing = transparent(&with(&layer, &on_sets));
     let opaque_on = render(&with(&layer, &on_sets));

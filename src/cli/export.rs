@@ -6,7 +6,7 @@ use std::path::Path;
 use super::render::parse_size;
 use super::{read_scene_or_link, write};
 use crate::export::{Format, Options, Up, export};
-use crate::render::offscreen::Offscreen;
+use crate::render::offscreen::{Backdrop, Offscreen};
 use crate::scene::Scene;
 
 /// What `cloudsketch export` was asked for.
@@ -59,12 +59,14 @@ pub fn run(r: &Request) -> Result<(), String> {
     let start = std::time::Instant::now();
     if format == Format::Png {
         let mut offscreen = Offscreen::new().map_err(|e| e.to_string())?;
-        let image = if r.transparent {
-            offscreen.render_transparent(&scene, width, height)
+        let backdrop = if r.transparent {
+            Backdrop::Transparent
         } else {
-            offscreen.render(&scene, width, height)
-        }
-        .map_err(|e| e.to_string())?;
+            Backdrop::Sky
+        };
+        let image = offscreen
+            .render(&scene, width, height, backdrop)
+            .map_err(|e| e.to_string())?;
         let png = image
             .to_png()
             .map_err(|e| format!("PNG encoding failed: {e}"))?;

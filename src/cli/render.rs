@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use super::{read_scene_or_link, write};
-use crate::render::offscreen::{MAX_SIDE, Offscreen};
+use crate::render::offscreen::{Backdrop, MAX_SIDE, Offscreen};
 use crate::scene::{Scene, set_by_pointer};
 
 /// Parses `WIDTHxHEIGHT`.
@@ -53,7 +53,7 @@ pub fn run(
     let mut offscreen = Offscreen::new().map_err(|e| e.to_string())?;
     let start = std::time::Instant::now();
     let image = offscreen
-        .render(&scene, width, height)
+        .render(&scene, width, height, Backdrop::Sky)
         .map_err(|e| e.to_string())?;
     let png = image
         .to_png()

@@ -77,6 +77,15 @@ fn check_size(width: u32, height: u32) -> Result<(), OffscreenError> {
     Ok(())
 }
 
+/// What an offscreen image shows behind the cloud.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Backdrop {
+    /// The scene's sky or background colour, every pixel opaque.
+    Sky,
+    /// Nothing: the cloud's own alpha, colours not premultiplied (a PNG's straight alpha).
+    Transparent,
+}
+
 /// A headless device with the volume renderer.
 pub struct Offscreen {
     device: wgpu::Device,
@@ -92,7 +101,7 @@ pub struct Offscreen {
 
 /// Which clock times the bench's GPU work.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Clock {
+pub enum Clock {
     /// The host's, from recording to the device being done (submission and waiting included).
     Wall,
     /// The device's own (timestamp queries).
@@ -215,61 +224,30 @@ impl Offscreen {
         self.info.device_type == wgpu::DeviceType::Cpu
     }
 
-    /// Renders `scene` from its camera at full quality.
+    /// Renders `scene` from its camera at full quality, over its sky or over nothing.
     pub fn render(
         &mut self,
         scene: &Scene,
         width: u32,
         height: u32,
+        backdrop: Backdrop,
     ) -> Result<Image, OffscreenError> {
         check_size(width, height)?;
         let job = self.full_job(scene, width, height);
-        self.draw(&job, Some(scene.light.background))
-    }
-
-    /// Renders `scene` like [`Offscreen::render`] over a transparent background (no sky): the
-    /// cloud's own alpha, colours not premultiplied (a PNG's straight alpha).
-    pub fn render_transparent(
-        &mut self,
-        scene: &Scene,
-        width: u32,
-        height: u32,
-    ) -> Result<Image, OffscreenError> {
-        check_size(width, height)?;
-        let job = self.full_job(scene, width, height);
-        let mut image = self.draw(&job, None)?;
-        unpremultiply(&mut image.rgba);
-        Ok(image)
+        match backdrop {
+            Backdrop::Sky => self.draw(&job, Some(scene.light.background)),
+            Backdrop::Transparent => {
+                let mut image = self.draw(&job, None)?;
+                unpremultiply(&mut image.rgba);
+                Ok(image)
+            }
+        }
     }
 
     /// Times `frames` full-quality frames of `scene` (slices and composite, no readback), each
-    /// waited for on the device. With `baseline`, the slices use the plain benchmark shader.
+    /// waited for on the device, by `clock`; `None` for the device's clock where the adapter
+    /// has no timestamp queries. With `baseline`, the slices use the plain benchmark shader.
     pub fn time_frames(
-        &mut self,
-        scene: &Scene,
-        width: u32,
-        height: u32,
-        frames: usize,
-        baseline: bool,
-    ) -> Result<Vec<f64>, OffscreenError> {
-        self.frame_times(scene, [width, height], frames, baseline, Clock::Wall)
-            .map(Option::unwrap_or_default)
-    }
-
-    /// Like [`Offscreen::time_frames`], timed by the device's own clock (timestamps before
-    /// and after each frame's commands); `None` where the adapter has no timestamp queries.
-    pub fn time_frames_on_gpu(
-        &mut self,
-        scene: &Scene,
-        width: u32,
-        height: u32,
-        frames: usize,
-        baseline: bool,
-    ) -> Result<Option<Vec<f64>>, OffscreenError> {
-        self.frame_times(scene, [width, height], frames, baseline, Clock::Device)
-    }
-
-    fn frame_times(
         &mut self,
         scene: &Scene,
         [width, height]: [u32; 2],
@@ -299,27 +277,9 @@ impl Offscreen {
     }
 
     /// Times `runs` computations of `scene`'s light volume on the GPU (every slice marched
-    /// toward the sun through the field and its noise), each waited for on the device.
+    /// toward the sun through the field and its noise), each waited for on the device, by
+    /// `clock`; `None` for the device's clock where the adapter has no timestamp queries.
     pub fn time_light_volume(
-        &mut self,
-        scene: &Scene,
-        runs: usize,
-    ) -> Result<Vec<f64>, OffscreenError> {
-        self.light_volume_times(scene, runs, Clock::Wall)
-            .map(Option::unwrap_or_default)
-    }
-
-    /// Like [`Offscreen::time_light_volume`], timed by the device's own clock; `None` where
-    /// the adapter has no timestamp queries.
-    pub fn time_light_volume_on_gpu(
-        &mut self,
-        scene: &Scene,
-        runs: usize,
-    ) -> Result<Option<Vec<f64>>, OffscreenError> {
-        self.light_volume_times(scene, runs, Clock::Device)
-    }
-
-    fn light_volume_times(
         &mut self,
         scene: &Scene,
         runs: usize,

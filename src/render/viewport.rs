@@ -110,50 +110,35 @@ pub struct ViewportPaint {
     pub fence: Option<(JobFence, u64)>,
 }
 
-impl egui_wgpu::CallbackTrait for ViewportPaint {
-    fn prepare(
-        &self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        _screen: &egui_wgpu::ScreenDescriptor,
-        _encoder: &mut wgpu::CommandEncoder,
-        resources: &mut egui_wgpu::CallbackResources,
-    ) -> Vec<wgpu::CommandBuffer> {
-        if let Some(renderer) = resources.get_mut::<VolumeRenderer>() {
-            renderer.begin_frame();
-            renderer.upload(device, queue, &self.volumes);
-            if let Some(job) = &self.job {
-                // The job goes to the GPU now, in a submission of its own (before the frame's,
-                // which composites it), so that the queue can report it done at once: a report
-                // asked for here covers only what is already submitted.
-                let mut own = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                    label: Some("volume job"),
-                });
-                renderer.update_light(device, queue, &mut own, &job.view);
-                renderer.draw_slices(device, queue, &mut own, job, None);
-                if let Some((fence, id)) = self.fence.clone() {
-                    fence.sent(id);
-                    queue.on_submitted_work_done(move || fence.free_for(id));
-                }
-                queue.submit([own.finish()]);
-                if let Some((fence, id)) = self.fence.clone() {
-                    queue.on_submitted_work_done(move || fence.finished(id));
-                }
+impl RendererPaint for ViewportPaint {
+    fn prepare(&self, renderer: &mut VolumeRenderer, device: &wgpu::Device, queue: &wgpu::Queue) {
+        renderer.begin_frame();
+        renderer.upload(device, queue, &self.volumes);
+        if let Some(job) = &self.job {
+            // The job goes to the GPU now, in a submission of its own (before the frame's,
+            // which composites it), so that the queue can report it done at once: a report
+            // asked for here covers only what is already submitted.
+            let mut own = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("volume job"),
+            });
+            renderer.update_light(device, queue, &mut own, &job.view);
+            renderer.draw_slices(device, queue, &mut own, job, None);
+            if let Some((fence, id)) = self.fence.clone() {
+                fence.sent(id);
+                queue.on_submitted_work_done(move || fence.free_for(id));
             }
-            if let Some(capture) = &self.capture {
-                capture.advance(renderer, device, queue);
+            queue.submit([own.finish()]);
+            if let Some((fence, id)) = self.fence.clone() {
+                queue.on_submitted_work_done(move || fence.finished(id));
             }
         }
-        Vec::new()
+        if let Some(capture) = &self.capture {
+            capture.advance(renderer, device, queue);
+        }
     }
 
-    fn paint(
-        &self,
-        _info: egui::PaintCallbackInfo,
-        pass: &mut wgpu::RenderPass<'static>,
-        resources: &egui_wgpu::CallbackResources,
-    ) {
-        if let (Some(renderer), Some(target)) = (resources.get::<VolumeRenderer>(), self.display) {
+    fn paint(&self, renderer: &VolumeRenderer, pass: &mut wgpu::RenderPass<'static>) {
+        if let Some(target) = self.display {
             renderer.composite(pass, target, false);
         }
     }
@@ -165,17 +150,46 @@ pub struct SkyPaint {
     pub view: super::gpu_types::View,
 }
 
-impl egui_wgpu::CallbackTrait for SkyPaint {
+impl RendererPaint for SkyPaint {
+    fn prepare(&self, renderer: &mut VolumeRenderer, _device: &wgpu::Device, queue: &wgpu::Queue) {
+        renderer.prepare_sky(queue, &self.view);
+    }
+
+    fn paint(&self, renderer: &VolumeRenderer, pass: &mut wgpu::RenderPass<'static>) {
+        renderer.draw_sky(pass);
+    }
+}
+
+/// A part of the viewport the volume renderer draws: its GPU work before egui's render pass,
+/// then its draw inside that pass. [`paint_callback`] hands one to egui.
+pub trait RendererPaint: Send + Sync + 'static {
+    /// Uploads and records what the draw needs (before egui's render pass).
+    fn prepare(&self, renderer: &mut VolumeRenderer, device: &wgpu::Device, queue: &wgpu::Queue);
+    /// Draws into egui's render pass, clipped to the callback's rectangle.
+    fn paint(&self, renderer: &VolumeRenderer, pass: &mut wgpu::RenderPass<'static>);
+}
+
+/// An egui paint callback over `rect` that runs `paint` on the renderer kept in egui-wgpu's
+/// callback resources (nothing, before the renderer exists).
+pub fn paint_callback(rect: egui::Rect, paint: impl RendererPaint) -> egui::PaintCallback {
+    egui_wgpu::Callback::new_paint_callback(rect, OnRenderer(paint))
+}
+
+/// Adapts a [`RendererPaint`] to egui-wgpu's callback, finding the renderer among its
+/// resources.
+struct OnRenderer<P>(P);
+
+impl<P: RendererPaint> egui_wgpu::CallbackTrait for OnRenderer<P> {
     fn prepare(
         &self,
-        _device: &wgpu::Device,
+        device: &wgpu::Device,
         queue: &wgpu::Queue,
         _screen: &egui_wgpu::ScreenDescriptor,
         _encoder: &mut wgpu::CommandEncoder,
         resources: &mut egui_wgpu::CallbackResources,
     ) -> Vec<wgpu::CommandBuffer> {
-        if let Some(renderer) = resources.get::<VolumeRenderer>() {
-            renderer.prepare_sky(queue, &self.view);
+        if let Some(renderer) = resources.get_mut::<VolumeRenderer>() {
+            self.0.prepare(renderer, device, queue);
         }
         Vec::new()
     }
@@ -187,7 +201,7 @@ impl egui_wgpu::CallbackTrait for SkyPaint {
         resources: &egui_wgpu::CallbackResources,
     ) {
         if let Some(renderer) = resources.get::<VolumeRenderer>() {
-            renderer.draw_sky(pass);
+            self.0.paint(renderer, pass);
         }
     }
 }

@@ -1,15 +1,17 @@
 //! Named starting points (`cloudsketch new --preset NAME`, `?preset=NAME`, the Scene group):
 //! the paper's cloud types (Schpok et al. 2003, Figures 3–7), each a set of ellipsoids with the
-//! media, light and camera that make it recognisable at first sight. Every random choice comes
-//! from a fixed seed, so a preset is the same document everywhere.
+//! media, light and camera that make it recognisable at first sight (those three kept as data,
+//! in `presets.json`). Every random choice comes from a fixed seed, so a preset is the same
+//! document everywhere.
 
 use std::sync::Arc;
 
-use glam::{Quat, Vec3};
+use std::collections::BTreeMap;
 
-use super::{
-    Ellipsoid, Lighting, NoiseBasis, NoiseFilter, OrbitCamera, RenderSettings, SCENE_VERSION, Scene,
-};
+use glam::{Quat, Vec3};
+use serde::Deserialize;
+
+use super::{Ellipsoid, Lighting, OrbitCamera, RenderSettings, SCENE_VERSION, Scene};
 use crate::seeded::SplitMix;
 
 /// Named starting points.
@@ -120,82 +122,46 @@ fn cumulonimbus() -> Vec<Ellipsoid> {
     v
 }
 
+/// Each preset's camera, light and media by name: the values an artist tunes, kept as data
+/// (what a preset leaves out keeps its default).
+const STAGING: &str = include_str!("presets.json");
+
+/// A preset's camera, light and media, as [`STAGING`] gives them.
+#[derive(Default, Deserialize)]
+#[serde(default)]
+struct Staging {
+    camera: OrbitCamera,
+    light: Lighting,
+    render: RenderSettings,
+}
+
+/// Every preset's staging in [`STAGING`], by name.
+fn all_staging() -> Result<BTreeMap<String, Staging>, serde_json::Error> {
+    serde_json::from_str(STAGING)
+}
+
 impl Scene {
     /// A new document from a preset.
     pub fn preset(preset: Preset) -> Self {
-        let mut camera = OrbitCamera::default();
-        let mut light = Lighting::default();
-        let mut render = RenderSettings::default();
+        // The file is checked by a test; a preset it lacks gets the defaults.
+        let Staging {
+            camera,
+            light,
+            render,
+        } = all_staging()
+            .ok()
+            .and_then(|mut all| all.remove(preset.name()))
+            .unwrap_or_default();
         let mut simulation = None;
         let mut time = 0.0;
         let ellipsoids = match preset {
             Preset::Cumulus => cumulus(),
-            Preset::Stratus => {
-                camera.distance = 34.0;
-                camera.pitch_deg = 10.0;
-                render.noise_filter = NoiseFilter::Stratus;
-                render.noise_scale = 5.0;
-                render.noise_amount = 0.3;
-                render.opacity = 1.2;
-                light.sun_elevation_deg = 25.0;
-                light.ambient = 0.6;
-                light.sky_color = [0.62, 0.66, 0.74];
-                light.background = [0.5, 0.58, 0.7];
-                layer(28, 30.0, 10.0, 3.0, Vec3::new(3.2, 0.7, 2.6), 11)
-            }
-            Preset::Cirrus => {
-                camera.target = Vec3::new(0.0, 9.0, 0.0);
-                camera.distance = 30.0;
-                camera.pitch_deg = 18.0;
-                render.noise_filter = NoiseFilter::Wispy;
-                render.noise_scale = 2.0;
-                render.noise_amount = 0.7;
-                render.noise_octaves = 5;
-                render.opacity = 0.8;
-                render.sharpness = 0.3;
-                render.wind = [1.5, 0.0];
-                light.sun_elevation_deg = 55.0;
-                light.background = [0.24, 0.45, 0.78];
-                layer(9, 22.0, 12.0, 9.0, Vec3::new(6.0, 0.35, 0.9), 23)
-            }
-            Preset::Cumulonimbus => {
-                camera.target = Vec3::new(0.5, 8.5, 0.0);
-                camera.distance = 36.0;
-                camera.pitch_deg = 4.0;
-                render.noise_filter = NoiseFilter::Cumulus;
-                render.noise_basis = NoiseBasis::Worley;
-                render.noise_scale = 8.0;
-                render.noise_amount = 0.55;
-                render.dirtiness = 1.6;
-                render.torque = 6.0;
-                light.sun_elevation_deg = 30.0;
-                light.background = [0.36, 0.46, 0.6];
-                cumulonimbus()
-            }
-            Preset::Sunset => {
-                camera.distance = 24.0;
-                camera.pitch_deg = 6.0;
-                render.noise_filter = NoiseFilter::Cumulus;
-                render.noise_amount = 0.4;
-                light.sun_azimuth_deg = 200.0;
-                light.sun_elevation_deg = 3.0;
-                light.sun_color = [1.0, 0.55, 0.32];
-                light.sun_intensity = 2.0;
-                light.sky_color = [0.95, 0.45, 0.6];
-                light.ambient = 0.55;
-                light.background = [0.42, 0.33, 0.5];
-                layer(14, 20.0, 8.0, 3.5, Vec3::new(2.6, 1.3, 2.2), 37)
-            }
+            Preset::Stratus => layer(28, 30.0, 10.0, 3.0, Vec3::new(3.2, 0.7, 2.6), 11),
+            Preset::Cirrus => layer(9, 22.0, 12.0, 9.0, Vec3::new(6.0, 0.35, 0.9), 23),
+            Preset::Cumulonimbus => cumulonimbus(),
+            Preset::Sunset => layer(14, 20.0, 8.0, 3.5, Vec3::new(2.6, 1.3, 2.2), 37),
             Preset::Empty => Vec::new(),
             Preset::Simulated => {
-                camera.target = Vec3::new(0.0, 3.0, 0.0);
-                camera.distance = 30.0;
-                camera.pitch_deg = 8.0;
-                render.noise_amount = 0.15;
-                render.softness = 0.2;
-                light.sun_elevation_deg = 14.0;
-                light.sun_azimuth_deg = 150.0;
-                light.ground = true;
                 simulation = Some(Arc::new(crate::simulate::Settings::default()));
                 // Forty steps in: the parcels have clouds when the preset opens.
                 time = 4.0;
@@ -220,6 +186,53 @@ impl Scene {
             reference: None,
             time,
             simulation,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Whether every value `file` sets stands in `kept` (a misspelt or out-of-range value would
+    /// be dropped or changed on the way in).
+    fn sets_nothing_lost(file: &serde_json::Value, kept: &serde_json::Value, at: &str) {
+        match (file, kept) {
+            (serde_json::Value::Object(f), serde_json::Value::Object(k)) => {
+                for (key, value) in f {
+                    let inner = k.get(key).unwrap_or(&serde_json::Value::Null);
+                    sets_nothing_lost(value, inner, &format!("{at}/{key}"));
+                }
+            }
+            (serde_json::Value::Number(f), serde_json::Value::Number(k)) => {
+                let (f, k) = (f.as_f64().unwrap(), k.as_f64().unwrap());
+                assert!(
+                    (f - k).abs() <= 1e-6 * f.abs().max(1.0),
+                    "{at}: {f} became {k}"
+                );
+            }
+            (serde_json::Value::Array(f), serde_json::Value::Array(k)) if f.len() == k.len() => {
+                for (i, (f, k)) in f.iter().zip(k).enumerate() {
+                    sets_nothing_lost(f, k, &format!("{at}/{i}"));
+                }
+            }
+            _ => assert_eq!(file, kept, "{at}"),
+        }
+    }
+
+    #[test]
+    fn every_presets_staging_is_read_whole_and_names_a_preset() {
+        let file: serde_json::Value = serde_json::from_str(STAGING).expect("presets.json parses");
+        let all = all_staging().expect("presets.json reads as staging");
+        for (name, staged) in file.as_object().expect("an object by name") {
+            let preset = Preset::from_name(name).unwrap_or_else(|| panic!("no preset {name}"));
+            let scene = serde_json::to_value(Scene::preset(preset)).unwrap();
+            sets_nothing_lost(staged, &scene, name);
+            assert!(all.contains_key(name));
+        }
+        // The looks that make each preset recognisable are there.
+        for name in ["stratus", "cirrus", "cumulonimbus", "sunset", "simulated"] {
+            assert!(all.contains_key(name), "{name} has no staging");
         }
     }
 }

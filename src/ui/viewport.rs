@@ -14,7 +14,7 @@ use crate::render::View;
 use crate::render::capture::Capture;
 use crate::render::progressive::{Budget, Progressive};
 use crate::render::viewport::{JobFence, ReportPoll};
-use crate::render::viewport::{SkyPaint, ViewportPaint};
+use crate::render::viewport::{SkyPaint, ViewportPaint, paint_callback};
 use crate::scene::Document;
 
 /// How often a viewport whose refinement waits for the GPU looks again without word from it.
@@ -139,10 +139,7 @@ impl Viewport {
             crop: crate::render::FULL_VIEW,
         };
         if (scene.light.sky_gradient || scene.light.ground) && self.stats.backend.is_some() {
-            painter.add(egui_wgpu::Callback::new_paint_callback(
-                rect,
-                SkyPaint { view: view.clone() },
-            ));
+            painter.add(paint_callback(rect, SkyPaint { view: view.clone() }));
         }
         guide.paint(&painter, rect, cx.doc, false);
 
@@ -236,7 +233,7 @@ impl Viewport {
         let capture = self.capture.clone();
         if crop.is_none() && capture.is_some() && self.stats.backend.is_some() {
             // Nothing of the cloud in view: the capture still needs the callback to run.
-            painter.add(egui_wgpu::Callback::new_paint_callback(
+            painter.add(paint_callback(
                 rect,
                 ViewportPaint {
                     volumes: volumes.clone(),
@@ -267,7 +264,7 @@ impl Viewport {
                     rect.min + egui::vec2(x0 as f32, y0 as f32) / ppp,
                     rect.min + egui::vec2(x1 as f32, y1 as f32) / ppp,
                 );
-                painter.add(egui_wgpu::Callback::new_paint_callback(
+                painter.add(paint_callback(
                     area,
                     ViewportPaint {
                         volumes,
