@@ -723,60 +723,88 @@ fn an_upper_tier_moves_with_its_own_wind_and_its_floor_shows_no_step() {
 }
 
 #[test]
-fn a_cloud_shadows_the_one_below_and_the_shadow_has_the_noise_in_it() {
-    // A caster right of the frame, the sun low on the right: its shadow falls on the sunny
-    // side of the cloud in view.
+fn a_broken_layer_casts_a_dappled_shadow_when_the_light_volume_sees_the_noise() {
+    // The sun behind the camera lights the face in view (so its own relief casts little
+    // shadow there); a thin, weak layer between the sun and that face, out of view above and
+    // behind the camera, shades it. The noise breaks the layer into puffs and gaps, so the
+    // shadow has sunlit gaps in it, if the light volume sees the noise.
     let scene = with(
         &Scene::preset(Preset::Empty),
         &[
-            "/ellipsoids=[{\"center\":[0,2,0],\"radii\":[3.0,1.6,3.0]},{\"center\":[9.5,2.4,0],\"radii\":[1.6,1.6,2.5]}]",
+            "/ellipsoids=[{\"center\":[0,2,0],\"radii\":[4.0,2.2,1.6]},\
+              {\"center\":[0,6.6,6.6],\"radii\":[7.0,0.5,5.0],\"strength\":0.6}]",
             "/camera/target=[0,2,0]",
             "/camera/pitch_deg=0",
             "/camera/yaw_deg=0",
-            "/camera/distance=12",
-            "/light/sun_azimuth_deg=0",
-            "/light/sun_elevation_deg=3",
+            "/camera/distance=9",
+            "/light/sun_azimuth_deg=90",
+            "/light/sun_elevation_deg=35",
+            "/light/ambient=0.15",
             "/light/multiple_scattering=0",
-            "/render/noise_amount=0.5",
+            "/render/noise_amount=1",
             "/render/noise_octaves=4",
-            "/render/light_resolution=64",
+            "/render/opacity=6",
+            "/render/light_resolution=96",
         ],
     );
     let bg = background(&scene);
     let lit = render(&with(&scene, &["/ellipsoids/1/hidden=true"]));
     let shadowed = render(&scene);
-    let cloud = |x: u32, y: u32| differs(lit.pixel(x, y), bg);
-    let middle = |x: u32, y: u32| cloud(x, y) && x > W / 2;
-    let mean = |img: &Image| {
-        let v: Vec<f64> = (0..H)
-            .flat_map(|y| (0..W).map(move |x| (x, y)))
-            .filter(|&(x, y)| middle(x, y))
-            .map(|(x, y)| luminance(img.pixel(x, y)))
-            .collect();
-        v.iter().sum::<f64>() / v.len().max(1) as f64
+    // The baseline: the same slices, a light volume without the noise (a smooth shadow).
+    let smooth = render(&with(&scene, &["/render/light_octaves=0"]));
+    // The shadowed region: where the smooth shadow takes at least half of what it takes at
+    // most, four pixels in from its edge (the edge itself is structure of any shadow).
+    let l = |img: &Image, x: u32, y: u32| luminance(img.pixel(x, y));
+    let darkened = |x: u32, y: u32| {
+        if differs(lit.pixel(x, y), bg) {
+            l(&lit, x, y) - l(&smooth, x, y)
+        } else {
+            0.0
+        }
     };
+    let most = (0..H)
+        .flat_map(|y| (0..W).map(move |x| (x, y)))
+        .map(|(x, y)| darkened(x, y))
+        .fold(0.0, f64::max);
+    let deep = |x: u32, y: u32| darkened(x, y) > 0.5 * most;
+    const IN: u32 = 4;
+    let region: Vec<(u32, u32)> = (IN..H - IN)
+        .flat_map(|y| (IN..W - IN).map(move |x| (x, y)))
+        .filter(|&(x, y)| (y - IN..=y + IN).all(|v| (x - IN..=x + IN).all(|u| deep(u, v))))
+        .collect();
+    assert!(region.len() > 500, "a shadow of {} pixels", region.len());
+    let mean =
+        |img: &Image| region.iter().map(|&(x, y)| l(img, x, y)).sum::<f64>() / region.len() as f64;
     let (bright, dark) = (mean(&lit), mean(&shadowed));
     assert!(
-        dark < bright - 15.0,
+        dark < bright - 30.0,
         "in the shadow {dark:.1}, in the sun {bright:.1}"
     );
-    // The shadow sees the noise: a light volume without it (the slices' noise the same)
-    // changes the shadowed side, and a light volume that ignored the noise would not.
-    let smooth = render(&with(&scene, &["/render/light_octaves=0"]));
-    let (mut sum, mut n) = (0.0, 0usize);
-    for y in 0..H {
-        for x in 0..W {
-            if middle(x, y) {
-                let (p, q) = (shadowed.pixel(x, y), smooth.pixel(x, y));
-                sum += (0..3).map(|i| p[i].abs_diff(q[i]) as f64).sum::<f64>() / 3.0;
-                n += 1;
-            }
-        }
-    }
-    let changed = sum / n.max(1) as f64;
+    // High-frequency energy there: the mean squared Laplacian of the luminance.
+    let energy = |img: &Image| {
+        let sum: f64 = region
+            .iter()
+            .map(|&(x, y)| {
+                4.0 * l(img, x, y)
+                    - l(img, x - 1, y)
+                    - l(img, x + 1, y)
+                    - l(img, x, y - 1)
+                    - l(img, x, y + 1)
+            })
+            .map(|lap| lap * lap)
+            .sum();
+        sum / region.len() as f64
+    };
+    let (dappled, plain) = (energy(&shadowed), energy(&smooth));
+    eprintln!(
+        "shadow: {} px, {bright:.1} lit → {dark:.1}; high-frequency energy {plain:.2} without \
+         the noise in the light volume, {dappled:.2} with it",
+        region.len()
+    );
     assert!(
-        changed > 2.0,
-        "noise in the light volume changed the shadow by {changed:.2}"
+        dappled >= 3.0 * plain,
+        "high-frequency energy in the shadow: {dappled:.2} with the light volume's noise, \
+         {plain:.2} without"
     );
 }
 
