@@ -70,6 +70,12 @@ pub struct FramePlan {
     /// The job's number (jobs are numbered from 1 as planned), which the GPU's fence reports
     /// back once the job is done ([`GpuReport::done`]).
     pub job_id: u64,
+    /// Whether the job goes to the GPU in a submission of its own, ahead of the frame's, so
+    /// that the GPU can time it (a fenced refinement chunk). Otherwise it goes with the frame's
+    /// own commands: one submission a frame (a second one, even empty, doubled the frame's
+    /// time on the CPU adapters of the browser tests), and its report is asked for at the next
+    /// frame.
+    pub own_submission: bool,
 }
 
 /// What the GPU has reported of the jobs the planner gave it ([`FramePlan::job_id`]).
@@ -289,6 +295,7 @@ impl Progressive {
                 // The last chunk is measured when the GPU reports it, not at the next input.
                 waiting_for_gpu: chunk_on_gpu,
                 job_id: 0,
+                own_submission: false,
             };
         }
         // The GPU has yet to report the last job (a chunk, or the preview before the first):
@@ -316,6 +323,7 @@ impl Progressive {
                 repaint: false,
                 waiting_for_gpu: true,
                 job_id: 0,
+                own_submission: false,
             };
         }
         let size = self.refine_size(viewport, full_slices);
@@ -397,6 +405,7 @@ impl Progressive {
             repaint: !fenced,
             waiting_for_gpu: fenced,
             job_id: self.jobs,
+            own_submission: fenced,
         }
     }
 
@@ -760,6 +769,8 @@ mod tests {
             range.end < 128,
             "the refinement takes several chunks: {range:?}"
         );
+        // The chunk goes to the GPU on its own, to be timed; the preview with its frame.
+        assert!(first.own_submission && !preview.own_submission);
         // The GPU is still on that chunk: nothing more is queued, the image shown stays, and
         // the fence is to wake the next frame.
         for t in [0.2, 0.3, 0.4] {
@@ -795,7 +806,10 @@ mod tests {
         // From then on chunks follow each other as frames come, as before fences.
         for _ in 0..3 {
             let plan = p.plan(t, 1, VIEW, 128, false, GpuReport::upto(0));
-            assert!(plan.job.is_some() && !plan.waiting_for_gpu, "{plan:?}");
+            assert!(
+                plan.job.is_some() && !plan.waiting_for_gpu && !plan.own_submission,
+                "{plan:?}"
+            );
             t += 0.1;
         }
     }

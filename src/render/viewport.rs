@@ -27,6 +27,9 @@ pub struct JobFence(Arc<FenceState>);
 struct FenceState {
     /// The last job handed to the GPU.
     sent: AtomicU64,
+    /// A job recorded with a frame's own commands whose report is yet to be asked for (0:
+    /// none): the frame is submitted after its callbacks, so the next frame asks.
+    in_frame: AtomicU64,
     done: AtomicU64,
     times: Mutex<Times>,
     clock: fn() -> f64,
@@ -48,6 +51,7 @@ impl JobFence {
     pub fn new(wake: impl Fn() + Send + Sync + 'static, clock: fn() -> f64) -> Self {
         Self(Arc::new(FenceState {
             sent: AtomicU64::new(0),
+            in_frame: AtomicU64::new(0),
             done: AtomicU64::new(0),
             times: Mutex::new(Times::default()),
             clock,
@@ -72,6 +76,22 @@ impl JobFence {
     /// Job `job` is handed to the GPU.
     fn sent(&self, job: u64) {
         self.0.sent.fetch_max(job, Ordering::AcqRel);
+    }
+
+    /// Job `job` is recorded with this frame's own commands (submitted after the callbacks).
+    fn recorded_in_frame(&self, job: u64) {
+        self.sent(job);
+        self.0.in_frame.store(job, Ordering::Release);
+    }
+
+    /// Asks `queue` to report the job recorded with an earlier frame's commands, if any: those
+    /// are submitted by now, and a report covers what is submitted when it is asked for.
+    fn ask_for_frame_report(&self, queue: &wgpu::Queue) {
+        let job = self.0.in_frame.swap(0, Ordering::AcqRel);
+        if job > 0 {
+            let fence = self.clone();
+            queue.on_submitted_work_done(move || fence.finished(job));
+        }
     }
 
     /// The work submitted before job `job` is done: the GPU can start it.
@@ -106,30 +126,56 @@ pub struct ViewportPaint {
     pub display: Option<usize>,
     /// A capture of the view for export, advanced every frame until read back.
     pub capture: Option<super::capture::Capture>,
-    /// The job's number and the fence to report it done through.
-    pub fence: Option<(JobFence, u64)>,
+    /// The fence the jobs are reported through (a job recorded with an earlier frame's
+    /// commands is reported from this frame on, job or not).
+    pub fence: Option<JobFence>,
+    /// The job's number ([`super::progressive::FramePlan::job_id`]).
+    pub job_id: u64,
+    /// Whether the job goes to the GPU on its own, ahead of the frame, timed by the fence
+    /// ([`super::progressive::FramePlan::own_submission`]); else with the frame's commands.
+    pub own_submission: bool,
 }
 
 impl RendererPaint for ViewportPaint {
-    fn prepare(&self, renderer: &mut VolumeRenderer, device: &wgpu::Device, queue: &wgpu::Queue) {
+    fn prepare(
+        &self,
+        renderer: &mut VolumeRenderer,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        frame: &mut wgpu::CommandEncoder,
+    ) {
         renderer.begin_frame();
         renderer.upload(device, queue, &self.volumes);
+        if let Some(fence) = &self.fence {
+            fence.ask_for_frame_report(queue);
+        }
         if let Some(job) = &self.job {
-            // The job goes to the GPU now, in a submission of its own (before the frame's,
-            // which composites it), so that the queue can report it done at once: a report
-            // asked for here covers only what is already submitted.
-            let mut own = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("volume job"),
-            });
-            renderer.update_light(device, queue, &mut own, &job.view);
-            renderer.draw_slices(device, queue, &mut own, job, None);
-            if let Some((fence, id)) = self.fence.clone() {
-                fence.sent(id);
-                queue.on_submitted_work_done(move || fence.free_for(id));
-            }
-            queue.submit([own.finish()]);
-            if let Some((fence, id)) = self.fence.clone() {
-                queue.on_submitted_work_done(move || fence.finished(id));
+            if self.own_submission {
+                // A timed chunk goes to the GPU now, in a submission of its own (before the
+                // frame's, which composites it), so that the queue can report when the GPU is
+                // free for it and when it is done: a report asked for here covers only what is
+                // already submitted.
+                let mut own = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                    label: Some("volume job"),
+                });
+                renderer.update_light(device, queue, &mut own, &job.view);
+                renderer.draw_slices(device, queue, &mut own, job, None);
+                if let Some(fence) = self.fence.clone() {
+                    let id = self.job_id;
+                    fence.sent(id);
+                    queue.on_submitted_work_done(move || fence.free_for(id));
+                }
+                queue.submit([own.finish()]);
+                if let Some(fence) = self.fence.clone() {
+                    let id = self.job_id;
+                    queue.on_submitted_work_done(move || fence.finished(id));
+                }
+            } else {
+                renderer.update_light(device, queue, frame, &job.view);
+                renderer.draw_slices(device, queue, frame, job, None);
+                if let Some(fence) = &self.fence {
+                    fence.recorded_in_frame(self.job_id);
+                }
             }
         }
         if let Some(capture) = &self.capture {
@@ -151,7 +197,13 @@ pub struct SkyPaint {
 }
 
 impl RendererPaint for SkyPaint {
-    fn prepare(&self, renderer: &mut VolumeRenderer, _device: &wgpu::Device, queue: &wgpu::Queue) {
+    fn prepare(
+        &self,
+        renderer: &mut VolumeRenderer,
+        _device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        _frame: &mut wgpu::CommandEncoder,
+    ) {
         renderer.prepare_sky(queue, &self.view);
     }
 
@@ -163,8 +215,15 @@ impl RendererPaint for SkyPaint {
 /// A part of the viewport the volume renderer draws: its GPU work before egui's render pass,
 /// then its draw inside that pass. [`paint_callback`] hands one to egui.
 pub trait RendererPaint: Send + Sync + 'static {
-    /// Uploads and records what the draw needs (before egui's render pass).
-    fn prepare(&self, renderer: &mut VolumeRenderer, device: &wgpu::Device, queue: &wgpu::Queue);
+    /// Uploads and records what the draw needs, into the frame's commands (`frame`, submitted
+    /// with egui's render pass after every callback's `prepare`) or a submission of its own.
+    fn prepare(
+        &self,
+        renderer: &mut VolumeRenderer,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        frame: &mut wgpu::CommandEncoder,
+    );
     /// Draws into egui's render pass, clipped to the callback's rectangle.
     fn paint(&self, renderer: &VolumeRenderer, pass: &mut wgpu::RenderPass<'static>);
 }
@@ -185,11 +244,11 @@ impl<P: RendererPaint> egui_wgpu::CallbackTrait for OnRenderer<P> {
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         _screen: &egui_wgpu::ScreenDescriptor,
-        _encoder: &mut wgpu::CommandEncoder,
+        encoder: &mut wgpu::CommandEncoder,
         resources: &mut egui_wgpu::CallbackResources,
     ) -> Vec<wgpu::CommandBuffer> {
         if let Some(renderer) = resources.get_mut::<VolumeRenderer>() {
-            self.0.prepare(renderer, device, queue);
+            self.0.prepare(renderer, device, queue, encoder);
         }
         Vec::new()
     }

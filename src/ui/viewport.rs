@@ -240,7 +240,9 @@ impl Viewport {
                     job: None,
                     display: None,
                     capture: capture.clone(),
-                    fence: None,
+                    fence: Some(fence.clone()),
+                    job_id: 0,
+                    own_submission: false,
                 },
             ));
         }
@@ -249,7 +251,6 @@ impl Viewport {
         if plan.job.is_some() && !drawn {
             fence.finished(plan.job_id);
         }
-        let job_fence = plan.job.is_some().then(|| (fence.clone(), plan.job_id));
         if let Some(crop) = crop {
             let job = plan.job.map(|plan| SliceJob {
                 plan,
@@ -271,7 +272,9 @@ impl Viewport {
                         job,
                         display: plan.display,
                         capture,
-                        fence: job_fence,
+                        fence: Some(fence),
+                        job_id: plan.job_id,
+                        own_submission: plan.own_submission,
                     },
                 ));
             }
