@@ -439,6 +439,44 @@ impl SkyPass {
     }
 }
 
+/// A flat colour over the current viewport (`shaders/fill.wgsl`): the render pass's blend
+/// constant, blended over nothing, so the pipeline binds nothing.
+pub struct FillPass {
+    pipeline: wgpu::RenderPipeline,
+}
+
+impl FillPass {
+    /// Creates the pass writing into `output_format`.
+    pub fn new(device: &wgpu::Device, output_format: wgpu::TextureFormat) -> Self {
+        const CONSTANT: wgpu::BlendComponent = wgpu::BlendComponent {
+            src_factor: wgpu::BlendFactor::Constant,
+            dst_factor: wgpu::BlendFactor::Zero,
+            operation: wgpu::BlendOperation::Add,
+        };
+        let blend = wgpu::BlendState {
+            color: CONSTANT,
+            alpha: CONSTANT,
+        };
+        Self {
+            pipeline: full_pipeline(
+                device,
+                "fill",
+                shaders::FILL,
+                &[],
+                output_format,
+                Some(blend),
+            ),
+        }
+    }
+
+    /// Fills the current render pass's viewport with `colour` (the values the target stores).
+    pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>, colour: wgpu::Color) {
+        pass.set_pipeline(&self.pipeline);
+        pass.set_blend_constant(colour);
+        pass.draw(0..3, 0..1);
+    }
+}
+
 /// Light slices one light volume may have (its grid's cap per side).
 pub const MAX_LIGHT_SLICES: u32 = 128;
 

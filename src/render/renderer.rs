@@ -2,7 +2,9 @@
 //! egui paint callback) and by offscreen rendering alike.
 
 use super::gpu_types::{LightSliceUniforms, Shells, SkyUniforms, View, VolumeUniforms};
-use super::passes::{CompositePass, LIGHT_FORMAT, LightPass, MAX_LIGHT_SLICES, SkyPass, SlicePass};
+use super::passes::{
+    CompositePass, FillPass, LIGHT_FORMAT, LightPass, MAX_LIGHT_SLICES, SkyPass, SlicePass,
+};
 use super::progressive::JobPlan;
 use super::resources::{TARGETS, Target, VolumeTextures, accumulation_texture, sampler, upload_3d};
 use crate::derive::Volumes;
@@ -23,6 +25,7 @@ pub struct VolumeRenderer {
     slices: SlicePass,
     composite: CompositePass,
     sky: SkyPass,
+    fill: FillPass,
     clamp_sampler: wgpu::Sampler,
     repeat_sampler: wgpu::Sampler,
     textures: VolumeTextures,
@@ -86,6 +89,7 @@ impl VolumeRenderer {
             slices: SlicePass::new(device, accum_format),
             composite: CompositePass::new(device, output_format),
             sky: SkyPass::new(device, output_format, &placeholder, &clamp_sampler),
+            fill: FillPass::new(device, output_format),
             clamp_sampler,
             repeat_sampler: sampler(device, wgpu::AddressMode::Repeat),
             textures: VolumeTextures::new(),
@@ -522,6 +526,11 @@ impl VolumeRenderer {
     /// Draws the sky gradient over the current render pass's viewport.
     pub fn draw_sky(&self, pass: &mut wgpu::RenderPass<'_>) {
         self.sky.draw(pass);
+    }
+
+    /// Fills the current render pass's viewport with `colour` (the values the target stores).
+    pub fn draw_fill(&self, pass: &mut wgpu::RenderPass<'_>, colour: wgpu::Color) {
+        self.fill.draw(pass, colour);
     }
 
     /// Draws accumulation target `index` over the current render pass's viewport; over a

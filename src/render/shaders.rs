@@ -49,8 +49,14 @@ pub const SKY: &str = concat!(
     include_str!("../../shaders/sky.wgsl")
 );
 
+/// A flat colour (the side panel's background): `fullscreen.wgsl` + `fill.wgsl`.
+pub const FILL: &str = concat!(
+    include_str!("../../shaders/fullscreen.wgsl"),
+    include_str!("../../shaders/fill.wgsl")
+);
+
 /// Every shader module with the files it is composed of, in order.
-pub const MODULES: [(&str, &[&str], &str); 6] = [
+pub const MODULES: [(&str, &[&str], &str); 7] = [
     (
         "volume",
         &[
@@ -91,4 +97,5 @@ pub const MODULES: [(&str, &[&str], &str); 6] = [
         &["sun_shadow.wgsl", "fullscreen.wgsl", "sky.wgsl"],
         SKY,
     ),
+    ("fill", &["fullscreen.wgsl", "fill.wgsl"], FILL),
 ];

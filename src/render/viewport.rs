@@ -212,6 +212,32 @@ impl RendererPaint for SkyPaint {
     }
 }
 
+/// A flat colour over a rectangle: the side panel's background, which egui then leaves
+/// unfilled (its own fill samples a texture and converts gamma at every pixel: on CPU adapters
+/// the panel's fill was a sixth of a frame).
+pub struct FillPaint {
+    /// The colour as egui would paint it.
+    pub colour: egui::Color32,
+}
+
+impl RendererPaint for FillPaint {
+    fn prepare(
+        &self,
+        _renderer: &mut VolumeRenderer,
+        _device: &wgpu::Device,
+        _queue: &wgpu::Queue,
+        _frame: &mut wgpu::CommandEncoder,
+    ) {
+    }
+
+    fn paint(&self, renderer: &VolumeRenderer, pass: &mut wgpu::RenderPass<'static>) {
+        // egui's colours are sRGB-encoded (premultiplied) and so is what it writes into the
+        // frame's (non-sRGB) target: the bytes go in as they are.
+        let [r, g, b, a] = self.colour.to_array().map(|c| f64::from(c) / 255.0);
+        renderer.draw_fill(pass, wgpu::Color { r, g, b, a });
+    }
+}
+
 /// A part of the viewport the volume renderer draws: its GPU work before egui's render pass,
 /// then its draw inside that pass. [`paint_callback`] hands one to egui.
 pub trait RendererPaint: Send + Sync + 'static {

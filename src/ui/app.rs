@@ -12,7 +12,7 @@ use super::selection::Selection;
 use super::sketch_tool::{Axis, SketchTool, ToolContext};
 use super::viewport::{Viewport, ViewportContext};
 use crate::derive::Derived;
-use crate::render::viewport::{BackendInfo, ReportPoll, install};
+use crate::render::viewport::{BackendInfo, FillPaint, ReportPoll, install, paint_callback};
 use crate::scene::{Document, Edit, Scene};
 
 /// What the page (or any embedder) is told after each frame.
@@ -523,14 +523,31 @@ impl eframe::App for CloudApp {
                 .export
                 .captured(size, pixels, &mut self.notices, now);
         }
-        // Fixed width: growing values never shift the buttons under the pointer.
+        // Fixed width: growing values never shift the buttons under the pointer. With a
+        // renderer, the panel's background is its flat fill (`FillPaint`, painted under the
+        // panel in a slot kept before it), not egui's.
         let mut open = self.panel_open;
-        egui::Panel::right("controls")
+        let own_fill = self.viewport.stats.backend.is_some();
+        let fill_slot = own_fill.then(|| ui.painter().add(egui::Shape::Noop));
+        let frame = egui::Frame::side_top_panel(ui.style());
+        let colour = frame.fill;
+        let shown = egui::Panel::right("controls")
+            .frame(if own_fill {
+                frame.fill(egui::Color32::TRANSPARENT)
+            } else {
+                frame
+            })
             .resizable(false)
             .exact_size(PANEL_WIDTH)
             .show_collapsible(ui, &mut open, |ui| {
                 egui::ScrollArea::vertical().show(ui, |ui| self.side_panel(ui));
             });
+        if let (Some(slot), Some(shown)) = (fill_slot, shown) {
+            ui.painter().set(
+                slot,
+                paint_callback(shown.response.rect, FillPaint { colour }),
+            );
+        }
         self.panel_open &= open;
         if !self.panel_open {
             egui::Area::new(egui::Id::unique("show panel"))

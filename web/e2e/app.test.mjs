@@ -57,6 +57,17 @@ for (const backend of ['webgpu', 'webgl2']) {
           assert.equal(countDiffering(first, { x, y, w: 1, h: 1 }, bg), 0, `background at (${x},${y})`);
         }
 
+        // The side panel's background (drawn by the renderer's flat fill under the panel, not by
+        // egui): one colour, not the sky's, down its left margin, with the panel's widgets over it.
+        const panel = { x: vw + 1, y: 0, w: first.width - vw - 1, h: first.height };
+        const margin = { x: vw + 4, y: 100, w: 2, h: first.height - 120 };
+        const at = 4 * (margin.y * first.width + margin.x);
+        const fill = [...first.data.subarray(at, at + 3)];
+        assert.equal(countDiffering(first, margin, fill, 6), 0, `panel background at x = ${margin.x} (${first.file})`);
+        assert.equal(countDiffering(first, { ...margin, w: 1, h: 1 }, bg, 60), 1, `the panel's ${fill} is not the sky's ${bg}`);
+        const widgets = countDiffering(first, panel, fill, 24);
+        assert.ok(widgets > 3000, `${widgets} pixels of the panel's widgets over its background`);
+
         const t0 = Date.now();
         await drag(page, rect, 160, 0);
         const dragSeconds = (Date.now() - t0) / 1000;
