@@ -137,13 +137,12 @@ pub struct ViewportPaint {
 }
 
 impl RendererPaint for ViewportPaint {
-    fn prepare(
-        &self,
-        renderer: &mut VolumeRenderer,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        frame: &mut wgpu::CommandEncoder,
-    ) {
+    fn prepare(&self, renderer: &mut VolumeRenderer, frame: FrameGpu<'_>) {
+        let FrameGpu {
+            device,
+            queue,
+            commands,
+        } = frame;
         renderer.begin_frame();
         renderer.upload(device, queue, &self.volumes);
         if let Some(fence) = &self.fence {
@@ -171,8 +170,8 @@ impl RendererPaint for ViewportPaint {
                     queue.on_submitted_work_done(move || fence.finished(id));
                 }
             } else {
-                renderer.update_light(device, queue, frame, &job.view);
-                renderer.draw_slices(device, queue, frame, job, None);
+                renderer.update_light(device, queue, commands, &job.view);
+                renderer.draw_slices(device, queue, commands, job, None);
                 if let Some(fence) = &self.fence {
                     fence.recorded_in_frame(self.job_id);
                 }
@@ -197,14 +196,8 @@ pub struct SkyPaint {
 }
 
 impl RendererPaint for SkyPaint {
-    fn prepare(
-        &self,
-        renderer: &mut VolumeRenderer,
-        _device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        _frame: &mut wgpu::CommandEncoder,
-    ) {
-        renderer.prepare_sky(queue, &self.view);
+    fn prepare(&self, renderer: &mut VolumeRenderer, frame: FrameGpu<'_>) {
+        renderer.prepare_sky(frame.queue, &self.view);
     }
 
     fn paint(&self, renderer: &VolumeRenderer, pass: &mut wgpu::RenderPass<'static>) {
@@ -221,15 +214,6 @@ pub struct FillPaint {
 }
 
 impl RendererPaint for FillPaint {
-    fn prepare(
-        &self,
-        _renderer: &mut VolumeRenderer,
-        _device: &wgpu::Device,
-        _queue: &wgpu::Queue,
-        _frame: &mut wgpu::CommandEncoder,
-    ) {
-    }
-
     fn paint(&self, renderer: &VolumeRenderer, pass: &mut wgpu::RenderPass<'static>) {
         // egui's colours are sRGB-encoded (premultiplied) and so is what it writes into the
         // frame's (non-sRGB) target: the bytes go in as they are.
@@ -241,17 +225,21 @@ impl RendererPaint for FillPaint {
 /// A part of the viewport the volume renderer draws: its GPU work before egui's render pass,
 /// then its draw inside that pass. [`paint_callback`] hands one to egui.
 pub trait RendererPaint: Send + Sync + 'static {
-    /// Uploads and records what the draw needs, into the frame's commands (`frame`, submitted
-    /// with egui's render pass after every callback's `prepare`) or a submission of its own.
-    fn prepare(
-        &self,
-        renderer: &mut VolumeRenderer,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        frame: &mut wgpu::CommandEncoder,
-    );
+    /// Uploads and records what the draw needs (nothing, unless implemented).
+    fn prepare(&self, _renderer: &mut VolumeRenderer, _frame: FrameGpu<'_>) {}
     /// Draws into egui's render pass, clipped to the callback's rectangle.
     fn paint(&self, renderer: &VolumeRenderer, pass: &mut wgpu::RenderPass<'static>);
+}
+
+/// What a [`RendererPaint`] prepares with.
+pub struct FrameGpu<'a> {
+    /// The device.
+    pub device: &'a wgpu::Device,
+    /// Its queue (a submission of its own goes ahead of the frame's).
+    pub queue: &'a wgpu::Queue,
+    /// The frame's commands, submitted with egui's render pass after every callback's
+    /// `prepare`.
+    pub commands: &'a mut wgpu::CommandEncoder,
 }
 
 /// An egui paint callback over `rect` that runs `paint` on the renderer kept in egui-wgpu's
@@ -274,7 +262,12 @@ impl<P: RendererPaint> egui_wgpu::CallbackTrait for OnRenderer<P> {
         resources: &mut egui_wgpu::CallbackResources,
     ) -> Vec<wgpu::CommandBuffer> {
         if let Some(renderer) = resources.get_mut::<VolumeRenderer>() {
-            self.0.prepare(renderer, device, queue, encoder);
+            let frame = FrameGpu {
+                device,
+                queue,
+                commands: encoder,
+            };
+            self.0.prepare(renderer, frame);
         }
         Vec::new()
     }
