@@ -4,7 +4,7 @@
 //! in `presets.json`). Every random choice comes from a fixed seed, so a preset is the same
 //! document everywhere.
 
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 use std::collections::BTreeMap;
 
@@ -127,7 +127,7 @@ fn cumulonimbus() -> Vec<Ellipsoid> {
 const STAGING: &str = include_str!("presets.json");
 
 /// A preset's camera, light and media, as [`STAGING`] gives them.
-#[derive(Default, Deserialize)]
+#[derive(Clone, Default, Deserialize)]
 #[serde(default)]
 struct Staging {
     camera: OrbitCamera,
@@ -140,18 +140,25 @@ fn all_staging() -> Result<BTreeMap<String, Staging>, serde_json::Error> {
     serde_json::from_str(STAGING)
 }
 
+/// `name`'s staging, read from [`STAGING`] once per process: `Scene::default` is the cumulus
+/// preset, and every document read fills its missing fields from it.
+fn staging(name: &str) -> Staging {
+    static ALL: OnceLock<BTreeMap<String, Staging>> = OnceLock::new();
+    // The file is checked by a test; a preset it lacks gets the defaults.
+    ALL.get_or_init(|| all_staging().unwrap_or_default())
+        .get(name)
+        .cloned()
+        .unwrap_or_default()
+}
+
 impl Scene {
     /// A new document from a preset.
     pub fn preset(preset: Preset) -> Self {
-        // The file is checked by a test; a preset it lacks gets the defaults.
         let Staging {
             camera,
             light,
             render,
-        } = all_staging()
-            .ok()
-            .and_then(|mut all| all.remove(preset.name()))
-            .unwrap_or_default();
+        } = staging(preset.name());
         let mut simulation = None;
         let mut time = 0.0;
         let ellipsoids = match preset {
