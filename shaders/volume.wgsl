@@ -170,23 +170,25 @@ fn sun_light(s: f32, cos_theta: f32) -> f32 {
     return light;
 }
 
-// One slice's light and opacity at a fragment, premultiplied (discards where it adds nothing).
-fn cloud(in: VsOut) -> vec4<f32> {
-    let uvw = (in.world - u.grid_min.xyz) * u.grid_inv_size.xyz;
+// One slice's light and opacity at world point `world`, premultiplied; zero where it adds
+// nothing (outside the box, no density, below the alpha cut-off). The fragment shaders discard
+// there; the marched slices (volume_march.wgsl) call it along each pixel's ray.
+fn cloud_at(world: vec3<f32>) -> vec4<f32> {
+    let uvw = (world - u.grid_min.xyz) * u.grid_inv_size.xyz;
     if any(uvw < vec3<f32>(0.0)) || any(uvw > vec3<f32>(1.0)) {
-        discard;
+        return vec4<f32>(0.0);
     }
     let sample = textureSampleLevel(volume_tex, clamp_smp, uvw, 0.0);
     let field = sample.r;
     let iso = u.media.y;
     let soft = u.media.z;
     let amount = u.media.w;
-    let v = noisy_field(field, in.world, i32(u.noise.y));
+    let v = noisy_field(field, world, i32(u.noise.y));
     let density = smoothstep(iso - soft, iso + soft, v);
     if density <= 0.0 {
-        discard;
+        return vec4<f32>(0.0);
     }
-    let view_dir = select(u.forward.xyz, normalize(in.world - u.eye.xyz), u.eye.w > 0.5);
+    let view_dir = select(u.forward.xyz, normalize(world - u.eye.xyz), u.eye.w > 0.5);
     let path = u.slicing.z / max(dot(view_dir, u.forward.xyz), 0.2);
     // Sharpness (Table 2): the alpha cut-off is Sharpness × this slice's opacity at full
     // density, and what is above it is stretched back to that opacity: the faint fringe goes,
@@ -198,7 +200,7 @@ fn cloud(in: VsOut) -> vec4<f32> {
         alpha = full * max(alpha - cut, 0.0) / max(full - cut, 1e-6);
     }
     if alpha <= 0.0 {
-        discard;
+        return vec4<f32>(0.0);
     }
     // Transmittance toward the sun from the light volume (the noise included, at the light's
     // own resolution and octaves: light_march.wgsl). Dirtiness scales the optical depth:
@@ -212,24 +214,28 @@ fn cloud(in: VsOut) -> vec4<f32> {
 
 @fragment
 fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
-    return cloud(in);
+    let c = cloud_at(in.world);
+    if c.a <= 0.0 {
+        discard;
+    }
+    return c;
 }
 
 // Sunlight the air scatters toward the eye over one shell's stretch of the pixel's ray
 // (Dobashi et al. 2000): the sun's light through the clouds (the light volume, noise and
 // all) × the air's phase × the share the stretch scatters × what the air in front lets
 // through. Nothing below the ground, which hides it.
-fn shaft(in: VsOut) -> vec3<f32> {
-    let a = in.near.xyz / in.near.w;
-    let b = in.far.xyz / in.far.w;
+// `a` and `b` are the pixel's points on the near and far planes, `pixel` its centre on the
+// target, `shell` the shell's index.
+fn shaft(a: vec3<f32>, b: vec3<f32>, pixel: vec2<f32>, shell: i32) -> vec3<f32> {
     let dir = normalize(b - a);
     // The eye in perspective; the pixel's point of the eye's plane in an orthographic view.
     let origin = a - dir * dot(a - u.eye.xyz, dir);
     // A per-pixel offset within the stretch (interleaved gradient noise) turns the shells'
     // steps into fine grain.
-    let jitter = fract(52.9829189 * fract(dot(in.clip.xy, vec2<f32>(0.06711056, 0.00583715))));
+    let jitter = fract(52.9829189 * fract(dot(pixel, vec2<f32>(0.06711056, 0.00583715))));
     let spacing = u.shafts.y;
-    let r = u.shafts.x - (f32(in.shell) + jitter) * spacing;
+    let r = u.shafts.x - (f32(shell) + jitter) * spacing;
     if r <= 0.0 {
         return vec3<f32>(0.0);
     }
@@ -258,10 +264,15 @@ fn fs_shafts(in: VsOut) -> ShaftsOut {
     var out: ShaftsOut;
     if in.shell >= 0 {
         out.cloud = vec4<f32>(0.0);
-        out.shafts = vec4<f32>(shaft(in), 0.0);
+        let a = in.near.xyz / in.near.w;
+        let b = in.far.xyz / in.far.w;
+        out.shafts = vec4<f32>(shaft(a, b, in.clip.xy, in.shell), 0.0);
         return out;
     }
-    out.cloud = cloud(in);
+    out.cloud = cloud_at(in.world);
+    if out.cloud.a <= 0.0 {
+        discard;
+    }
     out.shafts = vec4<f32>(0.0, 0.0, 0.0, out.cloud.a);
     return out;
 }

@@ -92,6 +92,35 @@ fn render_frame(offscreen: &mut Offscreen) -> Result<BenchResult, String> {
     ))
 }
 
+/// Offscreen frame at 1280×720 with 128 slices marched (compute) against the same rasterised,
+/// by the host's clock; nothing where the adapter cannot march them.
+fn marched_frame(offscreen: &mut Offscreen) -> Result<Vec<BenchResult>, String> {
+    const FRAMES: usize = 5;
+    let mut scene = Scene::default();
+    scene.render.slices = 128;
+    let (w, h) = (1280, 720);
+    let was = offscreen.marching();
+    let time = |o: &mut Offscreen, on: bool| -> Result<Option<f64>, String> {
+        if o.set_marching(on).is_err() {
+            return Ok(None);
+        }
+        wall_frames(o, &scene, (w, h), 1, false)?;
+        Ok(Some(median(wall_frames(o, &scene, (w, h), FRAMES, false)?)))
+    };
+    let (marched, rasterised) = (time(offscreen, true)?, time(offscreen, false)?);
+    offscreen.set_marching(was).map_err(|e| e.to_string())?;
+    Ok(match (marched, rasterised) {
+        (Some(m), Some(r)) => vec![result(
+            "render_frame_marched_1280x720_128_slices",
+            m * 1e3,
+            "ms",
+            "render_frame_rasterised_1280x720_128_slices",
+            r * 1e3,
+        )],
+        _ => Vec::new(),
+    })
+}
+
 /// Offscreen frames at 1280×720 for other qualities and octave counts (Table 2's Quality and
 /// Detail), each against the plain slice shader at the same slice count.
 fn render_frames_by_quality(offscreen: &mut Offscreen) -> Result<Vec<BenchResult>, String> {
@@ -496,10 +525,9 @@ fn device_timed(offscreen: &mut Offscreen) -> Result<Vec<BenchResult>, String> {
         Ok(Vec::new())
     };
     let mut out = Vec::new();
-    let mut frame = |scene: &Scene, (w, h): (u32, u32), plain: bool| {
-        // The first frame compiles and uploads; the median of the rest.
-        offscreen
-            .time_frames(scene, [w, h], frames + 1, plain, Clock::Device)
+    // The first frame compiles and uploads; the median of the rest.
+    let frame = |o: &mut Offscreen, scene: &Scene, (w, h): (u32, u32), plain: bool| {
+        o.time_frames(scene, [w, h], frames + 1, plain, Clock::Device)
             .map(|t| t.map(|mut t| median(t.split_off(1))))
             .map_err(|e| e.to_string())
     };
@@ -513,9 +541,10 @@ fn device_timed(offscreen: &mut Offscreen) -> Result<Vec<BenchResult>, String> {
         let mut scene = Scene::default();
         scene.render.slices = slices;
         scene.render.noise_octaves = octaves;
-        let (Some(ours), Some(plain)) =
-            (frame(&scene, (w, h), false)?, frame(&scene, (w, h), true)?)
-        else {
+        let (Some(ours), Some(plain)) = (
+            frame(offscreen, &scene, (w, h), false)?,
+            frame(offscreen, &scene, (w, h), true)?,
+        ) else {
             return skipped();
         };
         out.push(result(
@@ -529,13 +558,32 @@ fn device_timed(offscreen: &mut Offscreen) -> Result<Vec<BenchResult>, String> {
     let mut bare = Scene::default();
     bare.render.slices = 128;
     bare.render.noise_octaves = 4;
+    // The same frame with the slices marched (compute) and rasterised, where the adapter can
+    // march them (the default frame above is marched on a GPU, rasterised on a CPU adapter).
+    let was = offscreen.marching();
+    let mut by_method = [None, None];
+    for (i, on) in [true, false].into_iter().enumerate() {
+        if offscreen.set_marching(on).is_ok() {
+            by_method[i] = frame(offscreen, &bare, (1920, 1080), false)?;
+        }
+    }
+    offscreen.set_marching(was).map_err(|e| e.to_string())?;
+    if let [Some(marched), Some(rasterised)] = by_method {
+        out.push(result(
+            "gpu_marched_slices_1920x1080_128_slices",
+            marched * 1e3,
+            "ms",
+            "gpu_rasterised_slices_1920x1080_128_slices",
+            rasterised * 1e3,
+        ));
+    }
     let mut shafts = bare.clone();
     shafts.light.ground = true;
     shafts.light.ground_height = -2.0;
     shafts.light.shafts = true;
     if let (Some(with), Some(without)) = (
-        frame(&shafts, (1920, 1080), false)?,
-        frame(&bare, (1920, 1080), false)?,
+        frame(offscreen, &shafts, (1920, 1080), false)?,
+        frame(offscreen, &bare, (1920, 1080), false)?,
     ) {
         out.push(result(
             "gpu_ground_and_shafts_frame_1920x1080",
@@ -661,6 +709,7 @@ pub fn run(json: bool, only: Option<&str>) -> Result<(), String> {
     }
     if wanted("render") {
         results.push(render_frame(&mut offscreen)?);
+        results.extend(marched_frame(&mut offscreen)?);
     }
     if wanted("quality") {
         results.extend(render_frames_by_quality(&mut offscreen)?);

@@ -3,9 +3,12 @@
 
 use super::field_gpu::{FieldEvaluator, FieldGpuError};
 use super::gpu_types::{FULL_VIEW, View};
+use super::passes::MAX_SLICE_DRAWS_PER_FRAME;
 use super::progressive::JobPlan;
 use super::renderer::{SliceJob, VolumeRenderer};
-use super::resources::{accumulation_format, copy_for_readback, read_rows, unpremultiply};
+use super::resources::{
+    accumulation_format, can_march, copy_for_readback, marches_by_default, read_rows, unpremultiply,
+};
 use crate::derive::Derived;
 use crate::field::{DensityVolume, Field};
 use crate::scene::{Document, Scene};
@@ -31,6 +34,9 @@ pub enum OffscreenError {
     /// Reading the image back failed.
     #[error("reading the image back failed: {0}")]
     Readback(String),
+    /// Marching the slices was asked of an adapter without compute shaders.
+    #[error("this adapter cannot march the slices (it has no compute shaders or storage images)")]
+    NoMarching,
 }
 
 /// An RGBA8 image, rows top to bottom.
@@ -97,6 +103,8 @@ pub struct Offscreen {
     field_evaluator: Option<FieldEvaluator>,
     /// Timestamp queries around recorded work, where the adapter has them.
     stamps: Option<Stamps>,
+    /// Whether the adapter can march the slices.
+    can_march: bool,
 }
 
 /// Which clock times the bench's GPU work.
@@ -197,12 +205,13 @@ impl Offscreen {
             .await
             .map_err(|e| OffscreenError::Device(e.to_string()))?;
         let stamps = (features == Stamps::FEATURES).then(|| Stamps::new(&device, &queue));
-        let renderer = VolumeRenderer::new(
+        let mut renderer = VolumeRenderer::new(
             &device,
             &queue,
             OUTPUT_FORMAT,
             accumulation_format(&adapter),
         );
+        renderer.set_marching(&device, marches_by_default(&adapter));
         Ok(Self {
             device,
             queue,
@@ -211,7 +220,23 @@ impl Offscreen {
             derived: Derived::default(),
             field_evaluator: None,
             stamps,
+            can_march: can_march(&adapter),
         })
+    }
+
+    /// Marches the slices in a compute pass (the default on GPUs that can) or rasterises them
+    /// (the default elsewhere); an error where the adapter cannot march them.
+    pub fn set_marching(&mut self, on: bool) -> Result<(), OffscreenError> {
+        if on && !self.can_march {
+            return Err(OffscreenError::NoMarching);
+        }
+        self.renderer.set_marching(&self.device, on);
+        Ok(())
+    }
+
+    /// Whether the slices are marched (see [`Offscreen::set_marching`]).
+    pub fn marching(&self) -> bool {
+        self.renderer.marching()
     }
 
     /// Name and backend of the adapter, e.g. "llvmpipe (LLVM 15.0.6, 256 bits) (Vulkan)".
@@ -242,6 +267,41 @@ impl Offscreen {
                 Ok(image)
             }
         }
+    }
+
+    /// Renders `scene` as [`Offscreen::render`] does over its sky, but its slices drawn in
+    /// `chunks` draws of consecutive slices, far to near, as the app's refinement spreads an
+    /// image over frames: the same image as one draw. At most
+    /// [`MAX_SLICE_DRAWS_PER_FRAME`] chunks (one submission's uniform slots).
+    pub fn render_in_chunks(
+        &mut self,
+        scene: &Scene,
+        width: u32,
+        height: u32,
+        chunks: u32,
+    ) -> Result<Image, OffscreenError> {
+        check_size(width, height)?;
+        let mut job = self.full_job(scene, width, height);
+        let total = job.plan.total;
+        let chunks = chunks.clamp(1, total.clamp(1, MAX_SLICE_DRAWS_PER_FRAME));
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("offscreen in chunks"),
+            });
+        self.renderer
+            .update_light(&self.device, &self.queue, &mut encoder, &job.view);
+        let bound = |k: u32| total * k / chunks;
+        for k in 0..chunks - 1 {
+            job.plan.range = bound(k)..bound(k + 1);
+            job.plan.clear = k == 0;
+            self.renderer
+                .draw_slices(&self.device, &self.queue, &mut encoder, &job, None);
+        }
+        job.plan.range = bound(chunks - 1)..total;
+        job.plan.clear = chunks == 1;
+        self.queue.submit([encoder.finish()]);
+        self.draw(&job, Some(scene.light.background))
     }
 
     /// Times `frames` full-quality frames of `scene` (slices and composite, no readback), each

@@ -567,3 +567,113 @@ impl LightPass {
         (0..n as u64).map(|i| (i * self.stride) as u32).collect()
     }
 }
+
+/// The format of the marched slices' images (a storage format on every adapter with compute).
+pub const MARCH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+
+/// The marched slices (`shaders/volume_march.wgsl`, for adapters with compute shaders): a
+/// compute pass writes each draw's slices composited per pixel into two images (the cloud, the
+/// shafts' light), and a full-screen pass (`march_blend.wgsl`) lays them over the accumulation
+/// targets with the slices' "over" blending. Same uniforms and textures as the slice pass.
+pub struct MarchPass {
+    /// The compute pipeline.
+    pub pipeline: wgpu::ComputePipeline,
+    /// Group 0: the slice group's bindings, visible to compute.
+    pub layout: wgpu::BindGroupLayout,
+    /// Group 1: the two images it writes.
+    pub output_layout: wgpu::BindGroupLayout,
+    /// The images over the cloud's target.
+    pub blend: wgpu::RenderPipeline,
+    /// The images over both targets, with shafts of light.
+    pub blend_shafts: wgpu::RenderPipeline,
+    /// Layout of the blend's group: the two images.
+    pub blend_layout: wgpu::BindGroupLayout,
+}
+
+impl MarchPass {
+    /// Creates the pass blending into accumulation targets of `format`.
+    pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat) -> Self {
+        let compute = |mut e: wgpu::BindGroupLayoutEntry| {
+            e.visibility = wgpu::ShaderStages::COMPUTE;
+            e
+        };
+        let size = std::mem::size_of::<VolumeUniforms>() as u64;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("marched slices: volume"),
+            entries: &[
+                uniform_entry(0, wgpu::ShaderStages::COMPUTE, size, true),
+                compute(texture_3d(1)),
+                compute(sampler_entry(2)),
+                compute(texture_3d(3)),
+                compute(sampler_entry(4)),
+                compute(texture_3d(5)),
+            ],
+        });
+        let image = |binding| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::StorageTexture {
+                access: wgpu::StorageTextureAccess::WriteOnly,
+                format: MARCH_FORMAT,
+                view_dimension: wgpu::TextureViewDimension::D2,
+            },
+            count: None,
+        };
+        let output_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("marched slices: images"),
+            entries: &[image(0), image(1)],
+        });
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("marched slices"),
+            source: wgpu::ShaderSource::Wgsl(shaders::VOLUME_MARCH.into()),
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("marched slices"),
+            bind_group_layouts: &[Some(&layout), Some(&output_layout)],
+            immediate_size: 0,
+        });
+        let compute_pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("marched slices"),
+            layout: Some(&pipeline_layout),
+            module: &module,
+            entry_point: Some("cs_main"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        let loaded = |binding| {
+            let mut e = texture_entry(binding, wgpu::TextureViewDimension::D2);
+            e.ty = wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                view_dimension: wgpu::TextureViewDimension::D2,
+                multisampled: false,
+            };
+            e
+        };
+        let blend_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("marched slices: blend"),
+            entries: &[loaded(0), loaded(1)],
+        });
+        Self {
+            pipeline: compute_pipeline,
+            layout,
+            output_layout,
+            blend: pipeline(
+                device,
+                "marched slices: blend",
+                shaders::MARCH_BLEND,
+                &blend_layout,
+                format,
+            ),
+            blend_shafts: targets_pipeline(
+                device,
+                "marched slices: blend with shafts of light",
+                shaders::MARCH_BLEND,
+                &[&blend_layout],
+                "fs_shafts",
+                &[format, format],
+                Some(PREMULTIPLIED_OVER),
+            ),
+            blend_layout,
+        }
+    }
+}

@@ -3,10 +3,13 @@
 
 use super::gpu_types::{LightSliceUniforms, Shells, SkyUniforms, View, VolumeUniforms};
 use super::passes::{
-    CompositePass, FillPass, LIGHT_FORMAT, LightPass, MAX_LIGHT_SLICES, SkyPass, SlicePass,
+    CompositePass, FillPass, LIGHT_FORMAT, LightPass, MAX_LIGHT_SLICES, MarchPass, SkyPass,
+    SlicePass,
 };
 use super::progressive::JobPlan;
-use super::resources::{TARGETS, Target, VolumeTextures, accumulation_texture, sampler, upload_3d};
+use super::resources::{
+    MarchImages, TARGETS, Target, VolumeTextures, accumulation_texture, sampler, upload_3d,
+};
 use crate::derive::Volumes;
 
 /// One volume draw: the planner's job (which slices, into which target) and what it shows.
@@ -38,6 +41,9 @@ pub struct VolumeRenderer {
     light_placeholder: wgpu::TextureView,
     /// Group 0 of the light pass (the slice group without the light texture).
     light_bind_group: Option<wgpu::BindGroup>,
+    /// The marched slices' pass and its group 0, while the renderer marches the slices
+    /// instead of rasterising them (see [`VolumeRenderer::set_marching`]).
+    march: Option<(MarchPass, Option<wgpu::BindGroup>)>,
 }
 
 /// The light volume on the GPU. Each z-slice is rendered into `slice` (2D) and copied into
@@ -99,7 +105,27 @@ impl VolumeRenderer {
             light: None,
             light_placeholder: placeholder,
             light_bind_group: None,
+            march: None,
         }
+    }
+
+    /// Marches the slices in a compute pass (`shaders/volume_march.wgsl`) instead of
+    /// rasterising them, or goes back to rasterising: the same image either way. Only for
+    /// adapters that [`super::resources::can_march`].
+    pub fn set_marching(&mut self, device: &wgpu::Device, on: bool) {
+        if on == self.march.is_some() {
+            return;
+        }
+        self.march = on.then(|| (MarchPass::new(device, self.accum_format), None));
+        for target in self.targets.iter_mut().flatten() {
+            target.marched = None;
+        }
+        self.rebuild_bind_groups(device);
+    }
+
+    /// Whether the slices are marched (see [`VolumeRenderer::set_marching`]).
+    pub fn marching(&self) -> bool {
+        self.march.is_some()
     }
 
     /// The accumulation format in use.
@@ -172,6 +198,13 @@ impl VolumeRenderer {
             layout: &self.light_pass.volume_layout,
             entries: &entries[..5],
         }));
+        if let Some((pass, group)) = &mut self.march {
+            *group = Some(device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("marched slices: volume"),
+                layout: &pass.layout,
+                entries: &entries,
+            }));
+        }
     }
 
     /// Makes the next [`VolumeRenderer::update_light`] recompute the light volume (benchmarks).
@@ -343,7 +376,13 @@ impl VolumeRenderer {
                 composite,
                 shafts: None,
                 has_shafts: false,
+                marched: None,
             });
+        }
+        if let (Some(target), Some((pass, _))) = (&mut self.targets[index], &self.march)
+            && target.marched.is_none()
+        {
+            target.marched = Some(MarchImages::new(device, pass, size));
         }
         if let Some(target) = &mut self.targets[index]
             && shafts
@@ -414,6 +453,26 @@ impl VolumeRenderer {
             (Some((shafts, _)), true) => vec![attachment(&target.view), attachment(shafts)],
             _ => vec![attachment(&target.view)],
         };
+        let count = plan.range.end.saturating_sub(plan.range.start);
+        let empty = volume.is_empty() || count == 0;
+        // Marched (not the bench's baseline): a compute pass writes the draw's images, then
+        // the render pass lays them over the targets.
+        let marched = match (pipeline, &self.march, &target.marched) {
+            (None, Some((march, Some(group))), Some(images)) => Some((march, group, images)),
+            _ => None,
+        };
+        if let Some((march, group, images)) = marched
+            && !empty
+        {
+            let mut compute = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("marched slices"),
+                timestamp_writes: None,
+            });
+            compute.set_pipeline(&march.pipeline);
+            compute.set_bind_group(0, group, &[offset]);
+            compute.set_bind_group(1, &images.output, &[]);
+            compute.dispatch_workgroups(plan.size[0].div_ceil(8), plan.size[1].div_ceil(8), 1);
+        }
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("volume slices"),
             color_attachments: &attachments,
@@ -422,8 +481,18 @@ impl VolumeRenderer {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        let count = plan.range.end.saturating_sub(plan.range.start);
-        if volume.is_empty() || count == 0 {
+        if empty {
+            return;
+        }
+        if let Some((march, _, images)) = marched {
+            let blend = if with_shafts {
+                &march.blend_shafts
+            } else {
+                &march.blend
+            };
+            pass.set_pipeline(blend);
+            pass.set_bind_group(0, &images.blend, &[]);
+            pass.draw(0..3, 0..1);
             return;
         }
         let (pipeline, shells) = match pipeline {

@@ -147,6 +147,63 @@ pub struct Target {
     pub shafts: Option<(wgpu::TextureView, wgpu::BindGroup)>,
     /// Whether the image in it was drawn with shafts of light.
     pub has_shafts: bool,
+    /// The marched slices' images of its size, when the renderer marches.
+    pub marched: Option<MarchImages>,
+}
+
+/// The two images a draw of marched slices writes (the cloud, the shafts' light) and the bind
+/// groups that write and read them.
+pub struct MarchImages {
+    /// The compute pass's group 1: both images as storage.
+    pub output: wgpu::BindGroup,
+    /// The blend's group: both images as textures.
+    pub blend: wgpu::BindGroup,
+}
+
+impl MarchImages {
+    /// Two images of `size` for `pass`.
+    pub fn new(device: &wgpu::Device, pass: &super::passes::MarchPass, size: [u32; 2]) -> Self {
+        let image = || {
+            device
+                .create_texture(&wgpu::TextureDescriptor {
+                    label: Some("marched slices"),
+                    size: wgpu::Extent3d {
+                        width: size[0],
+                        height: size[1],
+                        depth_or_array_layers: 1,
+                    },
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: wgpu::TextureDimension::D2,
+                    format: super::passes::MARCH_FORMAT,
+                    usage: wgpu::TextureUsages::STORAGE_BINDING
+                        | wgpu::TextureUsages::TEXTURE_BINDING,
+                    view_formats: &[],
+                })
+                .create_view(&wgpu::TextureViewDescriptor::default())
+        };
+        let (cloud, shafts) = (image(), image());
+        let group = |label, layout| {
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some(label),
+                layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: wgpu::BindingResource::TextureView(&cloud),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: wgpu::BindingResource::TextureView(&shafts),
+                    },
+                ],
+            })
+        };
+        Self {
+            output: group("marched slices: images", &pass.output_layout),
+            blend: group("marched slices: blend", &pass.blend_layout),
+        }
+    }
 }
 
 /// Creates an accumulation target of `size` in `format`.
@@ -189,6 +246,32 @@ pub fn accumulation_format(adapter: &wgpu::Adapter) -> wgpu::TextureFormat {
     } else {
         wgpu::TextureFormat::Rgba8Unorm
     }
+}
+
+/// Whether the adapter can march the slices (`shaders/volume_march.wgsl`): compute shaders
+/// and storage images of the marched slices' format.
+pub fn can_march(adapter: &wgpu::Adapter) -> bool {
+    let compute = adapter
+        .get_downlevel_capabilities()
+        .flags
+        .contains(wgpu::DownlevelFlags::COMPUTE_SHADERS);
+    let storage = adapter
+        .get_texture_format_features(super::passes::MARCH_FORMAT)
+        .allowed_usages
+        .contains(wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING);
+    compute && storage && adapter.limits().max_storage_textures_per_shader_stage >= 2
+}
+
+/// Whether the renderer marches the slices on `adapter` unless told otherwise: on GPUs that
+/// can. CPU adapters (lavapipe, SwiftShader) and adapters that do not say what they are (a
+/// browser's WebGPU) rasterise them: the page's frame budget was measured that way.
+pub fn marches_by_default(adapter: &wgpu::Adapter) -> bool {
+    use wgpu::DeviceType::{DiscreteGpu, IntegratedGpu, VirtualGpu};
+    let gpu = matches!(
+        adapter.get_info().device_type,
+        DiscreteGpu | IntegratedGpu | VirtualGpu
+    );
+    gpu && can_march(adapter)
 }
 
 /// Records a copy of a 2D RGBA8-sized `texture` of `size` into a new mappable buffer; returns

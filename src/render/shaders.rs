@@ -14,6 +14,22 @@ pub const VOLUME: &str = concat!(
     include_str!("../../shaders/volume.wgsl")
 );
 
+/// The marched slices (compute): `volume_common.wgsl` + `volume_noise.wgsl` +
+/// `sun_shadow.wgsl` + `volume.wgsl` + `volume_march.wgsl`.
+pub const VOLUME_MARCH: &str = concat!(
+    include_str!("../../shaders/volume_common.wgsl"),
+    include_str!("../../shaders/volume_noise.wgsl"),
+    include_str!("../../shaders/sun_shadow.wgsl"),
+    include_str!("../../shaders/volume.wgsl"),
+    include_str!("../../shaders/volume_march.wgsl")
+);
+
+/// `fullscreen.wgsl` + `march_blend.wgsl`: marched slices over the accumulation targets.
+pub const MARCH_BLEND: &str = concat!(
+    include_str!("../../shaders/fullscreen.wgsl"),
+    include_str!("../../shaders/march_blend.wgsl")
+);
+
 /// The light volume pass: `volume_common.wgsl` + `volume_noise.wgsl` + `fullscreen.wgsl` +
 /// `light_march.wgsl`.
 pub const LIGHT_MARCH: &str = concat!(
@@ -56,7 +72,7 @@ pub const FILL: &str = concat!(
 );
 
 /// Every shader module with the files it is composed of, in order.
-pub const MODULES: [(&str, &[&str], &str); 7] = [
+pub const MODULES: [(&str, &[&str], &str); 9] = [
     (
         "volume",
         &[
@@ -66,6 +82,22 @@ pub const MODULES: [(&str, &[&str], &str); 7] = [
             "volume.wgsl",
         ],
         VOLUME,
+    ),
+    (
+        "volume_march",
+        &[
+            "volume_common.wgsl",
+            "volume_noise.wgsl",
+            "sun_shadow.wgsl",
+            "volume.wgsl",
+            "volume_march.wgsl",
+        ],
+        VOLUME_MARCH,
+    ),
+    (
+        "march_blend",
+        &["fullscreen.wgsl", "march_blend.wgsl"],
+        MARCH_BLEND,
     ),
     (
         "light_march",

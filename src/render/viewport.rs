@@ -9,7 +9,7 @@ use std::sync::{Arc, Mutex};
 
 use super::progressive::GpuReport;
 use super::renderer::{SliceJob, VolumeRenderer};
-use super::resources::accumulation_format;
+use super::resources::{accumulation_format, marches_by_default};
 use crate::derive::Volumes;
 
 /// The GPU's reports of the viewport's volume jobs (see
@@ -339,12 +339,14 @@ pub fn choose_web_backends(config: &mut egui_wgpu::WgpuConfiguration, webgl_buil
 /// is what the GL backend is called on this platform (`webgl2` in the browser).
 pub fn install(render_state: &egui_wgpu::RenderState, gl_name: &'static str) -> BackendInfo {
     let format = accumulation_format(&render_state.adapter);
-    let renderer = VolumeRenderer::new(
+    let mut renderer = VolumeRenderer::new(
         &render_state.device,
         &render_state.queue,
         render_state.target_format,
         format,
     );
+    let marching = marches_by_default(&render_state.adapter);
+    renderer.set_marching(&render_state.device, marching);
     render_state
         .renderer
         .write()
@@ -364,6 +366,9 @@ pub fn install(render_state: &egui_wgpu::RenderState, gl_name: &'static str) -> 
     } else {
         info.name.clone()
     };
-    log::info!("graphics: {backend} on {adapter} (volume accumulates in {format:?})");
+    let slices = if marching { "marched" } else { "rasterised" };
+    log::info!(
+        "graphics: {backend} on {adapter} (volume accumulates in {format:?}; slices {slices})"
+    );
     BackendInfo { backend, adapter }
 }
