@@ -709,6 +709,8 @@ pub fn run(json: bool, only: Option<&str>) -> Result<(), String> {
     }
     if wanted("render") {
         results.push(render_frame(&mut offscreen)?);
+    }
+    if wanted("march") {
         results.extend(marched_frame(&mut offscreen)?);
     }
     if wanted("quality") {

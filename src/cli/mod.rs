@@ -153,8 +153,9 @@ enum Command {
         /// Print one JSON object instead of a table.
         #[arg(long)]
         json: bool,
-        /// Run only these groups, comma-separated: sketch, light, stroke, worst, field, link, mesh, simulate,
-        /// shafts (the ground's shadow and the shafts of light), ca (simulate and shafts), render, quality.
+        /// Run only these groups, comma-separated: sketch, light, stroke, worst, field, link,
+        /// mesh, simulate, shafts (the ground's shadow and the shafts of light), ca (simulate
+        /// and shafts), render, march (the slices marched against rasterised), quality, gpu.
         #[arg(long)]
         only: Option<String>,
     },
