@@ -1229,7 +1229,8 @@ fn marched_and_rasterised(scene: &Scene, chunks: u32) -> [Image; 2] {
     let was = o.marching();
     let images = [true, false].map(|on| {
         o.set_marching(on).expect("lavapipe marches the slices");
-        o.render_in_chunks(scene, W, H, chunks).expect("render")
+        o.render_in_chunks(scene, [W, H], Backdrop::Sky, chunks)
+            .expect("render")
     });
     o.set_marching(was).unwrap();
     images

@@ -257,8 +257,44 @@ impl Offscreen {
         height: u32,
         backdrop: Backdrop,
     ) -> Result<Image, OffscreenError> {
+        self.render_in_chunks(scene, [width, height], backdrop, 1)
+    }
+
+    /// Renders `scene` as [`Offscreen::render`] does, its slices drawn in `chunks` draws of
+    /// consecutive slices, far to near, as the app's refinement spreads an image over frames:
+    /// the same image as one draw. At most [`MAX_SLICE_DRAWS_PER_FRAME`] chunks (one
+    /// submission's uniform slots).
+    pub fn render_in_chunks(
+        &mut self,
+        scene: &Scene,
+        [width, height]: [u32; 2],
+        backdrop: Backdrop,
+        chunks: u32,
+    ) -> Result<Image, OffscreenError> {
         check_size(width, height)?;
-        let job = self.full_job(scene, width, height);
+        let mut job = self.full_job(scene, width, height);
+        let total = job.plan.total;
+        let chunks = chunks.clamp(1, total.clamp(1, MAX_SLICE_DRAWS_PER_FRAME));
+        if chunks > 1 {
+            let mut encoder = self
+                .device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                    label: Some("offscreen chunks"),
+                });
+            self.renderer
+                .update_light(&self.device, &self.queue, &mut encoder, &job.view);
+            let bound = |k: u32| total * k / chunks;
+            for k in 0..chunks - 1 {
+                job.plan.range = bound(k)..bound(k + 1);
+                job.plan.clear = k == 0;
+                self.renderer
+                    .draw_slices(&self.device, &self.queue, &mut encoder, &job, None);
+            }
+            // The last chunk with the composite.
+            job.plan.range = bound(chunks - 1)..total;
+            job.plan.clear = false;
+            self.queue.submit([encoder.finish()]);
+        }
         match backdrop {
             Backdrop::Sky => self.draw(&job, Some(scene.light.background)),
             Backdrop::Transparent => {
@@ -267,41 +303,6 @@ impl Offscreen {
                 Ok(image)
             }
         }
-    }
-
-    /// Renders `scene` as [`Offscreen::render`] does over its sky, but its slices drawn in
-    /// `chunks` draws of consecutive slices, far to near, as the app's refinement spreads an
-    /// image over frames: the same image as one draw. At most
-    /// [`MAX_SLICE_DRAWS_PER_FRAME`] chunks (one submission's uniform slots).
-    pub fn render_in_chunks(
-        &mut self,
-        scene: &Scene,
-        width: u32,
-        height: u32,
-        chunks: u32,
-    ) -> Result<Image, OffscreenError> {
-        check_size(width, height)?;
-        let mut job = self.full_job(scene, width, height);
-        let total = job.plan.total;
-        let chunks = chunks.clamp(1, total.clamp(1, MAX_SLICE_DRAWS_PER_FRAME));
-        let mut encoder = self
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("offscreen in chunks"),
-            });
-        self.renderer
-            .update_light(&self.device, &self.queue, &mut encoder, &job.view);
-        let bound = |k: u32| total * k / chunks;
-        for k in 0..chunks - 1 {
-            job.plan.range = bound(k)..bound(k + 1);
-            job.plan.clear = k == 0;
-            self.renderer
-                .draw_slices(&self.device, &self.queue, &mut encoder, &job, None);
-        }
-        job.plan.range = bound(chunks - 1)..total;
-        job.plan.clear = chunks == 1;
-        self.queue.submit([encoder.finish()]);
-        self.draw(&job, Some(scene.light.background))
     }
 
     /// Times `frames` full-quality frames of `scene` (slices and composite, no readback), each

@@ -164,23 +164,13 @@ impl MarchImages {
     /// Two images of `size` for `pass`.
     pub fn new(device: &wgpu::Device, pass: &super::passes::MarchPass, size: [u32; 2]) -> Self {
         let image = || {
-            device
-                .create_texture(&wgpu::TextureDescriptor {
-                    label: Some("marched slices"),
-                    size: wgpu::Extent3d {
-                        width: size[0],
-                        height: size[1],
-                        depth_or_array_layers: 1,
-                    },
-                    mip_level_count: 1,
-                    sample_count: 1,
-                    dimension: wgpu::TextureDimension::D2,
-                    format: super::passes::MARCH_FORMAT,
-                    usage: wgpu::TextureUsages::STORAGE_BINDING
-                        | wgpu::TextureUsages::TEXTURE_BINDING,
-                    view_formats: &[],
-                })
-                .create_view(&wgpu::TextureViewDescriptor::default())
+            image_2d(
+                device,
+                "marched slices",
+                size,
+                super::passes::MARCH_FORMAT,
+                wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING,
+            )
         };
         let (cloud, shafts) = (image(), image());
         let group = |label, layout| {
@@ -212,9 +202,21 @@ pub fn accumulation_texture(
     size: [u32; 2],
     format: wgpu::TextureFormat,
 ) -> wgpu::TextureView {
+    let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
+    image_2d(device, "volume accumulation", size, format, usage)
+}
+
+/// Creates a 2D texture of `size` in `format` for `usage` and returns its view.
+fn image_2d(
+    device: &wgpu::Device,
+    label: &str,
+    size: [u32; 2],
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+) -> wgpu::TextureView {
     device
         .create_texture(&wgpu::TextureDescriptor {
-            label: Some("volume accumulation"),
+            label: Some(label),
             size: wgpu::Extent3d {
                 width: size[0],
                 height: size[1],
@@ -224,7 +226,7 @@ pub fn accumulation_texture(
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
             format,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            usage,
             view_formats: &[],
         })
         .create_view(&wgpu::TextureViewDescriptor::default())
