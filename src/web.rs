@@ -47,6 +47,11 @@ pub fn start() {
         notice: start.notice,
         file: start.file,
         autosave: true,
+        marching: match url_param("slices").as_deref() {
+            Some("march") => Some(true),
+            Some("raster") => Some(false),
+            _ => None,
+        },
     };
     wasm_bindgen_futures::spawn_local(async move {
         if let Err(message) = run(options).await {

@@ -9,7 +9,7 @@ use std::sync::{Arc, Mutex};
 
 use super::progressive::GpuReport;
 use super::renderer::{SliceJob, VolumeRenderer};
-use super::resources::{accumulation_format, marches_by_default};
+use super::resources::{accumulation_format, can_march, marches_by_default};
 use crate::derive::Volumes;
 
 /// The GPU's reports of the viewport's volume jobs (see
@@ -291,6 +291,8 @@ pub struct BackendInfo {
     pub backend: &'static str,
     /// Adapter name as the driver reports it.
     pub adapter: String,
+    /// How the slices are drawn: `marched` (a compute pass) or `rasterised`.
+    pub slices: &'static str,
 }
 
 /// Makes the queue's reports of finished work arrive without new work: wgpu's GL backend
@@ -336,8 +338,14 @@ pub fn choose_web_backends(config: &mut egui_wgpu::WgpuConfiguration, webgl_buil
 }
 
 /// Creates the renderer in egui-wgpu's callback resources; returns what is in use. `gl_name`
-/// is what the GL backend is called on this platform (`webgl2` in the browser).
-pub fn install(render_state: &egui_wgpu::RenderState, gl_name: &'static str) -> BackendInfo {
+/// is what the GL backend is called on this platform (`webgl2` in the browser); `marching`
+/// asks for marched (`Some(true)`) or rasterised slices instead of the adapter's default
+/// ([`marches_by_default`]); an adapter that cannot march them rasterises them.
+pub fn install(
+    render_state: &egui_wgpu::RenderState,
+    gl_name: &'static str,
+    marching: Option<bool>,
+) -> BackendInfo {
     let format = accumulation_format(&render_state.adapter);
     let mut renderer = VolumeRenderer::new(
         &render_state.device,
@@ -345,7 +353,8 @@ pub fn install(render_state: &egui_wgpu::RenderState, gl_name: &'static str) -> 
         render_state.target_format,
         format,
     );
-    let marching = marches_by_default(&render_state.adapter);
+    let marching = marching.unwrap_or_else(|| marches_by_default(&render_state.adapter))
+        && can_march(&render_state.adapter);
     renderer.set_marching(&render_state.device, marching);
     render_state
         .renderer
@@ -370,5 +379,9 @@ pub fn install(render_state: &egui_wgpu::RenderState, gl_name: &'static str) -> 
     log::info!(
         "graphics: {backend} on {adapter} (volume accumulates in {format:?}; slices {slices})"
     );
-    BackendInfo { backend, adapter }
+    BackendInfo {
+        backend,
+        adapter,
+        slices,
+    }
 }

@@ -57,6 +57,9 @@ pub struct StartOptions {
     pub file: Option<String>,
     /// Write the document to the platform's store as it changes (the app; not tests).
     pub autosave: bool,
+    /// Marched (`Some(true)`) or rasterised slices instead of the adapter's default (the
+    /// page's `?slices=march|raster`).
+    pub marching: Option<bool>,
 }
 
 impl Default for StartOptions {
@@ -68,6 +71,7 @@ impl Default for StartOptions {
             notice: None,
             file: None,
             autosave: false,
+            marching: None,
         }
     }
 }
@@ -115,7 +119,7 @@ impl CloudApp {
         let backend = cc
             .wgpu_render_state
             .as_ref()
-            .map(|rs| install(rs, super::platform::GL_BACKEND_NAME));
+            .map(|rs| install(rs, super::platform::GL_BACKEND_NAME, options.marching));
         let reports = cc.wgpu_render_state.as_ref().map(ReportPoll::new);
         if backend.is_none() {
             log::error!("no wgpu render state: the volume cannot be drawn");
@@ -376,6 +380,7 @@ impl CloudApp {
         let backend = stats.backend.clone().unwrap_or(BackendInfo {
             backend: "none",
             adapter: String::new(),
+            slices: "none",
         });
         let quality = stats.shown.map(|q| q.to_string()).unwrap_or_default();
         // The document is serialised again only when a revision changed.
@@ -405,6 +410,7 @@ impl CloudApp {
             })),
             "backend": backend.backend,
             "adapter": backend.adapter,
+            "slices": backend.slices,
             "undo": self.doc.undo_len(),
             "redo": self.doc.redo_len(),
             "tool": self.tool.tool.name(),

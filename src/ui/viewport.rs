@@ -313,7 +313,8 @@ impl Viewport {
         if scene.ellipsoids.is_empty() && scene.planes.is_empty() {
             text.push_str("Empty scene: open Scene › New cumulus, or sketch a cloud.");
         }
-        // Status line: backend, adapter and the volume's current quality.
+        // Status line: backend, adapter, how the slices are drawn and the volume's current
+        // quality.
         if let Some(b) = &self.stats.backend {
             let adapter: String = if b.adapter.chars().count() > 40 {
                 b.adapter
@@ -324,7 +325,7 @@ impl Viewport {
             } else {
                 b.adapter.clone()
             };
-            let mut status = format!("{} · {adapter}", b.backend);
+            let mut status = format!("{} · {adapter} · {}", b.backend, b.slices);
             if let Some(q) = self.stats.shown {
                 status.push_str(&format!(" · {q}"));
             }

@@ -91,7 +91,10 @@ impl ViewPanel {
                     .on_hover_text("5: parallel projection, as for drawing outlines");
                 doc.set_camera(camera);
                 match &stats.backend {
-                    Some(b) => ui.label(format!("backend: {}\nadapter: {}", b.backend, b.adapter)),
+                    Some(b) => ui.label(format!(
+                        "backend: {}\nadapter: {}\nslices: {}",
+                        b.backend, b.adapter, b.slices
+                    )),
                     None => ui.colored_label(egui::Color32::LIGHT_RED, "no GPU renderer"),
                 };
                 if let Some(q) = stats.shown {
