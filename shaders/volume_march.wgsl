@@ -34,6 +34,7 @@ fn box_stretch(a: vec3<f32>, dir: vec3<f32>) -> vec2<f32> {
     return vec2<f32>(max(max(near.x, near.y), near.z), min(min(far.x, far.y), far.z));
 }
 
+// 8 × 8 pixels a workgroup (MARCH_WORKGROUP in src/render/passes.rs).
 @compute @workgroup_size(8, 8)
 fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
     let size = textureDimensions(cloud_out);

@@ -571,6 +571,10 @@ impl LightPass {
 /// The format of the marched slices' images (a storage format on every adapter with compute).
 pub const MARCH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
+/// Pixels along each side of a marched slices' workgroup (`@workgroup_size` in
+/// `volume_march.wgsl`).
+pub const MARCH_WORKGROUP: u32 = 8;
+
 /// The marched slices (`shaders/volume_march.wgsl`, for adapters with compute shaders): a
 /// compute pass writes each draw's slices composited per pixel into two images (the cloud, the
 /// shafts' light), and a full-screen pass (`march_blend.wgsl`) lays them over the accumulation

@@ -3,8 +3,8 @@
 
 use super::gpu_types::{LightSliceUniforms, Shells, SkyUniforms, View, VolumeUniforms};
 use super::passes::{
-    CompositePass, FillPass, LIGHT_FORMAT, LightPass, MAX_LIGHT_SLICES, MarchPass, SkyPass,
-    SlicePass,
+    CompositePass, FillPass, LIGHT_FORMAT, LightPass, MARCH_WORKGROUP, MAX_LIGHT_SLICES, MarchPass,
+    SkyPass, SlicePass,
 };
 use super::progressive::JobPlan;
 use super::resources::{
@@ -471,7 +471,8 @@ impl VolumeRenderer {
             compute.set_pipeline(&march.pipeline);
             compute.set_bind_group(0, group, &[offset]);
             compute.set_bind_group(1, &images.output, &[]);
-            compute.dispatch_workgroups(plan.size[0].div_ceil(8), plan.size[1].div_ceil(8), 1);
+            let [x, y] = plan.size.map(|side| side.div_ceil(MARCH_WORKGROUP));
+            compute.dispatch_workgroups(x, y, 1);
         }
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("volume slices"),
