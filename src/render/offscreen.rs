@@ -211,7 +211,8 @@ impl Offscreen {
             OUTPUT_FORMAT,
             accumulation_format(&adapter),
         );
-        renderer.set_marching(&device, marches_by_default(&adapter));
+        renderer.set_marching(&device, marches_by_default(&adapter, &device));
+        let can_march = can_march(&adapter, &device);
         Ok(Self {
             device,
             queue,
@@ -220,7 +221,7 @@ impl Offscreen {
             derived: Derived::default(),
             field_evaluator: None,
             stamps,
-            can_march: can_march(&adapter),
+            can_march,
         })
     }
 

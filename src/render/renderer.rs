@@ -111,7 +111,7 @@ impl VolumeRenderer {
 
     /// Marches the slices in a compute pass (`shaders/volume_march.wgsl`) instead of
     /// rasterising them, or goes back to rasterising: the same image either way. Only for
-    /// adapters that [`super::resources::can_march`].
+    /// devices that [`super::resources::can_march`].
     pub fn set_marching(&mut self, device: &wgpu::Device, on: bool) {
         if on == self.march.is_some() {
             return;

@@ -250,9 +250,10 @@ pub fn accumulation_format(adapter: &wgpu::Adapter) -> wgpu::TextureFormat {
     }
 }
 
-/// Whether the adapter can march the slices (`shaders/volume_march.wgsl`): compute shaders
-/// and storage images of the marched slices' format.
-pub fn can_march(adapter: &wgpu::Adapter) -> bool {
+/// Whether `device` (of `adapter`) can march the slices (`shaders/volume_march.wgsl`):
+/// compute shaders, storage images of the marched slices' format, and limits that allow the
+/// pass (a device asked for WebGL2's limits, as egui-wgpu asks on every GL backend, has none).
+pub fn can_march(adapter: &wgpu::Adapter, device: &wgpu::Device) -> bool {
     let compute = adapter
         .get_downlevel_capabilities()
         .flags
@@ -261,15 +262,22 @@ pub fn can_march(adapter: &wgpu::Adapter) -> bool {
         .get_texture_format_features(super::passes::MARCH_FORMAT)
         .allowed_usages
         .contains(wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING);
-    compute && storage && adapter.limits().max_storage_textures_per_shader_stage >= 2
+    let limits = device.limits();
+    let side = super::passes::MARCH_WORKGROUP;
+    let fits = limits.max_storage_textures_per_shader_stage >= 2
+        && limits.max_compute_workgroup_size_x >= side
+        && limits.max_compute_workgroup_size_y >= side
+        && limits.max_compute_invocations_per_workgroup >= side * side
+        && limits.max_compute_workgroups_per_dimension > 0;
+    compute && storage && fits
 }
 
-/// Whether the renderer marches the slices on `adapter` unless told otherwise: on GPUs that
+/// Whether the renderer marches the slices on `device` unless told otherwise: on GPUs that
 /// can, a browser's WebGPU included (it says only whether it is a fallback adapter, and its
 /// description). CPU adapters (lavapipe, SwiftShader) rasterise them: there the march is
 /// slower (lavapipe: 1.1 s against 1.0 s a 720p frame), and the page's frame budget was
 /// measured that way. WebGL2 cannot march them.
-pub fn marches_by_default(adapter: &wgpu::Adapter) -> bool {
+pub fn marches_by_default(adapter: &wgpu::Adapter, device: &wgpu::Device) -> bool {
     use wgpu::DeviceType::{Cpu, DiscreteGpu, IntegratedGpu, Other, VirtualGpu};
     let info = adapter.get_info();
     let name = info.name.to_lowercase();
@@ -281,7 +289,7 @@ pub fn marches_by_default(adapter: &wgpu::Adapter) -> bool {
         Other => info.backend == wgpu::Backend::BrowserWebGpu,
         Cpu => false,
     };
-    gpu && !software && can_march(adapter)
+    gpu && !software && can_march(adapter, device)
 }
 
 /// Records a copy of a 2D RGBA8-sized `texture` of `size` into a new mappable buffer; returns

@@ -340,7 +340,7 @@ pub fn choose_web_backends(config: &mut egui_wgpu::WgpuConfiguration, webgl_buil
 /// Creates the renderer in egui-wgpu's callback resources; returns what is in use. `gl_name`
 /// is what the GL backend is called on this platform (`webgl2` in the browser); `marching`
 /// asks for marched (`Some(true)`) or rasterised slices instead of the adapter's default
-/// ([`marches_by_default`]); an adapter that cannot march them rasterises them.
+/// ([`marches_by_default`]); a device that cannot march them rasterises them.
 pub fn install(
     render_state: &egui_wgpu::RenderState,
     gl_name: &'static str,
@@ -353,8 +353,9 @@ pub fn install(
         render_state.target_format,
         format,
     );
-    let marching = marching.unwrap_or_else(|| marches_by_default(&render_state.adapter))
-        && can_march(&render_state.adapter);
+    let (adapter, device) = (&render_state.adapter, &render_state.device);
+    let marching = marching.unwrap_or_else(|| marches_by_default(adapter, device))
+        && can_march(adapter, device);
     renderer.set_marching(&render_state.device, marching);
     render_state
         .renderer
