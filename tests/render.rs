@@ -1243,7 +1243,7 @@ fn marched_slices_give_the_rasterised_slices_image() {
     // must give one image, whole or in refinement's chunks: within rounding (the rasterised
     // slices round to the 16-bit target at every slice, the march once). A march whose planes
     // sit a quarter of a slice off differs by up to 88 (cirrus); one whose shafts ignore the
-    // cloud in front of them by 19.
+    // cloud in front of them by 19. An empty scene must be the background both ways.
     let presets = ["cumulus", "stratus", "cirrus", "cumulonimbus", "sunset"];
     let mut scenes: Vec<(String, Scene)> = presets
         .iter()
@@ -1260,9 +1260,11 @@ fn marched_slices_give_the_rasterised_slices_image() {
             &["/light/shafts=true", "/light/shaft_density=0.004"],
         ),
     ));
+    scenes.push(("empty".into(), Scene::preset(Preset::Empty)));
     let mut identical = true;
     for (name, scene) in &scenes {
-        for chunks in [1, 3] {
+        // Whole, in three chunks, and asked for more chunks than one submission holds (8).
+        for chunks in [1, 3, 20] {
             let [marched, raster] = marched_and_rasterised(scene, chunks);
             let (mean, max) = image_difference(&marched, &raster);
             assert!(
@@ -1270,6 +1272,14 @@ fn marched_slices_give_the_rasterised_slices_image() {
                 "{name} in {chunks} draws: marched and rasterised differ by {mean:.3} on average, {max} at most"
             );
             identical &= marched.rgba == raster.rgba;
+            if name == "empty" {
+                let bg = background(scene);
+                let drawn = marched
+                    .rgba
+                    .chunks(4)
+                    .filter(|p| differs([p[0], p[1], p[2], p[3]], bg));
+                assert_eq!(drawn.count(), 0, "an empty scene marched draws something");
+            }
         }
     }
     // Both paths ran: they round differently somewhere.
