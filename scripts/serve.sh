@@ -5,4 +5,5 @@ set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$ROOT"
 bash scripts/setup.sh
-exec trunk serve --release --address 127.0.0.1 --port 8080
+# Trunk's server sends files uncompressed: no precompressed copies on each rebuild.
+CLOUDSKETCH_PRECOMPRESS=0 exec trunk serve --release --address 127.0.0.1 --port 8080

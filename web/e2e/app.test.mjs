@@ -1,8 +1,9 @@
 // The app in the browser: the default cloud is drawn (WebGPU, then the WebGL2 fallback), each
 // browser fetches only the build it needs (the WebGPU build, or the one with the WebGL2
-// fallback, also where a WebGPU device fails to start or `?backend=webgl` asks for it), a drag
-// orbits the camera and changes the image, nothing logs an error, ?preset=empty opens an empty
-// scene, and a browser with neither WebGPU nor WebGL2 gets a plain message.
+// fallback, also where a WebGPU device fails to start or `?backend=webgl` asks for it) and gets
+// its precompressed Brotli copy, a drag orbits the camera and changes the image, nothing logs an
+// error, ?preset=empty opens an empty scene, and a browser with neither WebGPU nor WebGL2 gets a
+// plain message.
 // Screenshots: web/test-results/screenshots/.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
@@ -43,6 +44,13 @@ for (const backend of ['webgpu', 'webgl2']) {
         assert.equal(await page.getAttribute('body', 'data-backend'), backend, 'active backend');
         const builds = await fetchedBuilds(page);
         assert.deepEqual(builds.map((b) => b.build), [backend === 'webgpu' ? 'webgpu' : 'webgl'], 'the one build fetched');
+        // The build came as its Brotli copy (web/precompress.mjs; the server sends it where the
+        // browser accepts br, as Chromium does) and decoded to the build's own wasm.
+        const [wasm] = builds;
+        assert.ok(wasm.brotliBytes > 0 && wasm.gzipBytes > 0, `precompressed copies of the wasm: ${JSON.stringify(wasm)}`);
+        assert.equal(wasm.transferBytes, wasm.brotliBytes, 'the browser received the Brotli copy');
+        assert.equal(wasm.decodedBytes, wasm.bytes, 'which decoded to the wasm file');
+        assert.ok(wasm.brotliBytes < wasm.gzipBytes, `Brotli ${wasm.brotliBytes} B < gzip ${wasm.gzipBytes} B`);
         const adapter = await page.getAttribute('body', 'data-adapter');
         const before = await state(page);
         const [vw, vh] = before.view.viewport;
@@ -81,7 +89,7 @@ for (const backend of ['webgpu', 'webgl2']) {
         assert.ok(countDiffering(second, rect, bg) > 0.03 * vw * vh, 'cloud still drawn after orbiting');
 
         assert.deepEqual(errors, [], `errors logged:\n${errors.join('\n')}`);
-        recordTiming({ test: 'orbit', backend, adapter, wasmBytes: builds[0].bytes, wasmGzipBytes: builds[0].gzipBytes, firstImageSeconds, readySeconds, dragSeconds, refineSeconds, quality: afterDrag.view.quality });
+        recordTiming({ test: 'orbit', backend, adapter, wasmBytes: wasm.bytes, wasmGzipBytes: wasm.gzipBytes, wasmBrotliBytes: wasm.brotliBytes, wasmTransferBytes: wasm.transferBytes, firstImageSeconds, readySeconds, dragSeconds, refineSeconds, quality: afterDrag.view.quality });
       } catch (e) {
         console.error(log.slice(-40).join('\n'));
         await screenshot(page, `${backend}-failure`).catch(() => {});

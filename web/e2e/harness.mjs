@@ -6,7 +6,6 @@ import http from 'node:http';
 import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
-import zlib from 'node:zlib';
 import { fileURLToPath } from 'node:url';
 import { chromium } from 'playwright-core';
 import { PNG } from 'pngjs';
@@ -20,6 +19,9 @@ export const SUB_PATH = '/some/sub/path/';
 
 const TYPES = { '.html': 'text/html', '.js': 'text/javascript', '.wasm': 'application/wasm', '.css': 'text/css', '.png': 'image/png', '.json': 'application/json' };
 
+/** The precompressed copies the server prefers, in order. */
+const ENCODINGS = [{ name: 'br', suffix: '.br' }, { name: 'gzip', suffix: '.gz' }];
+
 /** Starts a static server for DIST under SUB_PATH; resolves to { url, close }. */
 export function serve() {
   if (!fs.existsSync(path.join(DIST, 'index.html'))) {
@@ -31,8 +33,16 @@ export function serve() {
     let rel = decodeURIComponent(url.pathname.slice(SUB_PATH.length)) || 'index.html';
     const file = path.resolve(DIST, rel);
     if (!file.startsWith(DIST) || !fs.existsSync(file) || fs.statSync(file).isDirectory()) { res.writeHead(404); res.end(); return; }
-    res.writeHead(200, { 'content-type': TYPES[path.extname(file)] ?? 'application/octet-stream' });
-    fs.createReadStream(file).pipe(res);
+    // As a host with precompressed files does (web/precompress.mjs): the Brotli or gzip copy
+    // where the browser accepts it, else the file itself.
+    const accepted = (req.headers['accept-encoding'] ?? '').split(',').map((e) => e.trim().split(';')[0]);
+    const encoding = ENCODINGS.find((e) => accepted.includes(e.name) && fs.existsSync(file + e.suffix));
+    res.writeHead(200, {
+      'content-type': TYPES[path.extname(file)] ?? 'application/octet-stream',
+      vary: 'accept-encoding',
+      ...(encoding ? { 'content-encoding': encoding.name } : {}),
+    });
+    fs.createReadStream(encoding ? file + encoding.suffix : file).pipe(res);
   });
   return new Promise((resolve) => server.listen(0, '127.0.0.1', () => {
     const { port } = server.address();
@@ -74,18 +84,25 @@ export async function openApp(browser, base, query = '', viewport = { width: 900
 }
 
 /**
- * The builds of the app (index.html: `webgpu`, `webgl`) whose wasm the page fetched, in order,
- * each with the file's size raw and gzipped (`gzip -9`, as a server would send it).
+ * The builds of the app (index.html: `webgpu`, `webgl`) whose wasm the page fetched, in order:
+ * the file's size raw (`bytes`), its precompressed copies' sizes (`brotliBytes`, `gzipBytes`:
+ * web/precompress.mjs, null where missing), and what the browser says it received
+ * (`transferBytes`, the encoded body) and decoded (`decodedBytes`).
  */
 export async function fetchedBuilds(page) {
-  const urls = await page.evaluate(() => performance.getEntriesByType('resource').map((e) => e.name));
-  return urls
-    .map((u) => new URL(u).pathname)
-    .filter((p) => p.endsWith('_bg.wasm'))
-    .map((p) => {
-      const rel = decodeURIComponent(p.slice(p.indexOf(SUB_PATH) + SUB_PATH.length));
-      const bytes = fs.readFileSync(path.join(DIST, rel));
-      return { build: rel.split('/')[0], bytes: bytes.length, gzipBytes: zlib.gzipSync(bytes, { level: 9 }).length };
+  const entries = await page.evaluate(() => performance.getEntriesByType('resource')
+    .map((e) => ({ name: e.name, encoded: e.encodedBodySize, decoded: e.decodedBodySize })));
+  const size = (file) => (fs.existsSync(file) ? fs.statSync(file).size : null);
+  return entries
+    .map((e) => ({ ...e, pathname: new URL(e.name).pathname }))
+    .filter((e) => e.pathname.endsWith('_bg.wasm'))
+    .map((e) => {
+      const rel = decodeURIComponent(e.pathname.slice(e.pathname.indexOf(SUB_PATH) + SUB_PATH.length));
+      const file = path.join(DIST, rel);
+      return {
+        build: rel.split('/')[0], bytes: size(file), brotliBytes: size(`${file}.br`), gzipBytes: size(`${file}.gz`),
+        transferBytes: e.encoded, decodedBytes: e.decoded,
+      };
     });
 }
 
