@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Sets up whatever is missing (scripts/setup.sh) and runs every test: Rust unit and
 # integration tests (pure core, naga validation of shaders/, offscreen lavapipe renders, CLI,
-# link fixtures), a 30-second fuzz run of the link decoders (nightly + cargo-fuzz, installed
+# the desktop window under Xvfb, link fixtures), a 30-second fuzz run of the link decoders (nightly + cargo-fuzz, installed
 # here when missing), the release web build, and the browser end-to-end tests in headless
 # Chromium (WebGPU on SwiftShader, then the WebGL2 fallback), and the exports read back by
 # independent readers (OpenVDB's Python module, Mitsuba 3, the Khronos glTF validator).

@@ -25,13 +25,24 @@ pub use render::parse_size;
 #[command(
     name = "cloudsketch",
     version,
-    about = "Sketch a cloud's outline, get a volumetric 3D cloud."
+    about = "Sketch a cloud's outline, get a volumetric 3D cloud.",
+    args_conflicts_with_subcommands = true
 )]
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
     /// Scene file (or share link) to open in the desktop app.
     scene: Option<String>,
+    /// The desktop window's size in points, as WIDTHxHEIGHT.
+    #[arg(long, default_value = "1280x800")]
+    window: String,
+    /// Save the desktop window's first full-quality image (side panel and all) as this PNG,
+    /// then close it.
+    #[arg(long, value_name = "PNG")]
+    screenshot: Option<PathBuf>,
+    /// With --screenshot: also write the app's state (scene and view) as JSON here.
+    #[arg(long, value_name = "JSON", requires = "screenshot")]
+    state_out: Option<PathBuf>,
 }
 
 #[derive(Subcommand)]
@@ -169,7 +180,13 @@ pub fn main() -> ExitCode {
         headless_vulkan();
     }
     let result = match cli.command {
-        None => desktop::run(cli.scene.as_deref()),
+        None => parse_size(&cli.window).and_then(|size| {
+            let shot = cli.screenshot.map(|output| desktop::Screenshot {
+                output,
+                state: cli.state_out,
+            });
+            desktop::run(cli.scene.as_deref(), size, shot)
+        }),
         Some(Command::New { preset, output }) => new::run(&preset, &output),
         Some(Command::Render {
             scene,

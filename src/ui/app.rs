@@ -30,7 +30,8 @@ pub struct PageStatus {
     pub state: String,
 }
 
-/// Receives [`PageStatus`] updates (the web page's test contract; nothing natively).
+/// Receives [`PageStatus`] updates: the web page's test contract, and natively the desktop
+/// window's `--screenshot` (`cli/desktop.rs`).
 pub trait Host {
     /// Called after a frame when anything in the status changed.
     fn publish(&mut self, status: &PageStatus);
@@ -40,6 +41,10 @@ pub trait Host {
     fn take_edits(&mut self) -> Vec<String> {
         Vec::new()
     }
+
+    /// Called at the end of every frame with the status as last published (the desktop
+    /// window's `--screenshot` watches for the first full-quality image here).
+    fn end_frame(&mut self, _ctx: &egui::Context, _status: &PageStatus) {}
 }
 
 /// How the app starts.
@@ -468,6 +473,9 @@ impl CloudApp {
         if self.last_status.as_ref() != Some(&status) {
             host.publish(&status);
             self.last_status = Some(status);
+        }
+        if let Some(status) = &self.last_status {
+            host.end_frame(ctx, status);
         }
     }
 }

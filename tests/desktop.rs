@@ -1,0 +1,259 @@
+//! The desktop window, opened as a user opens it (`cloudsketch [SCENE]`) on a virtual X display
+//! (Xvfb, which scripts/setup.sh installs) with lavapipe drawing through a real window surface.
+//! `--screenshot` saves the window's first full-quality image and `--state-out` the app's state,
+//! the page's test contract natively.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::sync::Mutex;
+
+use serde_json::Value;
+
+/// `xvfb-run -a` picks a free display number racily: one window at a time.
+static DISPLAY: Mutex<()> = Mutex::new(());
+
+/// Runs the binary under `xvfb-run` with a 2048×1200 screen; no autosave of the user's is read
+/// or written (a fresh data folder per run).
+fn in_window(args: &[&str], data: &Path) -> Output {
+    let _one = DISPLAY.lock().unwrap_or_else(|e| e.into_inner());
+    let found = Command::new("sh")
+        .args(["-c", "command -v xvfb-run"])
+        .output()
+        .is_ok_and(|o| o.status.success());
+    assert!(
+        found,
+        "xvfb-run is missing: scripts/setup.sh installs it (Debian's xvfb)"
+    );
+    Command::new("timeout")
+        .args(["300", "xvfb-run", "-a", "-s", "-screen 0 2048x1200x24"])
+        .arg(env!("CARGO_BIN_EXE_cloudsketch"))
+        .args(args)
+        .env("XDG_DATA_HOME", data)
+        .output()
+        .expect("run cloudsketch under xvfb-run")
+}
+
+fn temp(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("cloudsketch-desktop-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// An RGBA8 image read from a PNG.
+struct Rgba {
+    width: usize,
+    height: usize,
+    data: Vec<u8>,
+}
+
+impl Rgba {
+    fn read(path: &Path) -> Rgba {
+        let decoder =
+            png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
+        let mut reader = decoder.read_info().unwrap();
+        let mut data = vec![0; reader.output_buffer_size().unwrap()];
+        let info = reader.next_frame(&mut data).unwrap();
+        assert_eq!(info.color_type, png::ColorType::Rgba);
+        Rgba {
+            width: info.width as usize,
+            height: info.height as usize,
+            data,
+        }
+    }
+
+    fn at(&self, x: usize, y: usize) -> [u8; 3] {
+        let i = 4 * (y * self.width + x);
+        [self.data[i], self.data[i + 1], self.data[i + 2]]
+    }
+
+    /// Pixels in `[x0, x1) × [y0, y1)` farther than `tol` (sum over channels) from `rgb`,
+    /// leaving out those `skip` says to.
+    fn differing(
+        &self,
+        (x0, x1): (usize, usize),
+        (y0, y1): (usize, usize),
+        rgb: [u8; 3],
+        tol: u32,
+        skip: impl Fn(usize, usize) -> bool,
+    ) -> usize {
+        let mut n = 0;
+        for y in y0..y1 {
+            for x in x0..x1 {
+                let p = self.at(x, y);
+                let d: u32 = (0..3).map(|c| p[c].abs_diff(rgb[c]) as u32).sum();
+                if d > tol && !skip(x, y) {
+                    n += 1;
+                }
+            }
+        }
+        n
+    }
+}
+
+/// What a `--screenshot` run left: the window's image and the app's state.
+struct Shot {
+    image: Rgba,
+    state: Value,
+    stdout: String,
+}
+
+/// Opens the window (on `scene` when given) at `size` and takes its screenshot.
+fn shoot(name: &str, size: &str, scene: Option<&Path>) -> Shot {
+    let png = temp(&format!("{name}.png"));
+    let json = temp(&format!("{name}.json"));
+    let data = temp(&format!("{name}-data"));
+    let mut args = vec!["--window", size];
+    if let Some(scene) = scene {
+        args.push(scene.to_str().unwrap());
+    }
+    args.extend([
+        "--screenshot",
+        png.to_str().unwrap(),
+        "--state-out",
+        json.to_str().unwrap(),
+    ]);
+    let out = in_window(&args, &data);
+    assert!(out.status.success(), "{}", stderr(&out));
+    Shot {
+        image: Rgba::read(&png),
+        state: serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap(),
+        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
+    }
+}
+
+/// The scene's sky colour as the window shows it (sRGB-encoded in the document).
+fn sky(state: &Value) -> [u8; 3] {
+    let bg = &state["scene"]["light"]["background"];
+    [0, 1, 2].map(|i| (bg[i].as_f64().unwrap() * 255.0).round() as u8)
+}
+
+/// Pixels of the view that are not sky, leaving out the sun handle's box, the notice line at
+/// the view's top and the status line at its foot (the overlays a scene without a cloud still
+/// shows).
+fn cloud_pixels(shot: &Shot) -> (usize, usize) {
+    let view = &shot.state["view"];
+    let w = view["viewport"][0].as_u64().unwrap() as usize;
+    let h = view["viewport"][1].as_u64().unwrap() as usize;
+    let handle = &view["sun_handle"];
+    let (cx, cy, r) = (
+        handle["center"][0].as_f64().unwrap(),
+        handle["center"][1].as_f64().unwrap(),
+        handle["radius"].as_f64().unwrap() + 6.0,
+    );
+    let skip = |x: usize, y: usize| {
+        ((x as f64 - cx).abs() <= r && (y as f64 - cy).abs() <= r) || y < 32 || y + 24 >= h
+    };
+    let n = shot
+        .image
+        .differing((0, w), (0, h), sky(&shot.state), 12, skip);
+    (n, w * h)
+}
+
+/// The default cloud in a window of `width`×`height`: the cloud in the view, the sky around
+/// it, the side panel beside it. Returns the shot.
+fn default_cloud(width: usize, height: usize) -> Shot {
+    let shot = shoot(
+        &format!("default-{width}x{height}"),
+        &format!("{width}x{height}"),
+        None,
+    );
+    assert_eq!(
+        (shot.image.width, shot.image.height),
+        (width, height),
+        "the window's size"
+    );
+    let view = &shot.state["view"];
+    assert!(
+        view["quality"].as_str().unwrap().starts_with("full"),
+        "{view}"
+    );
+    assert_eq!(view["backend"], "vulkan", "{view}");
+    assert!(
+        shot.stdout.contains(&format!("{width}x{height} pixels")),
+        "{}",
+        shot.stdout
+    );
+
+    // The cloud: at least 3% of the view, and sky in the view's top-left corner.
+    let (cloud, area) = cloud_pixels(&shot);
+    assert!(cloud * 100 > 3 * area, "{cloud} cloud pixels of {area}");
+    assert_eq!(shot.image.at(3, 3), sky(&shot.state), "the sky at (3, 3)");
+
+    // The side panel right of the view: its own flat fill down its left margin, widgets over it.
+    let w = view["viewport"][0].as_u64().unwrap() as usize;
+    let fill = shot.image.at(w + 4, height / 2);
+    assert_eq!(
+        shot.image
+            .differing((w + 4, w + 6), (100, height - 20), fill, 6, |_, _| false),
+        0,
+        "the panel's background"
+    );
+    let sky_distance: u32 = (0..3)
+        .map(|c| fill[c].abs_diff(sky(&shot.state)[c]) as u32)
+        .sum();
+    assert!(sky_distance > 60, "the panel {fill:?} is not the sky");
+    let widgets = shot
+        .image
+        .differing((w + 1, width), (0, height), fill, 24, |_, _| false);
+    assert!(widgets > 3000, "{widgets} pixels of the panel's widgets");
+    shot
+}
+
+#[test]
+fn the_window_draws_the_default_cloud_beside_its_panel_and_opens_a_scene_file() {
+    default_cloud(1920, 1080);
+    let (_, area) = cloud_pixels(&default_cloud(1280, 800));
+
+    // The baseline: a scene file without a cloud, with another sky. The window opens the file
+    // (its name in the state), shows that sky, and nothing of a cloud.
+    let scene_path = temp("empty.json");
+    let mut scene: Value = serde_json::from_str(
+        &cloudsketch::scene::Scene::preset(cloudsketch::scene::Preset::Empty).to_json(),
+    )
+    .unwrap();
+    scene["light"]["background"] = serde_json::json!([0.8, 0.35, 0.2]);
+    std::fs::write(&scene_path, scene.to_string()).unwrap();
+    let empty = shoot("empty", "1280x800", Some(&scene_path));
+    assert_eq!(sky(&empty.state), [204, 89, 51]);
+    assert!(
+        empty.state["view"]["file"]
+            .as_str()
+            .unwrap()
+            .ends_with("empty.json"),
+        "{}",
+        empty.state["view"]
+    );
+    assert_eq!(empty.image.at(3, 3), sky(&empty.state), "the file's sky");
+    let (none, _) = cloud_pixels(&empty);
+    assert!(
+        none * 10_000 < area,
+        "{none} pixels off the sky without a cloud"
+    );
+}
+
+#[test]
+fn the_window_reports_bad_arguments_and_an_unwritable_screenshot() {
+    let data = temp("bad-data");
+    let out = in_window(&["--window", "0x0"], &data);
+    assert!(!out.status.success());
+    assert!(stderr(&out).contains("WIDTHxHEIGHT"), "{}", stderr(&out));
+
+    let out = in_window(&["--state-out", "x.json"], &data);
+    assert!(!out.status.success());
+    assert!(stderr(&out).contains("--screenshot"), "{}", stderr(&out));
+
+    let out = in_window(&["--screenshot", "/nonexistent/dir/window.png"], &data);
+    assert!(!out.status.success(), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("/nonexistent/dir/window.png: no such folder"),
+        "{}",
+        stderr(&out)
+    );
+
+    let out = in_window(&["new", "-o", "x.json", "--screenshot", "a.png"], &data);
+    assert!(!out.status.success());
+}
