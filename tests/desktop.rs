@@ -1,7 +1,8 @@
 //! The desktop window, opened as a user opens it (`cloudsketch [SCENE]`) on a virtual X display
 //! (Xvfb, which scripts/setup.sh installs) with lavapipe drawing through a real window surface.
 //! `--screenshot` saves the window's first full-quality image and `--state-out` the app's state,
-//! the page's test contract natively.
+//! the page's test contract natively; xdotool (also from setup.sh) drives the pointer and the
+//! keyboard, and the scene the window saves (Ctrl+S) shows what the input did.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -263,4 +264,101 @@ fn the_window_reports_bad_arguments_and_an_unwritable_screenshot() {
 
     let out = in_window(&["new", "-o", "x.json", "--screenshot", "a.png"], &data);
     assert!(!out.status.success());
+}
+
+/// Drives an open window with xdotool: the Sketch tool (D), a closed stroke of 60 moves around a
+/// circle (`$PACE` between moves: empty sends them all at once, faster than any frame), Ctrl+S;
+/// then Ctrl+Z and Ctrl+S again. Each save is copied aside once the file changes.
+const DRIVE: &str = r#"
+set -u
+"$BIN" "$SCENE" --window 1280x800 & app=$!
+trap 'kill $app 2>/dev/null' EXIT
+wid=$(timeout 60 xdotool search --sync --onlyvisible --name '^cloudsketch$' | head -n 1)
+[ -n "$wid" ] || { echo "no window appeared" >&2; exit 1; }
+sleep 3  # the first frames (shaders compiled, the view drawn)
+xdotool windowfocus --sync "$wid" mousemove --window "$wid" 400 400 key d
+sleep 0.5
+moves="mousemove --window $wid 520 400 mousedown 1"
+for i in $(seq 1 60); do
+  xy=$(awk -v i="$i" 'BEGIN { a = i / 60 * 6.2831853; printf "%d %d", 400 + 120 * cos(a), 400 + 120 * sin(a) }')
+  moves="$moves mousemove --window $wid $xy $PACE"
+done
+xdotool $moves mouseup 1
+sleep 0.5
+# Saves with KEYS and waits (at most 60 s) for the file to change; copies it to $1.
+save() {
+  before=$(stat -c %y "$SCENE")
+  xdotool key --window "$wid" $KEYS ctrl+s
+  for _ in $(seq 1 120); do
+    [ "$(stat -c %y "$SCENE")" != "$before" ] && { cp "$SCENE" "$1"; return 0; }
+    sleep 0.5
+  done
+  echo "the scene was not saved ($1)" >&2; exit 1
+}
+KEYS="" save "$SAVED1"
+KEYS="ctrl+z" save "$SAVED2"
+"#;
+
+/// Sketches a stroke in the window (moves `pace` apart, e.g. `sleep 0.015`, or all at once),
+/// and returns the scene saved after it and the one saved after undoing it.
+fn sketch_in_window(name: &str, pace: &str) -> (Value, Value) {
+    let found = Command::new("sh")
+        .args(["-c", "command -v xdotool"])
+        .output()
+        .is_ok_and(|o| o.status.success());
+    assert!(
+        found,
+        "xdotool is missing: scripts/setup.sh installs it (Debian's xdotool)"
+    );
+    let scene = temp(&format!("{name}.json"));
+    let empty = cloudsketch::scene::Scene::preset(cloudsketch::scene::Preset::Empty);
+    std::fs::write(&scene, empty.to_json()).unwrap();
+    let saved = [1, 2].map(|i| temp(&format!("{name}-saved{i}.json")));
+    for path in &saved {
+        let _ = std::fs::remove_file(path);
+    }
+    let data = temp(&format!("{name}-data"));
+    let _one = DISPLAY.lock().unwrap_or_else(|e| e.into_inner());
+    let out = Command::new("timeout")
+        .args(["300", "xvfb-run", "-a", "-s", "-screen 0 2048x1200x24"])
+        .args(["sh", "-c", DRIVE])
+        .env("BIN", env!("CARGO_BIN_EXE_cloudsketch"))
+        .env("SCENE", &scene)
+        .env("SAVED1", &saved[0])
+        .env("SAVED2", &saved[1])
+        .env("PACE", pace)
+        .env("XDG_DATA_HOME", &data)
+        .output()
+        .expect("run the window under xvfb-run");
+    assert!(out.status.success(), "{}", stderr(&out));
+    saved
+        .map(|path| serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap())
+        .into()
+}
+
+/// The points of a saved scene's planes.
+fn plane_points(scene: &Value) -> Vec<usize> {
+    scene["planes"]
+        .as_array()
+        .map(|planes| {
+            planes
+                .iter()
+                .map(|p| p["points"].as_array().map_or(0, Vec::len))
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+#[test]
+fn the_window_keeps_every_sample_of_a_stroke_and_undoes_it() {
+    // 61 samples (the press and 60 moves): all of them, whether the moves come 15 ms apart
+    // (several frames' worth) or all at once (the press and the release in one frame, which
+    // egui calls a click; the stroke was lost before the press record).
+    for (name, pace) in [("paced", "sleep 0.015"), ("burst", "")] {
+        let (drawn, undone) = sketch_in_window(name, pace);
+        let points = plane_points(&drawn);
+        assert_eq!(points.len(), 1, "{name}: one drawing plane, {points:?}");
+        assert!(points[0] >= 55, "{name}: {} of 61 samples", points[0]);
+        assert_eq!(plane_points(&undone), Vec::<usize>::new(), "{name}: undone");
+    }
 }

@@ -3,6 +3,7 @@
 //! files and the autosave in the user's data folder.
 
 use super::guide::Loaded;
+use super::press_record::{PressRecord, Sample};
 use crate::limits::MAX_FILE_BYTES as MAX_BYTES;
 
 /// What the GL backend is called here.
@@ -45,16 +46,59 @@ pub fn read_path(path: &str) -> Loaded {
         .map_err(|e| format!("{path}: {e}"))
 }
 
-/// Pointer samples beyond egui's events: none natively, where every cursor move is an event
-/// (egui's native events carry no pen pressure).
-pub fn take_pointer_samples() -> Option<Vec<(egui::Pos2, Option<f32>)>> {
-    None
+thread_local! {
+    /// Every sample of the primary button's presses, from egui's events.
+    static RECORD: std::cell::RefCell<PressRecord> = std::cell::RefCell::new(PressRecord::default());
 }
 
-/// A whole press → release within one frame: natively egui's events carry every move, so a
-/// drag is always seen as one; nothing to recover.
-pub fn take_finished_press() -> Option<Vec<(egui::Pos2, Option<f32>)>> {
-    None
+/// Feeds this frame's events to the press record: natively egui's events carry every cursor
+/// move (and no pen pressure). Called once a frame by the tools that draw strokes.
+pub fn record_frame(input: &egui::InputState) {
+    let down = input.pointer.primary_down();
+    RECORD.with(|r| record_events(&mut r.borrow_mut(), &input.events, down));
+}
+
+/// Feeds one frame of egui's events to `record`. `still_down` is egui's view of the primary
+/// button after them, which ends a press whose release the record missed.
+fn record_events(record: &mut PressRecord, events: &[egui::Event], still_down: bool) {
+    use egui::{Event, PointerButton::Primary};
+    for event in events {
+        match event {
+            Event::PointerButton {
+                pos,
+                button: Primary,
+                pressed: true,
+                ..
+            } => record.pressed(Some((*pos, None))),
+            Event::PointerButton {
+                pos,
+                button: Primary,
+                pressed: false,
+                ..
+            } => record.released(Some((*pos, None))),
+            Event::PointerMoved(p) if record.is_down() => record.moved(&[(*p, None)]),
+            _ => {}
+        }
+    }
+    if !still_down && record.is_down() {
+        record.lost();
+    }
+}
+
+/// The primary button's last whole press → release (every sample, from the press), once: a
+/// stroke drawn within one long frame, which egui reports as a click.
+pub fn take_finished_press() -> Option<Vec<Sample>> {
+    RECORD.with(|r| r.borrow_mut().take_finished())
+}
+
+/// Pointer positions (in points) since the last call while the primary button was down.
+pub fn take_pointer_samples() -> Vec<Sample> {
+    RECORD.with(|r| r.borrow_mut().take_samples())
+}
+
+/// Every sample of the press under way, from where the button went down.
+pub fn press_samples() -> Vec<Sample> {
+    RECORD.with(|r| r.borrow().press_so_far())
 }
 
 /// Where the autosave lives: `$XDG_DATA_HOME/cloudsketch`, else `~/.local/share/cloudsketch`.
@@ -237,4 +281,58 @@ fn decode(bytes: &[u8]) -> Decoded {
         [rgba.width() as usize, rgba.height() as usize],
         rgba.as_raw(),
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use egui::{Event, Modifiers, PointerButton, pos2};
+
+    fn button(x: f32, pressed: bool) -> Event {
+        Event::PointerButton {
+            pos: pos2(x, 0.0),
+            button: PointerButton::Primary,
+            pressed,
+            modifiers: Modifiers::NONE,
+        }
+    }
+
+    fn moved(x: f32) -> Event {
+        Event::PointerMoved(pos2(x, 0.0))
+    }
+
+    #[test]
+    fn egui_events_over_two_frames_make_one_press_with_every_sample() {
+        let mut r = PressRecord::default();
+        // Hovering with no button down records nothing.
+        record_events(&mut r, &[moved(-1.0)], false);
+        assert!(r.take_samples().is_empty() && r.press_so_far().is_empty());
+        record_events(&mut r, &[button(0.0, true), moved(1.0), moved(2.0)], true);
+        assert_eq!(r.press_so_far().len(), 3);
+        assert!(r.take_finished().is_none());
+        record_events(&mut r, &[moved(3.0), button(4.0, false)], false);
+        let xs: Vec<f32> = r.take_finished().unwrap().iter().map(|s| s.0.x).collect();
+        assert_eq!(xs, [0.0, 1.0, 2.0, 3.0, 4.0]);
+    }
+
+    #[test]
+    fn a_press_within_one_frame_is_finished_in_that_frame() {
+        let mut r = PressRecord::default();
+        let mut events = vec![button(0.0, true)];
+        events.extend((1..=60).map(|i| moved(i as f32)));
+        events.push(button(60.0, false));
+        record_events(&mut r, &events, false);
+        assert_eq!(r.take_finished().map(|p| p.len()), Some(61));
+    }
+
+    #[test]
+    fn a_release_egui_saw_but_the_record_did_not_drops_the_press() {
+        let mut r = PressRecord::default();
+        record_events(&mut r, &[button(0.0, true), moved(1.0)], true);
+        record_events(&mut r, &[], false);
+        assert!(!r.is_down() && r.press_so_far().is_empty());
+        assert!(r.take_finished().is_none());
+        record_events(&mut r, &[moved(2.0)], false);
+        assert!(r.take_samples().is_empty());
+    }
 }

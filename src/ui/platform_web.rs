@@ -10,6 +10,7 @@ use wasm_bindgen::JsCast as _;
 use wasm_bindgen::prelude::*;
 
 use super::guide::Loaded;
+use super::press_record::{PressRecord, Sample};
 
 use crate::limits::MAX_FILE_BYTES;
 
@@ -51,10 +52,8 @@ const MAX_BYTES: f64 = MAX_FILE_BYTES as f64;
 
 thread_local! {
     static INBOX: RefCell<Vec<Loaded>> = const { RefCell::new(Vec::new()) };
-    static SAMPLES: RefCell<Vec<(egui::Pos2, Option<f32>)>> = const { RefCell::new(Vec::new()) };
-    /// The primary pointer's whole press → release, and the last one finished.
-    static PRESS: RefCell<Vec<(egui::Pos2, Option<f32>)>> = const { RefCell::new(Vec::new()) };
-    static FINISHED: RefCell<Option<Vec<(egui::Pos2, Option<f32>)>>> = const { RefCell::new(None) };
+    /// Every sample of the primary pointer's presses, from the page's own listeners.
+    static RECORD: RefCell<PressRecord> = RefCell::new(PressRecord::default());
     static REPAINT: RefCell<Option<egui::Context>> = const { RefCell::new(None) };
     static LINKS: RefCell<Vec<String>> = const { RefCell::new(Vec::new()) };
     static SCENE_FILES: RefCell<Vec<Loaded>> = const { RefCell::new(Vec::new()) };
@@ -334,7 +333,7 @@ fn keep_browser_shortcuts() {
 
 /// A pointer event's position in the canvas (points) and the pen's pressure (a mouse reports
 /// a constant 0.5, so only a pen's is kept).
-fn sample_at(e: &web_sys::PointerEvent, zoom: f32) -> Option<(egui::Pos2, Option<f32>)> {
+fn sample_at(e: &web_sys::PointerEvent, zoom: f32) -> Option<Sample> {
     let canvas = web_sys::window()
         .and_then(|w| w.document())
         .and_then(|d| d.get_element_by_id("cloudsketch_canvas"))?;
@@ -365,10 +364,8 @@ fn install_pointer_samples(ctx: &egui::Context) {
                         .is_some_and(|el| el.id() == "cloudsketch_canvas")
                 })
             {
-                SAMPLES.with(|s| s.borrow_mut().clear());
-                PRESS.with(|p| {
-                    *p.borrow_mut() = sample_at(&e, down_ctx.zoom_factor()).into_iter().collect()
-                });
+                let at = sample_at(&e, down_ctx.zoom_factor());
+                RECORD.with(|r| r.borrow_mut().pressed(at));
             }
         });
     let _ = document.add_event_listener_with_callback_and_bool(
@@ -379,10 +376,7 @@ fn install_pointer_samples(ctx: &egui::Context) {
     on_down.forget(); // lives as long as the page
     let on_up = Closure::<dyn FnMut(web_sys::PointerEvent)>::new(|e: web_sys::PointerEvent| {
         if e.is_primary() {
-            let press = PRESS.with(|p| std::mem::take(&mut *p.borrow_mut()));
-            if !press.is_empty() {
-                FINISHED.with(|f| *f.borrow_mut() = Some(press));
-            }
+            RECORD.with(|r| r.borrow_mut().released(None));
         }
     });
     let _ = document.add_event_listener_with_callback_and_bool(
@@ -395,12 +389,21 @@ fn install_pointer_samples(ctx: &egui::Context) {
     let ctx = ctx.clone();
     let on_move =
         Closure::<dyn FnMut(web_sys::PointerEvent)>::new(move |e: web_sys::PointerEvent| {
-            if !e.is_primary() || e.buttons() == 0 {
+            if !e.is_primary() {
+                return;
+            }
+            if e.buttons() == 0 {
+                // No button down: a press whose release the page never heard is over.
+                RECORD.with(|r| {
+                    if r.borrow().is_down() {
+                        r.borrow_mut().lost();
+                    }
+                });
                 return;
             }
             let zoom = ctx.zoom_factor();
             let coalesced = e.get_coalesced_events();
-            let mut new: Vec<(egui::Pos2, Option<f32>)> = Vec::new();
+            let mut new: Vec<Sample> = Vec::new();
             if coalesced.length() == 0 {
                 new.extend(sample_at(&e, zoom));
             }
@@ -409,33 +412,32 @@ fn install_pointer_samples(ctx: &egui::Context) {
                     new.extend(sample_at(&m, zoom));
                 }
             }
-            // A held button with no stroke being drawn must not grow these without bound.
-            let cap = crate::limits::MAX_PLANE_POINTS;
-            for buffer in [&SAMPLES, &PRESS] {
-                buffer.with(|s| {
-                    let mut s = s.borrow_mut();
-                    s.extend_from_slice(&new);
-                    let excess = s.len().saturating_sub(cap);
-                    s.drain(..excess);
-                });
-            }
+            RECORD.with(|r| r.borrow_mut().moved(&new));
         });
     let _ =
         document.add_event_listener_with_callback("pointermove", on_move.as_ref().unchecked_ref());
     on_move.forget(); // lives as long as the page
 }
 
+/// Nothing to feed: the page's listeners record every sample as it comes (egui's events in
+/// the browser hold one move per frame).
+pub fn record_frame(_input: &egui::InputState) {}
+
 /// The primary pointer's last whole press → release over the view (every sample, from the
 /// press), once: a stroke drawn within one long frame, which egui reports as a click.
-pub fn take_finished_press() -> Option<Vec<(egui::Pos2, Option<f32>)>> {
-    FINISHED.with(|f| f.borrow_mut().take())
+pub fn take_finished_press() -> Option<Vec<Sample>> {
+    RECORD.with(|r| r.borrow_mut().take_finished())
 }
 
 /// Pointer positions (in points) since the last call, every sample the browser saw while the
-/// primary pointer was down, each with the pen's pressure when a pen drew it; `None` where
-/// egui's own events already carry every sample.
-pub fn take_pointer_samples() -> Option<Vec<(egui::Pos2, Option<f32>)>> {
-    Some(SAMPLES.with(|s| std::mem::take(&mut *s.borrow_mut())))
+/// primary pointer was down, each with the pen's pressure when a pen drew it.
+pub fn take_pointer_samples() -> Vec<Sample> {
+    RECORD.with(|r| r.borrow_mut().take_samples())
+}
+
+/// Every sample of the press under way, from where the button went down.
+pub fn press_samples() -> Vec<Sample> {
+    RECORD.with(|r| r.borrow().press_so_far())
 }
 
 /// Installs the page's listeners: pointer samples, the file inputs' changes and the address

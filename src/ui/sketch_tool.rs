@@ -366,6 +366,7 @@ impl SketchTool {
             Tool::Move | Tool::Rotate | Tool::Scale => return self.manipulate(view, tc),
             Tool::Sketch | Tool::Cut => {}
         }
+        ui.input(super::platform::record_frame);
         let (alt, multi) = ui.input(|i| (i.modifiers.alt, i.multi_touch().is_some()));
         if alt || multi {
             self.stroke.clear();
@@ -376,33 +377,27 @@ impl SketchTool {
         }
         // Every pointer sample since the last frame, not one position per frame: on a slow
         // adapter a frame can hold a dozen samples of a fast stroke.
-        let samples = super::platform::take_pointer_samples().unwrap_or_else(|| {
-            ui.input(|i| {
-                i.events
-                    .iter()
-                    .filter_map(|e| match e {
-                        egui::Event::PointerMoved(p) => Some((*p, None)),
-                        _ => None,
-                    })
-                    .collect()
-            })
-        });
-        // The press → release the page recorded (see `quick` below).
+        let samples = super::platform::take_pointer_samples();
+        // A whole press → release recorded (see `quick` below).
         let press = super::platform::take_finished_press();
-        if response.drag_started_by(egui::PointerButton::Primary) {
-            self.stroke.clear();
-            self.pressure.clear();
-            // Start where the button went down, not where the drag was recognised.
-            if let Some(p) = ui
-                .input(|i| i.pointer.press_origin())
-                .or(response.interact_pointer_pos())
+        let started = response.drag_started_by(egui::PointerButton::Primary);
+        if started {
+            // Every sample since the button went down, not just where it went down: egui
+            // recognises the drag a frame or more after the press, and those frames hold the
+            // stroke's start (this frame's samples among them).
+            let so_far = super::platform::press_samples();
+            (self.stroke, self.pressure) = so_far.into_iter().unzip();
+            if self.stroke.is_empty()
+                && let Some(p) = ui
+                    .input(|i| i.pointer.press_origin())
+                    .or(response.interact_pointer_pos())
             {
                 self.stroke.push(p);
                 self.pressure.push(None);
             }
             self.drawing = true;
         }
-        if self.drawing {
+        if self.drawing && !started {
             for (p, pressure) in samples {
                 if self.stroke.last() != Some(&p) && self.stroke.len() < MAX_PLANE_POINTS {
                     self.stroke.push(p);
@@ -411,9 +406,9 @@ impl SketchTool {
             }
         }
         let now = ui.input(|i| i.time);
-        // A whole stroke egui never saw as a drag (the press and the release one long frame
-        // apart on a slow adapter, with the moves between them): the page recorded every
-        // sample, so it is drawn all the same, if the press landed on the view itself.
+        // A whole stroke egui never saw as a drag (the press and the release within one long
+        // frame, or in two, on a slow adapter, with the moves between them): every sample was
+        // recorded, so it is drawn all the same, if the press landed on the view itself.
         if ui.input(|i| i.pointer.primary_pressed()) {
             self.pressed_on_view = response.hovered();
         }
