@@ -13,9 +13,13 @@ use serde_json::Value;
 /// `xvfb-run -a` picks a free display number racily: one window at a time.
 static DISPLAY: Mutex<()> = Mutex::new(());
 
-/// Runs the binary under `xvfb-run` with a 2048×1200 screen; no autosave of the user's is read
-/// or written (a fresh data folder per run).
-fn in_window(args: &[&str], data: &Path) -> Output {
+/// The virtual display: room for a 1280×800-point window at 2 pixels a point.
+const SCREEN: &str = "-screen 0 2600x1700x24";
+
+/// Runs the binary under `xvfb-run` with a 2600×1700 screen at `scale` device pixels per point
+/// (winit's X11 scale factor, as a HiDPI desktop sets it); no autosave of the user's is read or
+/// written (a fresh data folder per run).
+fn in_window(args: &[&str], data: &Path, scale: usize) -> Output {
     let _one = DISPLAY.lock().unwrap_or_else(|e| e.into_inner());
     let found = Command::new("sh")
         .args(["-c", "command -v xvfb-run"])
@@ -26,10 +30,11 @@ fn in_window(args: &[&str], data: &Path) -> Output {
         "xvfb-run is missing: scripts/setup.sh installs it (Debian's xvfb)"
     );
     Command::new("timeout")
-        .args(["300", "xvfb-run", "-a", "-s", "-screen 0 2048x1200x24"])
+        .args(["300", "xvfb-run", "-a", "-s", SCREEN])
         .arg(env!("CARGO_BIN_EXE_cloudsketch"))
         .args(args)
         .env("XDG_DATA_HOME", data)
+        .env("WINIT_X11_SCALE_FACTOR", scale.to_string())
         // As a user's shell on a machine without a graphical login has it (scripts/test.sh
         // switches Mesa's device-select layer off for the offscreen tests; the app must itself).
         .env_remove("NODEVICE_SELECT")
@@ -101,13 +106,16 @@ impl Rgba {
 
 /// What a `--screenshot` run left: the window's image and the app's state.
 struct Shot {
+    /// Device pixels per point.
+    scale: usize,
     image: Rgba,
     state: Value,
     stdout: String,
 }
 
-/// Opens the window (on `scene` when given) at `size` and takes its screenshot.
-fn shoot(name: &str, size: &str, scene: Option<&Path>) -> Shot {
+/// Opens the window (on `scene` when given) at `size` points, `scale` pixels a point, and takes
+/// its screenshot.
+fn shoot(name: &str, size: &str, scale: usize, scene: Option<&Path>) -> Shot {
     let png = temp(&format!("{name}.png"));
     let json = temp(&format!("{name}.json"));
     let data = temp(&format!("{name}-data"));
@@ -121,12 +129,13 @@ fn shoot(name: &str, size: &str, scene: Option<&Path>) -> Shot {
         "--state-out",
         json.to_str().unwrap(),
     ]);
-    let out = in_window(&args, &data);
+    let out = in_window(&args, &data, scale);
     assert!(out.status.success(), "{}", stderr(&out));
     // A run that succeeds prints no line that reads like a failure (Mesa's device-select layer
     // looking for a Wayland session printed `error: XDG_RUNTIME_DIR is invalid…` four times).
     assert!(!stderr(&out).contains("error"), "{}", stderr(&out));
     Shot {
+        scale,
         image: Rgba::read(&png),
         state: serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap(),
         stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
@@ -146,14 +155,17 @@ fn cloud_pixels(shot: &Shot) -> (usize, usize) {
     let view = &shot.state["view"];
     let w = view["viewport"][0].as_u64().unwrap() as usize;
     let h = view["viewport"][1].as_u64().unwrap() as usize;
+    // The sun handle's place is in points.
     let handle = &view["sun_handle"];
+    let s = shot.scale as f64;
     let (cx, cy, r) = (
-        handle["center"][0].as_f64().unwrap(),
-        handle["center"][1].as_f64().unwrap(),
-        handle["radius"].as_f64().unwrap() + 6.0,
+        handle["center"][0].as_f64().unwrap() * s,
+        handle["center"][1].as_f64().unwrap() * s,
+        (handle["radius"].as_f64().unwrap() + 6.0) * s,
     );
+    let band = 32 * shot.scale;
     let skip = |x: usize, y: usize| {
-        ((x as f64 - cx).abs() <= r && (y as f64 - cy).abs() <= r) || y < 32 || y + 24 >= h
+        ((x as f64 - cx).abs() <= r && (y as f64 - cy).abs() <= r) || y < band || y + band >= h
     };
     let n = shot
         .image
@@ -161,14 +173,16 @@ fn cloud_pixels(shot: &Shot) -> (usize, usize) {
     (n, w * h)
 }
 
-/// The default cloud in a window of `width`×`height`: the cloud in the view, the sky around
-/// it, the side panel beside it. Returns the shot.
-fn default_cloud(width: usize, height: usize) -> Shot {
+/// The default cloud in a window of `width`×`height` points at `scale` pixels a point: the
+/// cloud in the view, the sky around it, the side panel beside it. Returns the shot.
+fn default_cloud(width: usize, height: usize, scale: usize) -> Shot {
     let shot = shoot(
-        &format!("default-{width}x{height}"),
+        &format!("default-{width}x{height}@{scale}"),
         &format!("{width}x{height}"),
+        scale,
         None,
     );
+    let (width, height) = (width * scale, height * scale);
     assert_eq!(
         (shot.image.width, shot.image.height),
         (width, height),
@@ -213,8 +227,10 @@ fn default_cloud(width: usize, height: usize) -> Shot {
 
 #[test]
 fn the_window_draws_the_default_cloud_beside_its_panel_and_opens_a_scene_file() {
-    default_cloud(1920, 1080);
-    let (_, area) = cloud_pixels(&default_cloud(1280, 800));
+    default_cloud(1920, 1080, 1);
+    // A HiDPI screen: the same window in twice the pixels, the cloud drawn in them.
+    default_cloud(1280, 800, 2);
+    let (_, area) = cloud_pixels(&default_cloud(1280, 800, 1));
 
     // The baseline: a scene file without a cloud, with another sky. The window opens the file
     // (its name in the state), shows that sky, and nothing of a cloud.
@@ -225,7 +241,7 @@ fn the_window_draws_the_default_cloud_beside_its_panel_and_opens_a_scene_file() 
     .unwrap();
     scene["light"]["background"] = serde_json::json!([0.8, 0.35, 0.2]);
     std::fs::write(&scene_path, scene.to_string()).unwrap();
-    let empty = shoot("empty", "1280x800", Some(&scene_path));
+    let empty = shoot("empty", "1280x800", 1, Some(&scene_path));
     assert_eq!(sky(&empty.state), [204, 89, 51]);
     assert!(
         empty.state["view"]["file"]
@@ -246,15 +262,15 @@ fn the_window_draws_the_default_cloud_beside_its_panel_and_opens_a_scene_file() 
 #[test]
 fn the_window_reports_bad_arguments_and_an_unwritable_screenshot() {
     let data = temp("bad-data");
-    let out = in_window(&["--window", "0x0"], &data);
+    let out = in_window(&["--window", "0x0"], &data, 1);
     assert!(!out.status.success());
     assert!(stderr(&out).contains("WIDTHxHEIGHT"), "{}", stderr(&out));
 
-    let out = in_window(&["--state-out", "x.json"], &data);
+    let out = in_window(&["--state-out", "x.json"], &data, 1);
     assert!(!out.status.success());
     assert!(stderr(&out).contains("--screenshot"), "{}", stderr(&out));
 
-    let out = in_window(&["--screenshot", "/nonexistent/dir/window.png"], &data);
+    let out = in_window(&["--screenshot", "/nonexistent/dir/window.png"], &data, 1);
     assert!(!out.status.success(), "{}", stderr(&out));
     assert!(
         stderr(&out).contains("/nonexistent/dir/window.png: no such folder"),
@@ -262,7 +278,7 @@ fn the_window_reports_bad_arguments_and_an_unwritable_screenshot() {
         stderr(&out)
     );
 
-    let out = in_window(&["new", "-o", "x.json", "--screenshot", "a.png"], &data);
+    let out = in_window(&["new", "-o", "x.json", "--screenshot", "a.png"], &data, 1);
     assert!(!out.status.success());
 }
 
@@ -320,7 +336,7 @@ fn sketch_in_window(name: &str, pace: &str) -> (Value, Value) {
     let data = temp(&format!("{name}-data"));
     let _one = DISPLAY.lock().unwrap_or_else(|e| e.into_inner());
     let out = Command::new("timeout")
-        .args(["300", "xvfb-run", "-a", "-s", "-screen 0 2048x1200x24"])
+        .args(["300", "xvfb-run", "-a", "-s", SCREEN])
         .args(["sh", "-c", DRIVE])
         .env("BIN", env!("CARGO_BIN_EXE_cloudsketch"))
         .env("SCENE", &scene)
