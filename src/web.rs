@@ -130,11 +130,11 @@ fn scene_from_url() -> Start {
         .unwrap_or_default();
     let preset = url_param("preset");
     if hash.starts_with("#s=") {
-        crate::ui::start_session(Opening::Link(&hash))
+        crate::ui::start_session(Opening::Link(&hash), true)
     } else if let Some(name) = &preset {
-        crate::ui::start_session(Opening::Preset(name))
+        crate::ui::start_session(Opening::Preset(name), true)
     } else {
-        crate::ui::start_session(Opening::Nothing)
+        crate::ui::start_session(Opening::Nothing, true)
     }
 }
 

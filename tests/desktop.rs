@@ -133,7 +133,13 @@ fn shoot(name: &str, size: &str, scale: usize, scene: Option<&Path>) -> Shot {
     assert!(out.status.success(), "{}", stderr(&out));
     // A run that succeeds prints no line that reads like a failure (Mesa's device-select layer
     // looking for a Wayland session printed `error: XDG_RUNTIME_DIR is invalid…` four times).
-    assert!(!stderr(&out).contains("error"), "{}", stderr(&out));
+    assert!(
+        !stderr(&out)
+            .lines()
+            .any(|l| l.starts_with("error") || l.contains("XDG_RUNTIME_DIR")),
+        "{}",
+        stderr(&out)
+    );
     Shot {
         scale,
         image: Rgba::read(&png),
@@ -289,24 +295,29 @@ const DRIVE: &str = r#"
 set -u
 "$BIN" "$SCENE" --window 1280x800 & app=$!
 trap 'kill $app 2>/dev/null' EXIT
+alive() { kill -0 "$app" 2>/dev/null || { echo "the app exited" >&2; exit 1; }; }
 wid=$(timeout 60 xdotool search --sync --onlyvisible --name '^cloudsketch$' | head -n 1)
 [ -n "$wid" ] || { echo "no window appeared" >&2; exit 1; }
-sleep 3  # the first frames (shaders compiled, the view drawn)
-xdotool windowfocus --sync "$wid" mousemove --window "$wid" 400 400 key d
+# Events sent before the first frame would wait for it (winit queues them); this only lets the
+# window settle so the input meets a running app, as a person's would.
+sleep 3
+alive
+xdotool windowfocus --sync "$wid" mousemove --window "$wid" 400 400 key d || exit 1
 sleep 0.5
 moves="mousemove --window $wid 520 400 mousedown 1"
 for i in $(seq 1 60); do
   xy=$(awk -v i="$i" 'BEGIN { a = i / 60 * 6.2831853; printf "%d %d", 400 + 120 * cos(a), 400 + 120 * sin(a) }')
   moves="$moves mousemove --window $wid $xy $PACE"
 done
-xdotool $moves mouseup 1
+xdotool $moves mouseup 1 || exit 1
 sleep 0.5
 # Saves with KEYS and waits (at most 60 s) for the file to change; copies it to $1.
 save() {
   before=$(stat -c %y "$SCENE")
-  xdotool key --window "$wid" $KEYS ctrl+s
+  xdotool key --window "$wid" $KEYS ctrl+s || exit 1
   for _ in $(seq 1 120); do
     [ "$(stat -c %y "$SCENE")" != "$before" ] && { cp "$SCENE" "$1"; return 0; }
+    alive
     sleep 0.5
   done
   echo "the scene was not saved ($1)" >&2; exit 1
@@ -367,14 +378,15 @@ fn plane_points(scene: &Value) -> Vec<usize> {
 
 #[test]
 fn the_window_keeps_every_sample_of_a_stroke_and_undoes_it() {
-    // 61 samples (the press and 60 moves): all of them, whether the moves come 15 ms apart
-    // (several frames' worth) or all at once (the press and the release in one frame, which
-    // egui calls a click; the stroke was lost before the press record).
+    // 61 samples (the press and 60 moves), every one, whether the moves come 15 ms apart
+    // (several frames' worth) or all at once (within a frame or two, which egui sees as neither
+    // a drag nor a click: the stroke was lost natively before the press record). Which frames
+    // the events fall into is the window's business; `ui::sketch_tool`'s unit test splits them
+    // deterministically.
     for (name, pace) in [("paced", "sleep 0.015"), ("burst", "")] {
         let (drawn, undone) = sketch_in_window(name, pace);
         let points = plane_points(&drawn);
-        assert_eq!(points.len(), 1, "{name}: one drawing plane, {points:?}");
-        assert!(points[0] >= 55, "{name}: {} of 61 samples", points[0]);
+        assert_eq!(points, [61], "{name}: one drawing plane with every sample");
         assert_eq!(plane_points(&undone), Vec::<usize>::new(), "{name}: undone");
     }
 }

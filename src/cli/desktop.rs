@@ -8,7 +8,7 @@ use crate::render::offscreen::Image;
 use crate::ui::{CloudApp, Host, Opening, PageStatus, Start, StartOptions};
 
 /// How long `--screenshot` waits for a full-quality image before giving up.
-const SCREENSHOT_WAIT_SECONDS: f64 = 300.0;
+const SCREENSHOT_WAIT_SECONDS: f64 = 240.0;
 
 /// What `--screenshot` asks for.
 pub struct Screenshot {
@@ -37,6 +37,7 @@ pub fn run(
             return Err(format!("{}: no such folder", path.display()));
         }
     }
+    let shooting = screenshot.is_some();
     let bytes = match open {
         Some(arg) if !arg.contains("#s=") => Some(
             std::fs::metadata(arg)
@@ -59,7 +60,8 @@ pub fn run(
         (Some(link), None) => Opening::Link(link),
         _ => Opening::Nothing,
     };
-    let start = crate::ui::start_session(opening);
+    // A screenshot run only looks: it keeps no autosave aside and writes none.
+    let start = crate::ui::start_session(opening, !shooting);
     if let Some((message, true)) = &start.notice {
         eprintln!("error: {message}");
     }
@@ -76,7 +78,6 @@ pub fn run(
         ..Default::default()
     };
     let outcome = Arc::new(Mutex::new(None));
-    let shooting = screenshot.is_some();
     let host = screenshot.map(|shot| {
         Box::new(WindowShot {
             shot,
@@ -97,7 +98,7 @@ pub fn run(
                     initial_cost: 1e-8,
                     notice,
                     file,
-                    autosave: true,
+                    autosave: !shooting,
                     ..Default::default()
                 },
             )))

@@ -176,7 +176,9 @@ enum Command {
 pub fn main() -> ExitCode {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     let cli = Cli::parse();
-    if cli.command.is_some() || std::env::var_os("XDG_RUNTIME_DIR").is_none() {
+    let runtime_folder = std::env::var_os("XDG_RUNTIME_DIR")
+        .is_some_and(|d| !d.is_empty() && std::path::Path::new(&d).is_dir());
+    if cli.command.is_some() || !runtime_folder {
         headless_vulkan();
     }
     let result = match cli.command {
@@ -265,8 +267,9 @@ pub fn main() -> ExitCode {
 /// machine without a display it connects to Wayland to look for one and prints two
 /// `error: XDG_RUNTIME_DIR is invalid…` lines that read like a failure. The layer's own switch
 /// turns it off for this process (unless the user set it). The desktop window keeps the layer
-/// where a session has a runtime folder (every graphical login does); without one (a virtual X
-/// display, as `xvfb-run` gives) the layer would print the same lines four times.
+/// where a session has a runtime folder (every graphical login does); without one, or with one
+/// that is not a folder (a virtual X display, as `xvfb-run` gives), the layer would print the
+/// same lines four times.
 fn headless_vulkan() {
     if std::env::var_os("NODEVICE_SELECT").is_none() {
         // SAFETY: called at start-up, before this process starts any thread.

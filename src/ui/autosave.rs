@@ -113,11 +113,12 @@ pub fn starting_scene(opening: Opening, autosave: Option<&str>) -> Start {
 }
 
 /// How a session starts ([`starting_scene`] over the platform's autosave); keeps the autosave
-/// aside when the session will not continue it.
-pub fn start_session(opening: Opening) -> Start {
+/// aside when the session will not continue it and `autosaving` (it will write its own; a
+/// desktop `--screenshot` run writes none and leaves the user's files as they are).
+pub fn start_session(opening: Opening, autosaving: bool) -> Start {
     let saved = super::platform::load_autosave();
     let start = starting_scene(opening, saved.as_deref());
-    if start.keep_previous {
+    if start.keep_previous && autosaving {
         super::platform::keep_previous_autosave();
     }
     start

@@ -86,7 +86,7 @@ fn record_events(record: &mut PressRecord, events: &[egui::Event], still_down: b
 }
 
 /// The primary button's last whole press → release (every sample, from the press), once: a
-/// stroke drawn within one long frame, which egui reports as a click.
+/// stroke drawn within one long frame, which egui reports as neither a drag nor a click.
 pub fn take_finished_press() -> Option<Vec<Sample>> {
     RECORD.with(|r| r.borrow_mut().take_finished())
 }

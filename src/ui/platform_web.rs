@@ -424,7 +424,8 @@ fn install_pointer_samples(ctx: &egui::Context) {
 pub fn record_frame(_input: &egui::InputState) {}
 
 /// The primary pointer's last whole press → release over the view (every sample, from the
-/// press), once: a stroke drawn within one long frame, which egui reports as a click.
+/// press), once: a stroke drawn within one long frame, which egui reports as neither a drag
+/// nor a click.
 pub fn take_finished_press() -> Option<Vec<Sample>> {
     RECORD.with(|r| r.borrow_mut().take_finished())
 }

@@ -29,13 +29,13 @@ impl PressRecord {
     }
 
     /// The pointer moved through `new` with a button down. Both buffers keep at most a plane's
-    /// worth of points (a held button with no stroke being drawn must not grow them unbounded).
+    /// worth of points, the first ones, as a stroke being drawn does (a held button must not
+    /// grow them unbounded).
     pub fn moved(&mut self, new: &[Sample]) {
         let cap = crate::limits::MAX_PLANE_POINTS;
         for buffer in [&mut self.samples, &mut self.press] {
-            buffer.extend_from_slice(new);
-            let excess = buffer.len().saturating_sub(cap);
-            buffer.drain(..excess);
+            let room = cap.saturating_sub(buffer.len());
+            buffer.extend(new.iter().take(room));
         }
     }
 
@@ -124,7 +124,9 @@ mod tests {
             .map(|i| (pos2(i as f32, 0.0), None))
             .collect();
         r.moved(&moves);
-        assert_eq!(r.press_so_far().len(), crate::limits::MAX_PLANE_POINTS);
+        let press = r.press_so_far();
+        assert_eq!(press.len(), crate::limits::MAX_PLANE_POINTS);
+        assert_eq!(press[0].0.x, 0.0, "the press's start is kept");
         assert_eq!(r.take_samples().len(), crate::limits::MAX_PLANE_POINTS);
         r.lost();
         assert!(!r.is_down() && r.press_so_far().is_empty());

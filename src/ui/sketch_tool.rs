@@ -380,14 +380,17 @@ impl SketchTool {
         let samples = super::platform::take_pointer_samples();
         // A whole press → release recorded (see `quick` below).
         let press = super::platform::take_finished_press();
-        let started = response.drag_started_by(egui::PointerButton::Primary);
-        if started {
+        // The stroke starts from the recorded press, which holds this frame's samples too; a
+        // press the record missed starts where egui saw the button go down.
+        let mut seeded = false;
+        if response.drag_started_by(egui::PointerButton::Primary) {
             // Every sample since the button went down, not just where it went down: egui
             // recognises the drag a frame or more after the press, and those frames hold the
             // stroke's start (this frame's samples among them).
             let so_far = super::platform::press_samples();
+            seeded = !so_far.is_empty();
             (self.stroke, self.pressure) = so_far.into_iter().unzip();
-            if self.stroke.is_empty()
+            if !seeded
                 && let Some(p) = ui
                     .input(|i| i.pointer.press_origin())
                     .or(response.interact_pointer_pos())
@@ -397,7 +400,7 @@ impl SketchTool {
             }
             self.drawing = true;
         }
-        if self.drawing && !started {
+        if self.drawing && !seeded {
             for (p, pressure) in samples {
                 if self.stroke.last() != Some(&p) && self.stroke.len() < MAX_PLANE_POINTS {
                     self.stroke.push(p);
@@ -1062,6 +1065,75 @@ mod tests {
             pen_pressure(&[None, Some(0.2), None, Some(0.8)]),
             [0.2, 0.2, 0.2, 0.8]
         );
+    }
+
+    /// A stroke through egui as the window gets it: the pointer over the view, then pressed at
+    /// the right of a circle, 60 moves around it and the release, those events split over
+    /// `frames` frames 0.15 s apart (a slow adapter's), then two idle frames. Returns each drawing plane's
+    /// point count.
+    fn stroke_over_frames(frames: usize) -> Vec<usize> {
+        use egui::{Event, Modifiers, PointerButton, RawInput, Sense, pos2};
+        let rect = crate::ui::test_view();
+        let at = |i: usize| {
+            let a = i as f32 / 60.0 * std::f32::consts::TAU;
+            pos2(640.0 + 120.0 * a.cos(), 400.0 + 120.0 * a.sin())
+        };
+        let button = |pressed| Event::PointerButton {
+            pos: at(60),
+            button: PointerButton::Primary,
+            pressed,
+            modifiers: Modifiers::NONE,
+        };
+        let mut events = vec![button(true)];
+        events.extend((1..=60).map(|i| Event::PointerMoved(at(i))));
+        events.push(button(false));
+        let per_frame = events.len().div_ceil(frames);
+        // A frame with the pointer over the view first (egui hit-tests against the last frame).
+        let mut chunks = vec![vec![Event::PointerMoved(at(0))]];
+        chunks.extend(events.chunks(per_frame).map(<[_]>::to_vec));
+        chunks.extend([Vec::new(), Vec::new()]);
+
+        let ctx = egui::Context::default();
+        let mut tool = SketchTool {
+            tool: Tool::Sketch,
+            ..Default::default()
+        };
+        let mut doc = Document::new(crate::scene::Scene::preset(crate::scene::Preset::Empty));
+        let (mut derived, mut selection, mut notices) = Default::default();
+        for (frame, events) in chunks.into_iter().enumerate() {
+            let raw = RawInput {
+                screen_rect: Some(rect),
+                time: Some(frame as f64 * 0.15),
+                events,
+                ..Default::default()
+            };
+            let _ = ctx.run_ui(raw, |ui| {
+                let response = ui.allocate_rect(rect, Sense::click_and_drag());
+                let view = ViewInput {
+                    ui,
+                    response: &response,
+                    rect,
+                };
+                let mut tc = ToolContext {
+                    doc: &mut doc,
+                    derived: &mut derived,
+                    selection: &mut selection,
+                    notices: &mut notices,
+                };
+                tool.input(&view, &mut tc);
+            });
+        }
+        doc.scene().planes.iter().map(|p| p.points.len()).collect()
+    }
+
+    #[test]
+    fn a_stroke_keeps_every_sample_however_its_events_fall_into_frames() {
+        // 61 samples (the press and 60 moves), all kept: within one frame and over two egui
+        // sees no drag (the press record draws it), over more the drag starts a frame after
+        // the press (and begins with every sample since it).
+        for frames in [1, 2, 3, 5, 31, 63] {
+            assert_eq!(stroke_over_frames(frames), [61], "over {frames} frames");
+        }
     }
 
     fn axis_angle(q: Quat) -> (Vec3, f32) {

@@ -35,7 +35,11 @@ export function serve() {
     if (!file.startsWith(DIST) || !fs.existsSync(file) || fs.statSync(file).isDirectory()) { res.writeHead(404); res.end(); return; }
     // As a host with precompressed files does (web/precompress.mjs): the Brotli or gzip copy
     // where the browser accepts it, else the file itself.
-    const accepted = (req.headers['accept-encoding'] ?? '').split(',').map((e) => e.trim().split(';')[0]);
+    // Encodings the browser accepts (`br;q=0` refuses Brotli).
+    const accepted = (req.headers['accept-encoding'] ?? '').split(',')
+      .map((e) => e.trim().split(';').map((p) => p.trim()))
+      .filter(([, q]) => !/^q=0(\.0*)?$/.test(q ?? ''))
+      .map(([name]) => name);
     const encoding = ENCODINGS.find((e) => accepted.includes(e.name) && fs.existsSync(file + e.suffix));
     res.writeHead(200, {
       'content-type': TYPES[path.extname(file)] ?? 'application/octet-stream',
