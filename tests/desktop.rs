@@ -16,19 +16,24 @@ static DISPLAY: Mutex<()> = Mutex::new(());
 /// The virtual display: room for a 1280×800-point window at 2 pixels a point.
 const SCREEN: &str = "-screen 0 2600x1700x24";
 
+/// Fails with what to install when `tool` (from Debian's `package`) is missing.
+fn require(tool: &str, package: &str) {
+    let found = Command::new("sh")
+        .args(["-c", &format!("command -v {tool}")])
+        .output()
+        .is_ok_and(|o| o.status.success());
+    assert!(
+        found,
+        "{tool} is missing: scripts/setup.sh installs it (Debian's {package})"
+    );
+}
+
 /// Runs the binary under `xvfb-run` with a 2600×1700 screen at `scale` device pixels per point
 /// (winit's X11 scale factor, as a HiDPI desktop sets it); no autosave of the user's is read or
 /// written (a fresh data folder per run).
 fn in_window(args: &[&str], data: &Path, scale: usize) -> Output {
     let _one = DISPLAY.lock().unwrap_or_else(|e| e.into_inner());
-    let found = Command::new("sh")
-        .args(["-c", "command -v xvfb-run"])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    assert!(
-        found,
-        "xvfb-run is missing: scripts/setup.sh installs it (Debian's xvfb)"
-    );
+    require("xvfb-run", "xvfb");
     Command::new("timeout")
         .args(["300", "xvfb-run", "-a", "-s", SCREEN])
         .arg(env!("CARGO_BIN_EXE_cloudsketch"))
@@ -329,14 +334,7 @@ KEYS="ctrl+z" save "$SAVED2"
 /// Sketches a stroke in the window (moves `pace` apart, e.g. `sleep 0.015`, or all at once),
 /// and returns the scene saved after it and the one saved after undoing it.
 fn sketch_in_window(name: &str, pace: &str) -> (Value, Value) {
-    let found = Command::new("sh")
-        .args(["-c", "command -v xdotool"])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    assert!(
-        found,
-        "xdotool is missing: scripts/setup.sh installs it (Debian's xdotool)"
-    );
+    require("xdotool", "xdotool");
     let scene = temp(&format!("{name}.json"));
     let empty = cloudsketch::scene::Scene::preset(cloudsketch::scene::Preset::Empty);
     std::fs::write(&scene, empty.to_json()).unwrap();

@@ -3,7 +3,7 @@
 //! files and the autosave in the user's data folder.
 
 use super::guide::Loaded;
-use super::press_record::{PressRecord, Sample};
+use super::press_record::{PressRecord, with_record};
 use crate::limits::MAX_FILE_BYTES as MAX_BYTES;
 
 /// What the GL backend is called here.
@@ -46,16 +46,11 @@ pub fn read_path(path: &str) -> Loaded {
         .map_err(|e| format!("{path}: {e}"))
 }
 
-thread_local! {
-    /// Every sample of the primary button's presses, from egui's events.
-    static RECORD: std::cell::RefCell<PressRecord> = std::cell::RefCell::new(PressRecord::default());
-}
-
 /// Feeds this frame's events to the press record: natively egui's events carry every cursor
 /// move (and no pen pressure). Called once a frame by the tools that draw strokes.
 pub fn record_frame(input: &egui::InputState) {
     let down = input.pointer.primary_down();
-    RECORD.with(|r| record_events(&mut r.borrow_mut(), &input.events, down));
+    with_record(|r| record_events(r, &input.events, down));
 }
 
 /// Feeds one frame of egui's events to `record`. `still_down` is egui's view of the primary
@@ -83,22 +78,6 @@ fn record_events(record: &mut PressRecord, events: &[egui::Event], still_down: b
     if !still_down && record.is_down() {
         record.lost();
     }
-}
-
-/// The primary button's last whole press → release (every sample, from the press), once: a
-/// stroke drawn within one long frame, which egui reports as neither a drag nor a click.
-pub fn take_finished_press() -> Option<Vec<Sample>> {
-    RECORD.with(|r| r.borrow_mut().take_finished())
-}
-
-/// Pointer positions (in points) since the last call while the primary button was down.
-pub fn take_pointer_samples() -> Vec<Sample> {
-    RECORD.with(|r| r.borrow_mut().take_samples())
-}
-
-/// Every sample of the press under way, from where the button went down.
-pub fn press_samples() -> Vec<Sample> {
-    RECORD.with(|r| r.borrow().press_so_far())
 }
 
 /// Where the autosave lives: `$XDG_DATA_HOME/cloudsketch`, else `~/.local/share/cloudsketch`.

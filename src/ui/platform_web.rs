@@ -10,7 +10,7 @@ use wasm_bindgen::JsCast as _;
 use wasm_bindgen::prelude::*;
 
 use super::guide::Loaded;
-use super::press_record::{PressRecord, Sample};
+use super::press_record::{Sample, with_record};
 
 use crate::limits::MAX_FILE_BYTES;
 
@@ -52,8 +52,6 @@ const MAX_BYTES: f64 = MAX_FILE_BYTES as f64;
 
 thread_local! {
     static INBOX: RefCell<Vec<Loaded>> = const { RefCell::new(Vec::new()) };
-    /// Every sample of the primary pointer's presses, from the page's own listeners.
-    static RECORD: RefCell<PressRecord> = RefCell::new(PressRecord::default());
     static REPAINT: RefCell<Option<egui::Context>> = const { RefCell::new(None) };
     static LINKS: RefCell<Vec<String>> = const { RefCell::new(Vec::new()) };
     static SCENE_FILES: RefCell<Vec<Loaded>> = const { RefCell::new(Vec::new()) };
@@ -365,7 +363,7 @@ fn install_pointer_samples(ctx: &egui::Context) {
                 })
             {
                 let at = sample_at(&e, down_ctx.zoom_factor());
-                RECORD.with(|r| r.borrow_mut().pressed(at));
+                with_record(|r| r.pressed(at));
             }
         });
     let _ = document.add_event_listener_with_callback_and_bool(
@@ -376,7 +374,7 @@ fn install_pointer_samples(ctx: &egui::Context) {
     on_down.forget(); // lives as long as the page
     let on_up = Closure::<dyn FnMut(web_sys::PointerEvent)>::new(|e: web_sys::PointerEvent| {
         if e.is_primary() {
-            RECORD.with(|r| r.borrow_mut().released(None));
+            with_record(|r| r.released(None));
         }
     });
     let _ = document.add_event_listener_with_callback_and_bool(
@@ -394,9 +392,9 @@ fn install_pointer_samples(ctx: &egui::Context) {
             }
             if e.buttons() == 0 {
                 // No button down: a press whose release the page never heard is over.
-                RECORD.with(|r| {
-                    if r.borrow().is_down() {
-                        r.borrow_mut().lost();
+                with_record(|r| {
+                    if r.is_down() {
+                        r.lost();
                     }
                 });
                 return;
@@ -412,7 +410,7 @@ fn install_pointer_samples(ctx: &egui::Context) {
                     new.extend(sample_at(&m, zoom));
                 }
             }
-            RECORD.with(|r| r.borrow_mut().moved(&new));
+            with_record(|r| r.moved(&new));
         });
     let _ =
         document.add_event_listener_with_callback("pointermove", on_move.as_ref().unchecked_ref());
@@ -422,24 +420,6 @@ fn install_pointer_samples(ctx: &egui::Context) {
 /// Nothing to feed: the page's listeners record every sample as it comes (egui's events in
 /// the browser hold one move per frame).
 pub fn record_frame(_input: &egui::InputState) {}
-
-/// The primary pointer's last whole press → release over the view (every sample, from the
-/// press), once: a stroke drawn within one long frame, which egui reports as neither a drag
-/// nor a click.
-pub fn take_finished_press() -> Option<Vec<Sample>> {
-    RECORD.with(|r| r.borrow_mut().take_finished())
-}
-
-/// Pointer positions (in points) since the last call, every sample the browser saw while the
-/// primary pointer was down, each with the pen's pressure when a pen drew it.
-pub fn take_pointer_samples() -> Vec<Sample> {
-    RECORD.with(|r| r.borrow_mut().take_samples())
-}
-
-/// Every sample of the press under way, from where the button went down.
-pub fn press_samples() -> Vec<Sample> {
-    RECORD.with(|r| r.borrow().press_so_far())
-}
 
 /// Installs the page's listeners: pointer samples, the file inputs' changes and the address
 /// bar's fragment (once, at start-up).

@@ -3,8 +3,38 @@
 //! every sample however few frames it spans: egui recognises a drag a frame or more after the
 //! press, and a stroke within one long frame is no drag at all to egui.
 
+use std::cell::RefCell;
+
 /// A pointer position in points, with the pen's pressure when a pen drew it.
 pub type Sample = (egui::Pos2, Option<f32>);
+
+thread_local! {
+    /// The UI thread's record, fed by the platform (`platform::record_frame` natively, the
+    /// page's pointer listeners in the browser).
+    static RECORD: RefCell<PressRecord> = RefCell::new(PressRecord::default());
+}
+
+/// Runs `f` on this thread's record.
+pub fn with_record<R>(f: impl FnOnce(&mut PressRecord) -> R) -> R {
+    RECORD.with(|r| f(&mut r.borrow_mut()))
+}
+
+/// The primary button's last whole press → release (every sample, from the press), once: a
+/// stroke drawn within one long frame, which egui reports as neither a drag nor a click.
+pub fn take_finished_press() -> Option<Vec<Sample>> {
+    with_record(PressRecord::take_finished)
+}
+
+/// Pointer positions (in points) since the last call while the primary button was down, each
+/// with the pen's pressure when a pen drew it.
+pub fn take_pointer_samples() -> Vec<Sample> {
+    with_record(PressRecord::take_samples)
+}
+
+/// Every sample of the press under way, from where the button went down.
+pub fn press_samples() -> Vec<Sample> {
+    with_record(|r| r.press_so_far())
+}
 
 /// The primary button's press being recorded, the samples since they were last taken, and the
 /// last whole press → release.

@@ -372,14 +372,14 @@ impl SketchTool {
             self.stroke.clear();
             self.drawing = false;
             // An orbit, not a stroke: its recorded press is dropped.
-            let _ = super::platform::take_finished_press();
+            let _ = super::press_record::take_finished_press();
             return true;
         }
         // Every pointer sample since the last frame, not one position per frame: on a slow
         // adapter a frame can hold a dozen samples of a fast stroke.
-        let samples = super::platform::take_pointer_samples();
+        let samples = super::press_record::take_pointer_samples();
         // A whole press → release recorded (see `quick` below).
-        let press = super::platform::take_finished_press();
+        let press = super::press_record::take_finished_press();
         // The stroke starts from the recorded press, which holds this frame's samples too; a
         // press the record missed starts where egui saw the button go down.
         let mut seeded = false;
@@ -387,7 +387,7 @@ impl SketchTool {
             // Every sample since the button went down, not just where it went down: egui
             // recognises the drag a frame or more after the press, and those frames hold the
             // stroke's start (this frame's samples among them).
-            let so_far = super::platform::press_samples();
+            let so_far = super::press_record::press_samples();
             seeded = !so_far.is_empty();
             (self.stroke, self.pressure) = so_far.into_iter().unzip();
             if !seeded
