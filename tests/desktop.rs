@@ -4,6 +4,7 @@
 //! the page's test contract natively; xdotool (also from setup.sh) drives the pointer and the
 //! keyboard, and the scene the window saves (Ctrl+S) shows what the input did.
 
+use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::Mutex;
@@ -28,16 +29,23 @@ fn require(tool: &str, package: &str) {
     );
 }
 
-/// Runs the binary under `xvfb-run` with a 2600×1700 screen at `scale` device pixels per point
-/// (winit's X11 scale factor, as a HiDPI desktop sets it); no autosave of the user's is read or
-/// written (a fresh data folder per run).
-fn in_window(args: &[&str], data: &Path, scale: usize) -> Output {
+/// Runs `program` with `args` under `xvfb-run` with a 2600×1700 screen at `scale` device pixels
+/// per point (winit's X11 scale factor, as a HiDPI desktop sets it), one display at a time; no
+/// autosave of the user's is read or written (`data` is a fresh data folder per run). `env`
+/// adds variables.
+fn under_xvfb(
+    program: &str,
+    args: &[&str],
+    data: &Path,
+    scale: usize,
+    env: &[(&str, &OsStr)],
+) -> Output {
     let _one = DISPLAY.lock().unwrap_or_else(|e| e.into_inner());
     require("xvfb-run", "xvfb");
     Command::new("timeout")
-        .args(["300", "xvfb-run", "-a", "-s", SCREEN])
-        .arg(env!("CARGO_BIN_EXE_cloudsketch"))
+        .args(["300", "xvfb-run", "-a", "-s", SCREEN, program])
         .args(args)
+        .envs(env.iter().copied())
         .env("XDG_DATA_HOME", data)
         .env("WINIT_X11_SCALE_FACTOR", scale.to_string())
         // As a user's shell on a machine without a graphical login has it (scripts/test.sh
@@ -45,7 +53,12 @@ fn in_window(args: &[&str], data: &Path, scale: usize) -> Output {
         .env_remove("NODEVICE_SELECT")
         .env_remove("XDG_RUNTIME_DIR")
         .output()
-        .expect("run cloudsketch under xvfb-run")
+        .expect("run under xvfb-run")
+}
+
+/// Runs the binary with `args` in a window (see [`under_xvfb`]).
+fn in_window(args: &[&str], data: &Path, scale: usize) -> Output {
+    under_xvfb(env!("CARGO_BIN_EXE_cloudsketch"), args, data, scale, &[])
 }
 
 fn temp(name: &str) -> PathBuf {
@@ -343,18 +356,19 @@ fn sketch_in_window(name: &str, pace: &str) -> (Value, Value) {
         let _ = std::fs::remove_file(path);
     }
     let data = temp(&format!("{name}-data"));
-    let _one = DISPLAY.lock().unwrap_or_else(|e| e.into_inner());
-    let out = Command::new("timeout")
-        .args(["300", "xvfb-run", "-a", "-s", SCREEN])
-        .args(["sh", "-c", DRIVE])
-        .env("BIN", env!("CARGO_BIN_EXE_cloudsketch"))
-        .env("SCENE", &scene)
-        .env("SAVED1", &saved[0])
-        .env("SAVED2", &saved[1])
-        .env("PACE", pace)
-        .env("XDG_DATA_HOME", &data)
-        .output()
-        .expect("run the window under xvfb-run");
+    let out = under_xvfb(
+        "sh",
+        &["-c", DRIVE],
+        &data,
+        1,
+        &[
+            ("BIN", OsStr::new(env!("CARGO_BIN_EXE_cloudsketch"))),
+            ("SCENE", scene.as_os_str()),
+            ("SAVED1", saved[0].as_os_str()),
+            ("SAVED2", saved[1].as_os_str()),
+            ("PACE", OsStr::new(pace)),
+        ],
+    );
     assert!(out.status.success(), "{}", stderr(&out));
     saved
         .map(|path| serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap())
