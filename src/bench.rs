@@ -666,8 +666,30 @@ fn links() -> Vec<BenchResult> {
     out
 }
 
-/// Runs the suite (or only the groups named in `only`, comma-separated) and prints it.
+/// The groups `--only` may name.
+pub const GROUPS: [&str; 15] = [
+    "sketch", "light", "stroke", "worst", "field", "link", "mesh", "simulate", "ca", "shafts",
+    "render", "march", "quality", "gpu", "all",
+];
+
+/// Runs the suite (or only the groups named in `only`, comma-separated) and prints it. A group
+/// name it does not know is an error, before anything runs.
 pub fn run(json: bool, only: Option<&str>) -> Result<(), String> {
+    if let Some(only) = only {
+        let unknown: Vec<&str> = only
+            .split(',')
+            .map(str::trim)
+            .filter(|g| !GROUPS.contains(g))
+            .collect();
+        if !unknown.is_empty() {
+            return Err(format!(
+                "--only: no bench group {} (the groups: {})",
+                unknown.join(", "),
+                GROUPS[..GROUPS.len() - 1].join(", ")
+            ));
+        }
+    }
+    let only = only.filter(|o| !o.split(',').any(|g| g.trim() == "all"));
     let mut offscreen = Offscreen::new().map_err(|e| e.to_string())?;
     let machine = format!(
         "{} cores, {} {}; adapter {}",

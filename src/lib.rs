@@ -12,6 +12,7 @@
 //! - [`limits`], [`seeded`]: every cap and range, and seeded randomness (pure);
 //! - [`render`]: the only user of wgpu;
 //! - [`ui`]: the eframe app;
+//! - `files` (native): the one safe writer and the one bounded reader;
 //! - `cli`, `bench` (native) and `web` (wasm32): the entry points of each target.
 
 pub mod derive;
@@ -30,6 +31,8 @@ pub mod ui;
 pub mod bench;
 #[cfg(not(target_arch = "wasm32"))]
 pub mod cli;
+#[cfg(not(target_arch = "wasm32"))]
+pub mod files;
 #[cfg(target_arch = "wasm32")]
 pub mod web;
 

@@ -1,7 +1,8 @@
 //! Architecture invariants, checked on the source text (in the style of rust-analyzer's tidy
 //! tests): the pure core imports no UI, GPU or browser crate; only `render` uses wgpu;
-//! `cfg(target_arch = "wasm32")` appears only in the files ARCHITECTURE.md lists; and every
-//! source and shader file is named in ARCHITECTURE.md's code map.
+//! `cfg(target_arch = "wasm32")` appears only in the files ARCHITECTURE.md lists; every file is
+//! written through `files::write_atomic`; and every source and shader file is named in
+//! ARCHITECTURE.md's code map.
 
 use std::path::{Path, PathBuf};
 
@@ -103,6 +104,34 @@ fn only_render_uses_wgpu() {
     assert!(bad.is_empty(), "wgpu used outside src/render/: {bad:?}");
 }
 
+/// The code of a source file before its unit tests (`#[cfg(test)]`, by convention at the end).
+fn before_tests(code: &str) -> &str {
+    code.find("#[cfg(test)]").map_or(code, |i| &code[..i])
+}
+
+/// Files whose writing does not go through `files::write_atomic`: `fs::write` or `File::create`.
+fn writes_in_place(code: &str) -> bool {
+    let code = before_tests(code);
+    code.contains("fs::write(") || code.contains("File::create(")
+}
+
+#[test]
+fn every_file_is_written_through_the_one_safe_writer() {
+    let bad: Vec<String> = sources()
+        .into_iter()
+        // `files.rs` is the writer; a module's unit tests in their own `tests.rs` may write
+        // their fixtures as they like.
+        .filter(|(path, code)| {
+            path != "src/files.rs" && !path.ends_with("/tests.rs") && writes_in_place(code)
+        })
+        .map(|(path, _)| path)
+        .collect();
+    assert!(
+        bad.is_empty(),
+        "files written in place (use cloudsketch::files::write_atomic): {bad:?}"
+    );
+}
+
 fn architecture() -> String {
     std::fs::read_to_string(root().join("ARCHITECTURE.md")).unwrap()
 }
@@ -157,4 +186,10 @@ fn the_checks_catch_what_they_look_for() {
     assert!(uses("let x = wgpu::Color::RED;", "wgpu"));
     assert!(!uses("egui_wgpu::Callback::new()", "wgpu"));
     assert!(!uses("my_wgpu::x", "wgpu"));
+    // The writer check: a write in place is found, one in a unit test module is not.
+    assert!(writes_in_place("std::fs::write(path, bytes)?;"));
+    assert!(writes_in_place("let f = std::fs::File::create(&p)?;"));
+    assert!(!writes_in_place(
+        "files::write_atomic(p, b)?;\n#[cfg(test)]\nfs::write(p, b)"
+    ));
 }

@@ -257,7 +257,34 @@ fn sketch_makes_a_scene_and_spheres_that_fit_the_outline() {
         zmin = zmin.min(c[2] - r);
         zmax = zmax.max(c[2] + r);
     }
-    assert!(zmax - zmin >= 0.4 * 110.0, "depth {}", zmax - zmin);
+    // Deeper than the same stroke without the 3D extension, whose depth is its widest
+    // sphere's (measured 132 against 118).
+    let flat_path = temp("spheres-flat.json");
+    let out = cloudsketch(&[
+        "sketch",
+        stroke.to_str().unwrap(),
+        "-o",
+        temp("sketched-flat.json").to_str().unwrap(),
+        "--spheres-out",
+        flat_path.to_str().unwrap(),
+        "--seed",
+        "5",
+        "--no-extend",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let flat: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&flat_path).unwrap()).unwrap();
+    let flat_depth = flat["spheres"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| 2.0 * s["radius"].as_f64().unwrap())
+        .fold(0.0, f64::max);
+    assert!(
+        zmax - zmin >= 1.05 * flat_depth,
+        "depth {} with the extension, {flat_depth} without",
+        zmax - zmin
+    );
 
     // The scene renders: the cloud is where the default camera looks.
     let png = temp("sketched.png");
@@ -502,10 +529,213 @@ fn export_and_simulate_refuse_bad_requests_clearly_and_write_what_is_asked() {
         out.to_str().unwrap(),
     ]);
     assert!(stderr(&o).contains("no simulation"), "{}", stderr(&o));
+    assert!(
+        !o.status.success(),
+        "a scene without a simulation is an error"
+    );
+    assert!(!out.exists(), "nothing was written");
     // The simulated preset's run writes a VDB that starts with OpenVDB's magic.
     let vdb = temp("sim.vdb");
     let o = cloudsketch(&["simulate", "--steps", "30", "-o", vdb.to_str().unwrap()]);
     assert!(o.status.success(), "{}", stderr(&o));
     let bytes = std::fs::read(&vdb).unwrap();
     assert_eq!(&bytes[..8], &0x5644_4220i64.to_le_bytes());
+}
+
+/// The files in a folder, sorted.
+fn listing(dir: &std::path::Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+/// A fresh folder of its own under the test's temporary folder.
+fn folder(name: &str) -> PathBuf {
+    let dir = temp(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+#[test]
+fn outputs_that_collide_or_cannot_be_written_are_refused_before_any_work() {
+    let dir = folder("collide");
+    // Leaked: each is one short path, for the lists of arguments below.
+    let at = |name: &str| -> &'static str {
+        Box::leak(dir.join(name).to_str().unwrap().to_owned().into_boxed_str())
+    };
+    let scene = at("scene.json");
+    assert!(cloudsketch(&["new", "-o", &scene]).status.success());
+    let scene_text = std::fs::read(&scene).unwrap();
+    let stroke = write_stroke("collide-stroke.json", &canvas_cloud(), true);
+    let stroke = stroke.to_str().unwrap();
+    std::fs::create_dir(dir.join("taken.vol")).unwrap();
+    std::fs::write(dir.join("taken.vol/inside"), b"x").unwrap();
+    let dot_a = format!("{}/./a.json", dir.display());
+    let dot_a = dot_a.as_str();
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        // Mitsuba's volume would overwrite its own XML.
+        (
+            vec!["export", &scene, "--format", "mitsuba", "-o", at("foo.vol")],
+            "the same file as the output",
+        ),
+        (
+            vec!["sketch", stroke, "-o", at("a.json"), "--spheres-out", dot_a],
+            "the same file as the output",
+        ),
+        (
+            vec!["render", &scene, "-o", &scene],
+            "the same file as the input",
+        ),
+        (
+            vec!["export", &scene, "--format", "vdb", "-o", &scene],
+            "the same file as the input",
+        ),
+        // Mitsuba's volume cannot be written (a folder holds its name): no XML either.
+        (
+            vec![
+                "export",
+                &scene,
+                "--format",
+                "mitsuba",
+                "-o",
+                at("taken.xml"),
+            ],
+            "taken.vol: a folder",
+        ),
+        (
+            vec!["render", &scene, "-o", at("nowhere/x.png")],
+            "no such folder",
+        ),
+        (
+            vec!["render", &scene, "-o", dir.to_str().unwrap()],
+            "a folder",
+        ),
+    ];
+    for (args, says) in &cases {
+        let o = cloudsketch(args);
+        assert!(!o.status.success(), "{args:?} succeeded");
+        assert!(stderr(&o).contains(says), "{args:?}: {}", stderr(&o));
+        assert_eq!(
+            listing(&dir),
+            ["scene.json", "taken.vol"],
+            "{args:?} left files behind"
+        );
+        assert_eq!(std::fs::read(&scene).unwrap(), scene_text, "{args:?}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn what_a_file_holds_is_said_plainly() {
+    let dir = folder("plain");
+    // Leaked: each is one short path, for the lists of arguments below.
+    let at = |name: &str| -> &'static str {
+        Box::leak(dir.join(name).to_str().unwrap().to_owned().into_boxed_str())
+    };
+    let png = at("never.png");
+    std::fs::write(at("empty.json"), "{}").unwrap();
+    let stroke = write_stroke("plain-stroke.json", &canvas_cloud(), true);
+    std::fs::write(
+        at("three.json"),
+        r#"{"points": [[0, 0, 1], [1, 0], [0, 1]]}"#,
+    )
+    .unwrap();
+    let huge: Vec<[f64; 2]> = canvas_cloud()
+        .iter()
+        .map(|&[x, y]| [x * 1e200, y * 1e200])
+        .collect();
+    let huge = write_stroke("plain-huge.json", &huge, true);
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (
+            vec!["render", at("empty.json"), "-o", &png],
+            "holds none of a scene's members",
+        ),
+        (
+            vec!["render", stroke.to_str().unwrap(), "-o", &png],
+            "holds none of a scene's members",
+        ),
+        (vec!["render", "", "-o", &png], "the path is empty"),
+        (
+            vec!["sketch", at("three.json"), "-o", at("s.json")],
+            "point 0 has 3 numbers",
+        ),
+        (
+            vec!["sketch", huge.to_str().unwrap(), "-o", at("s.json")],
+            "a stroke spans",
+        ),
+        (vec!["bench", "--only", "bogus"], "no bench group bogus"),
+        (
+            vec![
+                "export",
+                "--format",
+                "obj",
+                "--scale",
+                "1e38",
+                "-o",
+                at("big.obj"),
+            ],
+            "--scale",
+        ),
+    ];
+    for (args, says) in &cases {
+        let o = cloudsketch(args);
+        assert!(!o.status.success(), "{args:?} succeeded");
+        let err = stderr(&o);
+        assert!(err.contains(says), "{args:?}: {err}");
+        assert!(!err.contains(": :"), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+    }
+    assert!(!std::path::Path::new(&png).exists());
+
+    // A byte-order mark before a scene is no error; a file whose name holds `#s=` is a file.
+    let scene = at("x#s=AQ.json");
+    assert!(
+        cloudsketch(&["new", "--preset", "empty", "-o", &scene])
+            .status
+            .success()
+    );
+    let mut bom = b"\xef\xbb\xbf".to_vec();
+    bom.extend(std::fs::read(&scene).unwrap());
+    std::fs::write(&scene, bom).unwrap();
+    let o = cloudsketch(&["link", &scene]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_sketched_scenes_link_holds_its_strokes_exactly() {
+    // `sketch` stores strokes on the stroke grid as the app does, so the link of its scene
+    // decodes to the very same points (before, they moved by up to half a step).
+    let stroke = write_stroke("exact-stroke.json", &canvas_cloud(), true);
+    let scene = temp("exact.json");
+    let o = cloudsketch(&[
+        "sketch",
+        stroke.to_str().unwrap(),
+        "-o",
+        scene.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = cloudsketch(&["link", scene.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        !stderr(&o).contains("off the stroke grid"),
+        "{}",
+        stderr(&o)
+    );
+    let url = String::from_utf8_lossy(&o.stdout).trim().to_owned();
+    let back = temp("exact-back.json");
+    let o = cloudsketch(&["link", "--decode", &url, "-o", back.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let read = |p: &std::path::Path| {
+        cloudsketch::scene::Scene::from_json(&std::fs::read_to_string(p).unwrap())
+            .unwrap()
+            .0
+    };
+    let (sketched, decoded) = (read(&scene), read(&back));
+    assert_eq!(sketched.planes.len(), 1);
+    assert_eq!(decoded.planes[0].points, sketched.planes[0].points);
 }

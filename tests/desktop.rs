@@ -252,9 +252,18 @@ fn default_cloud(width: usize, height: usize, scale: usize) -> Shot {
 #[test]
 fn the_window_draws_the_default_cloud_beside_its_panel_and_opens_a_scene_file() {
     default_cloud(1920, 1080, 1);
-    // A HiDPI screen: the same window in twice the pixels, the cloud drawn in them.
-    default_cloud(1280, 800, 2);
-    let (_, area) = cloud_pixels(&default_cloud(1280, 800, 1));
+    // A HiDPI screen: the same window in twice the pixels, the cloud drawn in them at the same
+    // share of the view as at one pixel a point (a volume drawn at twice its size, or half,
+    // covers another share).
+    let (hidpi, area2) = cloud_pixels(&default_cloud(1280, 800, 2));
+    let (one, area) = cloud_pixels(&default_cloud(1280, 800, 1));
+    let (share2, share1) = (hidpi as f64 / area2 as f64, one as f64 / area as f64);
+    assert!(
+        (share2 / share1 - 1.0).abs() < 0.1,
+        "the cloud covers {:.1}% of the view at 2x and {:.1}% at 1x",
+        share2 * 100.0,
+        share1 * 100.0
+    );
 
     // The baseline: a scene file without a cloud, with another sky. The window opens the file
     // (its name in the state), shows that sky, and nothing of a cloud.
@@ -304,18 +313,50 @@ fn the_window_reports_bad_arguments_and_an_unwritable_screenshot() {
 
     let out = in_window(&["new", "-o", "x.json", "--screenshot", "a.png"], &data, 1);
     assert!(!out.status.success());
+
+    // Two outputs that are one file are refused before the window opens.
+    let shot = temp("same.png");
+    let shot = shot.to_str().unwrap();
+    let out = in_window(&["--screenshot", shot, "--state-out", shot], &data, 1);
+    assert!(!out.status.success());
+    assert!(stderr(&out).contains("the same file"), "{}", stderr(&out));
+    assert!(!Path::new(shot).exists());
+
+    // A screenshot run that cannot open its scene fails, and saves no picture of anything else.
+    let bad = temp("bad.json");
+    std::fs::write(&bad, "{\"version\": 1, \"ellipsoids\": 5}").unwrap();
+    let shot = temp("bad.png");
+    let out = in_window(
+        &[
+            bad.to_str().unwrap(),
+            "--screenshot",
+            shot.to_str().unwrap(),
+        ],
+        &data,
+        1,
+    );
+    assert!(!out.status.success(), "{}", stderr(&out));
+    assert!(stderr(&out).contains("bad.json"), "{}", stderr(&out));
+    assert!(!shot.exists(), "a picture was saved");
 }
 
 /// Drives an open window with xdotool: the Sketch tool (D), a closed stroke of 60 moves around a
 /// circle (`$PACE` between moves: empty sends them all at once, faster than any frame), Ctrl+S;
-/// then Ctrl+Z and Ctrl+S again. Each save is copied aside once the file changes.
+/// then Ctrl+Z and Ctrl+S again in one call (on a slow frame both land in one frame). Each save
+/// is copied aside once the file changes. With `$BUSY` set to 1, a busy loop runs on every core
+/// from the window's appearance to the end (a machine doing other work: its frames are slow).
 const DRIVE: &str = r#"
 set -u
 "$BIN" "$SCENE" --window 1280x800 & app=$!
-trap 'kill $app 2>/dev/null' EXIT
+busy=""
+trap 'kill $app $busy 2>/dev/null' EXIT INT TERM HUP
 alive() { kill -0 "$app" 2>/dev/null || { echo "the app exited" >&2; exit 1; }; }
 wid=$(timeout 60 xdotool search --sync --onlyvisible --name '^cloudsketch$' | head -n 1)
 [ -n "$wid" ] || { echo "no window appeared" >&2; exit 1; }
+if [ "$BUSY" = 1 ]; then
+  # Each loop also ends by itself within the test's time, whatever becomes of this script.
+  for _ in $(seq 1 "$(nproc)"); do timeout 240 sh -c 'while :; do :; done' & busy="$busy $!"; done
+fi
 # Events sent before the first frame would wait for it (winit queues them); this only lets the
 # window settle so the input meets a running app, as a person's would.
 sleep 3
@@ -344,9 +385,9 @@ KEYS="" save "$SAVED1"
 KEYS="ctrl+z" save "$SAVED2"
 "#;
 
-/// Sketches a stroke in the window (moves `pace` apart, e.g. `sleep 0.015`, or all at once),
-/// and returns the scene saved after it and the one saved after undoing it.
-fn sketch_in_window(name: &str, pace: &str) -> (Value, Value) {
+/// Sketches a stroke in the window (moves `pace` apart, e.g. `sleep 0.015`, or all at once; with
+/// every core `busy`), and returns the scene saved after it and the one saved after undoing it.
+fn sketch_in_window(name: &str, pace: &str, busy: bool) -> (Value, Value) {
     require("xdotool", "xdotool");
     let scene = temp(&format!("{name}.json"));
     let empty = cloudsketch::scene::Scene::preset(cloudsketch::scene::Preset::Empty);
@@ -367,6 +408,7 @@ fn sketch_in_window(name: &str, pace: &str) -> (Value, Value) {
             ("SAVED1", saved[0].as_os_str()),
             ("SAVED2", saved[1].as_os_str()),
             ("PACE", OsStr::new(pace)),
+            ("BUSY", OsStr::new(if busy { "1" } else { "0" })),
         ],
     );
     assert!(out.status.success(), "{}", stderr(&out));
@@ -394,11 +436,59 @@ fn the_window_keeps_every_sample_of_a_stroke_and_undoes_it() {
     // (several frames' worth) or all at once (within a frame or two, which egui sees as neither
     // a drag nor a click: the stroke was lost natively before the press record). Which frames
     // the events fall into is the window's business; `ui::sketch_tool`'s unit test splits them
-    // deterministically.
-    for (name, pace) in [("paced", "sleep 0.015"), ("burst", "")] {
-        let (drawn, undone) = sketch_in_window(name, pace);
+    // deterministically. The burst runs beside a busy loop on every core, so its frames are slow
+    // and the Ctrl+Z, Ctrl+S sent together land in one frame: the save must follow the undo
+    // (`ui::app`'s unit test orders them deterministically).
+    for (name, pace, busy) in [("paced", "sleep 0.015", false), ("burst", "", true)] {
+        let (drawn, undone) = sketch_in_window(name, pace, busy);
         let points = plane_points(&drawn);
         assert_eq!(points, [61], "{name}: one drawing plane with every sample");
         assert_eq!(plane_points(&undone), Vec::<usize>::new(), "{name}: undone");
     }
+}
+
+#[test]
+fn a_screenshot_run_leaves_the_users_autosave_as_it_was() {
+    // A real data folder with a session in it: the screenshot of a file neither writes over
+    // that session nor keeps it aside (as opening a file in the app would).
+    let data = temp("kept-data");
+    let store = data.join("cloudsketch");
+    std::fs::create_dir_all(&store).unwrap();
+    let session = cloudsketch::scene::Scene::preset(cloudsketch::scene::Preset::Stratus).to_json();
+    std::fs::write(store.join("autosave.json"), &session).unwrap();
+    let listing = || {
+        let mut names: Vec<String> = std::fs::read_dir(&store)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        names.sort();
+        names
+    };
+    let scene = temp("kept-scene.json");
+    std::fs::write(
+        &scene,
+        cloudsketch::scene::Scene::preset(cloudsketch::scene::Preset::Empty).to_json(),
+    )
+    .unwrap();
+    let shot = temp("kept.png");
+    let out = in_window(
+        &[
+            scene.to_str().unwrap(),
+            "--screenshot",
+            shot.to_str().unwrap(),
+        ],
+        &data,
+        1,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(shot.exists());
+    assert_eq!(
+        std::fs::read_to_string(store.join("autosave.json")).unwrap(),
+        session
+    );
+    assert_eq!(
+        listing(),
+        ["autosave.json"],
+        "nothing was kept aside or left behind"
+    );
 }

@@ -247,6 +247,45 @@ fn vdb_grids_and_probes_for_openvdbs_own_reader() {
     }
 }
 
+/// A Mitsuba 3 grid volume read as its format is documented (`VOL`, version 3, float32, the
+/// resolution, one channel, the box, then x fastest), checked against the field (and with
+/// `noise` the media) evaluated directly at voxel centres placed by the file's own box: the
+/// values the renderer will read are the cloud's.
+fn vol_holds_the_field(scene: &Scene, vol: &[u8], noise: bool) {
+    let int = |at: usize| i32::from_le_bytes(vol[at..at + 4].try_into().unwrap());
+    let float = |at: usize| f32::from_le_bytes(vol[at..at + 4].try_into().unwrap());
+    assert_eq!(&vol[..4], b"VOL\x03");
+    assert_eq!(int(4), 1, "float32 encoding");
+    let res = [int(8), int(12), int(16)].map(|r| r as usize);
+    assert_eq!(int(20), 1, "one channel");
+    let lo = Vec3::new(float(24), float(28), float(32));
+    let hi = Vec3::new(float(36), float(40), float(44));
+    assert_eq!(vol.len(), 48 + 4 * res[0] * res[1] * res[2]);
+    let field = cloudsketch::derive::field_of(scene);
+    let media = Media::new(scene);
+    let step = (hi - lo) / Vec3::new(res[0] as f32, res[1] as f32, res[2] as f32);
+    let (mut inside, mut worst) = (0, 0.0f32);
+    for k in 0..500usize {
+        let (x, y, z) = (
+            (k * 7919) % res[0],
+            (k * 104_729) % res[1],
+            (k * 1_299_709) % res[2],
+        );
+        let p = lo + (Vec3::new(x as f32, y as f32, z as f32) + 0.5) * step;
+        let f = field.value(p);
+        let want = if noise {
+            media.density(f, p)
+        } else {
+            density(f, scene.render.softness)
+        };
+        let got = float(48 + 4 * ((z * res[1] + y) * res[0] + x));
+        inside += (want > 0.0) as usize;
+        worst = worst.max((got - want).abs());
+    }
+    assert!(inside > 40, "{inside} probes in the cloud");
+    assert!(worst < 1e-4, "the .vol is off the field by {worst}");
+}
+
 #[test]
 fn mitsuba_scenes_and_the_apps_render_of_their_view() {
     // Strong noise, so it shapes the silhouette (what the check compares).
@@ -266,6 +305,8 @@ fn mitsuba_scenes_and_the_apps_render_of_their_view() {
         }
         let xml = std::fs::read_to_string(out_dir().join(format!("{stem}.xml"))).unwrap();
         assert!(xml.contains(&format!("value=\"{stem}.vol\"")));
+        let vol = std::fs::read(out_dir().join(format!("{stem}.vol"))).unwrap();
+        vol_holds_the_field(&scene, &vol, noise);
     }
     let mut offscreen = Offscreen::new().expect("an offscreen adapter");
     let image = offscreen

@@ -47,16 +47,36 @@ fn every_stored_link_version_still_opens_to_its_scene() {
         .unwrap();
     }
     for version in 1..=LINK_VERSION {
-        let link = std::fs::read_to_string(fixtures().join(format!("link_v{version}.txt")))
-            .unwrap_or_else(|e| panic!("the fixture of link format {version}: {e}"));
-        let json =
-            std::fs::read_to_string(fixtures().join(format!("link_v{version}.json"))).unwrap();
+        assert!(
+            fixtures().join(format!("link_v{version}.txt")).exists(),
+            "no fixture of link format {version}"
+        );
+    }
+    // Every stored link: each version's, and older links of a version kept when its fixture
+    // scene grew (`link_v1_before_every_field`: made before the fixture set every field).
+    let mut stored: Vec<PathBuf> = std::fs::read_dir(fixtures())
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| {
+            p.extension().is_some_and(|e| e == "txt")
+                && p.file_name()
+                    .unwrap()
+                    .to_string_lossy()
+                    .starts_with("link_v")
+        })
+        .collect();
+    stored.sort();
+    for path in stored {
+        let link = std::fs::read_to_string(&path).unwrap();
+        let json = std::fs::read_to_string(path.with_extension("json")).unwrap();
         let (expected, _) = Scene::from_json(&json).unwrap();
         let (opened, repairs) = decode_link(&link).unwrap();
-        assert!(repairs.is_empty(), "{repairs:?}");
+        assert!(repairs.is_empty(), "{}: {repairs:?}", path.display());
         assert_eq!(
-            opened, expected,
-            "a link of format {version} opens to a different scene than it did"
+            opened,
+            expected,
+            "{} opens to a different scene than it did",
+            path.display()
         );
     }
 }

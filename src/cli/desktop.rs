@@ -1,7 +1,7 @@
 //! No subcommand: the desktop app in a window; with `--screenshot`, the window's first
 //! full-quality image saved as a PNG, after which the window closes.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
 use crate::render::offscreen::Image;
@@ -27,31 +27,19 @@ pub fn run(
     size: (u32, u32),
     screenshot: Option<Screenshot>,
 ) -> Result<(), String> {
-    // A screenshot that could not be written is found out before the window opens.
-    for path in screenshot
-        .iter()
-        .flat_map(|s| std::iter::once(&s.output).chain(&s.state))
-    {
-        let folder = path.parent().filter(|p| !p.as_os_str().is_empty());
-        if folder.is_some_and(|f| !f.is_dir()) {
-            return Err(format!("{}: no such folder", path.display()));
-        }
+    // A screenshot that could not be written, or two outputs (or an output and the scene) that
+    // are one file, are found out before the window opens.
+    if let Some(shot) = &screenshot {
+        let outputs: Vec<&Path> = std::iter::once(shot.output.as_path())
+            .chain(shot.state.as_deref())
+            .collect();
+        super::check_outputs(&open.into_iter().collect::<Vec<_>>(), &outputs)?;
     }
     let shooting = screenshot.is_some();
     let bytes = match open {
-        Some(arg) if !arg.contains("#s=") => Some(
-            std::fs::metadata(arg)
-                .map_err(|e| format!("{arg}: {e}"))
-                .and_then(|m| {
-                    if m.len() > crate::limits::MAX_FILE_BYTES {
-                        Err(format!(
-                            "{arg}: more than the {} MiB a scene file may have",
-                            crate::limits::MAX_FILE_BYTES >> 20
-                        ))
-                    } else {
-                        std::fs::read(arg).map_err(|e| format!("{arg}: {e}"))
-                    }
-                })?,
+        Some(arg) if !super::is_link(arg) => Some(
+            crate::files::read_bounded(Path::new(arg), crate::limits::MAX_FILE_BYTES)
+                .map_err(|e| e.at(Path::new(arg)))?,
         ),
         _ => None,
     };
@@ -63,6 +51,10 @@ pub fn run(
     // A screenshot run only looks: it keeps no autosave aside and writes none.
     let start = crate::ui::start_session(opening, !shooting);
     if let Some((message, true)) = &start.notice {
+        // A screenshot run shows what it was asked to open, or nothing: not the last session.
+        if shooting {
+            return Err(message.clone());
+        }
         eprintln!("error: {message}");
     }
     let Start {
@@ -139,10 +131,9 @@ impl WindowShot {
         .to_png()
         .map_err(|e| format!("PNG encoding failed: {e}"))?;
         let output = &self.shot.output;
-        std::fs::write(output, png).map_err(|e| format!("{}: {e}", output.display()))?;
+        super::write(output, &png)?;
         if let Some(state) = &self.shot.state {
-            std::fs::write(state, &status.state)
-                .map_err(|e| format!("{}: {e}", state.display()))?;
+            super::write(state, status.state.as_bytes())?;
         }
         Ok(format!(
             "{}: the window, {width}x{height} pixels, at {} quality ({} on {})",

@@ -1,10 +1,10 @@
 //! `export`: the cloud for other tools — OpenVDB, Mitsuba 3, glb/OBJ/PLY meshes — or the
 //! rendered view as a PNG (optionally over a transparent background).
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use super::render::parse_size;
-use super::{read_scene_or_link, write};
+use super::{check_outputs, read_scene_or_link, write};
 use crate::export::{Format, Options, Up, export};
 use crate::render::offscreen::{Backdrop, Offscreen};
 use crate::scene::Scene;
@@ -44,14 +44,30 @@ pub fn run(r: &Request) -> Result<(), String> {
         "z" | "Z" => Up::Z,
         other => return Err(format!("--up {other:?}: y or z")),
     };
-    if !(r.scale.is_finite() && r.scale > 0.0) {
-        return Err(format!("--scale {}: a positive number", r.scale));
+    // Past a million units per world unit a far scene's coordinates leave the files' 32-bit
+    // floats (1e38 wrote -inf vertices and a glb without bounds).
+    if !(r.scale.is_finite() && (1e-6..=1e6).contains(&r.scale)) {
+        return Err(format!("--scale {}: a number from 1e-6 to 1e6", r.scale));
     }
     let max = crate::limits::MAX_EXPORT_RESOLUTION;
     if !(8..=max).contains(&r.resolution) {
         return Err(format!("--resolution {}: 8 to {max}", r.resolution));
     }
     let (width, height) = parse_size(r.size)?;
+    let stem = r
+        .output
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .filter(|s| !s.is_empty())
+        .unwrap_or("cloud");
+    let dir = r.output.parent().unwrap_or(Path::new(""));
+    // The main file where asked, the others (Mitsuba's volume) beside it under their own names.
+    let mut paths = vec![r.output.to_path_buf()];
+    paths.extend(format.companions(stem).iter().map(|name| dir.join(name)));
+    check_outputs(
+        &r.scene.into_iter().collect::<Vec<_>>(),
+        &paths.iter().map(PathBuf::as_path).collect::<Vec<_>>(),
+    )?;
     let scene = match r.scene {
         Some(arg) => read_scene_or_link(arg)?,
         None => Scene::default(),
@@ -64,9 +80,7 @@ pub fn run(r: &Request) -> Result<(), String> {
         } else {
             Backdrop::Sky
         };
-        let image = offscreen
-            .render(&scene, width, height, backdrop)
-            .map_err(|e| e.to_string())?;
+        let image = super::render_shown(&mut offscreen, &scene, [width, height], backdrop)?;
         let png = image
             .to_png()
             .map_err(|e| format!("PNG encoding failed: {e}"))?;
@@ -80,22 +94,20 @@ pub fn run(r: &Request) -> Result<(), String> {
             image: [width, height],
             samples: r.samples.clamp(1, 65_536),
         };
-        let stem = r
-            .output
-            .file_stem()
-            .and_then(|s| s.to_str())
-            .filter(|s| !s.is_empty())
-            .unwrap_or("cloud");
         let files = export(&scene, format, &options, stem).map_err(|e| e.to_string())?;
-        let dir = r.output.parent().unwrap_or(Path::new(""));
-        for (i, f) in files.iter().enumerate() {
-            // The main file goes where asked; the others beside it under their own names.
-            let path = if i == 0 {
-                r.output.to_path_buf()
-            } else {
-                dir.join(&f.name)
-            };
-            write(&path, &f.bytes)?;
+        // The companions first and the main file last, so a main file never refers to a
+        // volume that is not there; on a failure, what this run wrote is removed.
+        let mut written: Vec<&Path> = Vec::new();
+        for (f, path) in files.iter().zip(&paths).rev() {
+            if let Err(e) = write(path, &f.bytes) {
+                for done in written {
+                    let _ = std::fs::remove_file(done);
+                }
+                return Err(e);
+            }
+            written.push(path);
+        }
+        for (f, path) in files.iter().zip(&paths) {
             eprintln!("wrote {} ({} bytes)", path.display(), f.bytes.len());
         }
     }

@@ -7,6 +7,7 @@ mod desktop;
 mod export;
 mod link;
 mod new;
+mod progress;
 mod render;
 mod simulate;
 mod sketch;
@@ -277,18 +278,10 @@ fn headless_vulkan() {
     }
 }
 
-/// Reads a text file with a size cap.
+/// Reads a text file with a size cap ([`crate::files::read_bounded_text`]: a byte-order mark is
+/// dropped, and nothing past the cap is read).
 pub fn read_capped(path: &Path) -> Result<String, String> {
-    let meta = std::fs::metadata(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    if meta.len() > MAX_FILE_BYTES {
-        return Err(format!(
-            "{}: {} bytes is more than the {} MiB limit",
-            path.display(),
-            meta.len(),
-            MAX_FILE_BYTES >> 20
-        ));
-    }
-    std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))
+    crate::files::read_bounded_text(path, MAX_FILE_BYTES).map_err(|e| e.at(path))
 }
 
 /// Reads and validates a scene document (as the app opens one); each repair validation made
@@ -304,9 +297,15 @@ pub fn read_scene(path: &Path) -> Result<Scene, String> {
     Ok(scene)
 }
 
-/// Reads a scene from a file, or from a share link when the argument holds `#s=`.
+/// Whether a command-line argument is a share link rather than a file: it holds `#s=` and no
+/// file of that name exists (a path that exists is a file, whatever its name).
+pub fn is_link(arg: &str) -> bool {
+    arg.contains("#s=") && !Path::new(arg).exists()
+}
+
+/// Reads a scene from a file, or from a share link ([`is_link`]).
 pub fn read_scene_or_link(arg: &str) -> Result<Scene, String> {
-    if !arg.contains("#s=") {
+    if !is_link(arg) {
         return read_scene(Path::new(arg));
     }
     let (scene, repairs) = crate::share::decode_link(arg).map_err(|e| e.to_string())?;
@@ -316,7 +315,78 @@ pub fn read_scene_or_link(arg: &str) -> Result<Scene, String> {
     Ok(scene)
 }
 
-/// Writes a file, with the path in the error.
+/// Refuses, before any work, outputs that cannot be written or that collide with each other or
+/// with an input (compared as canonical paths: `./a.json` and `a.json` are one file, and so are
+/// a link and its target). `inputs` that are links or missing files take no part.
+pub fn check_outputs(inputs: &[&str], outputs: &[&Path]) -> Result<(), String> {
+    let mut taken: Vec<(PathBuf, String)> = inputs
+        .iter()
+        .filter(|arg| !is_link(arg))
+        .filter_map(|arg| {
+            Some((
+                Path::new(arg).canonicalize().ok()?,
+                format!("the input {arg}"),
+            ))
+        })
+        .collect();
+    for out in outputs {
+        let key = canonical_output(out)?;
+        if let Some((_, what)) = taken.iter().find(|(k, _)| *k == key) {
+            return Err(format!(
+                "{}: the same file as {what} (nothing was written)",
+                out.display()
+            ));
+        }
+        crate::files::check_writable(out)
+            .map_err(|e| format!("cannot write {}: {e}", out.display()))?;
+        taken.push((key, format!("the output {}", out.display())));
+    }
+    Ok(())
+}
+
+/// The canonical path an output will have: its own if it exists, else its folder's with its name.
+fn canonical_output(path: &Path) -> Result<PathBuf, String> {
+    if path.as_os_str().is_empty() {
+        return Err("an output path is empty".into());
+    }
+    if let Ok(c) = path.canonicalize() {
+        return Ok(c);
+    }
+    let name = path
+        .file_name()
+        .ok_or_else(|| format!("{}: not a file name", path.display()))?;
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let dir = dir
+        .canonicalize()
+        .map_err(|_| format!("{}: no such folder", path.display()))?;
+    Ok(dir.join(name))
+}
+
+/// Renders `scene` at full quality; on a terminal, in chunks with a progress line (the same
+/// image: chunks draw the same slices).
+pub fn render_shown(
+    offscreen: &mut crate::render::offscreen::Offscreen,
+    scene: &Scene,
+    [width, height]: [u32; 2],
+    backdrop: crate::render::offscreen::Backdrop,
+) -> Result<crate::render::offscreen::Image, String> {
+    let mut progress = progress::Progress::new(format!("rendering {width}x{height}"));
+    let image = if progress.shown() {
+        offscreen.render_with_progress(scene, [width, height], backdrop, 32, &mut |done| {
+            progress.set(done)
+        })
+    } else {
+        offscreen.render(scene, width, height, backdrop)
+    };
+    image.map_err(|e| e.to_string())
+}
+
+/// Writes a file ([`crate::files::write_atomic`]: on failure the old file, if any, is kept
+/// whole), with the path in the error.
 pub fn write(path: &Path, bytes: &[u8]) -> Result<(), String> {
-    std::fs::write(path, bytes).map_err(|e| format!("cannot write {}: {e}", path.display()))
+    crate::files::write_atomic(path, bytes)
+        .map_err(|e| format!("cannot write {}: {e}", path.display()))
 }

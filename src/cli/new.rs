@@ -14,5 +14,6 @@ pub fn run(preset: &str, output: &Path) -> Result<(), String> {
             names.join(", ")
         )
     })?;
+    super::check_outputs(&[], &[output])?;
     write(output, Scene::preset(preset).to_json().as_bytes())
 }

@@ -30,6 +30,7 @@ pub fn run(
     time: Option<f32>,
 ) -> Result<(), String> {
     let (width, height) = parse_size(size)?;
+    super::check_outputs(&scene.into_iter().collect::<Vec<_>>(), &[output])?;
     let mut scene = match scene {
         Some(arg) => read_scene_or_link(arg)?,
         None => Scene::default(),
@@ -52,9 +53,7 @@ pub fn run(
     }
     let mut offscreen = Offscreen::new().map_err(|e| e.to_string())?;
     let start = std::time::Instant::now();
-    let image = offscreen
-        .render(&scene, width, height, Backdrop::Sky)
-        .map_err(|e| e.to_string())?;
+    let image = super::render_shown(&mut offscreen, &scene, [width, height], Backdrop::Sky)?;
     let png = image
         .to_png()
         .map_err(|e| format!("PNG encoding failed: {e}"))?;

@@ -18,6 +18,14 @@ pub fn run(
     seed: Option<u64>,
     output: &Path,
 ) -> Result<(), String> {
+    let ext = output.extension().and_then(|e| e.to_str()).unwrap_or("");
+    if !matches!(ext, "vol" | "vdb") {
+        return Err(format!(
+            "{}: the output is a .vol or a .vdb",
+            output.display()
+        ));
+    }
+    super::check_outputs(&scene.into_iter().collect::<Vec<_>>(), &[output])?;
     let scene = match scene {
         Some(arg) => read_scene_or_link(arg)?,
         None => Scene::preset(Preset::Simulated),
@@ -34,16 +42,17 @@ pub fn run(
     if let Some(seed) = seed {
         settings.seed = seed;
     }
-    let ext = output.extension().and_then(|e| e.to_str()).unwrap_or("");
-    if !matches!(ext, "vol" | "vdb") {
-        return Err(format!(
-            "{}: the output is a .vol or a .vdb",
-            output.display()
-        ));
-    }
     let start = std::time::Instant::now();
     let mut sim = Simulation::new(&settings, &parcels(&scene));
-    sim.advance(steps);
+    let mut progress = super::progress::Progress::new(format!("simulating {steps} steps"));
+    let mut done = 0;
+    while done < steps {
+        let batch = (steps - done).min(256);
+        sim.advance(batch);
+        done += batch;
+        progress.set(done as f32 / steps as f32);
+    }
+    drop(progress);
     let volume = sim.density(None, 1.0);
     let h = settings.cell_size;
     let grid = DensityGrid {

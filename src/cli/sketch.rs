@@ -9,7 +9,8 @@ use crate::scene::Scene;
 /// A stroke file.
 #[derive(serde::Deserialize)]
 struct StrokeFile {
-    points: Vec<[f64; 2]>,
+    /// Each `[x, y]` (checked after reading, so a wrong count is named as such).
+    points: Vec<Vec<f64>>,
     #[serde(default = "yes")]
     closed: bool,
 }
@@ -38,6 +39,9 @@ pub fn run(
     if paths.len() > MAX_PLANES {
         return Err(format!("{} strokes (at most {MAX_PLANES})", paths.len()));
     }
+    let inputs: Vec<&str> = paths.iter().filter_map(|p| p.to_str()).collect();
+    let outputs: Vec<&Path> = std::iter::once(output).chain(spheres_out).collect();
+    super::check_outputs(&inputs, &outputs)?;
     let params = SketchParams {
         inflate,
         extend,
@@ -51,8 +55,15 @@ pub fn run(
                 path.display()
             )
         })?;
+        if let Some((i, p)) = file.points.iter().enumerate().find(|(_, p)| p.len() != 2) {
+            return Err(format!(
+                "{}: point {i} has {} numbers (a point is [x, y])",
+                path.display(),
+                p.len()
+            ));
+        }
         // y down → y up, so the plane's points read like the world.
-        let flipped: Vec<[f64; 2]> = file.points.iter().map(|&[x, y]| [x, -y]).collect();
+        let flipped: Vec<[f64; 2]> = file.points.iter().map(|p| [p[0], -p[1]]).collect();
         // The scene stores the stroke that was used: thinned here, not refused later.
         let (points, thinned) = crate::sketch::outline::thin(&flipped);
         if let Some(w) = thinned {
@@ -106,6 +117,8 @@ pub fn run(
             ..Default::default()
         }));
     }
+    // On the stroke grid, as the app stores a new stroke: the scene's link is then exact.
+    scene.snap_strokes();
     scene.validate().map_err(|e| e.to_string())?;
     write(output, scene.to_json().as_bytes())?;
     if let Some(path) = spheres_out {

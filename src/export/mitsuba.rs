@@ -12,6 +12,25 @@ use super::formats::grid_box;
 use super::grid::DensityGrid;
 use crate::scene::{Scene, srgb_to_linear};
 
+/// `text` as an XML attribute value: `&`, `<`, `>`, `"` and `'` escaped, and control characters
+/// (which XML 1.0 cannot hold) as `?`.
+pub fn xml_attribute(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&apos;"),
+            '\t' | '\n' | '\r' => out.push_str(&format!("&#{};", c as u32)),
+            c if c.is_control() => out.push('?'),
+            c => out.push(c),
+        }
+    }
+    out
+}
+
 fn v3(v: Vec3) -> String {
     format!("{:.6}, {:.6}, {:.6}", v.x, v.y, v.z)
 }
@@ -107,7 +126,8 @@ pub fn write_xml(
     let _ = writeln!(x, "    <medium type=\"heterogeneous\" name=\"interior\">");
     let _ = writeln!(
         x,
-        "      <volume type=\"gridvolume\" name=\"sigma_t\"><string name=\"filename\" value=\"{vol_name}\"/><transform name=\"to_world\"><scale value=\"{}\"/><translate value=\"{}\"/></transform></volume>",
+        "      <volume type=\"gridvolume\" name=\"sigma_t\"><string name=\"filename\" value=\"{}\"/><transform name=\"to_world\"><scale value=\"{}\"/><translate value=\"{}\"/></transform></volume>",
+        xml_attribute(vol_name),
         v3(hi - lo),
         v3(lo)
     );
@@ -126,4 +146,26 @@ pub fn write_xml(
     let _ = writeln!(x, "  </shape>");
     let _ = writeln!(x, "</scene>");
     x
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::export::{Format, Options, export};
+
+    #[test]
+    fn a_file_name_with_markup_characters_stays_one_attribute() {
+        let options = Options {
+            resolution: 8,
+            ..Default::default()
+        };
+        let files = export(&Scene::default(), Format::Mitsuba, &options, "a<&\"'>").unwrap();
+        let xml = String::from_utf8(files[0].bytes.clone()).unwrap();
+        assert!(
+            xml.contains("value=\"a&lt;&amp;&quot;&apos;&gt;.vol\""),
+            "{xml}"
+        );
+        assert!(!xml.contains("a<&"), "the raw name leaked into the XML");
+        assert_eq!(xml_attribute("x\ny\u{1}"), "x&#10;y?");
+    }
 }

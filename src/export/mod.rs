@@ -72,6 +72,14 @@ impl Format {
             .map_or("?", |(_, n)| n)
     }
 
+    /// The names of the files written beside the main one, `STEM.EXT` (Mitsuba's volume).
+    pub fn companions(self, stem: &str) -> Vec<String> {
+        match self {
+            Format::Mitsuba => vec![format!("{stem}.vol")],
+            _ => Vec::new(),
+        }
+    }
+
     /// The file extension of its main file.
     pub fn extension(self) -> &'static str {
         match self {
@@ -201,7 +209,7 @@ pub fn write(
             write_vdb(grid, axes, "density", scene.seed ^ 0x5644_4220),
         )],
         Format::Mitsuba => {
-            let vol = format!("{stem}.vol");
+            let vol = format.companions(stem).remove(0);
             let xml = write_xml(scene, grid, &vol, options.image, options.samples.max(1));
             vec![file("xml", xml.into_bytes()), file("vol", write_vol(grid))]
         }

@@ -268,33 +268,74 @@ impl Offscreen {
     pub fn render_in_chunks(
         &mut self,
         scene: &Scene,
+        size: [u32; 2],
+        backdrop: Backdrop,
+        chunks: u32,
+    ) -> Result<Image, OffscreenError> {
+        self.render_chunked(scene, size, backdrop, chunks, None)
+    }
+
+    /// Renders `scene` as [`Offscreen::render`] does (the same image), its slices drawn in
+    /// `chunks` submissions, each waited for, calling `progress` with the share done after each:
+    /// a long render (8192² on a CPU adapter) shows how far it is.
+    pub fn render_with_progress(
+        &mut self,
+        scene: &Scene,
+        size: [u32; 2],
+        backdrop: Backdrop,
+        chunks: u32,
+        progress: &mut dyn FnMut(f32),
+    ) -> Result<Image, OffscreenError> {
+        self.render_chunked(scene, size, backdrop, chunks, Some(progress))
+    }
+
+    /// The chunked render: all chunks in one submission, or with `progress` each chunk in its
+    /// own, waited for and reported.
+    fn render_chunked(
+        &mut self,
+        scene: &Scene,
         [width, height]: [u32; 2],
         backdrop: Backdrop,
         chunks: u32,
+        mut progress: Option<&mut dyn FnMut(f32)>,
     ) -> Result<Image, OffscreenError> {
         check_size(width, height)?;
         let mut job = self.full_job(scene, width, height);
         let total = job.plan.total;
-        let chunks = chunks.clamp(1, total.clamp(1, MAX_SLICE_DRAWS_PER_FRAME));
+        // One submission holds at most MAX_SLICE_DRAWS_PER_FRAME draws' uniforms; chunks
+        // submitted and waited for one by one may be as many as there are slices.
+        let most = if progress.is_some() {
+            total
+        } else {
+            MAX_SLICE_DRAWS_PER_FRAME
+        };
+        let chunks = chunks.clamp(1, most.clamp(1, total.max(1)));
         if chunks > 1 {
-            let mut encoder = self
-                .device
-                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            let encoder = |device: &wgpu::Device| {
+                device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
                     label: Some("offscreen chunks"),
-                });
+                })
+            };
+            let mut commands = encoder(&self.device);
             self.renderer
-                .update_light(&self.device, &self.queue, &mut encoder, &job.view);
+                .update_light(&self.device, &self.queue, &mut commands, &job.view);
             let bound = |k: u32| total * k / chunks;
             for k in 0..chunks - 1 {
                 job.plan.range = bound(k)..bound(k + 1);
                 job.plan.clear = k == 0;
                 self.renderer
-                    .draw_slices(&self.device, &self.queue, &mut encoder, &job, None);
+                    .draw_slices(&self.device, &self.queue, &mut commands, &job, None);
+                if let Some(report) = progress.as_mut() {
+                    let done = std::mem::replace(&mut commands, encoder(&self.device));
+                    self.queue.submit([done.finish()]);
+                    let _ = self.device.poll(wgpu::PollType::wait_indefinitely());
+                    report((k + 1) as f32 / chunks as f32);
+                }
             }
             // The last chunk with the composite.
             job.plan.range = bound(chunks - 1)..total;
             job.plan.clear = false;
-            self.queue.submit([encoder.finish()]);
+            self.queue.submit([commands.finish()]);
         }
         match backdrop {
             Backdrop::Sky => self.draw(&job, Some(scene.light.background)),

@@ -4,6 +4,7 @@
 //! blended field, sphere primitives, GPU buffers) is derived from it deterministically.
 
 mod camera;
+mod capped;
 mod document;
 mod edit;
 mod looks;
@@ -51,6 +52,19 @@ pub enum SceneError {
     /// Values outside the allowed ranges.
     #[error("invalid scene: {0}")]
     Invalid(String),
+    /// A JSON object with none of a scene's members (`{}`, a stroke file).
+    #[error("not a cloudsketch scene: it holds none of a scene's members ({})", capped::MEMBERS.join(", "))]
+    NoScene,
+}
+
+/// Refuses a document written by a newer build (a missing version is this build's).
+fn check_version(found: Option<u64>) -> Result<(), SceneError> {
+    match found {
+        Some(found) if found > SCENE_VERSION as u64 => Err(SceneError::TooNew {
+            found: found.min(u32::MAX as u64) as u32,
+        }),
+        _ => Ok(()),
+    }
 }
 
 /// The whole document.
@@ -72,8 +86,10 @@ pub struct Scene {
     /// Render quality and cloud media settings.
     pub render: RenderSettings,
     /// Implicit ellipsoids blended into the cloud field.
+    #[serde(deserialize_with = "capped::vec::<_, _, MAX_ELLIPSOIDS>")]
     pub ellipsoids: Vec<Arc<Ellipsoid>>,
     /// Drawing planes, each holding one sketched stroke (outline or cut).
+    #[serde(deserialize_with = "capped::vec::<_, _, MAX_PLANES>")]
     pub planes: Vec<Arc<DrawingPlane>>,
     /// The picture to trace, placed in the scene.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -96,9 +112,30 @@ impl Default for Scene {
 impl Scene {
     /// Parses a document, upgrading older versions and checking every limit. Returns the scene
     /// and what validation repaired in it, in words (see [`Scene::validate`]): tell the user.
+    ///
+    /// A leading byte-order mark is dropped. The text is read twice and never built into a
+    /// JSON tree: first its outline (the version; every value skipped), then the document
+    /// itself, its unknown members skipped and its lists stopped at their caps, so memory stays
+    /// a small multiple of the text.
     pub fn from_json(text: &str) -> Result<(Self, Vec<String>), SceneError> {
-        let value: serde_json::Value = serde_json::from_str(text)?;
-        Self::from_value(value)
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+        let outline: capped::Outline = serde_json::from_str(text)?;
+        check_version(outline.version)?;
+        let mut scene: Scene = serde_json::from_str(text)?;
+        scene.version = SCENE_VERSION;
+        let repairs = scene.validate()?;
+        Ok((scene, repairs))
+    }
+
+    /// Like [`Scene::from_json`] for a file: a JSON object without any of a scene's members
+    /// (`{}`, a stroke file) holds no scene, and says so instead of opening the default one.
+    pub fn from_file_json(text: &str) -> Result<(Self, Vec<String>), SceneError> {
+        let stripped = text.strip_prefix('\u{feff}').unwrap_or(text);
+        let outline: capped::Outline = serde_json::from_str(stripped)?;
+        if outline.members == 0 {
+            return Err(SceneError::NoScene);
+        }
+        Self::from_json(text)
     }
 
     /// Like [`Scene::from_json`] for an already parsed value.
@@ -108,19 +145,27 @@ impl Scene {
                 "a scene document is a JSON object".into(),
             ));
         }
-        let found = value
-            .get("version")
-            .and_then(|v| v.as_u64())
-            .unwrap_or(SCENE_VERSION as u64);
-        if found > SCENE_VERSION as u64 {
-            return Err(SceneError::TooNew {
-                found: found.min(u32::MAX as u64) as u32,
-            });
-        }
+        check_version(value.get("version").and_then(|v| v.as_u64()))?;
         let mut scene: Scene = serde_json::from_value(value)?;
         scene.version = SCENE_VERSION;
         let repairs = scene.validate()?;
         Ok((scene, repairs))
+    }
+
+    /// Moves every stroke that is off its grid onto it ([`DrawingPlane::snap_to_grid`]: by at
+    /// most half a step), as the app does when a stroke is made, so files and links hold it
+    /// exactly. Returns how many strokes moved.
+    pub fn snap_strokes(&mut self) -> usize {
+        let mut moved = 0;
+        for plane in &mut self.planes {
+            let mut snapped = (**plane).clone();
+            snapped.snap_to_grid();
+            if snapped.points != plane.points {
+                *plane = Arc::new(snapped);
+                moved += 1;
+            }
+        }
+        moved
     }
 
     /// Pretty JSON of the document.
@@ -444,6 +489,7 @@ pub struct RenderSettings {
     /// [`limits::MAX_TIERS`]): each its own filter, wind and torque (Schpok et al. §5.2).
     /// The first octave moves with the base wind and torque everywhere (the paper's Base tier),
     /// which keeps the tiers one cloud.
+    #[serde(deserialize_with = "capped::vec::<_, _, 64>")]
     pub tiers: Vec<Tier>,
     /// Height over which one tier blends into the next around a floor.
     pub tier_blend: f32,
@@ -530,15 +576,20 @@ impl RenderSettings {
     }
 }
 
-/// `q` made a unit rotation when it is not one already (a zero quaternion becomes none).
+/// `q` made a unit rotation when it is not one already (a zero quaternion, or one with an
+/// infinite component, becomes none). Scaled by its largest component first, so a quaternion of
+/// huge components (`[1e30; 4]`, whose squared length overflows) normalises without overflow.
 pub(crate) fn unit_rotation(q: Quat) -> Option<Quat> {
     if q.is_normalized() {
-        None
-    } else if q.length_squared() < 1e-12 {
-        Some(Quat::IDENTITY)
-    } else {
-        Some(q.normalize())
+        return None;
     }
+    let v = glam::Vec4::from(q);
+    let largest = v.abs().max_element();
+    if !largest.is_finite() || largest < 1e-6 {
+        return Some(Quat::IDENTITY);
+    }
+    let unit = (v / largest).normalize();
+    Some(Quat::from_vec4(unit))
 }
 
 /// Lists the leaves of `after` that differ from `before` (the same document before and after
@@ -548,15 +599,17 @@ fn describe_repairs(path: &str, before: &Value, after: &Value, out: &mut Vec<Str
         (Some(x), Some(y)) => (x - y).abs() <= 1e-5 * x.abs().max(1.0),
         _ => a == b,
     };
+    // A setting that serialises as null held a number beyond what it can store (JSON has no
+    // NaN, and a null in the file would not have parsed): `1e308` read into an `f32` is ∞.
     let show = |v: &Value| match v {
-        Value::Null => "not a number".to_owned(),
+        Value::Null => "a number beyond ±3.4e38".to_owned(),
         Value::String(text) if text.len() > 60 => format!("{} characters of data", text.len()),
         Value::Number(n) => n.as_f64().map_or_else(|| n.to_string(), |f| format!("{f}")),
         Value::Array(items) if items.len() > 4 => format!("{} values", items.len()),
         Value::Array(items) => {
             let parts: Vec<String> = items
                 .iter()
-                .map(|x| x.as_f64().map_or("NaN".to_owned(), |f| format!("{f}")))
+                .map(|x| x.as_f64().map_or("±∞".to_owned(), |f| format!("{f}")))
                 .collect();
             format!("[{}]", parts.join(", "))
         }
@@ -652,7 +705,8 @@ mod tests {
         let text = r#"{
             "ellipsoids": [{"center": [0, 2, 0], "radii": [1, 1, 1], "rotation": [0, 0, 0, 0]}],
             "planes": [{"points": [[0, 0], [1, 0], [0, 1]], "rotation": [0, 0, 0, 0]},
-                       {"points": [[0, 0], [1, 0], [0, 1]], "rotation": [0, 2, 0, 0]}],
+                       {"points": [[0, 0], [1, 0], [0, 1]], "rotation": [0, 2, 0, 0]},
+                       {"points": [[0, 0], [1, 0], [0, 1]], "rotation": [1e30, 1e30, 1e30, 1e30]}],
             "camera": {"distance": 1e300, "fov_y_deg": 1e39},
             "light": {"sun_intensity": -4}
         }"#;
@@ -664,8 +718,8 @@ mod tests {
             "/ellipsoids/0/rotation: [0, 0, 0, 0] → [0, 0, 0, 1]",
             "/planes/0/rotation: [0, 0, 0, 0] → [0, 0, 0, 1]",
             "/planes/1/rotation: [0, 2, 0, 0] → [0, 1, 0, 0]",
-            "/camera/distance: not a number →",
-            "/camera/fov_y_deg: not a number →",
+            "/camera/distance: a number beyond ±3.4e38 →",
+            "/camera/fov_y_deg: a number beyond ±3.4e38 →",
             "/light/sun_intensity: -4 → 0",
         ] {
             assert!(
@@ -673,6 +727,15 @@ mod tests {
                 "{needle} not in {repairs:#?}"
             );
         }
+        // Huge components normalise without overflow (they became [0, 0, 0, 0]).
+        assert_eq!(s.planes[2].rotation, Quat::from_xyzw(0.5, 0.5, 0.5, 0.5));
+        assert!(
+            repairs
+                .iter()
+                .any(|r| r.starts_with("/planes/2/rotation: [")
+                    && r.ends_with("→ [0.5, 0.5, 0.5, 0.5]")),
+            "{repairs:#?}"
+        );
         let (lo, hi) = crate::derive::field_of(&s).bounds().expect("a field");
         assert!(lo.is_finite() && hi.is_finite(), "{lo} {hi}");
         // Geometry that cannot be repaired is refused with a message.

@@ -32,6 +32,7 @@ pub struct DrawingPlane {
     /// x and y; its normal (toward the viewer who drew it) is the rotated z.
     pub rotation: Quat,
     /// Stroke points in plane units (world units, y up).
+    #[serde(deserialize_with = "super::capped::vec::<_, _, MAX_PLANE_POINTS>")]
     pub points: Vec<Vec2>,
     /// Whether the stroke was drawn closed.
     pub closed: bool,
@@ -42,7 +43,10 @@ pub struct DrawingPlane {
     /// Pen pressure (0–1) at each point of `points`, for strokes drawn with a pen; empty for
     /// the mouse, touch and imported strokes. Kept with the stroke (for future brushes); the
     /// shape does not depend on it yet.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
+    #[serde(
+        skip_serializing_if = "Vec::is_empty",
+        deserialize_with = "super::capped::vec::<_, _, MAX_PLANE_POINTS>"
+    )]
     pub pressure: Vec<f32>,
     /// Hidden: kept in the document, left out of the cloud (its stroke is drawn faintly).
     pub hidden: bool,

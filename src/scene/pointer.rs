@@ -53,14 +53,17 @@ pub fn set_by_pointer(scene: &Scene, assignment: &str) -> Result<(Scene, Vec<Str
         });
     }
     *slot = new_value;
-    Scene::from_value(doc).map_err(|e| SetError::BadValue {
+    let (mut set, repairs) = Scene::from_value(doc).map_err(|e| SetError::BadValue {
         path: path.to_string(),
         value: raw.to_string(),
         reason: match e {
             SceneError::Parse(p) => p.to_string(),
             other => other.to_string(),
         },
-    })
+    })?;
+    // A stroke set point by point lands on its grid, as one drawn in the app.
+    set.snap_strokes();
+    Ok((set, repairs))
 }
 
 fn kind_name(v: &serde_json::Value) -> &'static str {

@@ -45,15 +45,24 @@ pub fn open_scene_file(name: &str, bytes: &[u8]) -> Result<(Scene, Vec<String>),
         });
     }
     let text = std::str::from_utf8(bytes).map_err(|_| FileError::NotText(name.to_owned()))?;
-    let (mut scene, mut repairs) = Scene::from_json(text).map_err(|error| FileError::Scene {
-        name: name.to_owned(),
-        error,
-    })?;
+    let (mut scene, mut repairs) =
+        Scene::from_file_json(text).map_err(|error| FileError::Scene {
+            name: name.to_owned(),
+            error,
+        })?;
     let cost = crate::derive::check_cost(&mut scene).map_err(|error| FileError::TooCostly {
         name: name.to_owned(),
         error,
     })?;
     repairs.extend(cost);
+    // Strokes from elsewhere (an older build, a script) land on the grid the app draws on, so
+    // the file's link is exact.
+    let moved = scene.snap_strokes();
+    if moved > 0 {
+        repairs.push(format!(
+            "/planes: {moved} stroke(s) off the stroke grid moved onto it (by at most half a step)"
+        ));
+    }
     Ok((scene, repairs))
 }
 

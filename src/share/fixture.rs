@@ -64,7 +64,7 @@ pub fn hand_drawn() -> Scene {
 /// hidden plane, carving and rotated ellipsoids, a reference picture, media, light, camera
 /// and clock), so a change in how any part is written shows as a changed encoding.
 pub fn every_part() -> Scene {
-    use crate::scene::{Ellipsoid, NoiseBasis, NoiseFilter, ReferenceImage, StrokeKind};
+    use crate::scene::{Ellipsoid, NoiseBasis, NoiseFilter, ReferenceImage, StrokeKind, Tier};
     use std::sync::Arc;
     let mut scene = hand_drawn();
     scene.seed = 77;
@@ -78,6 +78,55 @@ pub fn every_part() -> Scene {
     scene.render.noise_basis = NoiseBasis::Worley;
     scene.render.noise_octaves = 6;
     scene.render.wind = [0.5, -0.25];
+    // Every other setting away from the link's base too (a unit test checks), so each one
+    // travels in the fixture's link.
+    let camera = &mut scene.camera;
+    (camera.fov_y_deg, camera.orthographic, camera.target) =
+        (40.0, true, Vec3::new(0.5, 2.5, -0.5));
+    let light = &mut scene.light;
+    light.ambient = 0.3;
+    light.background = [0.3, 0.45, 0.7];
+    light.exposure = 0.5;
+    light.forward_scattering = 0.7;
+    light.ground = true;
+    light.ground_color = [0.3, 0.35, 0.25];
+    light.ground_height = -2.0;
+    light.horizon_color = [0.8, 0.8, 0.85];
+    light.multiple_scattering = 0.35;
+    light.shaft_density = 0.008;
+    light.shaft_intensity = 1.5;
+    light.shafts = true;
+    light.sky_color = [0.5, 0.6, 0.8];
+    light.sky_gradient = true;
+    light.sun_elevation_deg = 28.0;
+    light.sun_intensity = 1.9;
+    let render = &mut scene.render;
+    render.detail = 2.5;
+    render.dirtiness = 0.8;
+    render.field_resolution = 80;
+    render.light_octaves = 3;
+    render.light_resolution = 32;
+    render.noise_amount = 0.4;
+    render.noise_scale = 2.5;
+    render.opacity = 3.0;
+    render.sharpness = 0.2;
+    render.slices = 160;
+    render.softness = 0.15;
+    render.tier_blend = 2.0;
+    render.tiers = vec![Tier {
+        floor: 6.0,
+        filter: NoiseFilter::Veined,
+        wind: [0.3, 0.1],
+        torque: 5.0,
+    }];
+    render.torque = 3.0;
+    {
+        let p = Arc::make_mut(&mut scene.planes[3]);
+        p.sketch.copies = 3;
+        p.sketch.extend = false;
+        p.sketch.prune = 0.05;
+        p.sketch.simplify = 0.02;
+    }
     {
         let p = Arc::make_mut(&mut scene.planes[1]);
         p.kind = StrokeKind::Cut;
@@ -100,6 +149,7 @@ pub fn every_part() -> Scene {
         Arc::new(Ellipsoid {
             rotation: Quat::from_rotation_z(0.4),
             strength: -0.5,
+            hidden: true,
             ..Ellipsoid::new(Vec3::new(1.0, 2.5, 0.5), Vec3::new(1.5, 1.0, 1.0))
         }),
     ];

@@ -5,7 +5,7 @@
 //!
 //! - a varint length, then compact JSON of the scene's *difference from a fixed base* (the
 //!   empty preset; each plane against a default plane, each ellipsoid against a default
-//!   ellipsoid), every number rounded to [`DIGITS`] significant digits, without the strokes'
+//!   ellipsoid, as they were when the version was made: stored as data, `link/base_v1.json`), every number rounded to [`DIGITS`] significant digits, without the strokes'
 //!   points and pressure and without the reference picture's bytes;
 //! - then, for each drawing plane in order, its stroke: the point count, the stroke's grid
 //!   (a step of 2^(e/8), at most [`STROKE_GRID`](crate::scene::STROKE_GRID) steps across its larger side; see
@@ -27,8 +27,8 @@ use serde_json::{Map, Value};
 
 use crate::limits::{MAX_ELLIPSOIDS, MAX_PLANE_POINTS, MAX_PLANES};
 use crate::scene::{
-    DrawingPlane, Ellipsoid, MAX_GRID_EXPONENT as MAX_EXPONENT, MAX_GRID_STEPS as MAX_STEPS,
-    Preset, SCENE_VERSION, Scene, SceneError, grid_exponent, grid_point, grid_points,
+    DrawingPlane, MAX_GRID_EXPONENT as MAX_EXPONENT, MAX_GRID_STEPS as MAX_STEPS, SCENE_VERSION,
+    Scene, SceneError, grid_exponent, grid_point, grid_points,
 };
 
 /// Format version written by this build; older ones keep opening (see docs/scene-format.md).
@@ -39,7 +39,7 @@ pub const LINK_VERSION: u8 = 1;
 pub const MAX_LINK_CHARS: usize = 64 * 1024;
 
 /// Largest payload after inflating (a deflate stream can expand a thousandfold).
-const MAX_INFLATED: usize = 2 << 20;
+pub const MAX_INFLATED: usize = 2 << 20;
 
 /// Largest JSON part of the payload.
 const MAX_JSON: usize = 1 << 20;
@@ -89,6 +89,10 @@ pub enum LinkError {
     /// Decoded, but too costly to build.
     #[error("the link's scene cannot be opened: {0}")]
     TooCostly(String),
+    /// The scene holds values a link cannot carry (they would not open again): it is refused
+    /// rather than written as a link that says it is damaged.
+    #[error("this scene cannot travel as a link ({0}): save it as a file instead")]
+    Unfit(String),
 }
 
 fn damaged(what: impl Into<String>) -> LinkError {
@@ -104,6 +108,9 @@ pub fn encode_link(scene: &Scene) -> Result<String, LinkError> {
     if token.len() > MAX_LINK_CHARS {
         return Err(LinkError::SceneTooLarge { chars: token.len() });
     }
+    // What is written must open: a value the link's grid cannot hold (a stroke point of 1e38)
+    // would decode as damaged.
+    decode_link(&format!("#s={token}")).map_err(|e| LinkError::Unfit(e.to_string()))?;
     Ok(token)
 }
 
@@ -169,6 +176,13 @@ pub fn decode_payload(payload: &[u8]) -> Result<(Scene, Vec<String>), LinkError>
     };
     let merged = merge_onto_base(diff)?;
     let (mut scene, mut repairs) = Scene::from_value(merged)?;
+    // A link never carries the reference picture's bytes (docs/scene-format.md): a crafted
+    // one that does gets its name and placement only.
+    if let Some(reference) = &mut scene.reference
+        && !reference.data.is_empty()
+    {
+        Arc::make_mut(reference).data = Default::default();
+    }
     for plane in &mut scene.planes {
         let (points, pressure) = read_stroke(&mut r)?;
         let plane = Arc::make_mut(plane);
@@ -187,8 +201,46 @@ pub fn decode_payload(payload: &[u8]) -> Result<(Scene, Vec<String>), LinkError>
 
 // --- the settings: JSON differences from a fixed base -------------------------------------
 
-fn base_scene() -> Scene {
-    Scene::preset(Preset::Empty)
+/// What a link's settings are the difference from, as format version 1 wrote and reads it:
+/// the empty preset, a default drawing plane and a default ellipsoid as they serialised when
+/// the format was made, kept as data (`src/share/link/base_v1.json`). Defaults may move (the
+/// ground's height, the sun); a version-1 link still opens to the scene it was made of.
+struct Bases {
+    scene: Value,
+    plane: Value,
+    ellipsoid: Value,
+}
+
+const BASE_V1: &str = include_str!("link/base_v1.json");
+
+/// The bases of link format version 1 (the only one so far: a new version adds its own file).
+fn bases() -> &'static Bases {
+    static BASES: std::sync::OnceLock<Bases> = std::sync::OnceLock::new();
+    BASES.get_or_init(|| {
+        let mut all = as_object(serde_json::from_str(BASE_V1).unwrap_or(Value::Null));
+        let mut take = |key: &str| all.remove(key).unwrap_or(Value::Null);
+        Bases {
+            scene: take("scene"),
+            plane: take("plane"),
+            ellipsoid: take("ellipsoid"),
+        }
+    })
+}
+
+/// Today's defaults as [`Bases`] holds them (what `base_v1.json` was written from).
+#[cfg(test)]
+fn todays_bases() -> Value {
+    serde_json::json!({
+        "scene": serde_json::to_value(Scene::preset(crate::scene::Preset::Empty)).unwrap(),
+        "plane": serde_json::to_value(DrawingPlane::default()).unwrap(),
+        "ellipsoid": serde_json::to_value(crate::scene::Ellipsoid::default()).unwrap(),
+    })
+}
+
+fn rounded(value: &Value) -> Value {
+    let mut v = value.clone();
+    round_numbers(&mut v);
+    v
 }
 
 fn to_rounded_value<T: serde::Serialize>(value: &T) -> Value {
@@ -263,10 +315,11 @@ fn as_object(v: Value) -> Map<String, Value> {
 /// The JSON part of the payload for `scene`.
 fn settings_json(scene: &Scene) -> Value {
     let mut value = as_object(to_rounded_value(scene));
-    let base = as_object(to_rounded_value(&base_scene()));
-    let mut plane_base = as_object(to_rounded_value(&DrawingPlane::default()));
+    let bases = bases();
+    let base = as_object(rounded(&bases.scene));
+    let mut plane_base = as_object(rounded(&bases.plane));
     plane_base.remove("points");
-    let ellipsoid_base = as_object(to_rounded_value(&Ellipsoid::default()));
+    let ellipsoid_base = as_object(rounded(&bases.ellipsoid));
     let list = |value: &mut Map<String, Value>, key: &str, base: &Map<String, Value>| {
         let items = match value.remove(key) {
             Some(Value::Array(items)) => items,
@@ -318,17 +371,10 @@ fn merge_onto_base(mut diff: Map<String, Value>) -> Result<Value, LinkError> {
         }
         Ok(Value::Array(out))
     };
-    let planes = list(
-        "planes",
-        MAX_PLANES,
-        serde_json::to_value(DrawingPlane::default()).unwrap_or(Value::Null),
-    )?;
-    let ellipsoids = list(
-        "ellipsoids",
-        MAX_ELLIPSOIDS,
-        serde_json::to_value(Ellipsoid::default()).unwrap_or(Value::Null),
-    )?;
-    let mut scene = serde_json::to_value(base_scene()).unwrap_or(Value::Null);
+    let bases = bases();
+    let planes = list("planes", MAX_PLANES, bases.plane.clone())?;
+    let ellipsoids = list("ellipsoids", MAX_ELLIPSOIDS, bases.ellipsoid.clone())?;
+    let mut scene = bases.scene.clone();
     merge(&mut scene, Value::Object(diff));
     if let Value::Object(o) = &mut scene {
         o.insert("planes".into(), planes);
@@ -415,7 +461,7 @@ fn read_stroke(r: &mut Reader) -> Result<Stroke, LinkError> {
                 let v = r.ivar()?;
                 *k = predict(i, &q, axis)
                     .and_then(|p| p.checked_add(v))
-                    .filter(|k| k.abs() <= MAX_STEPS)
+                    .filter(|k| k.unsigned_abs() <= MAX_STEPS as u64)
                     .ok_or_else(|| damaged("a stroke runs off its grid"))?;
             }
             q.push(k);

@@ -19,6 +19,11 @@ pub use outline::Outline;
 pub use skeleton::Skeleton;
 pub use spheres::Sphere;
 
+/// The smallest extent (the bounding box's larger side) a stroke may have, in its own units.
+pub const MIN_EXTENT: f64 = 1e-9;
+/// The largest extent a stroke may have.
+pub const MAX_EXTENT: f64 = 1e12;
+
 /// Why a stroke cannot become a cloud.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum SketchError {
@@ -31,6 +36,9 @@ pub enum SketchError {
     /// So many self-crossings that the repair ran out of its budget before finding any loop.
     #[error("the stroke crosses itself too often to find its outline: draw it with fewer loops")]
     TooTangled,
+    /// Too large or too small to draw with: its extent is outside [`MIN_EXTENT`, `MAX_EXTENT`].
+    #[error("the stroke spans {0:e} units: a stroke spans {MIN_EXTENT:e} to {MAX_EXTENT:e}")]
+    OutOfRange(f64),
     /// The triangulation refused the outline (should not happen after cleaning).
     #[error("could not triangulate the outline: {0}")]
     Triangulation(String),

@@ -223,9 +223,28 @@ pub fn clean(raw: &[[f64; 2]], closed: bool, simplify: f64) -> Result<Outline, S
     if points.len() < 3 {
         return Err(SketchError::TooFewPoints(points.len()));
     }
+    // The stroke's extent, measured without squaring (a diagonal of 1e200 units overflows).
+    let (lo, hi) = points
+        .iter()
+        .fold((DVec2::MAX, DVec2::MIN), |(lo, hi), &p| {
+            (lo.min(p), hi.max(p))
+        });
+    let extent = (hi - lo).max_element();
+    if extent > 0.0 && !(super::MIN_EXTENT..=super::MAX_EXTENT).contains(&extent) {
+        return Err(SketchError::OutOfRange(extent));
+    }
     let size = diagonal(&points);
     if !size.is_finite() || size <= 0.0 {
         return Err(SketchError::NoArea);
+    }
+    // A coordinate far below the stroke's precision is zero (the triangulation refuses
+    // magnitudes near the smallest doubles).
+    for p in &mut points {
+        for c in [&mut p.x, &mut p.y] {
+            if c.abs() < size * 1e-12 {
+                *c = 0.0;
+            }
+        }
     }
     // Coordinates far from the origin lose precision in the triangulation: work around the centre.
     let eps = size * 1e-7;

@@ -9,6 +9,7 @@ use super::panels::{
 };
 use super::scene_files::SceneFiles;
 use super::selection::Selection;
+use super::shortcuts::Shortcut;
 use super::sketch_tool::{Axis, SketchTool, ToolContext};
 use super::viewport::{Viewport, ViewportContext};
 use crate::derive::Derived;
@@ -181,64 +182,60 @@ impl CloudApp {
         self.selection.retain_valid(self.doc.scene());
     }
 
-    /// Undo (Ctrl+Z), redo (Ctrl+Shift+Z, Ctrl+Y), frame (F), play (Alt+A), export (Ctrl+E),
-    /// then the tools' shortcuts.
-    fn shortcuts(&mut self, ctx: &egui::Context) {
-        if ctx.egui_wants_keyboard_input() {
-            return;
+    /// Acts on each of a frame's shortcuts in the order they were pressed (see
+    /// [`super::shortcuts`]).
+    fn shortcuts(&mut self, ctx: &egui::Context, pressed: &[Shortcut]) {
+        for &shortcut in pressed {
+            self.shortcut(ctx, shortcut);
         }
-        use egui::{Key, Modifiers};
-        let export = ctx.input_mut(|i| i.consume_key(Modifiers::COMMAND, Key::E));
-        let (undo, redo, frame, panel) = ctx.input_mut(|i| {
-            let redo = i.consume_key(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z)
-                || i.consume_key(Modifiers::COMMAND, Key::Y);
-            let undo = i.consume_key(Modifiers::COMMAND, Key::Z);
-            let frame = i.consume_key(Modifiers::NONE, Key::F);
-            let panel = i.consume_key(Modifiers::NONE, Key::N);
-            // Alt+A plays and pauses (Blender's shortcut before Space took it over).
-            if i.consume_key(Modifiers::ALT, Key::A) {
-                self.panels.clock.playing = !self.panels.clock.playing;
-            }
-            (undo, redo, frame, panel)
-        });
-        if panel {
-            self.panel_open = !self.panel_open;
-        }
-        if let Some(change) = super::panels::view_keys(ctx) {
-            let mut camera = self.doc.scene().camera.clone();
-            change(&mut camera);
-            self.doc.set_camera(camera);
-        }
-        self.files.shortcuts(ctx, &self.doc, &mut self.notices);
+    }
+
+    /// One shortcut: undo, redo, frame, the panel, play, standard views, export and the file
+    /// keys here; the tools' keys go to the tool.
+    fn shortcut(&mut self, ctx: &egui::Context, shortcut: Shortcut) {
         let now = ctx.input(|i| i.time);
-        if undo {
-            self.undo(now);
-        }
-        if redo {
-            self.redo(now);
-        }
-        if frame {
-            self.viewport.frame_request = true;
-        }
-        if export {
-            let ask = self.panels.export.start(
-                &self.doc,
-                &mut self.notices,
-                now,
-                self.viewport.stats.viewport_px,
-                &self.files.name,
-            );
-            if ask.capture.is_some() {
-                self.viewport.capture_request = ask.capture;
+        match shortcut {
+            Shortcut::Undo => self.undo(now),
+            Shortcut::Redo => self.redo(now),
+            Shortcut::Frame => self.viewport.frame_request = true,
+            Shortcut::TogglePanel => self.panel_open = !self.panel_open,
+            // Alt+A plays and pauses (Blender's shortcut before Space took it over).
+            Shortcut::PlayPause => self.panels.clock.playing = !self.panels.clock.playing,
+            Shortcut::View(view) => {
+                let mut camera = self.doc.scene().camera.clone();
+                camera.set_view(view);
+                self.doc.set_camera(camera);
+            }
+            Shortcut::Orthographic => {
+                let mut camera = self.doc.scene().camera.clone();
+                camera.orthographic = !camera.orthographic;
+                self.doc.set_camera(camera);
+            }
+            Shortcut::Save | Shortcut::SaveAs | Shortcut::Open | Shortcut::CopyLink => self
+                .files
+                .shortcut(ctx, shortcut, &self.doc, &mut self.notices),
+            Shortcut::Export => {
+                let ask = self.panels.export.start(
+                    &self.doc,
+                    &mut self.notices,
+                    now,
+                    self.viewport.stats.viewport_px,
+                    &self.files.name,
+                );
+                if ask.capture.is_some() {
+                    self.viewport.capture_request = ask.capture;
+                }
+            }
+            _ => {
+                let mut tc = ToolContext {
+                    doc: &mut self.doc,
+                    derived: &mut self.derived,
+                    selection: &mut self.selection,
+                    notices: &mut self.notices,
+                };
+                self.tool.shortcut(shortcut, &mut tc, now);
             }
         }
-        let mut tc = ToolContext {
-            doc: &mut self.doc,
-            derived: &mut self.derived,
-            selection: &mut self.selection,
-            notices: &mut self.notices,
-        };
-        self.tool.shortcuts(ctx, &mut tc);
     }
 
     /// The side panel: undo/redo/frame buttons, then each group's view.
@@ -518,7 +515,8 @@ impl eframe::App for CloudApp {
     fn ui(&mut self, ui: &mut egui::Ui, frame: &mut eframe::Frame) {
         self.cpu_seconds = frame.info().cpu_usage;
         let ctx = ui.ctx().clone();
-        self.shortcuts(&ctx);
+        let pressed = super::shortcuts::take(&ctx);
+        self.shortcuts(&ctx, &pressed.before_pointer);
         if self
             .panels
             .clock
@@ -591,10 +589,106 @@ impl eframe::App for CloudApp {
                 },
             )
         });
+        // Keys pressed after a pointer button in this frame act once the view has taken it.
+        self.shortcuts(&ctx, &pressed.after_pointer);
         if !ctx.input(|i| i.pointer.any_down()) {
             self.doc.end_merge();
         }
         self.autosave(&ctx);
         self.publish(&ctx);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Preset;
+    use egui::{Event, Key, Modifiers, RawInput};
+
+    /// The app without a renderer, saving to `file`, after two edits: the stratus preset
+    /// opened over the empty scene, then the cumulus over that.
+    fn app_with_two_edits(ctx: &egui::Context, file: &std::path::Path) -> CloudApp {
+        let cc = eframe::CreationContext::_new_kittest(ctx.clone());
+        let mut app = CloudApp::new(
+            &cc,
+            StartOptions {
+                scene: Scene::preset(Preset::Empty),
+                file: Some(file.display().to_string()),
+                ..Default::default()
+            },
+        );
+        for preset in [Preset::Stratus, Preset::Cumulus] {
+            app.doc
+                .apply(Edit::Replace(Box::new(Scene::preset(preset))), None);
+        }
+        app
+    }
+
+    /// Runs one frame of the real app holding these key presses.
+    fn frame(ctx: &egui::Context, app: &mut CloudApp, keys: &[(Modifiers, Key)]) {
+        let events = keys
+            .iter()
+            .map(|&(modifiers, key)| Event::Key {
+                key,
+                physical_key: None,
+                pressed: true,
+                repeat: false,
+                modifiers,
+            })
+            .collect();
+        let raw = RawInput {
+            screen_rect: Some(crate::ui::test_view()),
+            events,
+            ..Default::default()
+        };
+        let mut eframe_frame = eframe::Frame::_new_kittest();
+        let mut output = ctx.run_ui(raw, |ui| eframe::App::ui(app, ui, &mut eframe_frame));
+        output.textures_delta.clear();
+    }
+
+    fn saved(file: &std::path::Path) -> Scene {
+        Scene::from_json(&std::fs::read_to_string(file).unwrap())
+            .unwrap()
+            .0
+    }
+
+    #[test]
+    fn shortcuts_in_one_frame_act_in_the_order_they_were_pressed() {
+        let dir = std::env::temp_dir().join(format!("cloudsketch-keys-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("keys.json");
+        let (z, s) = ((Modifiers::COMMAND, Key::Z), (Modifiers::COMMAND, Key::S));
+        let stratus = Scene::preset(Preset::Stratus);
+        let cumulus = Scene::preset(Preset::Cumulus);
+
+        // Ctrl+Z then Ctrl+S: what is saved is the undone scene.
+        let ctx = egui::Context::default();
+        let mut app = app_with_two_edits(&ctx, &file);
+        frame(&ctx, &mut app, &[z, s]);
+        assert_eq!(
+            saved(&file).ellipsoids,
+            stratus.ellipsoids,
+            "undo, then save"
+        );
+        assert_eq!(app.doc.scene().ellipsoids, stratus.ellipsoids);
+
+        // Ctrl+S then Ctrl+Z: the saved scene is the one before the undo.
+        let ctx = egui::Context::default();
+        let mut app = app_with_two_edits(&ctx, &file);
+        frame(&ctx, &mut app, &[s, z]);
+        assert_eq!(
+            saved(&file).ellipsoids,
+            cumulus.ellipsoids,
+            "save, then undo"
+        );
+        assert_eq!(app.doc.scene().ellipsoids, stratus.ellipsoids);
+
+        // Two presses of Ctrl+Z undo twice.
+        let ctx = egui::Context::default();
+        let mut app = app_with_two_edits(&ctx, &file);
+        frame(&ctx, &mut app, &[z, z, s]);
+        assert!(app.doc.scene().ellipsoids.is_empty(), "both edits undone");
+        assert!(saved(&file).ellipsoids.is_empty());
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

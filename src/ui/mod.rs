@@ -14,6 +14,7 @@
 //! - `guide`: the reference image (loading, texture, drawing, its panel group);
 //! - `scene_files`: Open, Save, Copy link, the unsaved marker and links pasted into the page;
 //! - `panels`: one struct per side-panel group, each with its own `ui()`;
+//! - `shortcuts`: a frame's key presses as shortcuts, in the order they were pressed;
 //! - `press_record`: every pointer sample of a press, however few frames it spans;
 //! - `selection`, `notice`, `widgets`: small shared pieces;
 //! - `platform_native` / `platform_web`: the one platform seam (chosen by `cfg` on the module).
@@ -36,6 +37,7 @@ mod platform;
 mod press_record;
 mod scene_files;
 mod selection;
+mod shortcuts;
 mod sketch_tool;
 mod sun_handle;
 mod viewport;

@@ -23,13 +23,8 @@ pub fn poll_reports(_poll: impl Fn() + 'static) {}
 /// Reads a dropped file at once.
 pub fn read_dropped(file: egui::DroppedFileHandle, _ctx: &egui::Context) -> Option<Loaded> {
     let name = file.path().display().to_string();
-    if let Ok(meta) = std::fs::metadata(file.path())
-        && meta.len() > MAX_BYTES
-    {
-        return Some(Err(format!("{name}: larger than {} MiB", MAX_BYTES >> 20)));
-    }
     Some(
-        file.bytes()
+        crate::files::read_bounded(file.path(), MAX_BYTES)
             .map(|b| (name.clone(), b))
             .map_err(|e| format!("{name}: {e}")),
     )
@@ -37,13 +32,10 @@ pub fn read_dropped(file: egui::DroppedFileHandle, _ctx: &egui::Context) -> Opti
 
 /// Reads a file by path.
 pub fn read_path(path: &str) -> Loaded {
-    let meta = std::fs::metadata(path).map_err(|e| format!("{path}: {e}"))?;
-    if meta.len() > MAX_BYTES {
-        return Err(format!("{path}: larger than {} MiB", MAX_BYTES >> 20));
-    }
-    std::fs::read(path)
+    let at = std::path::Path::new(path);
+    crate::files::read_bounded(at, MAX_BYTES)
         .map(|b| (path.to_string(), b))
-        .map_err(|e| format!("{path}: {e}"))
+        .map_err(|e| e.at(at))
 }
 
 /// Feeds this frame's events to the press record: natively egui's events carry every cursor
@@ -92,19 +84,17 @@ fn autosave_dir() -> Option<std::path::PathBuf> {
 
 /// A file of the app's own in its data folder, within the size cap.
 fn load_data(name: &str) -> Option<String> {
-    let path = autosave_dir()?.join(name);
-    (std::fs::metadata(&path).ok()?.len() <= MAX_BYTES)
-        .then(|| std::fs::read_to_string(path).ok())?
+    crate::files::read_bounded_text(&autosave_dir()?.join(name), MAX_BYTES).ok()
 }
 
-/// Writes a file of the app's own in its data folder (to a temporary file first, so a crash
+/// Writes a file of the app's own in its data folder ([`crate::files::write_atomic`]: a crash
 /// mid-write keeps the last one).
 fn store_data(name: &str, json: &str) -> Result<(), String> {
     let dir = autosave_dir().ok_or("no home folder to keep it in")?;
     std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-    let tmp = dir.join(format!("{name}.tmp"));
-    std::fs::write(&tmp, json).map_err(|e| format!("{}: {e}", tmp.display()))?;
-    std::fs::rename(&tmp, dir.join(name)).map_err(|e| format!("{}: {e}", dir.display()))
+    let path = dir.join(name);
+    crate::files::write_atomic(&path, json.as_bytes())
+        .map_err(|e| format!("{}: {e}", path.display()))
 }
 
 /// The last autosaved document, if any.
@@ -150,11 +140,11 @@ pub fn save_file(path: &str, text: &str) -> Result<String, String> {
     save_bytes(path, text.as_bytes(), "application/json")
 }
 
-/// Writes bytes at `path` (through a temporary file). The media type is the browser's concern.
+/// Writes bytes at `path` ([`crate::files::write_atomic`]). The media type is the browser's
+/// concern.
 pub fn save_bytes(path: &str, bytes: &[u8], _mime: &str) -> Result<String, String> {
-    let tmp = format!("{path}.tmp");
-    std::fs::write(&tmp, bytes).map_err(|e| format!("{path}: {e}"))?;
-    std::fs::rename(&tmp, path).map_err(|e| format!("{path}: {e}"))?;
+    crate::files::write_atomic(std::path::Path::new(path), bytes)
+        .map_err(|e| format!("{path}: {e}"))?;
     Ok(path.to_owned())
 }
 

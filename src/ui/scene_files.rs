@@ -5,6 +5,7 @@
 use super::notice::Notices;
 use super::platform;
 use super::selection::Selection;
+use super::shortcuts::Shortcut;
 use crate::scene::{Document, Edit, Scene};
 use crate::share::{LinkError, decode_link, link_url, open_scene_file, scene_file_name};
 
@@ -149,29 +150,24 @@ impl SceneFiles {
     }
 
     /// Ctrl+S saves, Ctrl+Shift+S asks for a name first, Ctrl+O opens, Ctrl+L copies a link
-    /// (Figma's key).
-    pub fn shortcuts(&mut self, ctx: &egui::Context, doc: &Document, notices: &mut Notices) {
-        use egui::{Key, Modifiers};
-        let (save_as, save, open, link) = ctx.input_mut(|i| {
-            (
-                i.consume_key(Modifiers::COMMAND | Modifiers::SHIFT, Key::S),
-                i.consume_key(Modifiers::COMMAND, Key::S),
-                i.consume_key(Modifiers::COMMAND, Key::O),
-                i.consume_key(Modifiers::COMMAND, Key::L),
-            )
-        });
-        if link {
-            self.copy_link(ctx, doc, notices);
-        }
+    /// (Figma's key); other shortcuts are not the file's.
+    pub fn shortcut(
+        &mut self,
+        ctx: &egui::Context,
+        shortcut: Shortcut,
+        doc: &Document,
+        notices: &mut Notices,
+    ) {
         let now = ctx.input(|i| i.time);
-        if save_as {
-            self.focus_name = true;
-            notices.note(now, "Save as: type the file's name, then Enter");
-        } else if save {
-            self.save(doc, notices, now);
-        }
-        if open {
-            self.ask_to_open(notices, now);
+        match shortcut {
+            Shortcut::CopyLink => self.copy_link(ctx, doc, notices),
+            Shortcut::SaveAs => {
+                self.focus_name = true;
+                notices.note(now, "Save as: type the file's name, then Enter");
+            }
+            Shortcut::Save => self.save(doc, notices, now),
+            Shortcut::Open => self.ask_to_open(notices, now),
+            _ => {}
         }
     }
 

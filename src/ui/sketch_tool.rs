@@ -10,6 +10,7 @@ use super::gizmo::{Gizmo, Handle, ring_turn};
 use super::notice::Notices;
 use super::picking;
 use super::selection::{Item, Selection};
+use super::shortcuts::Shortcut;
 use crate::derive::{Derived, Shape};
 use crate::scene::{
     Document, DrawingPlane, Edit, MAX_PLANE_POINTS, MAX_PLANES, OrbitCamera, StrokeKind,
@@ -136,17 +137,6 @@ impl Axis {
     }
 }
 
-/// Each tool's key (Blender's where it has one).
-const TOOL_KEYS: [(egui::Key, Tool); 7] = [
-    (egui::Key::V, Tool::Navigate),
-    (egui::Key::D, Tool::Sketch),
-    (egui::Key::C, Tool::Cut),
-    (egui::Key::E, Tool::Ellipsoid),
-    (egui::Key::G, Tool::Move),
-    (egui::Key::R, Tool::Rotate),
-    (egui::Key::S, Tool::Scale),
-];
-
 /// Turn per pixel of drag: about 1° per 5 px (a 150 px drag turns 30°), as the gizmos will.
 const TURN_PER_PX: f32 = 0.2 * std::f32::consts::PI / 180.0;
 /// The step Ctrl snaps turns to.
@@ -264,70 +254,63 @@ fn pen_pressure(samples: &[Option<f32>]) -> Vec<f32> {
 }
 
 impl SketchTool {
-    /// Tool shortcuts: V navigate, D draw, C cut, E ellipsoid, G move, R rotate, S scale (then
-    /// X, Y or Z locks the axis, the same key again frees it), H hides guides, Shift+H hides the
-    /// selected item (Alt+H shows all), K shows the skeleton and spheres, Esc cancels a drag or
-    /// a stroke (or clears the selection), Delete removes the selected ellipsoid or plane,
-    /// Ctrl+D duplicates it.
-    pub fn shortcuts(&mut self, ctx: &egui::Context, tc: &mut ToolContext<'_>) {
-        if ctx.egui_wants_keyboard_input() {
-            return;
-        }
-        use egui::{Key, Modifiers};
-        // Ctrl+D, Shift+H and Alt+H first, so the plain D and H below do not take them.
-        let dup = ctx.input_mut(|i| i.consume_key(Modifiers::COMMAND, Key::D));
-        let hide = ctx.input_mut(|i| i.consume_key(Modifiers::SHIFT, Key::H));
-        let reveal = ctx.input_mut(|i| i.consume_key(Modifiers::ALT, Key::H));
-        for (key, tool) in TOOL_KEYS {
-            if ctx.input_mut(|i| i.consume_key(Modifiers::NONE, key)) {
+    /// One of the tools' shortcuts: V navigate, D draw, C cut, E ellipsoid, G move, R rotate,
+    /// S scale (then X, Y or Z locks the axis, the same key again frees it), H hides guides,
+    /// Shift+H hides the selected item (Alt+H shows all), K shows the skeleton and spheres, Esc
+    /// cancels a drag or a stroke (or clears the selection), Delete removes the selected
+    /// ellipsoid or plane, Ctrl+D duplicates it. Other shortcuts are not the tools'.
+    pub fn shortcut(&mut self, shortcut: Shortcut, tc: &mut ToolContext<'_>, now: f64) {
+        let message = match shortcut {
+            Shortcut::Tool(tool) => {
                 self.tool = tool;
+                None
             }
-        }
-        let [h, k, esc, del, b] = [Key::H, Key::K, Key::Escape, Key::Delete, Key::B]
-            .map(|key| ctx.input_mut(|i| i.consume_key(Modifiers::NONE, key)));
-        if b {
-            self.box_armed = true;
-        }
-        if matches!(self.tool, Tool::Move | Tool::Rotate | Tool::Scale) {
-            for (key, axis) in [(Key::X, Axis::X), (Key::Y, Axis::Y), (Key::Z, Axis::Z)] {
-                if ctx.input_mut(|i| i.consume_key(Modifiers::NONE, key)) {
+            Shortcut::BoxSelect => {
+                self.box_armed = true;
+                None
+            }
+            Shortcut::Lock(axis) => {
+                if matches!(self.tool, Tool::Move | Tool::Rotate | Tool::Scale) {
                     self.axis_lock = (self.axis_lock != Some(axis)).then_some(axis);
                 }
+                None
             }
+            Shortcut::ToggleGuides => {
+                self.hide_guides = !self.hide_guides;
+                None
+            }
+            Shortcut::ToggleSkeleton => {
+                self.show_skeleton = !self.show_skeleton;
+                None
+            }
+            Shortcut::Escape => self.escape(tc),
+            Shortcut::HideSelected => super::selection::toggle_hidden(tc.doc, tc.selection)
+                .map(|m| format!("{m} (Shift+H again shows it, Alt+H shows all)")),
+            Shortcut::ShowAll => super::selection::show_all(tc.doc),
+            Shortcut::Duplicate => super::selection::duplicate(tc.doc, tc.selection),
+            Shortcut::Delete => super::selection::delete(tc.doc, tc.selection),
+            _ => None,
+        };
+        if let Some(m) = message {
+            tc.notices.note(now, m);
         }
-        let now = ctx.input(|i| i.time);
-        if h {
-            self.hide_guides = !self.hide_guides;
-        }
-        if k {
-            self.show_skeleton = !self.show_skeleton;
-        }
-        if esc && (self.box_armed || self.area.is_some()) {
+    }
+
+    /// Esc: drops an armed or dragged selection box, else cancels the drag under way, else
+    /// drops the stroke being drawn (and with none, clears the selection).
+    fn escape(&mut self, tc: &mut ToolContext<'_>) -> Option<String> {
+        if self.box_armed || self.area.is_some() {
             (self.box_armed, self.area) = (false, None);
-        } else if esc && self.cancel_gesture(tc.doc) {
-            tc.notices.note(now, "Cancelled: back where the drag began");
-        } else if esc {
+        } else if self.cancel_gesture(tc.doc) {
+            return Some("Cancelled: back where the drag began".to_owned());
+        } else {
             if self.stroke.is_empty() {
                 tc.selection.clear();
             }
             self.stroke.clear();
             self.drawing = false;
         }
-        if hide && let Some(m) = super::selection::toggle_hidden(tc.doc, tc.selection) {
-            tc.notices.note(
-                now,
-                format!("{m} (Shift+H again shows it, Alt+H shows all)"),
-            );
-        }
-        if reveal && let Some(m) = super::selection::show_all(tc.doc) {
-            tc.notices.note(now, m);
-        }
-        if dup && let Some(m) = super::selection::duplicate(tc.doc, tc.selection) {
-            tc.notices.note(now, m);
-        }
-        if del && let Some(m) = super::selection::delete(tc.doc, tc.selection) {
-            tc.notices.note(now, m);
-        }
+        None
     }
 
     /// Stroke capture in the viewport. Returns whether the primary button draws (so the camera

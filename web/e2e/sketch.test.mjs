@@ -274,7 +274,8 @@ test('a pen stroke stores its pressure per point; a mouse stroke stores none', {
     let s = await until(page, (s) => s.scene.planes.length === 1, 'the pen stroke');
     const { points, pressure } = s.scene.planes[0];
     assert.ok(Array.isArray(pressure) && pressure.length === points.length, `${pressure?.length} pressures for ${points.length} points`);
-    assert.ok(points.length >= 0.9 * n, `${points.length} of ${n} samples`);
+    // The press and every move: all n + 1 samples.
+    assert.equal(points.length, n + 1, `${points.length} of ${n + 1} samples`);
     assert.ok(Math.min(...pressure) < 0.3 && Math.max(...pressure) > 0.8, `pressure ${Math.min(...pressure)}–${Math.max(...pressure)}`);
     // The mouse: no pressure stored.
     await stroke(page, loop(vw * 0.7, vh * 0.5, vh * 0.1));

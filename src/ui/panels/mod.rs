@@ -16,7 +16,7 @@ pub use light::LIGHT;
 pub use render::RENDER;
 pub use scene::ScenePanel;
 pub use sketch::SketchPanel;
-pub use view::{GeometryUpdate, ViewPanel, ViewStats, view_keys};
+pub use view::{GeometryUpdate, ViewPanel, ViewStats};
 
 use egui::Ui;
 

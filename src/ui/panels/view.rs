@@ -4,7 +4,7 @@ use egui::Ui;
 
 use crate::render::progressive::Quality;
 use crate::render::viewport::BackendInfo;
-use crate::scene::{Document, OrbitCamera, StandardView};
+use crate::scene::{Document, StandardView};
 
 /// The standard views with their keys (the number row or the numpad; Ctrl: the opposite side).
 const VIEWS: [(StandardView, &str, &str); 6] = [
@@ -15,28 +15,6 @@ const VIEWS: [(StandardView, &str, &str); 6] = [
     (StandardView::Left, "Left", "Ctrl+3"),
     (StandardView::Bottom, "Bottom", "Ctrl+7"),
 ];
-
-/// A camera change asked for by the keyboard: 1/3/7 standard views (Ctrl: opposite side), 5
-/// orthographic on/off.
-pub fn view_keys(ctx: &egui::Context) -> Option<Box<dyn FnOnce(&mut OrbitCamera)>> {
-    use egui::{Key, Modifiers};
-    ctx.input_mut(|i| {
-        for (key, view, opposite) in [
-            (Key::Num1, StandardView::Front, StandardView::Back),
-            (Key::Num3, StandardView::Right, StandardView::Left),
-            (Key::Num7, StandardView::Top, StandardView::Bottom),
-        ] {
-            if i.consume_key(Modifiers::NONE, key) {
-                return Some(Box::new(move |c: &mut OrbitCamera| c.set_view(view)) as Box<_>);
-            }
-            if i.consume_key(Modifiers::COMMAND, key) {
-                return Some(Box::new(move |c: &mut OrbitCamera| c.set_view(opposite)) as Box<_>);
-            }
-        }
-        i.consume_key(Modifiers::NONE, Key::Num5)
-            .then(|| Box::new(|c: &mut OrbitCamera| c.orthographic = !c.orthographic) as Box<_>)
-    })
-}
 
 /// What the viewport reports about itself.
 #[derive(Clone, Debug, Default, PartialEq)]
