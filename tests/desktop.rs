@@ -267,7 +267,7 @@ fn the_window_draws_the_default_cloud_beside_its_panel_and_opens_a_scene_file() 
 
     // The baseline: a scene file without a cloud, with another sky. The window opens the file
     // (its name in the state), shows that sky, and nothing of a cloud.
-    let scene_path = temp("empty.json");
+    let scene_path = temp("empty-scene.json");
     let mut scene: Value = serde_json::from_str(
         &cloudsketch::scene::Scene::preset(cloudsketch::scene::Preset::Empty).to_json(),
     )
@@ -280,7 +280,7 @@ fn the_window_draws_the_default_cloud_beside_its_panel_and_opens_a_scene_file() 
         empty.state["view"]["file"]
             .as_str()
             .unwrap()
-            .ends_with("empty.json"),
+            .ends_with("empty-scene.json"),
         "{}",
         empty.state["view"]
     );

@@ -15,6 +15,7 @@ pub mod capture;
 pub mod field_gpu;
 pub mod gpu_types;
 pub mod passes;
+pub mod probe;
 pub mod progressive;
 pub mod renderer;
 pub mod resources;

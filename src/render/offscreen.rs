@@ -329,6 +329,8 @@ impl Offscreen {
                     let done = std::mem::replace(&mut commands, encoder(&self.device));
                     self.queue.submit([done.finish()]);
                     let _ = self.device.poll(wgpu::PollType::wait_indefinitely());
+                    // The chunk is done: its uniform slot may be written again.
+                    self.renderer.begin_frame();
                     report((k + 1) as f32 / chunks as f32);
                 }
             }
@@ -345,6 +347,43 @@ impl Offscreen {
                 Ok(image)
             }
         }
+    }
+
+    /// The density the slices' shader gives `scene`'s media at each probe, a world point and
+    /// the field's value there ([`super::probe`]): what the CPU's media (`field::media`, which
+    /// the exports bake) must agree with.
+    pub fn media_at(
+        &mut self,
+        scene: &Scene,
+        probes: &[(glam::Vec3, f32)],
+    ) -> Result<Vec<f32>, OffscreenError> {
+        let job = self.full_job(scene, 16, 16);
+        let data: Vec<[f32; 4]> = probes.iter().map(|(p, f)| [p.x, p.y, p.z, *f]).collect();
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("media probe"),
+            });
+        let Some(readback) =
+            self.renderer
+                .probe_media(&self.device, &self.queue, &mut encoder, &job.view, &data)
+        else {
+            return Ok(Vec::new());
+        };
+        self.queue.submit([encoder.finish()]);
+        self.map_for_reading(&readback)?;
+        let densities = {
+            let bytes = readback
+                .slice(..)
+                .get_mapped_range()
+                .map_err(|e| OffscreenError::Readback(e.to_string()))?;
+            bytes
+                .chunks_exact(4)
+                .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+                .collect()
+        };
+        readback.unmap();
+        Ok(densities)
     }
 
     /// Times `frames` full-quality frames of `scene` (slices and composite, no readback), each

@@ -594,25 +594,30 @@ pub struct MarchPass {
     pub blend_layout: wgpu::BindGroupLayout,
 }
 
+/// The slice group's bindings (`volume_common.wgsl`'s group 0) for a compute pass.
+pub fn compute_volume_layout(device: &wgpu::Device, label: &str) -> wgpu::BindGroupLayout {
+    let compute = |mut e: wgpu::BindGroupLayoutEntry| {
+        e.visibility = wgpu::ShaderStages::COMPUTE;
+        e
+    };
+    let size = std::mem::size_of::<VolumeUniforms>() as u64;
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(label),
+        entries: &[
+            uniform_entry(0, wgpu::ShaderStages::COMPUTE, size, true),
+            compute(texture_3d(1)),
+            compute(sampler_entry(2)),
+            compute(texture_3d(3)),
+            compute(sampler_entry(4)),
+            compute(texture_3d(5)),
+        ],
+    })
+}
+
 impl MarchPass {
     /// Creates the pass blending into accumulation targets of `format`.
     pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat) -> Self {
-        let compute = |mut e: wgpu::BindGroupLayoutEntry| {
-            e.visibility = wgpu::ShaderStages::COMPUTE;
-            e
-        };
-        let size = std::mem::size_of::<VolumeUniforms>() as u64;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("marched slices: volume"),
-            entries: &[
-                uniform_entry(0, wgpu::ShaderStages::COMPUTE, size, true),
-                compute(texture_3d(1)),
-                compute(sampler_entry(2)),
-                compute(texture_3d(3)),
-                compute(sampler_entry(4)),
-                compute(texture_3d(5)),
-            ],
-        });
+        let layout = compute_volume_layout(device, "marched slices: volume");
         let image = |binding| wgpu::BindGroupLayoutEntry {
             binding,
             visibility: wgpu::ShaderStages::COMPUTE,

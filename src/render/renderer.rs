@@ -149,16 +149,49 @@ impl VolumeRenderer {
     /// The slice group (and the light pass's, which lacks the light texture) over the current
     /// textures.
     fn rebuild_bind_groups(&mut self, device: &wgpu::Device) {
-        let t = &self.textures;
         let light = self
             .light
             .as_ref()
             .map_or(&self.light_placeholder, |l| &l.view);
         self.sky.bind_light(device, light, &self.clamp_sampler);
-        let (Some((_, volume)), Some((_, noise))) = (&t.volume, &t.noise) else {
+        let Some(entries) = self.volume_entries() else {
             return;
         };
-        let entries = [
+        let group = |label, layout| {
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some(label),
+                layout,
+                entries: &entries,
+            })
+        };
+        let slices = group("volume", &self.slices.layout);
+        let march = self
+            .march
+            .as_ref()
+            .map(|(pass, _)| group("marched slices: volume", &pass.layout));
+        let light = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("light volume: volume"),
+            layout: &self.light_pass.volume_layout,
+            entries: &entries[..5],
+        });
+        self.bind_group = Some(slices);
+        self.light_bind_group = Some(light);
+        if let Some((_, group)) = &mut self.march {
+            *group = march;
+        }
+    }
+
+    /// The slice group's entries over the current textures (none before both are uploaded).
+    fn volume_entries(&self) -> Option<[wgpu::BindGroupEntry<'_>; 6]> {
+        let t = &self.textures;
+        let light = self
+            .light
+            .as_ref()
+            .map_or(&self.light_placeholder, |l| &l.view);
+        let (Some((_, volume)), Some((_, noise))) = (&t.volume, &t.noise) else {
+            return None;
+        };
+        Some([
             wgpu::BindGroupEntry {
                 binding: 0,
                 resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
@@ -187,24 +220,35 @@ impl VolumeRenderer {
                 binding: 5,
                 resource: wgpu::BindingResource::TextureView(light),
             },
-        ];
-        self.bind_group = Some(device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("volume"),
-            layout: &self.slices.layout,
-            entries: &entries,
-        }));
-        self.light_bind_group = Some(device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("light volume: volume"),
-            layout: &self.light_pass.volume_layout,
-            entries: &entries[..5],
-        }));
-        if let Some((pass, group)) = &mut self.march {
-            *group = Some(device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("marched slices: volume"),
-                layout: &pass.layout,
-                entries: &entries,
-            }));
+        ])
+    }
+
+    /// Records the media probe ([`super::probe`]) of `view`'s media over the uploaded volume
+    /// at `probes` (world point, field value); returns the buffer to map for the densities, or
+    /// `None` with nothing uploaded or no probes.
+    pub fn probe_media(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        view: &View,
+        probes: &[[f32; 4]],
+    ) -> Option<wgpu::Buffer> {
+        if probes.is_empty() {
+            return None;
         }
+        let volume = self.textures.density_volume.clone();
+        let offset = self
+            .slices
+            .write(queue, &VolumeUniforms::new(view, &volume, 1, 0..1, None));
+        let pass = super::probe::ProbePass::new(device);
+        let entries = self.volume_entries()?;
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("media probe: volume"),
+            layout: &pass.layout,
+            entries: &entries,
+        });
+        Some(pass.record(device, encoder, &group, offset, probes))
     }
 
     /// Makes the next [`VolumeRenderer::update_light`] recompute the light volume (benchmarks).

@@ -24,6 +24,14 @@ pub const VOLUME_MARCH: &str = concat!(
     include_str!("../../shaders/volume_march.wgsl")
 );
 
+/// The media at probe points (tests): `volume_common.wgsl` + `volume_noise.wgsl` +
+/// `media_probe.wgsl`.
+pub const MEDIA_PROBE: &str = concat!(
+    include_str!("../../shaders/volume_common.wgsl"),
+    include_str!("../../shaders/volume_noise.wgsl"),
+    include_str!("../../shaders/media_probe.wgsl")
+);
+
 /// `fullscreen.wgsl` + `march_blend.wgsl`: marched slices over the accumulation targets.
 pub const MARCH_BLEND: &str = concat!(
     include_str!("../../shaders/fullscreen.wgsl"),
@@ -72,7 +80,7 @@ pub const FILL: &str = concat!(
 );
 
 /// Every shader module with the files it is composed of, in order.
-pub const MODULES: [(&str, &[&str], &str); 9] = [
+pub const MODULES: [(&str, &[&str], &str); 10] = [
     (
         "volume",
         &[
@@ -93,6 +101,15 @@ pub const MODULES: [(&str, &[&str], &str); 9] = [
             "volume_march.wgsl",
         ],
         VOLUME_MARCH,
+    ),
+    (
+        "media_probe",
+        &[
+            "volume_common.wgsl",
+            "volume_noise.wgsl",
+            "media_probe.wgsl",
+        ],
+        MEDIA_PROBE,
     ),
     (
         "march_blend",
