@@ -1,5 +1,7 @@
 //! Exports as other tools read them. Here: the glb through the `gltf` crate (every edge shared
-//! by two faces of opposite orientation, the enclosed volume the field's), and the files that
+//! by two faces of opposite orientation, the enclosed volume the field's), the VDB through the
+//! `vdb-rs` crate and Mitsuba's `.vol` as its format is documented (each against the field at
+//! probe points), the CPU media they bake against the shader's; and the files that
 //! `scripts/check_exports.py` then reads with independent readers (written to
 //! `target/export-check/`): VDB grids with probe points whose values come from the field
 //! evaluated directly (OpenVDB's Python reader), Mitsuba scenes with and without the noise and
@@ -233,6 +235,7 @@ fn vdb_grids_and_probes_for_openvdbs_own_reader() {
             probes.push((axes.point(far), 0.0));
         }
         assert!(inside > 40, "{inside} probes in the cloud");
+        vdb_holds_the_probes(&files[0].bytes, &probes);
         let json = serde_json::json!({
             "file": files[0].name,
             "points": probes.iter().map(|(p, _)| p.to_array()).collect::<Vec<_>>(),
@@ -245,6 +248,39 @@ fn vdb_grids_and_probes_for_openvdbs_own_reader() {
         )
         .unwrap();
     }
+}
+
+/// The VDB read by an independent reader (the `vdb-rs` crate: the tree, the transform, the
+/// voxels), its `density` grid checked at every probe (file coordinates, the value the field
+/// and media give there): under `cargo test`, before `scripts/check_exports.py` reads the same
+/// file with OpenVDB's own Python module.
+fn vdb_holds_the_probes(bytes: &[u8], probes: &[(Vec3, f32)]) {
+    let mut reader = vdb_rs::VdbReader::new(std::io::Cursor::new(bytes)).expect("a VDB file");
+    let grid = reader.read_grid::<f32>("density").expect("its density grid");
+    let (translation, voxel) = match &grid.transform {
+        vdb_rs::Map::ScaleTranslateMap {
+            translation,
+            voxel_size,
+            ..
+        } => (
+            Vec3::new(translation.x as f32, translation.y as f32, translation.z as f32),
+            Vec3::new(voxel_size.x as f32, voxel_size.y as f32, voxel_size.z as f32),
+        ),
+        other => panic!("an unexpected transform {other:?}"),
+    };
+    let voxels: HashMap<[i32; 3], f32> = grid
+        .iter()
+        .filter(|(_, _, level)| *level == vdb_rs::VdbLevel::Voxel)
+        .map(|(c, v, _)| ([c.x, c.y, c.z].map(|x| x.round() as i32), v))
+        .collect();
+    assert!(!voxels.is_empty(), "no voxels");
+    let mut worst = 0.0f32;
+    for &(q, want) in probes {
+        let ijk = ((q - translation) / voxel).round().as_ivec3().to_array();
+        let got = voxels.get(&ijk).copied().unwrap_or(0.0);
+        worst = worst.max((got - want).abs());
+    }
+    assert!(worst < 1e-5, "the VDB is off the field by {worst} at a probe");
 }
 
 /// A Mitsuba 3 grid volume read as its format is documented (`VOL`, version 3, float32, the
