@@ -256,15 +256,25 @@ fn vdb_grids_and_probes_for_openvdbs_own_reader() {
 /// file with OpenVDB's own Python module.
 fn vdb_holds_the_probes(bytes: &[u8], probes: &[(Vec3, f32)]) {
     let mut reader = vdb_rs::VdbReader::new(std::io::Cursor::new(bytes)).expect("a VDB file");
-    let grid = reader.read_grid::<f32>("density").expect("its density grid");
+    let grid = reader
+        .read_grid::<f32>("density")
+        .expect("its density grid");
     let (translation, voxel) = match &grid.transform {
         vdb_rs::Map::ScaleTranslateMap {
             translation,
             voxel_size,
             ..
         } => (
-            Vec3::new(translation.x as f32, translation.y as f32, translation.z as f32),
-            Vec3::new(voxel_size.x as f32, voxel_size.y as f32, voxel_size.z as f32),
+            Vec3::new(
+                translation.x as f32,
+                translation.y as f32,
+                translation.z as f32,
+            ),
+            Vec3::new(
+                voxel_size.x as f32,
+                voxel_size.y as f32,
+                voxel_size.z as f32,
+            ),
         ),
         other => panic!("an unexpected transform {other:?}"),
     };
@@ -280,7 +290,10 @@ fn vdb_holds_the_probes(bytes: &[u8], probes: &[(Vec3, f32)]) {
         let got = voxels.get(&ijk).copied().unwrap_or(0.0);
         worst = worst.max((got - want).abs());
     }
-    assert!(worst < 1e-5, "the VDB is off the field by {worst} at a probe");
+    assert!(
+        worst < 1e-5,
+        "the VDB is off the field by {worst} at a probe"
+    );
 }
 
 /// A Mitsuba 3 grid volume read as its format is documented (`VOL`, version 3, float32, the

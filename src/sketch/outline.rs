@@ -276,7 +276,9 @@ pub fn clean(raw: &[[f64; 2]], closed: bool, simplify: f64) -> Result<Outline, S
         ));
     }
     dedup(&mut simple, eps);
-    if simple.len() < 3 || signed_area(&simple).abs() < size * size * 1e-6 {
+    // No test of the whole stroke's signed area here: a scribble's loops turn both ways and
+    // cancel (a figure eight's is zero) while each encloses area; the loops decide below.
+    if simple.len() < 3 {
         return Err(SketchError::NoArea);
     }
 
@@ -597,6 +599,28 @@ mod tests {
         assert!(o.area > 5.6 && o.area < 6.2, "{}", o.area);
         assert!(o.warnings.iter().any(|w| w.contains("crossed itself")));
         assert_eq!(first_crossing(&o.points, &mut u64::MAX.clone()), Ok(None));
+    }
+
+    #[test]
+    fn a_scribble_whose_loops_turn_both_ways_keeps_its_largest_loop() {
+        // A figure eight: two equal lobes, one turning each way, so the stroke's signed area
+        // is zero; it was refused as enclosing no area. Now one lobe is kept, with a word.
+        let eight: Vec<[f64; 2]> = (0..120)
+            .map(|i| {
+                let t = i as f64 / 120.0 * std::f64::consts::TAU;
+                [2.0 * t.sin(), (2.0 * t).sin()]
+            })
+            .collect();
+        let outline = clean(&eight, true, 0.01).expect("the larger lobe");
+        assert!(outline.area > 0.5, "area {}", outline.area);
+        assert!(
+            outline
+                .warnings
+                .iter()
+                .any(|w| w.contains("crossed itself")),
+            "{:?}",
+            outline.warnings
+        );
     }
 
     #[test]
