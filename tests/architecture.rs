@@ -132,6 +132,85 @@ fn every_file_is_written_through_the_one_safe_writer() {
     );
 }
 
+/// The modules of `src/ui/` each file names (`super::x`, `crate::ui::x`, `super::{x, …}`),
+/// outside its unit tests; `panels/` counts as one module.
+fn ui_imports() -> std::collections::BTreeMap<String, std::collections::BTreeSet<String>> {
+    let mut graph = std::collections::BTreeMap::new();
+    let modules: Vec<(String, String)> = sources()
+        .into_iter()
+        .filter_map(|(path, code)| {
+            let rest = path.strip_prefix("src/ui/")?;
+            let name = match rest.split_once('/') {
+                Some((dir, _)) => dir.to_owned(),
+                None => rest.trim_end_matches(".rs").to_owned(),
+            };
+            Some((name, before_tests(&code).to_owned()))
+        })
+        .collect();
+    let names: std::collections::BTreeSet<String> =
+        modules.iter().map(|(n, _)| n.clone()).collect();
+    for (name, code) in &modules {
+        let entry: &mut std::collections::BTreeSet<String> = graph.entry(name.clone()).or_default();
+        for other in &names {
+            if other == name || other == "mod" {
+                continue;
+            }
+            let named = [
+                format!("super::{other}::"),
+                format!("crate::ui::{other}::"),
+                format!("super::{{{other}"),
+                format!(", {other}::"),
+                format!("super::{other};"),
+            ];
+            // In `panels/`, `super::` is the panels module itself: only `crate::ui::` names
+            // another ui module.
+            let from_panels = name == "panels";
+            if named
+                .iter()
+                .enumerate()
+                .any(|(i, pat)| (!from_panels || i == 1) && code.contains(pat.as_str()))
+            {
+                entry.insert(other.clone());
+            }
+        }
+    }
+    graph
+}
+
+/// Every circle of imports in `graph`, as the modules on it.
+fn circles(
+    graph: &std::collections::BTreeMap<String, std::collections::BTreeSet<String>>,
+) -> Vec<Vec<String>> {
+    fn walk(
+        graph: &std::collections::BTreeMap<String, std::collections::BTreeSet<String>>,
+        start: &str,
+        path: &mut Vec<String>,
+        out: &mut Vec<Vec<String>>,
+    ) {
+        let last = path.last().cloned().unwrap_or_default();
+        for next in graph.get(&last).into_iter().flatten() {
+            if next == start {
+                out.push(path.clone());
+            } else if next.as_str() > start && !path.contains(next) {
+                path.push(next.clone());
+                walk(graph, start, path, out);
+                path.pop();
+            }
+        }
+    }
+    let mut out = Vec::new();
+    for start in graph.keys() {
+        walk(graph, start, &mut vec![start.clone()], &mut out);
+    }
+    out
+}
+
+#[test]
+fn no_module_of_the_ui_imports_one_that_imports_it_back() {
+    let found = circles(&ui_imports());
+    assert!(found.is_empty(), "import circles in src/ui/: {found:?}");
+}
+
 fn architecture() -> String {
     std::fs::read_to_string(root().join("ARCHITECTURE.md")).unwrap()
 }
@@ -186,6 +265,21 @@ fn the_checks_catch_what_they_look_for() {
     assert!(uses("let x = wgpu::Color::RED;", "wgpu"));
     assert!(!uses("egui_wgpu::Callback::new()", "wgpu"));
     assert!(!uses("my_wgpu::x", "wgpu"));
+    // The circle finder: a → b → a is one circle, a → b alone none.
+    let graph = |edges: &[(&str, &str)]| {
+        let mut g = std::collections::BTreeMap::<String, std::collections::BTreeSet<String>>::new();
+        for (a, b) in edges {
+            g.entry(a.to_string()).or_default().insert(b.to_string());
+            g.entry(b.to_string()).or_default();
+        }
+        g
+    };
+    assert_eq!(circles(&graph(&[("a", "b"), ("b", "a")])).len(), 1);
+    assert_eq!(
+        circles(&graph(&[("a", "b"), ("b", "c"), ("c", "a")])).len(),
+        1
+    );
+    assert!(circles(&graph(&[("a", "b"), ("b", "c")])).is_empty());
     // The writer check: a write in place is found, one in a unit test module is not.
     assert!(writes_in_place("std::fs::write(path, bytes)?;"));
     assert!(writes_in_place("let f = std::fs::File::create(&p)?;"));

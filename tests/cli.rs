@@ -739,3 +739,28 @@ fn a_sketched_scenes_link_holds_its_strokes_exactly() {
     assert_eq!(sketched.planes.len(), 1);
     assert_eq!(decoded.planes[0].points, sketched.planes[0].points);
 }
+
+#[test]
+fn long_work_shows_its_progress_on_a_terminal_and_nowhere_else() {
+    // Through a pseudo-terminal (util-linux's `script`), as a person runs it: a progress line
+    // that is redrawn in place. Piped (as the other tests run it), not a trace of it.
+    let vol = temp("progress.vol");
+    let command = format!(
+        "'{}' simulate --steps 3000 -o '{}'",
+        env!("CARGO_BIN_EXE_cloudsketch"),
+        vol.display()
+    );
+    let o = Command::new("script")
+        .args(["-qec", &command, "/dev/null"])
+        .output()
+        .expect("util-linux's script");
+    let shown = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{shown}");
+    assert!(
+        shown.contains("\rsimulating 3000 steps:") && shown.contains('%'),
+        "{shown:?}"
+    );
+    let o = cloudsketch(&["simulate", "--steps", "3000", "-o", vol.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!stderr(&o).contains('%'), "{}", stderr(&o));
+}

@@ -421,6 +421,22 @@ impl Field {
         self.raycast(ray, radius / 200.0)
     }
 
+    /// Where a ray leaves the cloud on its far side: the last surface it crosses inside the
+    /// field's box, found by marching back from the box's far side ([`Field::surface_under`]
+    /// of the reversed ray). A drawing plane there lies behind the cloud.
+    pub fn surface_behind(&self, ray: &crate::scene::Ray) -> Option<Vec3> {
+        let (lo, hi) = self.bounds()?;
+        let (_, t1) = ray_box(ray.origin, ray.dir, lo, hi)?;
+        let back = crate::scene::Ray {
+            origin: ray.at(t1),
+            dir: -ray.dir,
+        };
+        let (_, radius) = self.bounding_sphere()?;
+        let hit = self.raycast(&back, radius / 200.0)?;
+        // The reversed ray may meet the cloud behind the viewer: only what lies ahead counts.
+        ((hit - ray.origin).dot(ray.dir) > 0.0).then_some(hit)
+    }
+
     /// First point where a ray enters the visible surface, marching in steps of `step`.
     pub fn raycast(&self, ray: &crate::scene::Ray, step: f32) -> Option<Vec3> {
         let (lo, hi) = self.bounds()?;

@@ -269,23 +269,29 @@ impl Document {
 
     /// Steps back; the camera stays where the user put it. Returns what was undone, or `None`
     /// when there is nothing to undo.
-    pub fn undo(&mut self) -> Option<&'static str> {
+    pub fn undo(&mut self) -> Option<String> {
         self.step(true)
     }
 
     /// Steps forward again. Returns what was redone, or `None` when there is nothing to redo.
-    pub fn redo(&mut self) -> Option<&'static str> {
+    pub fn redo(&mut self) -> Option<String> {
         self.step(false)
     }
 
-    fn step(&mut self, back: bool) -> Option<&'static str> {
+    /// Undoes or redoes one step; returns what it did in words (what changed between the two
+    /// scenes: "move 3 ellipsoids"), undoing and redoing alike said as the change was made.
+    fn step(&mut self, back: bool) -> Option<String> {
         let step = if back {
             self.undo.pop_back()
         } else {
             self.redo.pop()
         }?;
+        let label = if back {
+            super::edit::describe_change(&step.scene, &self.scene, step.label)
+        } else {
+            super::edit::describe_change(&self.scene, &step.scene, step.label)
+        };
         let done = self.restore(step);
-        let label = done.label;
         if back {
             self.redo.push(done);
         } else {
@@ -353,7 +359,7 @@ mod tests {
         r.slices = 64;
         assert!(doc.apply(Edit::SetRender(r), None));
         assert_eq!(doc.scene().render.slices, 64);
-        assert_eq!(doc.undo(), Some("render settings"));
+        assert_eq!(doc.undo().as_deref(), Some("render settings"));
         assert_eq!(*doc.scene(), original);
         assert!(doc.redo().is_some());
         assert_eq!(doc.scene().render.slices, 64);
@@ -526,7 +532,7 @@ mod reference_tests {
             (before.geometry, before.light, before.render, before.camera),
             "a reference edit re-derives nothing"
         );
-        assert_eq!(doc.undo(), Some("reference image"));
+        assert_eq!(doc.undo().as_deref(), Some("reference image"));
         assert_eq!(doc.scene().reference.as_deref(), Some(&image));
         doc.undo();
         assert!(doc.scene().reference.is_none());

@@ -49,3 +49,154 @@ impl Edit {
         }
     }
 }
+
+/// What changed from `from` to `to` in words for the undo notice ("move 3 ellipsoids", "add a
+/// drawing plane", "hide an ellipsoid and a drawing plane"): the ellipsoids and drawing planes
+/// counted by what changed in them; anything else by the edit's `label`.
+pub fn describe_change(from: &Scene, to: &Scene, label: &str) -> String {
+    let ellipsoids = list_change(
+        &from.ellipsoids,
+        &to.ellipsoids,
+        ("an ellipsoid", "ellipsoids"),
+        |a, b| {
+            [
+                ("move", a.center != b.center),
+                ("rotate", a.rotation != b.rotation),
+                ("scale", a.radii != b.radii),
+                ("change the strength of", a.strength != b.strength),
+                (if b.hidden { "hide" } else { "show" }, a.hidden != b.hidden),
+            ]
+        },
+    );
+    let planes = list_change(
+        &from.planes,
+        &to.planes,
+        ("a drawing plane", "drawing planes"),
+        |a, b| {
+            [
+                ("move", a.origin != b.origin),
+                ("rotate", a.rotation != b.rotation),
+                (
+                    "redraw",
+                    a.points != b.points || a.kind != b.kind || a.closed != b.closed,
+                ),
+                (
+                    "change",
+                    a.sketch != b.sketch || a.name != b.name || a.seed != b.seed,
+                ),
+                (if b.hidden { "hide" } else { "show" }, a.hidden != b.hidden),
+            ]
+        },
+    );
+    let others = from.light != to.light
+        || from.render != to.render
+        || from.reference != to.reference
+        || from.simulation != to.simulation;
+    let parts: Vec<String> = ellipsoids.into_iter().chain(planes).collect();
+    match (parts.as_slice(), others) {
+        ([], _) | (_, true) => label.to_owned(),
+        ([one], false) => one.clone(),
+        (many, false) => {
+            // One verb for all when they share it: "move 2 ellipsoids and a drawing plane".
+            let verbs: Vec<&str> = many.iter().filter_map(|p| p.split(' ').next()).collect();
+            if verbs.windows(2).all(|w| w[0] == w[1]) {
+                let verb = verbs[0];
+                let objects: Vec<&str> = many.iter().map(|p| &p[verb.len() + 1..]).collect();
+                format!("{verb} {}", objects.join(" and "))
+            } else {
+                many.join(", ")
+            }
+        }
+    }
+}
+
+/// One list's change in words: items added, deleted, or changed (each changed item by the one
+/// kind of change `kinds` finds in it, or "edit" when several).
+fn list_change<T: PartialEq>(
+    from: &[Arc<T>],
+    to: &[Arc<T>],
+    (one, many): (&str, &str),
+    kinds: impl Fn(&T, &T) -> [(&'static str, bool); 5],
+) -> Option<String> {
+    let count = |n: usize| {
+        if n == 1 {
+            one.to_owned()
+        } else {
+            format!("{n} {many}")
+        }
+    };
+    if to.len() > from.len() {
+        return Some(format!("add {}", count(to.len() - from.len())));
+    }
+    if to.len() < from.len() {
+        return Some(format!("delete {}", count(from.len() - to.len())));
+    }
+    let mut verbs: Vec<&'static str> = Vec::new();
+    let mut changed = 0;
+    for (a, b) in from.iter().zip(to) {
+        if Arc::ptr_eq(a, b) || **a == **b {
+            continue;
+        }
+        changed += 1;
+        let found: Vec<&'static str> = kinds(a, b)
+            .into_iter()
+            .filter_map(|(verb, yes)| yes.then_some(verb))
+            .collect();
+        verbs.push(if found.len() == 1 { found[0] } else { "edit" });
+    }
+    if changed == 0 {
+        return None;
+    }
+    let verb = if verbs.windows(2).all(|w| w[0] == w[1]) {
+        verbs[0]
+    } else {
+        "edit"
+    };
+    Some(format!("{verb} {}", count(changed)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Preset;
+
+    #[test]
+    fn a_change_is_said_by_what_it_did_and_to_how_many() {
+        let before = Scene::preset(Preset::Cumulus);
+        let mut after = before.clone();
+        for e in after.ellipsoids.iter_mut().take(3) {
+            Arc::make_mut(e).center.x += 1.0;
+        }
+        assert_eq!(
+            describe_change(&before, &after, "ellipsoids"),
+            "move 3 ellipsoids"
+        );
+        let mut one = before.clone();
+        Arc::make_mut(&mut one.ellipsoids[0]).hidden = true;
+        assert_eq!(
+            describe_change(&before, &one, "ellipsoids"),
+            "hide an ellipsoid"
+        );
+        let mut fewer = before.clone();
+        fewer.ellipsoids.truncate(before.ellipsoids.len() - 2);
+        assert_eq!(
+            describe_change(&before, &fewer, "ellipsoids"),
+            "delete 2 ellipsoids"
+        );
+        // Something else than shapes: the edit's own word.
+        let mut lit = before.clone();
+        lit.light.sun_intensity += 1.0;
+        assert_eq!(describe_change(&before, &lit, "lighting"), "lighting");
+        // Ellipsoids and a plane moved together.
+        let mut with_plane = before.clone();
+        with_plane.planes.push(Arc::new(DrawingPlane::default()));
+        let mut moved = with_plane.clone();
+        Arc::make_mut(&mut moved.ellipsoids[0]).center.y += 1.0;
+        Arc::make_mut(&mut moved.ellipsoids[1]).center.y += 1.0;
+        Arc::make_mut(&mut moved.planes[0]).origin.y += 1.0;
+        assert_eq!(
+            describe_change(&with_plane, &moved, "ellipsoids"),
+            "move 2 ellipsoids and a drawing plane"
+        );
+    }
+}

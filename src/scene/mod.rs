@@ -708,7 +708,8 @@ mod tests {
                        {"points": [[0, 0], [1, 0], [0, 1]], "rotation": [0, 2, 0, 0]},
                        {"points": [[0, 0], [1, 0], [0, 1]], "rotation": [1e30, 1e30, 1e30, 1e30]}],
             "camera": {"distance": 1e300, "fov_y_deg": 1e39},
-            "light": {"sun_intensity": -4}
+            "light": {"sun_intensity": -4},
+            "render": {"tiers": [{"floor": 6, "wind": [1e39, -1e39]}]}
         }"#;
         let (s, repairs) = Scene::from_json(text).unwrap();
         assert_eq!(s.ellipsoids[0].rotation, Quat::IDENTITY);
@@ -721,6 +722,8 @@ mod tests {
             "/camera/distance: a number beyond ±3.4e38 →",
             "/camera/fov_y_deg: a number beyond ±3.4e38 →",
             "/light/sun_intensity: -4 → 0",
+            // An out-of-range pair says so (it read "[NaN, NaN]").
+            "/render/tiers/0/wind: [±∞, ±∞] → [0, 0]",
         ] {
             assert!(
                 repairs.iter().any(|r| r.starts_with(needle)),

@@ -5,12 +5,14 @@ use super::autosave::Autosave;
 use super::guide::Guide;
 use super::notice::Notices;
 use super::panels::{
-    ClockPanel, ExportPanel, LIGHT, RENDER, ScenePanel, SketchPanel, ViewPanel, ViewStats,
+    ClockPanel, ExportPanel, LIGHT, RENDER, ScenePanel, SimulationPanel, SketchPanel, ViewPanel,
+    ViewStats,
 };
 use super::scene_files::SceneFiles;
 use super::selection::Selection;
 use super::shortcuts::Shortcut;
-use super::sketch_tool::{Axis, SketchTool, ToolContext};
+use super::sketch_tool::{SketchTool, ToolContext};
+use super::transform::Axis;
 use super::viewport::{Viewport, ViewportContext};
 use crate::derive::Derived;
 use crate::render::viewport::{BackendInfo, FillPaint, ReportPoll, install, paint_callback};
@@ -92,6 +94,7 @@ struct Panels {
     export: ExportPanel,
     sketch: SketchPanel,
     scene: ScenePanel,
+    simulation: SimulationPanel,
     view: ViewPanel,
 }
 
@@ -295,7 +298,7 @@ impl CloudApp {
         p.scene
             .ui(ui, &mut self.doc, &mut self.selection, &mut self.notices);
         p.view.ui(ui, &self.viewport.stats, &mut self.doc);
-        super::panels::simulation::ui(ui, &mut self.doc);
+        p.simulation.ui(ui, &mut self.doc);
         let ask = p.export.ui(
             ui,
             &self.doc,

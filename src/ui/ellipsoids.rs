@@ -7,8 +7,8 @@ use std::sync::Arc;
 use egui::{Pos2, Rect};
 use glam::Vec3;
 
+use super::projection::ray_at;
 use super::selection::{Item, Selection};
-use super::sketch_tool::ray_at;
 use crate::derive::Derived;
 use crate::field::Blob;
 use crate::scene::{Document, Edit, Ellipsoid, MAX_ELLIPSOIDS};

@@ -9,7 +9,9 @@ use egui::{Color32, Pos2, Rect, Stroke};
 use glam::{Quat, Vec2, Vec3};
 
 use super::picking::segment_distance;
-use super::sketch_tool::{Axis, Tool, project};
+use super::projection::project;
+use super::tool::Tool;
+use super::transform::Axis;
 use crate::scene::OrbitCamera;
 
 /// Length in pixels of a handle whose axis lies in the view plane.

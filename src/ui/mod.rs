@@ -7,6 +7,9 @@
 //!   starts with;
 //! - `viewport`: the 3D view (progressive quality, camera input, status line);
 //! - `sketch_tool`: the Sketch, Cut, Ellipsoid, Move and Rotate tools and their overlay;
+//! - `tool`: which tool the primary drag serves; `transform`: the world axes a drag locks to,
+//!   what Move, Rotate and Scale drags do, the axes of a new drawing plane; `projection`: the
+//!   view's maths between screen and world (shared by the tools, the gizmo and picking);
 //! - `ellipsoids`: adding, picking, moving, duplicating and deleting ellipsoids;
 //! - `gizmo`: the on-canvas Move, Rotate and Scale handles and their drag maths;
 //! - `picking`: what a click or a dragged box selects;
@@ -35,11 +38,14 @@ mod platform;
 #[path = "platform_web.rs"]
 mod platform;
 mod press_record;
+mod projection;
 mod scene_files;
 mod selection;
 mod shortcuts;
 mod sketch_tool;
 mod sun_handle;
+mod tool;
+mod transform;
 mod viewport;
 mod widgets;
 
@@ -53,4 +59,4 @@ fn test_view() -> egui::Rect {
 }
 pub use platform::{forget_opening_in_url, wake};
 pub use selection::Selection;
-pub use sketch_tool::Tool;
+pub use tool::Tool;

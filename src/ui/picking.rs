@@ -6,8 +6,8 @@ use egui::{Pos2, Rect};
 use glam::Vec3;
 
 use super::ellipsoids;
+use super::projection::project;
 use super::selection::Item;
-use super::sketch_tool::project;
 use crate::derive::Derived;
 use crate::scene::{Document, Ellipsoid, OrbitCamera, StrokeKind};
 use crate::sketch::outline;

@@ -10,7 +10,8 @@
 
 use egui::{Event, Key, Modifiers};
 
-use super::sketch_tool::{Axis, Tool};
+use super::tool::Tool;
+use super::transform::Axis;
 use crate::scene::StandardView;
 
 /// What one key press asks for.
@@ -52,6 +53,8 @@ pub enum Shortcut {
     ToggleGuides,
     /// K: show or hide the selected outline's skeleton.
     ToggleSkeleton,
+    /// Q: new outlines behind the cloud, or in front again.
+    ToggleBehind,
     /// Esc: cancel a drag or stroke, or clear the selection.
     Escape,
     /// Delete: delete the selection.
@@ -100,6 +103,7 @@ const TABLE: &[(Modifiers, Key, Shortcut)] = {
         (NONE, Key::S, S::Tool(Tool::Scale)),
         (NONE, Key::H, S::ToggleGuides),
         (NONE, Key::K, S::ToggleSkeleton),
+        (NONE, Key::Q, S::ToggleBehind),
         (NONE, Key::Escape, S::Escape),
         (NONE, Key::Delete, S::Delete),
         (NONE, Key::B, S::BoxSelect),

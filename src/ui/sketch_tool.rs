@@ -9,50 +9,16 @@ use super::ellipsoids;
 use super::gizmo::{Gizmo, Handle, ring_turn};
 use super::notice::Notices;
 use super::picking;
+use super::projection::{ndc, project};
 use super::selection::{Item, Selection};
 use super::shortcuts::Shortcut;
+use super::tool::Tool;
+use super::transform::{Axis, SNAP_STEP, drag_scale, drag_turn, drawing_axes, view_move};
 use crate::derive::{Derived, Shape};
 use crate::scene::{
     Document, DrawingPlane, Edit, MAX_PLANE_POINTS, MAX_PLANES, OrbitCamera, StrokeKind,
 };
 use crate::seeded::hash64;
-
-/// What a primary drag in the viewport does.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Tool {
-    /// Drag orbits (Blender-like camera).
-    #[default]
-    Navigate,
-    /// Drag draws a cloud outline.
-    Sketch,
-    /// Drag draws a cut line (flat base).
-    Cut,
-    /// A click adds an ellipsoid where it lands (a drag orbits).
-    Ellipsoid,
-    /// Drag moves the selected drawing plane or ellipsoid parallel to the view (Shift: toward
-    /// or away).
-    Move,
-    /// Drag turns the selected drawing plane or ellipsoid (sideways: about the vertical;
-    /// up/down: tilt).
-    Rotate,
-    /// Drag scales the selected ellipsoid (right or up grows it).
-    Scale,
-}
-
-impl Tool {
-    /// Name for the UI and the page state.
-    pub fn name(self) -> &'static str {
-        match self {
-            Tool::Navigate => "navigate",
-            Tool::Sketch => "sketch",
-            Tool::Cut => "cut",
-            Tool::Ellipsoid => "ellipsoid",
-            Tool::Move => "move",
-            Tool::Rotate => "rotate",
-            Tool::Scale => "scale",
-        }
-    }
-}
 
 /// State of the sketch tools.
 #[derive(Default)]
@@ -81,6 +47,9 @@ pub struct SketchTool {
     box_armed: bool,
     /// The selection box being dragged: where it began and where the pointer is.
     area: Option<(Pos2, Pos2)>,
+    /// New outlines land behind the cloud (the far side under the stroke's start) instead of
+    /// in front of it (Q).
+    pub behind: bool,
 }
 
 /// Where a selected item was when a drag began: its place, turn and radii (a plane's are ones).
@@ -106,79 +75,6 @@ struct Gesture {
     cancelled: bool,
 }
 
-/// A world axis the Rotate tool can be locked to (for Scale: the ellipsoid's own axis).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Axis {
-    /// World X (right in the front view).
-    X,
-    /// World Y (up).
-    Y,
-    /// World Z (toward the front view's camera).
-    Z,
-}
-
-impl Axis {
-    /// The world unit vector.
-    pub fn vector(self) -> Vec3 {
-        match self {
-            Axis::X => Vec3::X,
-            Axis::Y => Vec3::Y,
-            Axis::Z => Vec3::Z,
-        }
-    }
-
-    /// The axis's letter.
-    pub fn name(self) -> &'static str {
-        match self {
-            Axis::X => "X",
-            Axis::Y => "Y",
-            Axis::Z => "Z",
-        }
-    }
-}
-
-/// Turn per pixel of drag: about 1° per 5 px (a 150 px drag turns 30°), as the gizmos will.
-const TURN_PER_PX: f32 = 0.2 * std::f32::consts::PI / 180.0;
-/// The step Ctrl snaps turns to.
-const SNAP_STEP: f32 = 15.0 * std::f32::consts::PI / 180.0;
-
-/// Scale per pixel of drag: a 140 px drag doubles.
-const SCALE_PER_PX: f32 = std::f32::consts::LN_2 / 140.0;
-
-/// The factor per axis a Scale drag of `drag` pixels gives: right or up grows, left or down
-/// shrinks; locked, only that axis changes; `snap` rounds the factor to tenths.
-pub fn drag_scale(drag: Vec2, lock: Option<Axis>, snap: bool) -> Vec3 {
-    let mut f = ((drag.x - drag.y) * SCALE_PER_PX).exp();
-    if snap {
-        f = ((f * 10.0).round() / 10.0).max(0.1);
-    }
-    match lock {
-        Some(axis) => Vec3::ONE + axis.vector() * (f - 1.0),
-        None => Vec3::splat(f),
-    }
-}
-
-/// The turn a Rotate drag of `drag` pixels (screen x right, y down) gives. Locked to an axis,
-/// a drag right or up turns positively about it; free, sideways turns about the vertical and
-/// up/down tilts about the view's right axis. `snap` rounds each angle to 15°.
-pub fn drag_turn(drag: Vec2, lock: Option<Axis>, snap: bool, view_right: Vec3) -> Quat {
-    let angle = |px: f32| {
-        let a = px * TURN_PER_PX;
-        if snap {
-            (a / SNAP_STEP).round() * SNAP_STEP
-        } else {
-            a
-        }
-    };
-    match lock {
-        Some(axis) => Quat::from_axis_angle(axis.vector(), angle(drag.x - drag.y)),
-        None => {
-            Quat::from_axis_angle(Vec3::Y, angle(drag.x))
-                * Quat::from_axis_angle(view_right, angle(drag.y))
-        }
-    }
-}
-
 /// The pointer in the viewport this frame.
 pub struct ViewInput<'a> {
     /// The viewport's `Ui`.
@@ -201,35 +97,6 @@ pub struct ToolContext<'a> {
     pub notices: &'a mut Notices,
 }
 
-/// The camera ray through screen point `p` of the view `rect`.
-pub fn ray_at(camera: &OrbitCamera, rect: Rect, p: Pos2) -> crate::scene::Ray {
-    camera.ray(ndc(rect, p), rect.aspect_ratio())
-}
-
-fn ndc(rect: Rect, p: Pos2) -> Vec2 {
-    Vec2::new(
-        (p.x - rect.left()) / rect.width() * 2.0 - 1.0,
-        1.0 - (p.y - rect.top()) / rect.height() * 2.0,
-    )
-}
-
-fn screen(rect: Rect, ndc: Vec2) -> Pos2 {
-    Pos2::new(
-        rect.left() + (ndc.x + 1.0) * 0.5 * rect.width(),
-        rect.top() + (1.0 - ndc.y) * 0.5 * rect.height(),
-    )
-}
-
-/// Where world point `p` appears in the view `rect`, if in front of the camera.
-pub fn project(camera: &OrbitCamera, rect: Rect, p: Vec3) -> Option<Pos2> {
-    camera
-        .project(p, rect.aspect_ratio())
-        .map(|n| screen(rect, n))
-}
-
-/// A stroke's pen pressure, one value per point, when a pen drew it (any sample has a
-/// pressure); points without one (the press itself, samples from egui's events) take the
-/// nearest earlier value, or the first one known. Empty for the mouse and touch.
 /// Whether recorded samples are a drag, not a click: several points spread over more than a
 /// few points of the screen.
 fn is_drag(samples: &[(Pos2, Option<f32>)]) -> bool {
@@ -239,6 +106,9 @@ fn is_drag(samples: &[(Pos2, Option<f32>)]) -> bool {
     samples.len() >= 3 && samples.iter().any(|(p, _)| p.distance(first) > 6.0)
 }
 
+/// A stroke's pen pressure, one value per point, when a pen drew it (any sample has a
+/// pressure); points without one (the press itself, samples from egui's events) take the
+/// nearest earlier value, or the first one known. Empty for the mouse and touch.
 fn pen_pressure(samples: &[Option<f32>]) -> Vec<f32> {
     let Some(first) = samples.iter().flatten().next().copied() else {
         return Vec::new();
@@ -282,6 +152,14 @@ impl SketchTool {
             Shortcut::ToggleSkeleton => {
                 self.show_skeleton = !self.show_skeleton;
                 None
+            }
+            Shortcut::ToggleBehind => {
+                self.behind = !self.behind;
+                Some(if self.behind {
+                    "New outlines go behind the cloud (Q again: in front)".to_owned()
+                } else {
+                    "New outlines go in front of the cloud".to_owned()
+                })
             }
             Shortcut::Escape => self.escape(tc),
             Shortcut::HideSelected => super::selection::toggle_hidden(tc.doc, tc.selection)
@@ -463,8 +341,15 @@ impl SketchTool {
         let Some(&first) = stroke.first() else { return };
         let first_ray = camera.ray(ndc(rect, first), aspect);
         let field = tc.derived.field(scene, Some(tc.doc.revisions().geometry));
-        let anchor = field.surface_under(&first_ray).unwrap_or(camera.target);
-        let normal = -camera.forward();
+        // Wither's rule: through the cloud's near side under the stroke's start; Behind, its
+        // far side; over the sky, the focus point.
+        let hit = if self.behind && kind == StrokeKind::Outline {
+            field.surface_behind(&first_ray)
+        } else {
+            field.surface_under(&first_ray)
+        };
+        let anchor = hit.unwrap_or(camera.target);
+        let (right, up, normal) = drawing_axes(&camera);
         // Each point with its pressure (when the pen gave one), so both stay paired.
         let (world, pressure): (Vec<Vec3>, Vec<Option<f32>>) = stroke
             .iter()
@@ -481,15 +366,7 @@ impl SketchTool {
             StrokeKind::Cut => format!("Cut {count}"),
         };
         let seed = hash64(scene.seed ^ ((scene.planes.len() as u64) << 32) ^ world.len() as u64);
-        let mut plane = DrawingPlane::facing(
-            name,
-            kind,
-            anchor,
-            camera.right(),
-            camera.up(),
-            &world,
-            seed,
-        );
+        let mut plane = DrawingPlane::facing(name, kind, anchor, right, up, &world, seed);
         plane.pressure = pressure.into_iter().flatten().collect();
         if plane.pressure.len() != plane.points.len() {
             plane.pressure.clear();
@@ -671,11 +548,8 @@ impl SketchTool {
                 _ => {
                     let depth = (g.origin - camera.eye()).dot(camera.forward()).max(0.1);
                     let per_px = camera.world_per_px(depth, rect.height());
-                    origin += if ui.input(|i| i.modifiers.shift) {
-                        camera.forward() * (g.drag.y * per_px)
-                    } else {
-                        camera.right() * (g.drag.x * per_px) - camera.up() * (g.drag.y * per_px)
-                    };
+                    let toward = ui.input(|i| i.modifiers.shift);
+                    origin += view_move(&camera, g.drag, per_px, toward);
                 }
             },
             Tool::Scale => {
@@ -1029,16 +903,6 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_scale_drag_grows_rightward_per_axis_and_snaps() {
-        let grow = drag_scale(Vec2::new(140.0, 0.0), None, false);
-        assert!(grow.abs_diff_eq(Vec3::splat(2.0), 1e-4), "{grow}");
-        let shrink = drag_scale(Vec2::new(0.0, 140.0), None, false);
-        assert!(shrink.abs_diff_eq(Vec3::splat(0.5), 1e-4), "{shrink}");
-        let y = drag_scale(Vec2::new(100.0, 0.0), Some(Axis::Y), true);
-        assert_eq!(y, Vec3::new(1.0, 1.6, 1.0));
-    }
-
-    #[test]
     fn pen_pressure_fills_the_points_without_one() {
         assert!(
             pen_pressure(&[None, None]).is_empty(),
@@ -1055,11 +919,28 @@ mod tests {
     /// `frames` frames 0.15 s apart (a slow adapter's), then two idle frames. Returns each drawing plane's
     /// point count.
     fn stroke_over_frames(frames: usize) -> Vec<usize> {
+        let tool = SketchTool {
+            tool: Tool::Sketch,
+            ..Default::default()
+        };
+        let doc = Document::new(crate::scene::Scene::preset(crate::scene::Preset::Empty));
+        let (doc, _) = draw_circle(doc, tool, frames, 120.0);
+        doc.scene().planes.iter().map(|p| p.points.len()).collect()
+    }
+
+    /// Draws a circle of `radius` points about the view's centre with `tool` over `doc`, its
+    /// events split over `frames` frames; returns the document and the tool.
+    fn draw_circle(
+        mut doc: Document,
+        mut tool: SketchTool,
+        frames: usize,
+        radius: f32,
+    ) -> (Document, SketchTool) {
         use egui::{Event, Modifiers, PointerButton, RawInput, Sense, pos2};
         let rect = crate::ui::test_view();
         let at = |i: usize| {
             let a = i as f32 / 60.0 * std::f32::consts::TAU;
-            pos2(640.0 + 120.0 * a.cos(), 400.0 + 120.0 * a.sin())
+            pos2(640.0 + radius * a.cos(), 400.0 + radius * a.sin())
         };
         let button = |pressed| Event::PointerButton {
             pos: at(60),
@@ -1077,11 +958,6 @@ mod tests {
         chunks.extend([Vec::new(), Vec::new()]);
 
         let ctx = egui::Context::default();
-        let mut tool = SketchTool {
-            tool: Tool::Sketch,
-            ..Default::default()
-        };
-        let mut doc = Document::new(crate::scene::Scene::preset(crate::scene::Preset::Empty));
         let (mut derived, mut selection, mut notices) = Default::default();
         for (frame, events) in chunks.into_iter().enumerate() {
             let raw = RawInput {
@@ -1108,7 +984,57 @@ mod tests {
             // No painter here: the font atlas's first upload is dropped on purpose.
             output.textures_delta.clear();
         }
-        doc.scene().planes.iter().map(|p| p.points.len()).collect()
+        (doc, tool)
+    }
+
+    /// The depth along the view of the plane a small outline drawn over the default cumulus's
+    /// middle lands on, in front or behind.
+    fn outline_depth(behind: bool) -> f32 {
+        let scene = crate::scene::Scene::default();
+        let camera = scene.camera.clone();
+        let tool = SketchTool {
+            tool: Tool::Sketch,
+            behind,
+            ..Default::default()
+        };
+        let (doc, _) = draw_circle(Document::new(scene), tool, 5, 40.0);
+        let plane = doc.scene().planes.last().expect("a plane").clone();
+        (plane.origin - camera.eye()).dot(camera.forward())
+    }
+
+    #[test]
+    fn an_outline_over_the_cloud_lands_in_front_or_behind_it() {
+        let target = {
+            let c = crate::scene::Scene::default().camera;
+            (c.target - c.eye()).dot(c.forward())
+        };
+        let (front, back) = (outline_depth(false), outline_depth(true));
+        // In front: nearer than the focus point (the cloud's near side); behind: beyond it.
+        assert!(front < target - 0.5, "front {front} vs focus {target}");
+        assert!(back > target + 0.5, "behind {back} vs focus {target}");
+    }
+
+    #[test]
+    fn a_view_near_level_draws_on_vertical_planes() {
+        let mut camera = crate::scene::Scene::default().camera;
+        assert!((camera.pitch_deg - 8.0).abs() < 1e-3, "the default view");
+        let (_, up, normal) = drawing_axes(&camera);
+        assert_eq!(up, Vec3::Y);
+        assert!(normal.y.abs() < 1e-6, "{normal}");
+        // The plane of an outline drawn in the default view stands upright.
+        let doc = Document::new(crate::scene::Scene::preset(crate::scene::Preset::Empty));
+        let tool = SketchTool {
+            tool: Tool::Sketch,
+            ..Default::default()
+        };
+        let (doc, _) = draw_circle(doc, tool, 3, 120.0);
+        let plane_up = doc.scene().planes[0].rotation * Vec3::Y;
+        assert!(plane_up.abs_diff_eq(Vec3::Y, 1e-5), "{plane_up}");
+        // Looking down steeply, the plane faces the view.
+        camera.pitch_deg = 40.0;
+        let (_, up, normal) = drawing_axes(&camera);
+        assert!(up.abs_diff_eq(camera.up(), 1e-6));
+        assert!(normal.abs_diff_eq(-camera.forward(), 1e-6));
     }
 
     #[test]
@@ -1119,38 +1045,5 @@ mod tests {
         for frames in [1, 2, 3, 5, 31, 63] {
             assert_eq!(stroke_over_frames(frames), [61], "over {frames} frames");
         }
-    }
-
-    fn axis_angle(q: Quat) -> (Vec3, f32) {
-        let (axis, angle) = q.to_axis_angle();
-        (axis, angle.to_degrees())
-    }
-
-    #[test]
-    fn a_150_px_drag_turns_30_degrees_about_the_vertical() {
-        let (axis, deg) = axis_angle(drag_turn(Vec2::new(150.0, 0.0), None, false, Vec3::X));
-        assert!(axis.abs_diff_eq(Vec3::Y, 1e-5), "{axis}");
-        assert!((deg - 30.0).abs() < 1e-3, "{deg}");
-    }
-
-    #[test]
-    fn a_locked_axis_takes_the_whole_drag_and_ctrl_snaps_to_15_degrees() {
-        // Right 160 and up 60: 220 px, 44° about Z; snapped, 45°.
-        let drag = Vec2::new(160.0, -60.0);
-        let (axis, deg) = axis_angle(drag_turn(drag, Some(Axis::Z), false, Vec3::X));
-        assert!(
-            axis.abs_diff_eq(Vec3::Z, 1e-5) && (deg - 44.0).abs() < 1e-3,
-            "{axis} {deg}"
-        );
-        let (axis, deg) = axis_angle(drag_turn(drag, Some(Axis::Z), true, Vec3::X));
-        assert!(
-            axis.abs_diff_eq(Vec3::Z, 1e-5) && (deg - 45.0).abs() < 1e-3,
-            "{axis} {deg}"
-        );
-        // Free, the same drag turns about two axes, each snapped on its own.
-        let free = drag_turn(drag, None, true, Vec3::X);
-        let expected =
-            Quat::from_rotation_y(30f32.to_radians()) * Quat::from_rotation_x(-15f32.to_radians());
-        assert!(free.abs_diff_eq(expected, 1e-5), "{free} {expected}");
     }
 }

@@ -72,18 +72,28 @@ pub fn take_marks(ctx: &egui::Context) -> Marks {
 /// A slider over a parameter's one range, with its label and tooltip (see [`crate::limits`]).
 /// Its rail is marked as `param:LABEL` (see [`mark`]). Returns whether it changed.
 pub fn param<T: egui::emath::Numeric>(ui: &mut Ui, value: &mut T, param: &Param) -> bool {
+    param_as(ui, value, param, param.label)
+}
+
+/// [`param`] under another label (one range, several values: "wind x", "wind z").
+pub fn param_as<T: egui::emath::Numeric>(
+    ui: &mut Ui,
+    value: &mut T,
+    param: &Param,
+    label: &str,
+) -> bool {
     let response = ui
         .add(
             Slider::new(value, T::from_f64(param.min)..=T::from_f64(param.max))
                 .logarithmic(param.logarithmic)
-                .text(param.label),
+                .text(label),
         )
         .on_hover_text(param.tip);
     let rail = egui::Rect::from_min_size(
         response.rect.min,
         egui::vec2(ui.spacing().slider_width, response.rect.height()),
     );
-    mark(ui, &format!("param:{}", param.label), rail);
+    mark(ui, &format!("param:{label}"), rail);
     response.changed()
 }
 

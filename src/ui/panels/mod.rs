@@ -6,7 +6,7 @@ mod export;
 mod light;
 mod render;
 mod scene;
-pub mod simulation;
+mod simulation;
 mod sketch;
 mod view;
 
@@ -15,6 +15,7 @@ pub use export::ExportPanel;
 pub use light::LIGHT;
 pub use render::RENDER;
 pub use scene::ScenePanel;
+pub use simulation::SimulationPanel;
 pub use sketch::SketchPanel;
 pub use view::{GeometryUpdate, ViewPanel, ViewStats};
 

@@ -5,7 +5,7 @@ use egui::Ui;
 use super::PartPanel;
 use crate::limits;
 use crate::scene::{Edit, NoiseBasis, NoiseFilter, RenderSettings, Tier};
-use crate::ui::widgets::param;
+use crate::ui::widgets::{param, param_as};
 
 /// The Render group.
 pub const RENDER: PartPanel<RenderSettings> =
@@ -35,18 +35,17 @@ fn body(ui: &mut Ui, r: &mut RenderSettings) {
                 ui.selectable_value(&mut r.noise_basis, NoiseBasis::Perlin, "Perlin");
                 ui.selectable_value(&mut r.noise_basis, NoiseBasis::Worley, "Worley (puffs)");
             });
-            let [wx, wz] = &mut r.wind;
-            ui.horizontal(|ui| {
-                ui.label("wind");
-                param(ui, wx, &limits::WIND);
-            });
-            ui.horizontal(|ui| {
-                ui.label("wind z");
-                param(ui, wz, &limits::WIND);
-            });
-            param(ui, &mut r.torque, &limits::TORQUE);
+            wind_and_torque(ui, &mut r.wind, &mut r.torque);
         });
     tiers(ui, r);
+}
+
+/// The wind along x and z and the torque, each slider under its own label.
+fn wind_and_torque(ui: &mut Ui, wind: &mut [f32; 2], torque: &mut f32) {
+    let [wx, wz] = wind;
+    param_as(ui, wx, &limits::WIND, "wind x");
+    param_as(ui, wz, &limits::WIND, "wind z");
+    param_as(ui, torque, &limits::TORQUE, "torque");
 }
 
 fn filter_combo(ui: &mut Ui, id: &str, filter: &mut NoiseFilter) {
@@ -64,7 +63,10 @@ fn filter_combo(ui: &mut Ui, id: &str, filter: &mut NoiseFilter) {
 /// Atmospheric tiers: from each floor up, the noise has its own filter and motion; the media
 /// above are the base, below the first floor (and their first octave moves everywhere).
 fn tiers(ui: &mut Ui, r: &mut RenderSettings) {
+    // Its id does not follow its label: adding a tier changes the count it shows, and a new
+    // id would close the group under the pointer.
     egui::CollapsingHeader::new(format!("Tiers ({})", r.tiers.len()))
+        .id_salt("tiers")
         .default_open(false)
         .show(ui, |ui| {
             let mut remove = None;
@@ -81,10 +83,7 @@ fn tiers(ui: &mut Ui, r: &mut RenderSettings) {
                 });
                 param(ui, &mut t.floor, &limits::TIER_FLOOR);
                 filter_combo(ui, &format!("tier {k} filter"), &mut t.filter);
-                let [wx, wz] = &mut t.wind;
-                param(ui, wx, &limits::WIND);
-                param(ui, wz, &limits::WIND);
-                param(ui, &mut t.torque, &limits::TORQUE);
+                wind_and_torque(ui, &mut t.wind, &mut t.torque);
             }
             if let Some(k) = remove {
                 r.tiers.remove(k);

@@ -7,7 +7,8 @@ use crate::limits;
 use crate::scene::{Document, Edit, StrokeKind};
 use crate::ui::notice::Notices;
 use crate::ui::selection::{Item, Selection, delete, duplicate};
-use crate::ui::sketch_tool::{SketchTool, Tool};
+use crate::ui::sketch_tool::SketchTool;
+use crate::ui::tool::Tool;
 use crate::ui::widgets::{param, rotation_fields, vec3_fields};
 
 /// The Sketch group.
@@ -69,6 +70,9 @@ impl SketchPanel {
                     ui.checkbox(&mut tool.show_skeleton, "skeleton")
                         .on_hover_text("K: the selected outline's skeleton and spheres");
                 });
+                ui.checkbox(&mut tool.behind, "behind the cloud").on_hover_text(
+                    "Q: a new outline drawn over the cloud lands on its far side (off: its near side, so it goes in front)",
+                );
                 let planes = &doc.scene().planes;
                 if planes.is_empty() {
                     ui.label("No drawing planes yet. Pick Sketch and drag an outline in the view.");
