@@ -299,7 +299,9 @@ pub const GROUND_HEIGHT: Param = Param::linear(
     "Where the ground lies (world height); the clouds' shadows fall on it",
     -50.0,
     50.0,
-    0.0,
+    // Well below the presets' lowest cloud bases (the cumulus's is at 0.1: it stood on the
+    // ground at 0), about a cloud's height under them.
+    -5.0,
 );
 /// Shafts of light: how bright the sunlight the air scatters toward the eye is.
 pub const SHAFT_INTENSITY: Param = Param::linear(

@@ -904,6 +904,7 @@ fn broken_layer() -> Scene {
         &Scene::default(),
         &[
             "/light/ground=true",
+            "/light/ground_height=0",
             "/light/sun_azimuth_deg=270",
             "/light/sun_elevation_deg=30",
             "/camera/yaw_deg=0",

@@ -351,7 +351,7 @@ impl Default for Lighting {
             horizon_color: [0.78, 0.84, 0.9],
             exposure: limits::EXPOSURE.default as f32,
             ground: false,
-            ground_height: 0.0,
+            ground_height: limits::GROUND_HEIGHT.default as f32,
             ground_color: [0.36, 0.42, 0.3],
             shafts: false,
             shaft_intensity: limits::SHAFT_INTENSITY.default as f32,
@@ -697,6 +697,23 @@ mod tests {
                 "/render/slices: 100000 → 512"
             ],
         );
+    }
+
+    #[test]
+    fn the_default_ground_lies_well_below_every_presets_cloud() {
+        // It sat at the cumulus's base (the cloud stood on the lawn when the ground was on).
+        for (preset, name) in Preset::ALL {
+            let scene = Scene::preset(preset);
+            let Some((lo, _)) = crate::derive::field_of(&scene).bounds() else {
+                continue;
+            };
+            assert!(
+                lo.y >= scene.light.ground_height + 3.0,
+                "{name}: cloud from {} with the ground at {}",
+                lo.y,
+                scene.light.ground_height
+            );
+        }
     }
 
     #[test]

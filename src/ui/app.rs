@@ -136,6 +136,12 @@ impl CloudApp {
         cc.egui_ctx.set_visuals(egui::Visuals::dark());
         super::widgets::install_fonts(&cc.egui_ctx);
         super::platform::install(&cc.egui_ctx);
+        // The side panel's groups as the user left them (the app's, like the autosave).
+        if options.autosave
+            && let Some(json) = super::platform::load_groups()
+        {
+            super::widgets::install_groups(&cc.egui_ctx, super::widgets::Groups::from_json(&json));
+        }
         let doc = Document::new(options.scene);
         let mut notices = Notices::default();
         match options.notice {
@@ -366,6 +372,12 @@ impl CloudApp {
             return;
         };
         let now = ctx.input(|i| i.time);
+        if let Some(groups) = super::widgets::take_changed_groups(ctx)
+            && let Err(e) = super::platform::store_groups(&groups.to_json())
+        {
+            self.notices
+                .error(now, format!("The panel's layout was not kept: {e}"));
+        }
         if let Some(json) = autosave.due(&self.doc, now)
             && let Some(message) = autosave.written(super::platform::store_autosave(&json))
         {
@@ -451,6 +463,7 @@ impl CloudApp {
             "guides_hidden": self.tool.hide_guides,
             "skeleton_shown": self.tool.show_skeleton,
             "panel_open": self.panel_open,
+            "groups_open": super::widgets::open_groups(ctx),
             "my_presets": self.panels.scene.looks.looks.iter().map(|l| l.name.as_str()).collect::<Vec<_>>(),
             "file": self.files.name,
             "unsaved": self.files.unsaved(&self.doc),

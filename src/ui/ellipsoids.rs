@@ -16,9 +16,20 @@ use crate::scene::{Document, Edit, Ellipsoid, MAX_ELLIPSOIDS};
 /// Share of the view's height a new ellipsoid's vertical radius takes.
 const NEW_SIZE: f32 = 0.12;
 
-/// Where a click at `p` lands: the cloud's surface under it, or the plane through the focus
-/// point facing the view.
-fn landing(doc: &Document, derived: &mut Derived, rect: Rect, p: Pos2) -> Option<Vec3> {
+/// A new puff's radius as a share of the local scale of what it lands on (half the size of
+/// the part under it: a smaller puff on a larger one, as cumulus build up).
+const PUFF_SHARE: f32 = 0.5;
+
+/// Where a click at `p` lands: the cloud's surface under it, with the local scale there (the
+/// mean radius of the ellipsoid that shapes the cloud there, or for a sketched part half the
+/// cloud's depth along the ray from the hit), or the plane through the focus point facing the
+/// view, with no scale.
+fn landing(
+    doc: &Document,
+    derived: &mut Derived,
+    rect: Rect,
+    p: Pos2,
+) -> Option<(Vec3, Option<f32>)> {
     let scene = doc.scene();
     let camera = &scene.camera;
     let ray = ray_at(camera, rect, p);
@@ -27,14 +38,30 @@ fn landing(doc: &Document, derived: &mut Derived, rect: Rect, p: Pos2) -> Option
         .bounding_sphere()
         .map(|(_, r)| r / 200.0)
         .unwrap_or(0.05);
-    field.raycast(&ray, step).or_else(|| {
-        ray.hit_plane(camera.target, -camera.forward())
-            .map(|t| ray.at(t))
-    })
+    if let Some(hit) = field.raycast(&ray, step) {
+        let scale = match most_at(&scene.ellipsoids, hit) {
+            Some(i) => {
+                let r = scene.ellipsoids[i].radii;
+                (r.x * r.y * r.z).cbrt()
+            }
+            None => {
+                // How far the ray stays inside past the hit (at most 400 steps).
+                let inside = (1..=400)
+                    .take_while(|k| {
+                        field.inside(ray.at((hit - ray.origin).length() + *k as f32 * step))
+                    })
+                    .count();
+                0.5 * (inside as f32 + 1.0) * step
+            }
+        };
+        return Some((hit, Some(scale)));
+    }
+    ray.hit_plane(camera.target, -camera.forward())
+        .map(|t| (ray.at(t), None))
 }
 
-/// Adds an ellipsoid where a click at `p` lands, sized for the view; selects it. Returns what
-/// was done.
+/// Adds an ellipsoid where a click at `p` lands, sized for what it lands on (half the local
+/// scale of the cloud there; over the sky, for the view); selects it. Returns what was done.
 pub fn add_at(
     doc: &mut Document,
     derived: &mut Derived,
@@ -48,10 +75,14 @@ pub fn add_at(
             "at most {MAX_ELLIPSOIDS} ellipsoids: delete one first"
         ));
     }
-    let center = landing(doc, derived, rect, p)?;
+    let (center, scale) = landing(doc, derived, rect, p)?;
     let camera = &doc.scene().camera;
     let depth = (center - camera.eye()).dot(camera.forward()).max(0.1);
-    let r = camera.world_per_px(depth, rect.height()) * rect.height() * NEW_SIZE;
+    let view_size = camera.world_per_px(depth, rect.height()) * rect.height() * NEW_SIZE;
+    // Sized for what it lands on, within a twentieth and twice the view's size.
+    let r = scale.map_or(view_size, |s| {
+        (PUFF_SHARE * s).clamp(0.05 * view_size, 2.0 * view_size)
+    });
     // Wider than tall, as the puffs of a cumulus are.
     let e = Ellipsoid::new(center, Vec3::new(1.4 * r, r, 1.2 * r));
     let mut list = doc.scene().ellipsoids.clone();
@@ -139,6 +170,30 @@ mod tests {
         // Undo takes the ellipsoids away one at a time.
         doc.undo();
         assert_eq!(doc.scene().ellipsoids.len(), 1);
+    }
+
+    #[test]
+    fn a_new_ellipsoid_is_sized_for_what_it_lands_on() {
+        // A big ellipsoid and a small one side by side: a click on each adds a puff about
+        // half its size (one size for the view before, whatever it landed on).
+        let mut scene = Scene::preset(Preset::Empty);
+        scene.ellipsoids = vec![
+            Arc::new(Ellipsoid::new(Vec3::new(-3.0, 3.0, 0.0), Vec3::splat(2.5))),
+            Arc::new(Ellipsoid::new(Vec3::new(3.0, 3.0, 0.0), Vec3::splat(0.6))),
+        ];
+        let camera = scene.camera.clone();
+        let mut doc = Document::new(scene);
+        let mut derived = Derived::default();
+        let mut selection = Selection::default();
+        let mut added = Vec::new();
+        for centre in [Vec3::new(-3.0, 3.0, 0.0), Vec3::new(3.0, 3.0, 0.0)] {
+            let at = crate::ui::projection::project(&camera, view(), centre).unwrap();
+            add_at(&mut doc, &mut derived, &mut selection, view(), at).unwrap();
+            added.push(doc.scene().ellipsoids.last().unwrap().radii.y);
+        }
+        let (on_big, on_small) = (added[0], added[1]);
+        assert!((on_big - 1.25).abs() < 0.2, "{on_big} on the big one");
+        assert!((on_small - 0.3).abs() < 0.1, "{on_small} on the small one");
     }
 
     #[test]

@@ -164,11 +164,9 @@ impl Guide {
 
     /// The Reference image group of the side panel.
     pub fn ui(&mut self, ui: &mut Ui, doc: &mut Document, notices: &mut Notices) {
-        egui::CollapsingHeader::new("Reference image")
-            .default_open(false)
-            .show(ui, |ui| {
-                let now = ui.input(|i| i.time);
-                ui.horizontal(|ui| {
+        super::widgets::group(ui, "Reference image", false, |ui| {
+            let now = ui.input(|i| i.time);
+            ui.horizontal(|ui| {
                     if files::HAS_PICKER
                         && ui
                             .button("Load…")
@@ -184,48 +182,57 @@ impl Guide {
                         notices.note(now, "Removed the reference image (Ctrl+Z undoes)");
                     }
                 });
-                if !files::HAS_PICKER {
-                    ui.horizontal(|ui| {
-                        ui.text_edit_singleline(&mut self.path)
-                            .on_hover_text("path of a PNG or JPEG; or drop one on the view");
-                        if ui.button("Load").clicked() {
-                            self.load(files::read_path(self.path.trim()));
-                        }
-                    });
+            if !files::HAS_PICKER {
+                ui.horizontal(|ui| {
+                    ui.text_edit_singleline(&mut self.path)
+                        .on_hover_text("path of a PNG or JPEG; or drop one on the view");
+                    if ui.button("Load").clicked() {
+                        self.load(files::read_path(self.path.trim()));
+                    }
+                });
+            }
+            if let Some(current) = doc.scene().reference.as_deref() {
+                let mut image = current.clone();
+                ui.label(format!(
+                    "{} ({}×{})",
+                    image.name, image.size[0], image.size[1]
+                ));
+                if !image.embedded() {
+                    ui.label(
+                        egui::RichText::new(
+                            "not in the document (too large): load it again after reopening",
+                        )
+                        .small()
+                        .color(ui.visuals().warn_fg_color),
+                    );
                 }
-                if let Some(current) = doc.scene().reference.as_deref() {
-                    let mut image = current.clone();
-                    ui.label(format!("{} ({}×{})", image.name, image.size[0], image.size[1]));
-                    if !image.embedded() {
-                        ui.label(
-                            egui::RichText::new("not in the document (too large): load it again after reopening")
-                                .small()
-                                .color(ui.visuals().warn_fg_color),
+                ui.horizontal(|ui| {
+                    ui.checkbox(&mut image.visible, "show");
+                    ui.checkbox(&mut image.in_front, "over the cloud")
+                        .on_hover_text(
+                            "Draw the picture in front of the cloud, to trace a photo's outline",
                         );
-                    }
-                    ui.horizontal(|ui| {
-                        ui.checkbox(&mut image.visible, "show");
-                        ui.checkbox(&mut image.in_front, "over the cloud")
-                            .on_hover_text("Draw the picture in front of the cloud, to trace a photo's outline");
-                    });
-                    ui.add(egui::Slider::new(&mut image.opacity, 0.0..=1.0).text("opacity"));
-                    if ui
-                        .button("Face the view")
-                        .on_hover_text("Turn the picture to face the current view, through its focus point")
-                        .clicked()
-                    {
-                        image.face(&doc.scene().camera, FILL);
-                    }
-                    if image != *current {
-                        doc.apply(Edit::SetReference(Some(image)), Some("reference"));
-                    }
-                } else {
-                    ui.label("Drop a PNG or JPEG on the view to trace over it.");
+                });
+                ui.add(egui::Slider::new(&mut image.opacity, 0.0..=1.0).text("opacity"));
+                if ui
+                    .button("Face the view")
+                    .on_hover_text(
+                        "Turn the picture to face the current view, through its focus point",
+                    )
+                    .clicked()
+                {
+                    image.face(&doc.scene().camera, FILL);
                 }
-                if let Some(e) = &self.error {
-                    ui.colored_label(Color32::LIGHT_RED, e);
+                if image != *current {
+                    doc.apply(Edit::SetReference(Some(image)), Some("reference"));
                 }
-            });
+            } else {
+                ui.label("Drop a PNG or JPEG on the view to trace over it.");
+            }
+            if let Some(e) = &self.error {
+                ui.colored_label(Color32::LIGHT_RED, e);
+            }
+        });
     }
 }
 

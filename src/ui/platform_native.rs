@@ -117,6 +117,16 @@ pub fn store_looks(json: &str) -> Result<(), String> {
     store_data("presets.json", json)
 }
 
+/// Which side-panel groups the user left open, if stored.
+pub fn load_groups() -> Option<String> {
+    load_data("groups.json")
+}
+
+/// Writes which side-panel groups are open.
+pub fn store_groups(json: &str) -> Result<(), String> {
+    store_data("groups.json", json)
+}
+
 /// The session kept aside by [`keep_previous_autosave`], if any.
 pub fn load_previous_autosave() -> Option<String> {
     load_data("autosave.previous.json")

@@ -66,6 +66,7 @@ fn deliver(loaded: Loaded) {
 const AUTOSAVE_KEY: &str = "cloudsketch.autosave";
 const PREVIOUS_KEY: &str = "cloudsketch.autosave.previous";
 const LOOKS_KEY: &str = "cloudsketch.presets";
+const GROUPS_KEY: &str = "cloudsketch.groups";
 
 fn storage() -> Option<web_sys::Storage> {
     web_sys::window().and_then(|w| w.local_storage().ok().flatten())
@@ -94,6 +95,19 @@ pub fn store_looks(json: &str) -> Result<(), String> {
     let storage = storage().ok_or("this browser keeps no local storage for the page")?;
     storage
         .set_item(LOOKS_KEY, json)
+        .map_err(|_| "the browser's storage for this page is full".to_owned())
+}
+
+/// Which side-panel groups the user left open, if stored.
+pub fn load_groups() -> Option<String> {
+    storage()?.get_item(GROUPS_KEY).ok().flatten()
+}
+
+/// Writes which side-panel groups are open.
+pub fn store_groups(json: &str) -> Result<(), String> {
+    let storage = storage().ok_or("this browser keeps no local storage for the page")?;
+    storage
+        .set_item(GROUPS_KEY, json)
         .map_err(|_| "the browser's storage for this page is full".to_owned())
 }
 

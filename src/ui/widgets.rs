@@ -69,6 +69,88 @@ pub fn take_marks(ctx: &egui::Context) -> Marks {
         .unwrap_or_default()
 }
 
+/// Which side-panel groups are open, as the user last left them: kept with the app in the
+/// platform's store (not the document), held in the egui context's data while it runs.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Groups {
+    /// Each group's title and whether it is open.
+    open: std::collections::BTreeMap<String, bool>,
+    /// The user opened or closed one since the last [`take_changed_groups`].
+    #[serde(skip)]
+    changed: bool,
+}
+
+impl Groups {
+    /// Reads the stored groups (nothing remembered when the text is not theirs).
+    pub fn from_json(text: &str) -> Self {
+        serde_json::from_str(text).unwrap_or_default()
+    }
+
+    /// The groups as stored.
+    pub fn to_json(&self) -> String {
+        serde_json::to_string(self).unwrap_or_default()
+    }
+}
+
+fn groups_id() -> egui::Id {
+    egui::Id::unique("cloudsketch side-panel groups")
+}
+
+/// Makes `groups` what the side panel opens its groups as (at start, from the store).
+pub fn install_groups(ctx: &egui::Context, groups: Groups) {
+    ctx.data_mut(|d| d.insert_temp(groups_id(), groups));
+}
+
+/// The groups as they are now, when the user opened or closed one since the last call.
+pub fn take_changed_groups(ctx: &egui::Context) -> Option<Groups> {
+    ctx.data_mut(|d| {
+        let groups = d.get_temp_mut_or_default::<Groups>(groups_id());
+        std::mem::take(&mut groups.changed).then(|| groups.clone())
+    })
+}
+
+/// The titles of the groups open now (the page state's `groups_open`).
+pub fn open_groups(ctx: &egui::Context) -> Vec<String> {
+    ctx.data(|d| d.get_temp::<Groups>(groups_id()))
+        .map(|g| {
+            g.open
+                .iter()
+                .filter(|(_, open)| **open)
+                .map(|(title, _)| title.clone())
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+/// A side-panel group titled `title`: open as the user last left it (see [`Groups`]), else
+/// as `default_open` says; its header is marked `group:TITLE` for the browser tests.
+pub fn group<R>(
+    ui: &mut Ui,
+    title: &str,
+    default_open: bool,
+    body: impl FnOnce(&mut Ui) -> R,
+) -> egui::CollapsingResponse<R> {
+    let ctx = ui.ctx().clone();
+    let remembered = ctx
+        .data(|d| d.get_temp::<Groups>(groups_id()))
+        .and_then(|g| g.open.get(title).copied());
+    let response = egui::CollapsingHeader::new(title)
+        .id_salt(("side-panel group", title))
+        .default_open(remembered.unwrap_or(default_open))
+        .show(ui, body);
+    mark(ui, &format!("group:{title}"), response.header_response.rect);
+    let open = response.openness > 0.5;
+    if remembered != Some(open) {
+        let clicked = response.header_response.clicked();
+        ctx.data_mut(|d| {
+            let groups = d.get_temp_mut_or_default::<Groups>(groups_id());
+            groups.open.insert(title.to_owned(), open);
+            groups.changed |= clicked;
+        });
+    }
+    response
+}
+
 /// A slider over a parameter's one range, with its label and tooltip (see [`crate::limits`]).
 /// Its rail is marked as `param:LABEL` (see [`mark`]). Returns whether it changed.
 pub fn param<T: egui::emath::Numeric>(ui: &mut Ui, value: &mut T, param: &Param) -> bool {
@@ -163,6 +245,30 @@ pub fn rotation_fields(ui: &mut Ui, rotation: &mut glam::Quat) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Whether the group `title` (closed by default) shows its body in a frame of `ctx`.
+    fn shown(ctx: &egui::Context, title: &str) -> bool {
+        let mut ran = false;
+        let mut output = ctx.run_ui(Default::default(), |ui| {
+            group(ui, title, false, |_| ran = true);
+        });
+        output.textures_delta.clear();
+        ran
+    }
+
+    #[test]
+    fn a_group_opens_as_the_user_left_it_and_else_as_its_default() {
+        let ctx = egui::Context::default();
+        assert!(!shown(&ctx, "View"), "closed by default");
+        let kept = Groups::from_json(r#"{"open": {"View": true}}"#);
+        let ctx = egui::Context::default();
+        install_groups(&ctx, kept);
+        assert!(shown(&ctx, "View"), "opened as it was left");
+        assert_eq!(open_groups(&ctx), ["View"]);
+        // Nothing the user did: nothing to store.
+        assert!(take_changed_groups(&ctx).is_none());
+        assert_eq!(Groups::from_json("not json"), Groups::default());
+    }
 
     /// The icon glyphs the UI's labels use (undo, redo, sketch, cut, move, rotate).
     const ICONS: &str = "⟲⟳✏✂⬌";

@@ -3,7 +3,7 @@
 // preset never replaces that session silently: it is kept aside under its own key.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { serve, launch, openApp, waitForBody, state, until, recordTiming } from './harness.mjs';
+import { serve, launch, openApp, waitForBody, state, until, recordTiming, openGroup } from './harness.mjs';
 
 let server;
 before(async () => { server = await serve(); });
@@ -62,6 +62,26 @@ test('a user\'s own presets are kept by the page and listed after a reload (webg
     await page.reload();
     await waitForBody(page, 'data-ready', (v) => v === 'true');
     assert.deepEqual((await state(page)).view.my_presets, ['golden hour']);
+    assert.deepEqual(errors, []);
+  } finally {
+    await close();
+  }
+});
+
+test('the side panel opens the groups a new user needs, then as the user left them (webgpu)', { timeout: 180_000 }, async () => {
+  const { browser, close } = await launch({ webgpu: true });
+  try {
+    const { page, errors } = await openApp(browser, server.url, '', { width: 1280, height: 800 });
+    await waitForBody(page, 'data-ready', (v) => v === 'true');
+    let open = (await state(page)).view.groups_open;
+    for (const title of ['Sketch', 'Render']) assert.ok(open.includes(title), `${title} open at first: ${open}`);
+    for (const title of ['Light', 'Scene', 'Export', 'Simulation']) assert.ok(!open.includes(title), `${title} closed at first: ${open}`);
+    // Opened by a click on its header, Export stays open over a reload.
+    await openGroup(page, 'Export');
+    await page.reload();
+    await waitForBody(page, 'data-ready', (v) => v === 'true');
+    open = (await until(page, (s) => s.view.groups_open.includes('Render'), 'the panel drawn')).view.groups_open;
+    assert.ok(open.includes('Export'), `Export kept open: ${open}`);
     assert.deepEqual(errors, []);
   } finally {
     await close();

@@ -203,6 +203,17 @@ export async function reveal(page, name) {
   throw new Error(`${name} never came into view`);
 }
 
+/**
+ * Opens the side panel's group `title` (a new user's panel opens File, Sketch and Render only)
+ * by clicking its header, as a person does, unless it is open already.
+ */
+export async function openGroup(page, title) {
+  if ((await state(page)).view.groups_open.includes(title)) return;
+  const r = await reveal(page, `group:${title}`);
+  await page.mouse.click(r[0] + 12, r[1] + r[3] / 2);
+  await until(page, (s) => s.view.groups_open.includes(title), `the ${title} group open`);
+}
+
 /** The sun handle's box in the page state's view (or null when it is not drawn). */
 export function sunHandleBox(view) {
   const o = view.sun_handle;

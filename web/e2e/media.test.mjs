@@ -4,7 +4,7 @@
 // test-results/screenshots/media-*.png.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { serve, launch, openApp, waitForBody, state, screenshot, countChanged, countDiffering, until, withApp, waitForFullQuality, reveal as revealWidget } from './harness.mjs';
+import { serve, launch, openApp, waitForBody, state, screenshot, countChanged, countDiffering, until, withApp, waitForFullQuality, reveal as revealWidget, openGroup } from './harness.mjs';
 
 let server;
 before(async () => { server = await serve(); });
@@ -225,6 +225,7 @@ for (const backend of ['webgpu', 'webgl2']) {
       await away();
       await waitForFullQuality(page);
       const before = await screenshot(page, `shafts-0-off-${backend}`);
+      await openGroup(page, 'Light');
       const box = await revealWidget(page, 'light:shafts');
       const undo = s.view.undo;
       await page.mouse.click(box[0] + 8, box[1] + box[3] / 2);

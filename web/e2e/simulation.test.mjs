@@ -7,7 +7,7 @@ import fs from 'node:fs';
 import path from 'node:path';
 import { execFileSync } from 'node:child_process';
 import { fileURLToPath } from 'node:url';
-import { serve, state, screenshot, countChanged, until, withApp, waitForFullQuality, recordTiming, reveal } from './harness.mjs';
+import { serve, state, screenshot, countChanged, until, withApp, waitForFullQuality, recordTiming, reveal, openGroup } from './harness.mjs';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
 
@@ -73,6 +73,7 @@ for (const backend of ['webgpu', 'webgl2']) {
       // Drag the leftmost parcel far to the right with the move gizmo's X arrow (selected
       // from its E1 button in the Scene group): clouds form there, not where it was.
       const undo = s.view.undo;
+      await openGroup(page, 'Scene');
       const button = await reveal(page, 'ellipsoid:1');
       await page.mouse.click(button[0] + button[2] / 2, button[1] + button[3] / 2);
       await page.mouse.move(5, vh - 5);

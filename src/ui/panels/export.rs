@@ -112,63 +112,70 @@ impl ExportPanel {
         scene_file: &str,
     ) -> ExportAsk {
         let mut ask = ExportAsk::default();
-        let header = egui::CollapsingHeader::new("Export")
-            .default_open(false)
-            .show(ui, |ui| {
-                ui.horizontal_wrapped(|ui| {
-                    for (format, name) in Format::ALL {
-                        let r = ui.selectable_label(self.format == format, name);
-                        mark(ui, &format!("export:{name}"), r.rect);
-                        if r.clicked() {
-                            self.format = format;
-                        }
+        crate::ui::widgets::group(ui, "Export", false, |ui| {
+            ui.horizontal_wrapped(|ui| {
+                for (format, name) in Format::ALL {
+                    let r = ui.selectable_label(self.format == format, name);
+                    mark(ui, &format!("export:{name}"), r.rect);
+                    if r.clicked() {
+                        self.format = format;
                     }
+                }
+            });
+            let o = &mut self.options;
+            if self.format == Format::Png {
+                ui.horizontal(|ui| {
+                    ui.add(egui::DragValue::new(&mut self.png_width).range(16..=8192));
+                    let h = png_height(self.png_width, view_px);
+                    ui.label(format!("× {h} px (the view's shape)"));
                 });
-                let o = &mut self.options;
-                if self.format == Format::Png {
-                    ui.horizontal(|ui| {
-                        ui.add(egui::DragValue::new(&mut self.png_width).range(16..=8192));
-                        let h = png_height(self.png_width, view_px);
-                        ui.label(format!("× {h} px (the view's shape)"));
-                    });
-                    let r = ui.checkbox(&mut self.transparent, "transparent background");
-                    mark(ui, "export:transparent", r.rect);
-                } else {
-                    ui.add(
+                let r = ui.checkbox(&mut self.transparent, "transparent background");
+                mark(ui, "export:transparent", r.rect);
+            } else {
+                ui.add(
                         egui::Slider::new(&mut o.resolution, 16..=crate::limits::MAX_EXPORT_RESOLUTION)
                             .text("grid (texels)"),
                     )
                     .on_hover_text("Texels along the cloud's longest side: finer grids take longer and make bigger files");
-                    ui.checkbox(&mut o.noise, "noise media as shown")
-                        .on_hover_text("Off: the plain blended field (a smooth surface, a soft density)");
-                    if self.format != Format::Mitsuba {
-                        ui.horizontal(|ui| {
-                            ui.label("up:");
-                            ui.selectable_value(&mut o.axes_up, Up::Y, "Y (glTF, Houdini)");
-                            ui.selectable_value(&mut o.axes_up, Up::Z, "Z (Blender)");
-                        });
-                        ui.add(egui::DragValue::new(&mut o.scale).range(1e-4..=1e4).speed(0.01).prefix("scale ×"));
-                    }
+                ui.checkbox(&mut o.noise, "noise media as shown")
+                    .on_hover_text(
+                        "Off: the plain blended field (a smooth surface, a soft density)",
+                    );
+                if self.format != Format::Mitsuba {
+                    ui.horizontal(|ui| {
+                        ui.label("up:");
+                        ui.selectable_value(&mut o.axes_up, Up::Y, "Y (glTF, Houdini)");
+                        ui.selectable_value(&mut o.axes_up, Up::Z, "Z (Blender)");
+                    });
+                    ui.add(
+                        egui::DragValue::new(&mut o.scale)
+                            .range(1e-4..=1e4)
+                            .speed(0.01)
+                            .prefix("scale ×"),
+                    );
                 }
-                let running = self.job.is_some();
-                ui.horizontal(|ui| {
-                    let button = ui
-                        .add_enabled(!running, egui::Button::new(format!("Export {}", self.format.name())))
-                        .on_hover_text("Ctrl+E");
-                    mark(ui, "export:run", button.rect);
-                    if button.clicked() {
-                        ask = self.start(doc, notices, ui.input(|i| i.time), view_px, scene_file);
-                    }
-                    if running && ui.button("Cancel").clicked() {
-                        self.job = None;
-                        notices.note(ui.input(|i| i.time), "Export cancelled");
-                    }
-                });
-                if let Some(p) = self.progress() {
-                    ui.add(egui::ProgressBar::new(p).show_percentage());
+            }
+            let running = self.job.is_some();
+            ui.horizontal(|ui| {
+                let button = ui
+                    .add_enabled(
+                        !running,
+                        egui::Button::new(format!("Export {}", self.format.name())),
+                    )
+                    .on_hover_text("Ctrl+E");
+                mark(ui, "export:run", button.rect);
+                if button.clicked() {
+                    ask = self.start(doc, notices, ui.input(|i| i.time), view_px, scene_file);
+                }
+                if running && ui.button("Cancel").clicked() {
+                    self.job = None;
+                    notices.note(ui.input(|i| i.time), "Export cancelled");
                 }
             });
-        mark(ui, "group:Export", header.header_response.rect);
+            if let Some(p) = self.progress() {
+                ui.add(egui::ProgressBar::new(p).show_percentage());
+            }
+        });
         ask
     }
 

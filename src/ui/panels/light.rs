@@ -8,7 +8,8 @@ use crate::scene::{Edit, Lighting};
 use crate::ui::widgets::{mark, param, srgb_button};
 
 /// The Light group.
-pub const LIGHT: PartPanel<Lighting> = PartPanel::new("Light", |s| &s.light, Edit::SetLight, body);
+pub const LIGHT: PartPanel<Lighting> =
+    PartPanel::new("Light", |s| &s.light, Edit::SetLight, body, false);
 
 fn body(ui: &mut Ui, l: &mut Lighting) {
     param(ui, &mut l.sun_azimuth_deg, &limits::SUN_AZIMUTH);

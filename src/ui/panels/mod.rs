@@ -34,34 +34,37 @@ pub struct PartPanel<T: 'static> {
     pub edit: fn(T) -> Edit,
     /// The group's widgets.
     pub body: fn(&mut Ui, &mut T),
+    /// Open until the user closes it (the groups a new user needs first).
+    pub open: bool,
 }
 
 impl<T: Clone + PartialEq> PartPanel<T> {
-    /// A group titled `title` whose `body` edits the `part` that `edit` replaces.
+    /// A group titled `title` whose `body` edits the `part` that `edit` replaces, open at
+    /// first when `open` says.
     pub const fn new(
         title: &'static str,
         part: fn(&Scene) -> &T,
         edit: fn(T) -> Edit,
         body: fn(&mut Ui, &mut T),
+        open: bool,
     ) -> Self {
         Self {
             title,
             part,
             edit,
             body,
+            open,
         }
     }
 
     /// Draws the group.
     pub fn ui(&self, ui: &mut Ui, doc: &mut Document) {
-        egui::CollapsingHeader::new(self.title)
-            .default_open(true)
-            .show(ui, |ui| {
-                let mut value = (self.part)(doc.scene()).clone();
-                (self.body)(ui, &mut value);
-                if value != *(self.part)(doc.scene()) {
-                    doc.apply((self.edit)(value), Some(self.title));
-                }
-            });
+        crate::ui::widgets::group(ui, self.title, self.open, |ui| {
+            let mut value = (self.part)(doc.scene()).clone();
+            (self.body)(ui, &mut value);
+            if value != *(self.part)(doc.scene()) {
+                doc.apply((self.edit)(value), Some(self.title));
+            }
+        });
     }
 }

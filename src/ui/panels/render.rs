@@ -9,7 +9,7 @@ use crate::ui::widgets::{param, param_as};
 
 /// The Render group.
 pub const RENDER: PartPanel<RenderSettings> =
-    PartPanel::new("Render", |s| &s.render, Edit::SetRender, body);
+    PartPanel::new("Render", |s| &s.render, Edit::SetRender, body, true);
 
 /// Table 2's qualitative controls first (Opacity, Quality, Detail, Dirtiness, Sharpness, cloud
 /// size), the finer settings after, the media's filter, noise and motion in a deeper group.

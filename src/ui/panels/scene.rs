@@ -104,27 +104,26 @@ impl ScenePanel {
         selection: &mut Selection,
         notices: &mut Notices,
     ) {
-        egui::CollapsingHeader::new("Scene")
-            .default_open(true)
-            .show(ui, |ui| {
-                ui.horizontal_wrapped(|ui| {
-                    ui.label("New:");
-                    for (preset, name) in Preset::ALL {
-                        let button = ui.small_button(name).on_hover_text(format!(
-                            "Start again from the {name} preset (Ctrl+Z undoes)"
-                        ));
-                        mark(ui, &format!("preset:{name}"), button.rect);
-                        if button.clicked() {
-                            // A preset brings its own camera, framed for its cloud.
-                            let scene = Scene::preset(preset);
-                            doc.apply(Edit::Replace(Box::new(scene)), None);
-                        }
+        // Closed at first: a new user starts from File, Sketch and Render.
+        crate::ui::widgets::group(ui, "Scene", false, |ui| {
+            ui.horizontal_wrapped(|ui| {
+                ui.label("New:");
+                for (preset, name) in Preset::ALL {
+                    let button = ui.small_button(name).on_hover_text(format!(
+                        "Start again from the {name} preset (Ctrl+Z undoes)"
+                    ));
+                    mark(ui, &format!("preset:{name}"), button.rect);
+                    if button.clicked() {
+                        // A preset brings its own camera, framed for its cloud.
+                        let scene = Scene::preset(preset);
+                        doc.apply(Edit::Replace(Box::new(scene)), None);
                     }
-                });
-                self.my_presets(ui, doc, notices);
-                ui.label(contents(doc.scene()));
-                ellipsoid_list(ui, doc, selection);
+                }
             });
+            self.my_presets(ui, doc, notices);
+            ui.label(contents(doc.scene()));
+            ellipsoid_list(ui, doc, selection);
+        });
     }
 }
 

@@ -26,10 +26,8 @@ impl SketchPanel {
         selection: &mut Selection,
         notices: &mut Notices,
     ) {
-        egui::CollapsingHeader::new("Sketch")
-            .default_open(true)
-            .show(ui, |ui| {
-                ui.horizontal_wrapped(|ui| {
+        crate::ui::widgets::group(ui, "Sketch", true, |ui| {
+            ui.horizontal_wrapped(|ui| {
                     for (t, label, tip) in [
                         (Tool::Navigate, "Navigate", "V: drag orbits the view"),
                         (Tool::Sketch, "✏ Sketch", "D: drag draws a cloud's outline"),
@@ -63,84 +61,84 @@ impl SketchPanel {
                             .on_hover_text(tip);
                     }
                 });
-                ui.horizontal(|ui| {
-                    ui.checkbox(&mut tool.show_all_planes, "all grids");
-                    ui.checkbox(&mut tool.hide_guides, "hide guides")
-                        .on_hover_text("H");
-                    ui.checkbox(&mut tool.show_skeleton, "skeleton")
-                        .on_hover_text("K: the selected outline's skeleton and spheres");
-                });
-                ui.checkbox(&mut tool.behind, "behind the cloud").on_hover_text(
+            ui.horizontal(|ui| {
+                ui.checkbox(&mut tool.show_all_planes, "all grids");
+                ui.checkbox(&mut tool.hide_guides, "hide guides")
+                    .on_hover_text("H");
+                ui.checkbox(&mut tool.show_skeleton, "skeleton")
+                    .on_hover_text("K: the selected outline's skeleton and spheres");
+            });
+            ui.checkbox(&mut tool.behind, "behind the cloud").on_hover_text(
                     "Q: a new outline drawn over the cloud lands on its far side (off: its near side, so it goes in front)",
                 );
-                let planes = &doc.scene().planes;
-                if planes.is_empty() {
-                    ui.label("No drawing planes yet. Pick Sketch and drag an outline in the view.");
-                    return;
-                }
-                ui.label("Drawing planes:");
-                let mut clicked = None;
-                for (i, plane) in planes.iter().enumerate() {
-                    let selected = selection.contains(Item::Plane(i));
-                    // A plane whose stroke the field cannot use says so, and why.
-                    let shape = derived.derived_shape(plane);
-                    let response = match shape.as_deref() {
-                        Some(Shape::Unusable(e)) => ui
-                            .selectable_label(
-                                selected,
-                                egui::RichText::new(format!("{} (not used)", plane.name))
-                                    .color(ui.visuals().warn_fg_color),
-                            )
-                            .on_hover_text(format!("This stroke adds nothing to the cloud: {e}")),
-                        _ if plane.hidden => ui
-                            .selectable_label(
-                                selected,
-                                egui::RichText::new(format!("{} (hidden)", plane.name)).weak(),
-                            )
-                            .on_hover_text("Hidden: left out of the cloud (Shift+H shows it)"),
-                        _ => ui.selectable_label(selected, plane.name.as_str()),
-                    };
-                    if response.clicked() {
-                        clicked = Some((i, selected));
-                    }
-                }
-                if let Some((i, was)) = clicked {
-                    if ui.input(|i| i.modifiers.shift) {
-                        selection.toggle(Item::Plane(i));
-                    } else {
-                        selection.set_plane((!was).then_some(i));
-                    }
-                }
-                if let Some(i) = selection.plane().filter(|&i| i < doc.scene().planes.len()) {
-                    ui.separator();
-                    let notes = match derived.derived_shape(&doc.scene().planes[i]).as_deref() {
-                        Some(Shape::Unusable(e)) => vec![format!("Not used: {e}")],
-                        Some(Shape::Outline { warnings, .. }) => warnings.clone(),
-                        _ => Vec::new(),
-                    };
-                    for note in notes {
-                        ui.label(
-                            egui::RichText::new(note)
-                                .small()
+            let planes = &doc.scene().planes;
+            if planes.is_empty() {
+                ui.label("No drawing planes yet. Pick Sketch and drag an outline in the view.");
+                return;
+            }
+            ui.label("Drawing planes:");
+            let mut clicked = None;
+            for (i, plane) in planes.iter().enumerate() {
+                let selected = selection.contains(Item::Plane(i));
+                // A plane whose stroke the field cannot use says so, and why.
+                let shape = derived.derived_shape(plane);
+                let response = match shape.as_deref() {
+                    Some(Shape::Unusable(e)) => ui
+                        .selectable_label(
+                            selected,
+                            egui::RichText::new(format!("{} (not used)", plane.name))
                                 .color(ui.visuals().warn_fg_color),
-                        );
-                    }
-                    plane_controls(ui, doc, i);
-                    ui.horizontal(|ui| {
-                        let now = ui.input(|i| i.time);
-                        if ui.button("Duplicate").on_hover_text("Ctrl+D").clicked()
-                            && let Some(m) = duplicate(doc, selection)
-                        {
-                            notices.note(now, m);
-                        }
-                        if ui.button("Delete").on_hover_text("Delete").clicked()
-                            && let Some(m) = delete(doc, selection)
-                        {
-                            notices.note(now, m);
-                        }
-                    });
+                        )
+                        .on_hover_text(format!("This stroke adds nothing to the cloud: {e}")),
+                    _ if plane.hidden => ui
+                        .selectable_label(
+                            selected,
+                            egui::RichText::new(format!("{} (hidden)", plane.name)).weak(),
+                        )
+                        .on_hover_text("Hidden: left out of the cloud (Shift+H shows it)"),
+                    _ => ui.selectable_label(selected, plane.name.as_str()),
+                };
+                if response.clicked() {
+                    clicked = Some((i, selected));
                 }
-            });
+            }
+            if let Some((i, was)) = clicked {
+                if ui.input(|i| i.modifiers.shift) {
+                    selection.toggle(Item::Plane(i));
+                } else {
+                    selection.set_plane((!was).then_some(i));
+                }
+            }
+            if let Some(i) = selection.plane().filter(|&i| i < doc.scene().planes.len()) {
+                ui.separator();
+                let notes = match derived.derived_shape(&doc.scene().planes[i]).as_deref() {
+                    Some(Shape::Unusable(e)) => vec![format!("Not used: {e}")],
+                    Some(Shape::Outline { warnings, .. }) => warnings.clone(),
+                    _ => Vec::new(),
+                };
+                for note in notes {
+                    ui.label(
+                        egui::RichText::new(note)
+                            .small()
+                            .color(ui.visuals().warn_fg_color),
+                    );
+                }
+                plane_controls(ui, doc, i);
+                ui.horizontal(|ui| {
+                    let now = ui.input(|i| i.time);
+                    if ui.button("Duplicate").on_hover_text("Ctrl+D").clicked()
+                        && let Some(m) = duplicate(doc, selection)
+                    {
+                        notices.note(now, m);
+                    }
+                    if ui.button("Delete").on_hover_text("Delete").clicked()
+                        && let Some(m) = delete(doc, selection)
+                    {
+                        notices.note(now, m);
+                    }
+                });
+            }
+        });
     }
 }
 

@@ -54,41 +54,39 @@ pub struct ViewPanel;
 impl ViewPanel {
     /// Draws the group: standard views and the projection, then what the viewport draws.
     pub fn ui(&mut self, ui: &mut Ui, stats: &ViewStats, doc: &mut Document) {
-        egui::CollapsingHeader::new("View")
-            .default_open(false)
-            .show(ui, |ui| {
-                let mut camera = doc.scene().camera.clone();
-                ui.horizontal_wrapped(|ui| {
-                    for (view, label, key) in VIEWS {
-                        if ui.button(label).on_hover_text(key).clicked() {
-                            camera.set_view(view);
-                        }
+        crate::ui::widgets::group(ui, "View", false, |ui| {
+            let mut camera = doc.scene().camera.clone();
+            ui.horizontal_wrapped(|ui| {
+                for (view, label, key) in VIEWS {
+                    if ui.button(label).on_hover_text(key).clicked() {
+                        camera.set_view(view);
                     }
-                });
-                ui.checkbox(&mut camera.orthographic, "orthographic")
-                    .on_hover_text("5: parallel projection, as for drawing outlines");
-                doc.set_camera(camera);
-                match &stats.backend {
-                    Some(b) => ui.label(format!(
-                        "backend: {}\nadapter: {}\nslices: {}",
-                        b.backend, b.adapter, b.slices
-                    )),
-                    None => ui.colored_label(egui::Color32::LIGHT_RED, "no GPU renderer"),
-                };
-                if let Some(q) = stats.shown {
-                    ui.label(format!("volume: {q} (width × height × slices)"));
                 }
-                if let Some(p) = stats.refining {
-                    ui.add(egui::ProgressBar::new(p).text("refining"));
-                }
-                if let Some(s) = stats.frame_seconds {
-                    ui.label(format!("last volume frame: {:.0} ms", s * 1000.0));
-                }
-                ui.label(format!(
-                    "viewport: {}×{} px",
-                    stats.viewport_px[0], stats.viewport_px[1]
-                ));
-                ui.small("Drag: orbit · Shift/right/middle drag: pan · wheel: zoom · F: frame");
             });
+            ui.checkbox(&mut camera.orthographic, "orthographic")
+                .on_hover_text("5: parallel projection, as for drawing outlines");
+            doc.set_camera(camera);
+            match &stats.backend {
+                Some(b) => ui.label(format!(
+                    "backend: {}\nadapter: {}\nslices: {}",
+                    b.backend, b.adapter, b.slices
+                )),
+                None => ui.colored_label(egui::Color32::LIGHT_RED, "no GPU renderer"),
+            };
+            if let Some(q) = stats.shown {
+                ui.label(format!("volume: {q} (width × height × slices)"));
+            }
+            if let Some(p) = stats.refining {
+                ui.add(egui::ProgressBar::new(p).text("refining"));
+            }
+            if let Some(s) = stats.frame_seconds {
+                ui.label(format!("last volume frame: {:.0} ms", s * 1000.0));
+            }
+            ui.label(format!(
+                "viewport: {}×{} px",
+                stats.viewport_px[0], stats.viewport_px[1]
+            ));
+            ui.small("Drag: orbit · Shift/right/middle drag: pan · wheel: zoom · F: frame");
+        });
     }
 }
