@@ -315,6 +315,9 @@ impl CloudApp {
         if ask.capture.is_some() {
             self.viewport.capture_request = ask.capture;
         }
+        if ask.cancel_capture {
+            self.viewport.cancel_capture();
+        }
         self.selection.retain_valid(self.doc.scene());
     }
 
@@ -546,6 +549,7 @@ impl eframe::App for CloudApp {
         if self.panels.export.step(&mut self.notices, now) {
             ctx.request_repaint();
         }
+        self.panels.export.capture_progress = self.viewport.capture_progress().unwrap_or(0.0);
         if let Some((size, pixels)) = self.viewport.captured.take() {
             self.panels
                 .export

@@ -11,7 +11,11 @@ use super::sketch_tool::{SketchTool, ToolContext, ViewInput};
 use crate::derive::Derived;
 use crate::render::SliceJob;
 use crate::render::View;
-use crate::render::capture::Capture;
+use crate::render::capture::{Capture, capture_chunks};
+
+/// Seconds of a frame an export's capture may take (the rest is the view's: a drag during an
+/// export keeps its frames).
+const CAPTURE_BUDGET: f64 = 0.04;
 use crate::render::progressive::{Budget, Progressive};
 use crate::render::viewport::{JobFence, ReportPoll};
 use crate::render::viewport::{SkyPaint, ViewportPaint, paint_callback};
@@ -43,6 +47,19 @@ pub struct Viewport {
     capture: Option<Capture>,
     /// A finished capture: its size and pixels (straight-alpha RGBA), or why it failed.
     pub captured: Option<([u32; 2], Result<Vec<u8>, String>)>,
+}
+
+impl Viewport {
+    /// The share of the capture under way that is done, if one is.
+    pub fn capture_progress(&self) -> Option<f32> {
+        self.capture.as_ref().map(Capture::progress)
+    }
+
+    /// Drops the capture under way (the export was cancelled): nothing more is drawn for it.
+    pub fn cancel_capture(&mut self) {
+        self.capture = None;
+        self.capture_request = None;
+    }
 }
 
 /// Everything the viewport works on this frame: what the tools work on, the tools, the
@@ -220,7 +237,15 @@ impl Viewport {
             self.ready = true;
         }
         if let Some((size, transparent)) = self.capture_request.take() {
-            self.capture = Some(Capture::new(&view, size, transparent));
+            // Its slices spread over frames within a frame's budget, as refinement's are.
+            let pixels = size[0] as u64 * size[1] as u64;
+            let chunks = capture_chunks(
+                pixels,
+                view.render.slices,
+                self.progressive.cost(),
+                CAPTURE_BUDGET,
+            );
+            self.capture = Some(Capture::new(&view, size, transparent, chunks));
         }
         if let Some(capture) = &self.capture {
             if let Some(result) = capture.take() {

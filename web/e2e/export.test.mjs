@@ -5,7 +5,7 @@ import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import fs from 'node:fs';
 import { PNG } from 'pngjs';
-import { serve, state, screenshot, until, withApp, waitForFullQuality } from './harness.mjs';
+import { serve, state, screenshot, until, withApp, waitForFullQuality, recordTiming, reveal as revealWidget } from './harness.mjs';
 
 let server;
 before(async () => { server = await serve(); });
@@ -89,6 +89,49 @@ for (const backend of ['webgpu', 'webgl2']) {
       assert.equal(at(t, 3, 3)[3], 0, 'a transparent corner');
       assert.equal(at(t, t.width / 2, t.height / 2)[3], 255, 'an opaque middle');
       await screenshot(page, `export-app-${backend}`);
+    });
+  });
+}
+
+// A PNG export no longer holds the page: its slices are drawn a chunk a frame (it froze the
+// page for 35 s at 1920×1566 on a CPU adapter, its progress stuck at a half). While it runs the
+// progress moves, a drag orbits the camera, and Cancel stops it with no download.
+for (const backend of ['webgpu', 'webgl2']) {
+  test(`a PNG export draws over frames: a drag orbits meanwhile, Cancel leaves no download (${backend})`, { timeout: 300_000 }, async () => {
+    await withApp({ base: server.url, webgpu: backend === 'webgpu', viewport: { width: 1280, height: 800 } }, async (page) => {
+      let s = await state(page);
+      const [vw, vh] = s.view.viewport;
+      const click = async (name) => {
+        const r = await revealWidget(page, name);
+        await page.mouse.click(r[0] + r[2] / 2, r[1] + r[3] / 2);
+      };
+      let downloads = 0;
+      page.on('download', () => { downloads += 1; });
+      await page.mouse.click(5, vh - 5);
+      await waitForFullQuality(page);
+      await click('group:Export');
+      await click('export:png');
+      await until(page, (s) => s.view.export.format === 'png', 'PNG chosen');
+      await click('export:run');
+      s = await until(page, (s) => s.view.export.progress > 0, 'the capture under way');
+      const first = s.view.export.progress;
+      s = await until(page, (s) => s.view.export.progress > first, 'its progress moves');
+      // A drag over the view orbits the camera while the capture runs.
+      const yaw = s.scene.camera.yaw_deg;
+      const t0 = Date.now();
+      await page.mouse.move(vw * 0.5, vh * 0.5);
+      await page.mouse.down();
+      for (let i = 1; i <= 10; i++) await page.mouse.move(vw * 0.5 + i * 15, vh * 0.5);
+      await page.mouse.up();
+      s = await until(page, (s) => s.scene.camera.yaw_deg !== yaw, 'the camera orbited');
+      recordTiming({ test: 'export_drag', backend, drag_answered_ms: Date.now() - t0, progress: s.view.export.progress });
+      assert.ok(s.view.export.progress != null, 'the export was still running during the drag');
+      await click('export:cancel');
+      s = await until(page, (s) => s.view.export.progress == null, 'the export stopped');
+      assert.match(s.view.notice.text, /Export cancelled/);
+      await page.waitForTimeout(3000);
+      assert.equal(downloads, 0, 'a cancelled export downloads nothing');
+      assert.equal((await state(page)).view.export.last, null, 'nothing was exported');
     });
   });
 }

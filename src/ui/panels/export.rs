@@ -69,6 +69,8 @@ pub struct ExportPanel {
     job: Option<Job>,
     /// The last export's result, for the page state: the file names or the error.
     pub last: Option<Result<Vec<String>, String>>,
+    /// How far the view's capture is (the app reports it each frame).
+    pub capture_progress: f32,
 }
 
 impl Default for ExportPanel {
@@ -80,6 +82,7 @@ impl Default for ExportPanel {
             transparent: false,
             job: None,
             last: None,
+            capture_progress: 0.0,
         }
     }
 }
@@ -89,6 +92,8 @@ impl Default for ExportPanel {
 pub struct ExportAsk {
     /// Render a capture of the view at this size (pixels), transparent or not.
     pub capture: Option<([u32; 2], bool)>,
+    /// Drop the capture under way (Cancel).
+    pub cancel_capture: bool,
 }
 
 impl ExportPanel {
@@ -96,7 +101,7 @@ impl ExportPanel {
     pub fn progress(&self) -> Option<f32> {
         match &self.job {
             Some(Job::Sampling { sampling, .. }) => Some(sampling.progress() * 0.9),
-            Some(Job::Capture { .. }) => Some(0.5),
+            Some(Job::Capture { .. }) => Some(self.capture_progress),
             None => None,
         }
     }
@@ -167,9 +172,14 @@ impl ExportPanel {
                 if button.clicked() {
                     ask = self.start(doc, notices, ui.input(|i| i.time), view_px, scene_file);
                 }
-                if running && ui.button("Cancel").clicked() {
-                    self.job = None;
-                    notices.note(ui.input(|i| i.time), "Export cancelled");
+                if running {
+                    let cancel = ui.button("Cancel");
+                    mark(ui, "export:cancel", cancel.rect);
+                    if cancel.clicked() {
+                        ask.cancel_capture = matches!(self.job, Some(Job::Capture { .. }));
+                        self.job = None;
+                        notices.note(ui.input(|i| i.time), "Export cancelled");
+                    }
                 }
             });
             if let Some(p) = self.progress() {
@@ -198,8 +208,10 @@ impl ExportPanel {
                 png_height(self.png_width, view_px),
             ];
             self.job = Some(Job::Capture { place });
+            self.capture_progress = 0.0;
             return ExportAsk {
                 capture: Some((size, self.transparent)),
+                ..Default::default()
             };
         }
         let scene = doc.scene().clone();
