@@ -139,13 +139,15 @@ pub fn group<R>(
         .default_open(remembered.unwrap_or(default_open))
         .show(ui, body);
     mark(ui, &format!("group:{title}"), response.header_response.rect);
+    // Half open or more counts as open: a click starts an animation over several frames, and
+    // the state is recorded once it passes halfway. Only a change from a state already known
+    // is the user's (the first frame records the group as it opened).
     let open = response.openness > 0.5;
     if remembered != Some(open) {
-        let clicked = response.header_response.clicked();
         ctx.data_mut(|d| {
             let groups = d.get_temp_mut_or_default::<Groups>(groups_id());
             groups.open.insert(title.to_owned(), open);
-            groups.changed |= clicked;
+            groups.changed |= remembered.is_some();
         });
     }
     response
@@ -267,6 +269,39 @@ mod tests {
         assert_eq!(open_groups(&ctx), ["View"]);
         // Nothing the user did: nothing to store.
         assert!(take_changed_groups(&ctx).is_none());
+        // A click on its header closes it: once the animation passes halfway, that is the
+        // user's change, to be stored.
+        let header = take_marks(&ctx)["group:View"];
+        let at = egui::pos2(header[0] + 10.0, header[1] + header[3] / 2.0);
+        let button = |pressed| egui::Event::PointerButton {
+            pos: at,
+            button: egui::PointerButton::Primary,
+            pressed,
+            modifiers: egui::Modifiers::NONE,
+        };
+        let frames = [
+            vec![egui::Event::PointerMoved(at)],
+            vec![button(true)],
+            vec![button(false)],
+        ];
+        for (k, events) in frames
+            .into_iter()
+            .chain((0..30).map(|_| Vec::new()))
+            .enumerate()
+        {
+            let raw = egui::RawInput {
+                time: Some(k as f64 * 0.05),
+                events,
+                ..Default::default()
+            };
+            let mut output = ctx.run_ui(raw, |ui| {
+                group(ui, "View", false, |_| {});
+            });
+            output.textures_delta.clear();
+        }
+        let stored = take_changed_groups(&ctx).expect("the click was a change");
+        assert_eq!(stored.open.get("View"), Some(&false));
+        assert!(open_groups(&ctx).is_empty());
         assert_eq!(Groups::from_json("not json"), Groups::default());
     }
 
