@@ -137,7 +137,9 @@ for (const backend of ['webgpu', 'webgl2']) {
       await away();
       await waitForFullQuality(page);
       let last = await screenshot(page, `widgets-0-start-${backend}`);
-      // Every preset from its button: one undo step each, and an image unlike the last.
+      // Every preset from its button (in the Scene group, closed at first): one undo step
+      // each, and an image unlike the last.
+      await openGroup(page, 'Scene');
       for (const name of ['stratus', 'cirrus', 'cumulonimbus', 'sunset', 'cumulus']) {
         const undo = s.view.undo;
         await page.mouse.click(...centre(await reveal(`preset:${name}`)));
