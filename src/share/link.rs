@@ -32,7 +32,9 @@ use crate::scene::{
 };
 
 /// Format version written by this build; older ones keep opening (see docs/scene-format.md).
-pub const LINK_VERSION: u8 = 1;
+/// Version 2 is version 1 on a newer base (the ground's default height moved from 0 to -5):
+/// the payload's layout is the same.
+pub const LINK_VERSION: u8 = 2;
 
 /// Longest token accepted or written (characters after `#s=`). Browsers take URLs of
 /// megabytes, but mail and chat tools cut them far sooner.
@@ -155,11 +157,17 @@ pub fn decode_link(text: &str) -> Result<(Scene, Vec<String>), LinkError> {
             )),
             _ => damaged("not a deflate stream"),
         })?;
-    decode_payload(&payload)
+    decode_payload_of(version, &payload)
 }
 
-/// Decodes an inflated version-1 payload (public for the fuzz target).
+/// Decodes an inflated payload of the current version (public for the fuzz target).
 pub fn decode_payload(payload: &[u8]) -> Result<(Scene, Vec<String>), LinkError> {
+    decode_payload_of(LINK_VERSION, payload)
+}
+
+/// Decodes an inflated payload of link format `version` (1 or 2: the same layout, each on its
+/// own base).
+fn decode_payload_of(version: u8, payload: &[u8]) -> Result<(Scene, Vec<String>), LinkError> {
     let mut r = Reader {
         bytes: payload,
         at: 0,
@@ -174,7 +182,7 @@ pub fn decode_payload(payload: &[u8]) -> Result<(Scene, Vec<String>), LinkError>
     let Value::Object(diff) = diff else {
         return Err(damaged("settings are not an object"));
     };
-    let merged = merge_onto_base(diff)?;
+    let merged = merge_onto_base(bases(version), diff)?;
     let (mut scene, mut repairs) = Scene::from_value(merged)?;
     // A link never carries the reference picture's bytes (docs/scene-format.md): a crafted
     // one that does gets its name and placement only.
@@ -201,30 +209,40 @@ pub fn decode_payload(payload: &[u8]) -> Result<(Scene, Vec<String>), LinkError>
 
 // --- the settings: JSON differences from a fixed base -------------------------------------
 
-/// What a link's settings are the difference from, as format version 1 wrote and reads it:
+/// What a link's settings are the difference from, as a format version wrote and reads it:
 /// the empty preset, a default drawing plane and a default ellipsoid as they serialised when
-/// the format was made, kept as data (`src/share/link/base_v1.json`). Defaults may move (the
-/// ground's height, the sun); a version-1 link still opens to the scene it was made of.
+/// the version was made, kept as data (`src/share/link/base_vN.json`). Defaults may move (the
+/// ground's height, the sun); a link still opens to the scene it was made of.
 struct Bases {
     scene: Value,
     plane: Value,
     ellipsoid: Value,
 }
 
-const BASE_V1: &str = include_str!("link/base_v1.json");
-
-/// The bases of link format version 1 (the only one so far: a new version adds its own file).
-fn bases() -> &'static Bases {
-    static BASES: std::sync::OnceLock<Bases> = std::sync::OnceLock::new();
-    BASES.get_or_init(|| {
-        let mut all = as_object(serde_json::from_str(BASE_V1).unwrap_or(Value::Null));
+impl Bases {
+    fn parse(text: &str) -> Self {
+        let mut all = as_object(serde_json::from_str(text).unwrap_or(Value::Null));
         let mut take = |key: &str| all.remove(key).unwrap_or(Value::Null);
         Bases {
             scene: take("scene"),
             plane: take("plane"),
             ellipsoid: take("ellipsoid"),
         }
-    })
+    }
+}
+
+/// Each link format version's base: version 1's (the ground at 0), version 2's (at -5).
+const BASES: [&str; LINK_VERSION as usize] = [
+    include_str!("link/base_v1.json"),
+    include_str!("link/base_v2.json"),
+];
+
+/// The base of link format `version` (1 to [`LINK_VERSION`]; others take the current one).
+fn bases(version: u8) -> &'static Bases {
+    static PARSED: [std::sync::OnceLock<Bases>; LINK_VERSION as usize] =
+        [const { std::sync::OnceLock::new() }; LINK_VERSION as usize];
+    let k = (version.clamp(1, LINK_VERSION) - 1) as usize;
+    PARSED[k].get_or_init(|| Bases::parse(BASES[k]))
 }
 
 /// Today's defaults as [`Bases`] holds them (what `base_v1.json` was written from).
@@ -315,7 +333,7 @@ fn as_object(v: Value) -> Map<String, Value> {
 /// The JSON part of the payload for `scene`.
 fn settings_json(scene: &Scene) -> Value {
     let mut value = as_object(to_rounded_value(scene));
-    let bases = bases();
+    let bases = bases(LINK_VERSION);
     let base = as_object(rounded(&bases.scene));
     let mut plane_base = as_object(rounded(&bases.plane));
     plane_base.remove("points");
@@ -350,7 +368,7 @@ fn settings_json(scene: &Scene) -> Value {
 }
 
 /// The scene JSON a settings object describes; counts checked before anything is built.
-fn merge_onto_base(mut diff: Map<String, Value>) -> Result<Value, LinkError> {
+fn merge_onto_base(bases: &Bases, mut diff: Map<String, Value>) -> Result<Value, LinkError> {
     let mut list = |key: &str, cap: usize, base: Value| -> Result<Value, LinkError> {
         let items = match diff.remove(key) {
             Some(Value::Array(items)) => items,
@@ -371,7 +389,6 @@ fn merge_onto_base(mut diff: Map<String, Value>) -> Result<Value, LinkError> {
         }
         Ok(Value::Array(out))
     };
-    let bases = bases();
     let planes = list("planes", MAX_PLANES, bases.plane.clone())?;
     let ellipsoids = list("ellipsoids", MAX_ELLIPSOIDS, bases.ellipsoid.clone())?;
     let mut scene = bases.scene.clone();

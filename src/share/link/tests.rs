@@ -285,26 +285,43 @@ fn a_scene_a_link_cannot_carry_is_refused_not_written_damaged() {
 
 #[test]
 fn each_link_version_keeps_its_own_base() {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/src/share/link/base_v1.json");
+    // The current version's base is written from today's defaults when a version is added.
     if std::env::var_os("CLOUDSKETCH_WRITE_LINK_BASE").is_some() {
+        let path = format!(
+            "{}/src/share/link/base_v{LINK_VERSION}.json",
+            env!("CARGO_MANIFEST_DIR")
+        );
         let text = serde_json::to_string_pretty(&todays_bases()).unwrap();
         std::fs::write(path, text + "\n").unwrap();
     }
-    let bases = bases();
-    for (name, base) in [
-        ("scene", &bases.scene),
-        ("plane", &bases.plane),
-        ("ellipsoid", &bases.ellipsoid),
-    ] {
-        assert!(
-            base.as_object().is_some_and(|o| !o.is_empty()),
-            "base_v1.json has no {name}"
-        );
+    for version in 1..=LINK_VERSION {
+        let bases = bases(version);
+        for (name, base) in [
+            ("scene", &bases.scene),
+            ("plane", &bases.plane),
+            ("ellipsoid", &bases.ellipsoid),
+        ] {
+            assert!(
+                base.as_object().is_some_and(|o| !o.is_empty()),
+                "base_v{version}.json has no {name}"
+            );
+        }
+        // The stored base is data: decoding does not look at today's defaults. A base that
+        // no longer deserialises (a member renamed without a version bump) fails here.
+        let scene: Scene = serde_json::from_value(bases.scene.clone()).unwrap();
+        assert!(scene.planes.is_empty() && scene.ellipsoids.is_empty());
     }
-    // The stored base is data: decoding does not look at today's defaults. A base that no
-    // longer deserialises (a member renamed without a version bump) fails here.
-    let scene: Scene = serde_json::from_value(bases.scene.clone()).unwrap();
-    assert!(scene.planes.is_empty() && scene.ellipsoids.is_empty());
+    // The bases differ where the defaults moved between versions: the ground's height.
+    assert_eq!(bases(1).scene["light"]["ground_height"], 0.0);
+    assert_eq!(bases(2).scene["light"]["ground_height"], -5.0);
+    // Today's defaults are the current version's base (as links round them), or a version is
+    // due.
+    assert_eq!(
+        rounded(&todays_bases()["scene"]),
+        rounded(&bases(LINK_VERSION).scene),
+        "the defaults moved: add link format {} with its base (see docs/scene-format.md)",
+        LINK_VERSION + 1
+    );
 }
 
 /// The paths of `value`'s leaves (arrays are leaves: vectors, colours) equal to `base`'s.
@@ -329,7 +346,7 @@ fn the_fixture_sets_every_field_the_link_carries_apart_from_its_base() {
     // to something, changes the fixture's payload and asks for a version bump.
     let scene = fixture::every_part();
     let value = to_rounded_value(&scene);
-    let bases = bases();
+    let bases = bases(LINK_VERSION);
     let mut same = Vec::new();
     let mut top = value.clone();
     if let Value::Object(o) = &mut top {
