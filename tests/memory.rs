@@ -73,6 +73,7 @@ fn peak_memory_follows_the_caps_not_the_input() {
     // /dev/zero reports no size and never ends.
     let (read, peak) = peak_of(|| read_bounded(Path::new("/dev/zero"), MAX_FILE_BYTES));
     assert!(matches!(read, Err(ReadError::TooLarge { .. })), "{read:?}");
+    eprintln!("/dev/zero: peak {:.1} MiB", peak as f64 / MIB as f64);
     assert!(peak <= cap + MIB, "/dev/zero: peak {} MiB", peak / MIB);
 
     // A FIFO fed 80 MiB by another process.
@@ -95,6 +96,7 @@ fn peak_memory_follows_the_caps_not_the_input() {
         .unwrap();
     let (read, peak) = peak_of(|| read_bounded(&fifo, MAX_FILE_BYTES));
     assert!(matches!(read, Err(ReadError::TooLarge { .. })), "{read:?}");
+    eprintln!("FIFO fed 80 MiB: peak {:.1} MiB", peak as f64 / MIB as f64);
     assert!(peak <= cap + MIB, "FIFO: peak {} MiB", peak / MIB);
     let _ = writer.kill();
     let _ = writer.wait();
@@ -118,6 +120,11 @@ fn peak_memory_follows_the_caps_not_the_input() {
         cloudsketch::share::open_scene_file("crafted.json", &bytes).map(|(s, _)| s.seed)
     });
     assert_eq!(opened.unwrap(), 7);
+    eprintln!(
+        "a {:.1} MB scene file read and opened: peak {:.1} MiB",
+        size as f64 / 1e6,
+        peak as f64 / MIB as f64
+    );
     assert!(
         peak <= size + 16 * MIB,
         "a {} MB scene file: peak {} MiB",
@@ -142,6 +149,7 @@ fn peak_memory_follows_the_caps_not_the_input() {
     });
     let err = opened.unwrap_err().to_string();
     assert!(err.contains("at most 4096"), "{err}");
+    eprintln!("60 MB of ellipsoids refused: peak {:.1} MiB", peak as f64 / MIB as f64);
     assert!(
         peak <= size + 16 * MIB,
         "ellipsoids: peak {} MiB",
@@ -163,6 +171,7 @@ fn peak_memory_follows_the_caps_not_the_input() {
     let (decoded, peak) = peak_of(|| cloudsketch::share::decode_link(&link).map(|_| ()));
     let err = decoded.unwrap_err().to_string();
     assert!(err.contains("inflates to more than"), "{err}");
+    eprintln!("a link over its cap: peak {:.2} MiB", peak as f64 / MIB as f64);
     assert!(
         peak <= 2 * cap + MIB,
         "a link over its {} MiB cap: peak {} MiB",
