@@ -72,48 +72,52 @@ fn storage() -> Option<web_sys::Storage> {
     web_sys::window().and_then(|w| w.local_storage().ok().flatten())
 }
 
+/// The page's stored item `key`, if any.
+fn load_item(key: &str) -> Option<String> {
+    storage()?.get_item(key).ok().flatten()
+}
+
+/// Stores `json` under `key` (the browser's quota may refuse it).
+fn store_item(key: &str, json: &str) -> Result<(), String> {
+    let storage = storage().ok_or("this browser keeps no local storage for the page")?;
+    storage
+        .set_item(key, json)
+        .map_err(|_| "the browser's storage for this page is full".to_owned())
+}
+
 /// The last autosaved document, if any.
 pub fn load_autosave() -> Option<String> {
-    storage()?.get_item(AUTOSAVE_KEY).ok().flatten()
+    load_item(AUTOSAVE_KEY)
 }
 
 /// Writes the autosave (the browser's quota may refuse a large reference image).
 pub fn store_autosave(json: &str) -> Result<(), String> {
-    let storage = storage().ok_or("this browser keeps no local storage for the page")?;
-    storage
-        .set_item(AUTOSAVE_KEY, json)
-        .map_err(|_| "the browser's storage for this page is full".to_owned())
+    store_item(AUTOSAVE_KEY, json)
 }
 
 /// The user's own presets, if any were saved.
 pub fn load_looks() -> Option<String> {
-    storage()?.get_item(LOOKS_KEY).ok().flatten()
+    load_item(LOOKS_KEY)
 }
 
 /// Writes the user's own presets.
 pub fn store_looks(json: &str) -> Result<(), String> {
-    let storage = storage().ok_or("this browser keeps no local storage for the page")?;
-    storage
-        .set_item(LOOKS_KEY, json)
-        .map_err(|_| "the browser's storage for this page is full".to_owned())
+    store_item(LOOKS_KEY, json)
 }
 
 /// Which side-panel groups the user left open, if stored.
 pub fn load_groups() -> Option<String> {
-    storage()?.get_item(GROUPS_KEY).ok().flatten()
+    load_item(GROUPS_KEY)
 }
 
 /// Writes which side-panel groups are open.
 pub fn store_groups(json: &str) -> Result<(), String> {
-    let storage = storage().ok_or("this browser keeps no local storage for the page")?;
-    storage
-        .set_item(GROUPS_KEY, json)
-        .map_err(|_| "the browser's storage for this page is full".to_owned())
+    store_item(GROUPS_KEY, json)
 }
 
 /// The session kept aside by [`keep_previous_autosave`], if any.
 pub fn load_previous_autosave() -> Option<String> {
-    storage()?.get_item(PREVIOUS_KEY).ok().flatten()
+    load_item(PREVIOUS_KEY)
 }
 
 /// Keeps the last autosave aside (under its own key) before a new session writes over it.

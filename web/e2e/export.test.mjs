@@ -24,6 +24,22 @@ function parseGlb(bytes) {
   return { json, binLength };
 }
 
+/**
+ * Scrolls the side panel until widget `name` is in view with 2 px to spare (the harness's
+ * `reveal` wants 10: the Export group's last row sits at the panel's foot); returns its box.
+ */
+async function revealAtFoot(page, name) {
+  const [vw, vh] = (await state(page)).view.viewport;
+  for (let i = 0; i < 30; i++) {
+    const r = (await state(page)).view.widgets[name];
+    if (r && r[1] >= 2 && r[1] + r[3] <= vh - 2) return r;
+    await page.mouse.move(vw + 100, vh / 2);
+    await page.mouse.wheel(0, r && r[1] < 10 ? -200 : 200);
+    await page.waitForTimeout(150);
+  }
+  throw new Error(`${name} never came into view`);
+}
+
 // A full-quality 1920-px capture takes 50–100 s on SwiftShader (a CI machine: more); the
 // limits only catch a download that never comes.
 const DOWNLOAD_WAIT = 240_000;
@@ -34,16 +50,7 @@ for (const backend of ['webgpu', 'webgl2']) {
       let s = await state(page);
       const [vw, vh] = s.view.viewport;
       const centre = (r) => [r[0] + r[2] / 2, r[1] + r[3] / 2];
-      const reveal = async (name) => {
-        for (let i = 0; i < 30; i++) {
-          const r = (await state(page)).view.widgets[name];
-          if (r && r[1] >= 2 && r[1] + r[3] <= vh - 2) return r;
-          await page.mouse.move(vw + 100, vh / 2);
-          await page.mouse.wheel(0, r && r[1] < 10 ? -200 : 200);
-          await page.waitForTimeout(150);
-        }
-        throw new Error(`${name} never came into view`);
-      };
+      const reveal = (name) => revealAtFoot(page, name);
       const click = async (name) => page.mouse.click(...centre(await reveal(name)));
       await page.mouse.click(5, vh - 5);
       await waitForFullQuality(page);
@@ -101,20 +108,8 @@ for (const backend of ['webgpu', 'webgl2']) {
     await withApp({ base: server.url, webgpu: backend === 'webgpu', viewport: { width: 1280, height: 800 } }, async (page) => {
       let s = await state(page);
       const [vw, vh] = s.view.viewport;
-      // The Export group's last row sits at the panel's foot: revealed with 2 px to spare (the
-      // harness's `reveal` wants 10), as the test above does.
-      const reveal = async (name) => {
-        for (let i = 0; i < 30; i++) {
-          const r = (await state(page)).view.widgets[name];
-          if (r && r[1] >= 2 && r[1] + r[3] <= vh - 2) return r;
-          await page.mouse.move(vw + 100, vh / 2);
-          await page.mouse.wheel(0, r && r[1] < 10 ? -200 : 200);
-          await page.waitForTimeout(150);
-        }
-        throw new Error(`${name} never came into view`);
-      };
       const click = async (name) => {
-        const r = await reveal(name);
+        const r = await revealAtFoot(page, name);
         await page.mouse.click(r[0] + r[2] / 2, r[1] + r[3] / 2);
       };
       let downloads = 0;
