@@ -149,7 +149,10 @@ fn peak_memory_follows_the_caps_not_the_input() {
     });
     let err = opened.unwrap_err().to_string();
     assert!(err.contains("at most 4096"), "{err}");
-    eprintln!("60 MB of ellipsoids refused: peak {:.1} MiB", peak as f64 / MIB as f64);
+    eprintln!(
+        "60 MB of ellipsoids refused: peak {:.1} MiB",
+        peak as f64 / MIB as f64
+    );
     assert!(
         peak <= size + 16 * MIB,
         "ellipsoids: peak {} MiB",
@@ -171,7 +174,10 @@ fn peak_memory_follows_the_caps_not_the_input() {
     let (decoded, peak) = peak_of(|| cloudsketch::share::decode_link(&link).map(|_| ()));
     let err = decoded.unwrap_err().to_string();
     assert!(err.contains("inflates to more than"), "{err}");
-    eprintln!("a link over its cap: peak {:.2} MiB", peak as f64 / MIB as f64);
+    eprintln!(
+        "a link over its cap: peak {:.2} MiB",
+        peak as f64 / MIB as f64
+    );
     assert!(
         peak <= 2 * cap + MIB,
         "a link over its {} MiB cap: peak {} MiB",

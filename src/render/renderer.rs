@@ -44,6 +44,8 @@ pub struct VolumeRenderer {
     /// The marched slices' pass and its group 0, while the renderer marches the slices
     /// instead of rasterising them (see [`VolumeRenderer::set_marching`]).
     march: Option<(MarchPass, Option<wgpu::BindGroup>)>,
+    /// The media probe's pipeline, created at its first use (tests only use it).
+    probe: Option<super::probe::ProbePass>,
 }
 
 /// The light volume on the GPU. Each z-slice is rendered into `slice` (2D) and copied into
@@ -106,6 +108,7 @@ impl VolumeRenderer {
             light_placeholder: placeholder,
             light_bind_group: None,
             march: None,
+            probe: None,
         }
     }
 
@@ -241,7 +244,10 @@ impl VolumeRenderer {
         let offset = self
             .slices
             .write(queue, &VolumeUniforms::new(view, &volume, 1, 0..1, None));
-        let pass = super::probe::ProbePass::new(device);
+        if self.probe.is_none() {
+            self.probe = Some(super::probe::ProbePass::new(device));
+        }
+        let pass = self.probe.as_ref()?;
         let entries = self.volume_entries()?;
         let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("media probe: volume"),

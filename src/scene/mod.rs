@@ -118,24 +118,28 @@ impl Scene {
     /// itself, its unknown members skipped and its lists stopped at their caps, so memory stays
     /// a small multiple of the text.
     pub fn from_json(text: &str) -> Result<(Self, Vec<String>), SceneError> {
-        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-        let outline: capped::Outline = serde_json::from_str(text)?;
-        check_version(outline.version)?;
-        let mut scene: Scene = serde_json::from_str(text)?;
-        scene.version = SCENE_VERSION;
-        let repairs = scene.validate()?;
-        Ok((scene, repairs))
+        Self::parse(text, false)
     }
 
     /// Like [`Scene::from_json`] for a file: a JSON object without any of a scene's members
     /// (`{}`, a stroke file) holds no scene, and says so instead of opening the default one.
     pub fn from_file_json(text: &str) -> Result<(Self, Vec<String>), SceneError> {
-        let stripped = text.strip_prefix('\u{feff}').unwrap_or(text);
-        let outline: capped::Outline = serde_json::from_str(stripped)?;
-        if outline.members == 0 {
+        Self::parse(text, true)
+    }
+
+    /// [`Scene::from_json`], refusing with `needs_members` a document that has none of a
+    /// scene's members. The outline is read once.
+    fn parse(text: &str, needs_members: bool) -> Result<(Self, Vec<String>), SceneError> {
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+        let outline: capped::Outline = serde_json::from_str(text)?;
+        if needs_members && outline.members == 0 {
             return Err(SceneError::NoScene);
         }
-        Self::from_json(text)
+        check_version(outline.version)?;
+        let mut scene: Scene = serde_json::from_str(text)?;
+        scene.version = SCENE_VERSION;
+        let repairs = scene.validate()?;
+        Ok((scene, repairs))
     }
 
     /// Like [`Scene::from_json`] for an already parsed value.
