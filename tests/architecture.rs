@@ -133,7 +133,7 @@ fn every_file_is_written_through_the_one_safe_writer() {
 }
 
 /// The modules of `src/ui/` each file names (`super::x`, `crate::ui::x`, `super::{x, …}`),
-/// outside its unit tests; `panels/` counts as one module.
+/// outside its unit tests; a folder (`panels/`, `tools/`) counts as one module.
 fn ui_imports() -> std::collections::BTreeMap<String, std::collections::BTreeSet<String>> {
     let mut graph = std::collections::BTreeMap::new();
     let modules: Vec<(String, String)> = sources()
@@ -149,6 +149,12 @@ fn ui_imports() -> std::collections::BTreeMap<String, std::collections::BTreeSet
         .collect();
     let names: std::collections::BTreeSet<String> =
         modules.iter().map(|(n, _)| n.clone()).collect();
+    // Folders: inside one, `super::` is the folder's own module.
+    let modules_in_dirs: std::collections::BTreeSet<String> = sources()
+        .iter()
+        .filter_map(|(path, _)| path.strip_prefix("src/ui/")?.split_once('/'))
+        .map(|(dir, _)| dir.to_owned())
+        .collect();
     for (name, code) in &modules {
         let entry: &mut std::collections::BTreeSet<String> = graph.entry(name.clone()).or_default();
         for other in &names {
@@ -162,13 +168,13 @@ fn ui_imports() -> std::collections::BTreeMap<String, std::collections::BTreeSet
                 format!(", {other}::"),
                 format!("super::{other};"),
             ];
-            // In `panels/`, `super::` is the panels module itself: only `crate::ui::` names
+            // In a folder, `super::` is the folder's module itself: only `crate::ui::` names
             // another ui module.
-            let from_panels = name == "panels";
+            let in_folder = modules_in_dirs.contains(name);
             if named
                 .iter()
                 .enumerate()
-                .any(|(i, pat)| (!from_panels || i == 1) && code.contains(pat.as_str()))
+                .any(|(i, pat)| (!in_folder || i == 1) && code.contains(pat.as_str()))
             {
                 entry.insert(other.clone());
             }

@@ -11,7 +11,7 @@ use super::panels::{
 use super::scene_files::SceneFiles;
 use super::selection::Selection;
 use super::shortcuts::Shortcut;
-use super::sketch_tool::{SketchTool, ToolContext};
+use super::tools::{ToolContext, Toolbox};
 use super::transform::Axis;
 use super::viewport::{Viewport, ViewportContext};
 use crate::derive::Derived;
@@ -103,7 +103,7 @@ pub struct CloudApp {
     doc: Document,
     derived: Derived,
     viewport: Viewport,
-    tool: SketchTool,
+    tool: Toolbox,
     selection: Selection,
     notices: Notices,
     guide: Guide,
@@ -162,7 +162,7 @@ impl CloudApp {
                 },
                 reports,
             ),
-            tool: SketchTool::default(),
+            tool: Toolbox::default(),
             selection: Selection::default(),
             notices,
             guide: Guide::default(),
@@ -462,6 +462,10 @@ impl CloudApp {
                 }),
             },
             "axis_lock": self.tool.axis_lock.map(|a| a.name()),
+            "modal": self.tool.modal_state().map(|(kind, axis, typed)| serde_json::json!({
+                "kind": kind.name(), "axis": axis.map(|a| a.name()), "typed": typed,
+            })),
+            "behind": self.tool.behind(),
             "playing": self.panels.clock.playing,
             "guides_hidden": self.tool.hide_guides,
             "skeleton_shown": self.tool.show_skeleton,
@@ -534,7 +538,7 @@ impl eframe::App for CloudApp {
     fn ui(&mut self, ui: &mut egui::Ui, frame: &mut eframe::Frame) {
         self.cpu_seconds = frame.info().cpu_usage;
         let ctx = ui.ctx().clone();
-        let pressed = super::shortcuts::take(&ctx);
+        let pressed = super::shortcuts::take(&ctx, self.tool.modal_active());
         self.shortcuts(&ctx, &pressed.before_pointer);
         if self
             .panels
@@ -611,7 +615,8 @@ impl eframe::App for CloudApp {
         });
         // Keys pressed after a pointer button in this frame act once the view has taken it.
         self.shortcuts(&ctx, &pressed.after_pointer);
-        if !ctx.input(|i| i.pointer.any_down()) {
+        // A modal transform's edits fold into one step until it is confirmed.
+        if !ctx.input(|i| i.pointer.any_down()) && !self.tool.modal_active() {
             self.doc.end_merge();
         }
         self.autosave(&ctx);
@@ -709,6 +714,71 @@ mod tests {
         frame(&ctx, &mut app, &[z, z, s]);
         assert!(app.doc.scene().ellipsoids.is_empty(), "both edits undone");
         assert!(saved(&file).ellipsoids.is_empty());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// Runs one frame of the real app with these raw events.
+    fn frame_events(ctx: &egui::Context, app: &mut CloudApp, events: Vec<Event>) {
+        let raw = RawInput {
+            screen_rect: Some(crate::ui::test_view()),
+            events,
+            ..Default::default()
+        };
+        let mut eframe_frame = eframe::Frame::_new_kittest();
+        let mut output = ctx.run_ui(raw, |ui| eframe::App::ui(app, ui, &mut eframe_frame));
+        output.textures_delta.clear();
+    }
+
+    fn press(key: Key) -> Event {
+        Event::Key {
+            key,
+            physical_key: None,
+            pressed: true,
+            repeat: false,
+            modifiers: Modifiers::NONE,
+        }
+    }
+
+    #[test]
+    fn modal_grab_with_a_lock_and_a_typed_distance_then_esc_puts_it_back_exactly() {
+        let dir = std::env::temp_dir().join(format!("cloudsketch-modal-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let ctx = egui::Context::default();
+        let mut app = app_with_two_edits(&ctx, &dir.join("modal.json"));
+        app.selection.set(super::super::selection::Item::Ellipsoid(0));
+        let before = app.doc.scene().ellipsoids.clone();
+        let undo = app.doc.undo_len();
+        let at = |x: f32, y: f32| Event::PointerMoved(egui::pos2(x, y));
+        frame_events(&ctx, &mut app, vec![at(900.0, 400.0)]);
+        // G, the mouse moving, X, "2", the mouse again, Enter: all in two frames.
+        frame_events(
+            &ctx,
+            &mut app,
+            vec![press(Key::G), at(940.0, 420.0), at(980.0, 380.0)],
+        );
+        assert!(app.tool.modal_active());
+        assert_ne!(app.doc.scene().ellipsoids, before, "the grab follows the mouse");
+        frame_events(
+            &ctx,
+            &mut app,
+            vec![press(Key::X), press(Key::Num2), at(1000.0, 300.0), press(Key::Enter)],
+        );
+        assert!(!app.tool.modal_active(), "Enter confirms");
+        let moved = &app.doc.scene().ellipsoids;
+        assert_eq!(moved[0].center, before[0].center + glam::Vec3::new(2.0, 0.0, 0.0));
+        assert_eq!(moved[1..], before[1..], "only the selection moves");
+        frame_events(&ctx, &mut app, vec![]);
+        assert_eq!(app.doc.undo_len(), undo + 1, "one undo step");
+
+        // G, a move, Esc: back exactly, no new step; then Ctrl+Z undoes the confirmed grab.
+        let confirmed = app.doc.scene().ellipsoids.clone();
+        frame_events(&ctx, &mut app, vec![press(Key::G), at(700.0, 600.0)]);
+        frame_events(&ctx, &mut app, vec![at(650.0, 640.0), press(Key::Escape)]);
+        assert!(!app.tool.modal_active());
+        assert_eq!(app.doc.scene().ellipsoids, confirmed);
+        assert_eq!(app.doc.undo_len(), undo + 1);
+        frame(&ctx, &mut app, &[(Modifiers::COMMAND, Key::Z)]);
+        assert_eq!(app.doc.scene().ellipsoids, before);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

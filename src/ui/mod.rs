@@ -6,7 +6,8 @@
 //! - `autosave`: when the document is written to the platform's store, and what a session
 //!   starts with;
 //! - `viewport`: the 3D view (progressive quality, camera input, status line);
-//! - `sketch_tool`: the Sketch, Cut, Ellipsoid, Move and Rotate tools and their overlay;
+//! - `tools`: one struct per viewport tool behind one trait (Navigate, Sketch, Cut,
+//!   Ellipsoid, Move, Rotate, Scale), box selection, Blender's modal G/R/S and the overlay;
 //! - `tool`: which tool the primary drag serves; `transform`: the world axes a drag locks to,
 //!   what Move, Rotate and Scale drags do, the axes of a new drawing plane; `projection`: the
 //!   view's maths between screen and world (shared by the tools, the gizmo and picking);
@@ -42,9 +43,9 @@ mod projection;
 mod scene_files;
 mod selection;
 mod shortcuts;
-mod sketch_tool;
 mod sun_handle;
 mod tool;
+mod tools;
 mod transform;
 mod viewport;
 mod widgets;

@@ -10,7 +10,7 @@
 
 use egui::{Event, Key, Modifiers};
 
-use super::tool::Tool;
+use super::tool::{ModalKind, Tool};
 use super::transform::Axis;
 use crate::scene::StandardView;
 
@@ -41,8 +41,16 @@ pub enum Shortcut {
     View(StandardView),
     /// 5: orthographic on or off.
     Orthographic,
-    /// V, D, C, E, G, R, S: pick a tool.
+    /// V, D, C, E, Shift+G, Shift+R, Shift+S: pick a tool.
     Tool(Tool),
+    /// G, R, S: a modal grab, rotate or scale of the selection.
+    Modal(ModalKind),
+    /// A digit, a point or a minus typed during a modal transform.
+    Typed(char),
+    /// Backspace during a modal transform: the last typed character goes.
+    Erase,
+    /// Enter during a modal transform: confirm it.
+    Confirm,
     /// Ctrl+D: duplicate the selection.
     Duplicate,
     /// Shift+H: hide the selected item.
@@ -61,7 +69,8 @@ pub enum Shortcut {
     Delete,
     /// B: the next drag draws a selection box.
     BoxSelect,
-    /// X, Y, Z: lock the Move, Rotate or Scale tool to that axis (again: free).
+    /// X, Y, Z: lock the Move, Rotate or Scale tool, or the modal transform, to that axis
+    /// (again: free).
     Lock(Axis),
 }
 
@@ -98,9 +107,12 @@ const TABLE: &[(Modifiers, Key, Shortcut)] = {
         (NONE, Key::D, S::Tool(Tool::Sketch)),
         (NONE, Key::C, S::Tool(Tool::Cut)),
         (NONE, Key::E, S::Tool(Tool::Ellipsoid)),
-        (NONE, Key::G, S::Tool(Tool::Move)),
-        (NONE, Key::R, S::Tool(Tool::Rotate)),
-        (NONE, Key::S, S::Tool(Tool::Scale)),
+        (Modifiers::SHIFT, Key::G, S::Tool(Tool::Move)),
+        (Modifiers::SHIFT, Key::R, S::Tool(Tool::Rotate)),
+        (Modifiers::SHIFT, Key::S, S::Tool(Tool::Scale)),
+        (NONE, Key::G, S::Modal(ModalKind::Grab)),
+        (NONE, Key::R, S::Modal(ModalKind::Rotate)),
+        (NONE, Key::S, S::Modal(ModalKind::Scale)),
         (NONE, Key::H, S::ToggleGuides),
         (NONE, Key::K, S::ToggleSkeleton),
         (NONE, Key::Q, S::ToggleBehind),
@@ -113,8 +125,38 @@ const TABLE: &[(Modifiers, Key, Shortcut)] = {
     ]
 };
 
-/// The shortcut a key press with these modifiers asks for, if any.
-pub fn lookup(key: Key, modifiers: Modifiers) -> Option<Shortcut> {
+/// What a key types during a modal transform: digits, a point, a minus, Backspace and Enter
+/// (the number row's and the keypad's alike: egui names both the same).
+fn modal_key(key: Key) -> Option<Shortcut> {
+    let digit = match key {
+        Key::Num0 => '0',
+        Key::Num1 => '1',
+        Key::Num2 => '2',
+        Key::Num3 => '3',
+        Key::Num4 => '4',
+        Key::Num5 => '5',
+        Key::Num6 => '6',
+        Key::Num7 => '7',
+        Key::Num8 => '8',
+        Key::Num9 => '9',
+        Key::Period | Key::Comma => '.',
+        Key::Minus => '-',
+        Key::Backspace => return Some(Shortcut::Erase),
+        Key::Enter => return Some(Shortcut::Confirm),
+        _ => return None,
+    };
+    Some(Shortcut::Typed(digit))
+}
+
+/// The shortcut a key press with these modifiers asks for, if any; during a modal transform
+/// (`modal`) digits, the point, the minus, Backspace and Enter are its.
+pub fn lookup(key: Key, modifiers: Modifiers, modal: bool) -> Option<Shortcut> {
+    if modal
+        && modifiers.is_none()
+        && let Some(s) = modal_key(key)
+    {
+        return Some(s);
+    }
     TABLE
         .iter()
         .find(|(m, k, _)| *k == key && modifiers.matches_logically(*m))
@@ -132,8 +174,8 @@ pub struct Pressed {
 
 /// Takes the frame's shortcut presses (key repeats included, as egui's `consume_key`) out of
 /// its events, in order, leaving every other event. Nothing is taken while a text field has
-/// the keyboard.
-pub fn take(ctx: &egui::Context) -> Pressed {
+/// the keyboard. During a modal transform (`modal`) the keys that type a number are its.
+pub fn take(ctx: &egui::Context, modal: bool) -> Pressed {
     let mut pressed = Pressed::default();
     if ctx.egui_wants_keyboard_input() {
         return pressed;
@@ -150,7 +192,7 @@ pub fn take(ctx: &egui::Context) -> Pressed {
                 modifiers,
                 pressed: true,
                 ..
-            } => match lookup(*key, *modifiers) {
+            } => match lookup(*key, *modifiers, modal) {
                 Some(s) => {
                     if pointer_seen {
                         pressed.after_pointer.push(s);
@@ -189,7 +231,7 @@ mod tests {
             events,
             ..Default::default()
         };
-        let mut output = ctx.run_ui(raw, |ui| out = take(ui.ctx()));
+        let mut output = ctx.run_ui(raw, |ui| out = take(ui.ctx(), false));
         // No painter here: the font atlas's first upload is dropped on purpose.
         output.textures_delta.clear();
         out
@@ -214,12 +256,50 @@ mod tests {
             taken(vec![z.clone(), z.clone()]).before_pointer,
             [Undo, Undo]
         );
-        // The most specific pattern wins: Ctrl+Shift+Z redoes, Shift+H hides, plain S scales.
+        // The most specific pattern wins: Ctrl+Shift+Z redoes, Shift+H hides, Shift+S picks
+        // the Scale tool, plain S scales modally.
         let shift_z = key(Key::Z, Modifiers::COMMAND | Modifiers::SHIFT);
         let shift_h = key(Key::H, Modifiers::SHIFT);
+        let shift_s = key(Key::S, Modifiers::SHIFT);
         assert_eq!(
-            taken(vec![shift_z, shift_h, key(Key::S, Modifiers::NONE)]).before_pointer,
-            [Redo, HideSelected, Tool(super::Tool::Scale)]
+            taken(vec![
+                shift_z,
+                shift_h,
+                shift_s,
+                key(Key::S, Modifiers::NONE)
+            ])
+            .before_pointer,
+            [
+                Redo,
+                HideSelected,
+                Tool(super::Tool::Scale),
+                Modal(ModalKind::Scale)
+            ]
+        );
+    }
+
+    #[test]
+    fn during_a_modal_transform_digits_type_and_enter_confirms() {
+        assert_eq!(
+            lookup(Key::Num1, Modifiers::NONE, false),
+            Some(Shortcut::View(StandardView::Front))
+        );
+        assert_eq!(
+            lookup(Key::Num1, Modifiers::NONE, true),
+            Some(Shortcut::Typed('1'))
+        );
+        assert_eq!(
+            lookup(Key::Minus, Modifiers::NONE, true),
+            Some(Shortcut::Typed('-'))
+        );
+        assert_eq!(
+            lookup(Key::Enter, Modifiers::NONE, true),
+            Some(Shortcut::Confirm)
+        );
+        assert_eq!(lookup(Key::Enter, Modifiers::NONE, false), None);
+        assert_eq!(
+            lookup(Key::X, Modifiers::NONE, true),
+            Some(Shortcut::Lock(Axis::X))
         );
     }
 

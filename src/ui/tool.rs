@@ -1,4 +1,5 @@
-//! Which tool the viewport's primary drag serves (its key, its name in the page state).
+//! Which tool the viewport's primary drag serves (its key, its name in the page state), and
+//! which modal transform G, R or S started.
 
 /// What a primary drag in the viewport does.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -33,6 +34,37 @@ impl Tool {
             Tool::Move => "move",
             Tool::Rotate => "rotate",
             Tool::Scale => "scale",
+        }
+    }
+}
+
+/// Which modal transform.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ModalKind {
+    /// G: move.
+    Grab,
+    /// R: turn.
+    Rotate,
+    /// S: scale.
+    Scale,
+}
+
+impl ModalKind {
+    /// Its name in the page state.
+    pub fn name(self) -> &'static str {
+        match self {
+            ModalKind::Grab => "grab",
+            ModalKind::Rotate => "rotate",
+            ModalKind::Scale => "scale",
+        }
+    }
+
+    /// What it does to the selection, as a noun ("Cancelled: the move …").
+    pub fn verb(self) -> &'static str {
+        match self {
+            ModalKind::Grab => "the move is",
+            ModalKind::Rotate => "the turn is",
+            ModalKind::Scale => "the scale is",
         }
     }
 }

@@ -7,7 +7,7 @@ use super::guide::Guide;
 use super::notice::Notices;
 use super::panels::{GeometryUpdate, ViewStats};
 use super::selection::Selection;
-use super::sketch_tool::{SketchTool, ToolContext, ViewInput};
+use super::tools::{ToolContext, Toolbox, ViewInput};
 use crate::derive::Derived;
 use crate::render::SliceJob;
 use crate::render::View;
@@ -68,7 +68,7 @@ pub struct ViewportContext<'a> {
     /// Document, derivation cache, selection and messages.
     pub cx: ToolContext<'a>,
     /// The sketch tools.
-    pub tool: &'a mut SketchTool,
+    pub tool: &'a mut Toolbox,
     /// The reference image's view.
     pub guide: &'a mut Guide,
 }

@@ -67,7 +67,7 @@ for (const backend of ['webgpu', 'webgl2']) {
       const camera = JSON.stringify(s.scene.camera);
       const undo = s.view.undo;
       const x0 = s.scene.ellipsoids[0].center[0];
-      await page.keyboard.press('g');
+      await page.keyboard.press('Shift+G');
       await until(page, (s) => s.view.tool === 'move', 'move tool');
       await page.mouse.move(vw * 0.4, vh * 0.5);
       await page.mouse.down();
@@ -92,7 +92,7 @@ for (const backend of ['webgpu', 'webgl2']) {
       assert.ok(back < 0.02 * away, `after undo the image is as placed: ${back} px differ (${away} when moved)`);
       // Scale: a drag right grows it, and the cloud with it.
       const r0 = s.scene.ellipsoids[0].radii[0];
-      await page.keyboard.press('s');
+      await page.keyboard.press('Shift+S');
       await until(page, (s) => s.view.tool === 'scale', 'scale tool');
       await waitForFullQuality(page);
       const before = cloud(await screenshot(page, `ellipsoid-3-before-scale-${backend}`), view, bg);
@@ -123,7 +123,7 @@ for (const backend of ['webgpu', 'webgl2']) {
       const [vw, vh] = view;
       const bg = toBytes(s.scene.light.background);
       s = await addEllipsoids(page, [[0.4, 0.5]]);
-      await page.keyboard.press('g');
+      await page.keyboard.press('Shift+G');
       s = await until(page, (s) => s.view.gizmo?.x, 'the move gizmo with an x arrow');
       const camera = JSON.stringify(s.scene.camera);
       const c0 = s.scene.ellipsoids[0].center;
@@ -209,7 +209,7 @@ for (const backend of ['webgpu', 'webgl2']) {
       const [vw, vh] = s.view.viewport;
       s = await addEllipsoids(page, [[0.3, 0.5], [0.6, 0.5]]);
       const before = s.scene.ellipsoids.map((e) => e.center);
-      await page.keyboard.press('g');
+      await page.keyboard.press('Shift+G');
       await page.keyboard.press('Escape'); // nothing selected: a drag now draws a box
       await until(page, (s) => s.view.selected_ellipsoids.length === 0, 'nothing selected');
       await page.mouse.move(vw * 0.15, vh * 0.3);

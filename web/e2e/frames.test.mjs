@@ -105,7 +105,7 @@ for (const backend of ['webgpu', 'webgl2']) {
         }
         await page.keyboard.press('v');
         await measure('strokes10_orbit', vw * 0.5, vh * 0.5, -200, 30);
-        await page.keyboard.press('g');
+        await page.keyboard.press('Shift+G');
         s = await until(page, (s) => s.view.tool === 'move' && s.view.selected_plane != null, 'move tool with a selection');
         await measure('strokes10_plane_move', vw * 0.5, vh * 0.5, 120, -40);
         s = await state(page);

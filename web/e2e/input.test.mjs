@@ -84,14 +84,14 @@ for (const backend of ['webgpu', 'webgl2']) {
       const undo = s.view.undo;
       await page.mouse.move(vw * 0.5, vh * 0.2);
       for (const key of ['Tab', 'Tab', 'Space', 'Enter', 'Tab', 'Space']) await page.keyboard.press(key);
-      await page.keyboard.press('g');
+      await page.keyboard.press('Shift+G');
       s = await until(page, (s) => s.view.tool === 'move', 'G after Tab and Space');
       assert.equal(s.scene.planes.length, 2, 'Space pressed no Undo');
       assert.equal(s.view.undo, undo);
 
       // The side panel keeps its width while values grow (rotating the selected plane
       // rewrites its angle fields), and N hides and shows it.
-      await page.keyboard.press('r');
+      await page.keyboard.press('Shift+R');
       await until(page, (s) => s.view.tool === 'rotate', 'rotate tool');
       const rot0 = JSON.stringify(s.scene.planes[1].rotation);
       await page.mouse.move(vw * 0.7, vh * 0.5);

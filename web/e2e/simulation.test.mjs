@@ -77,7 +77,7 @@ for (const backend of ['webgpu', 'webgl2']) {
       const button = await reveal(page, 'ellipsoid:1');
       await page.mouse.click(button[0] + button[2] / 2, button[1] + button[3] / 2);
       await page.mouse.move(5, vh - 5);
-      await page.keyboard.press('g');
+      await page.keyboard.press('Shift+G');
       s = await until(page, (s) => s.view.gizmo?.x, 'the move gizmo on the first parcel');
       const c0p = s.scene.ellipsoids[0].center;
       const { center, x: xEnd } = s.view.gizmo;

@@ -109,7 +109,7 @@ test('draw an outline, then cut its base', { timeout: 300_000 }, async () => {
       await page.keyboard.press('Control+z');
       s = await until(page, (s) => s.scene.planes.length === 1, 'undo of the cut');
       // Move tool: click the cloud to select its plane, drag it right; one undo step.
-      await page.keyboard.press('g');
+      await page.keyboard.press('Shift+G');
       await until(page, (s) => s.view.tool === 'move', 'move tool');
       await page.mouse.click(cx, base - h * 0.4);
       s = await until(page, (s) => s.view.selected_plane === 0, 'the plane selected by a click');
@@ -121,7 +121,7 @@ test('draw an outline, then cut its base', { timeout: 300_000 }, async () => {
       await until(page, (s) => Math.abs(s.scene.planes[0].origin[0] - before.x) < 1e-6, 'move undone');
 
       // Rotate tool: a sideways drag turns the selected plane; duplicate and delete by shortcut.
-      await page.keyboard.press('r');
+      await page.keyboard.press('Shift+R');
       await until(page, (s) => s.view.tool === 'rotate', 'rotate tool');
       const rot0 = JSON.stringify(s.scene.planes[0].rotation);
       await stroke(page, Array.from({ length: 8 }, (_, i) => [cx + i * 10, base - h * 0.4]));

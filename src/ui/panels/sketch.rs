@@ -7,8 +7,8 @@ use crate::limits;
 use crate::scene::{Document, Edit, StrokeKind};
 use crate::ui::notice::Notices;
 use crate::ui::selection::{Item, Selection, delete, duplicate};
-use crate::ui::sketch_tool::SketchTool;
 use crate::ui::tool::Tool;
+use crate::ui::tools::Toolbox;
 use crate::ui::widgets::{param, rotation_fields, vec3_fields};
 
 /// The Sketch group.
@@ -22,7 +22,7 @@ impl SketchPanel {
         ui: &mut Ui,
         doc: &mut Document,
         derived: &Derived,
-        tool: &mut SketchTool,
+        tool: &mut Toolbox,
         selection: &mut Selection,
         notices: &mut Notices,
     ) {
@@ -44,17 +44,17 @@ impl SketchPanel {
                         (
                             Tool::Move,
                             "⬌ Move",
-                            "G: drag moves the selected drawing plane or ellipsoid across the view (Shift: toward or away)",
+                            "Shift+G: drag moves the selected drawing plane or ellipsoid across the view (Shift: toward or away), or along an arrow. G alone grabs the selection without the tool (X/Y/Z lock, type a distance, Enter or a click confirms, Esc cancels)",
                         ),
                         (
                             Tool::Scale,
                             "Scale",
-                            "S: drag right or up grows the selected ellipsoid; X, Y or Z scales one axis, Ctrl snaps to tenths",
+                            "Shift+S: drag right or up grows the selected ellipsoid; X, Y or Z scales one axis, Ctrl snaps to tenths. S alone scales the selection without the tool",
                         ),
                         (
                             Tool::Rotate,
                             "⟳ Rotate",
-                            "R: drag turns the selected drawing plane or ellipsoid; X, Y or Z locks the axis, Ctrl snaps to 15°",
+                            "Shift+R: drag turns the selected drawing plane or ellipsoid; X, Y or Z locks the axis, Ctrl snaps to 15°. R alone rotates the selection without the tool",
                         ),
                     ] {
                         ui.selectable_value(&mut tool.tool, t, label)
@@ -68,7 +68,7 @@ impl SketchPanel {
                 ui.checkbox(&mut tool.show_skeleton, "skeleton")
                     .on_hover_text("K: the selected outline's skeleton and spheres");
             });
-            ui.checkbox(&mut tool.behind, "behind the cloud").on_hover_text(
+            ui.checkbox(&mut tool.sketch.behind, "behind the cloud").on_hover_text(
                     "Q: a new outline drawn over the cloud lands on its far side (off: its near side, so it goes in front)",
                 );
             let planes = &doc.scene().planes;

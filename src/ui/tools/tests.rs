@@ -1,0 +1,140 @@
+//! The tools driven through egui as the window drives them: strokes over frames, outlines in
+//! front of and behind the cloud, upright planes, and the modal G with typed numbers.
+
+use glam::Vec3;
+
+use super::*;
+use crate::ui::transform::drawing_axes;
+
+/// A stroke through egui as the window gets it: the pointer over the view, then pressed at
+/// the right of a circle, 60 moves around it and the release, those events split over
+/// `frames` frames 0.15 s apart (a slow adapter's), then two idle frames. Returns each drawing plane's
+/// point count.
+fn stroke_over_frames(frames: usize) -> Vec<usize> {
+    let tool = Toolbox {
+        tool: Tool::Sketch,
+        ..Default::default()
+    };
+    let doc = Document::new(crate::scene::Scene::preset(crate::scene::Preset::Empty));
+    let (doc, _) = draw_circle(doc, tool, frames, 120.0);
+    doc.scene().planes.iter().map(|p| p.points.len()).collect()
+}
+
+/// Draws a circle of `radius` points about the view's centre with `tool` over `doc`, its
+/// events split over `frames` frames; returns the document and the tool.
+fn draw_circle(
+    mut doc: Document,
+    mut tool: Toolbox,
+    frames: usize,
+    radius: f32,
+) -> (Document, Toolbox) {
+    use egui::{Event, Modifiers, PointerButton, RawInput, Sense, pos2};
+    let rect = crate::ui::test_view();
+    let at = |i: usize| {
+        let a = i as f32 / 60.0 * std::f32::consts::TAU;
+        pos2(640.0 + radius * a.cos(), 400.0 + radius * a.sin())
+    };
+    let button = |pressed| Event::PointerButton {
+        pos: at(60),
+        button: PointerButton::Primary,
+        pressed,
+        modifiers: Modifiers::NONE,
+    };
+    let mut events = vec![button(true)];
+    events.extend((1..=60).map(|i| Event::PointerMoved(at(i))));
+    events.push(button(false));
+    let per_frame = events.len().div_ceil(frames);
+    // A frame with the pointer over the view first (egui hit-tests against the last frame).
+    let mut chunks = vec![vec![Event::PointerMoved(at(0))]];
+    chunks.extend(events.chunks(per_frame).map(<[_]>::to_vec));
+    chunks.extend([Vec::new(), Vec::new()]);
+
+    let ctx = egui::Context::default();
+    let (mut derived, mut selection, mut notices) = Default::default();
+    for (frame, events) in chunks.into_iter().enumerate() {
+        let raw = RawInput {
+            screen_rect: Some(rect),
+            time: Some(frame as f64 * 0.15),
+            events,
+            ..Default::default()
+        };
+        let mut output = ctx.run_ui(raw, |ui| {
+            let response = ui.allocate_rect(rect, Sense::click_and_drag());
+            let view = ViewInput {
+                ui,
+                response: &response,
+                rect,
+            };
+            let mut tc = ToolContext {
+                doc: &mut doc,
+                derived: &mut derived,
+                selection: &mut selection,
+                notices: &mut notices,
+            };
+            tool.input(&view, &mut tc);
+        });
+        // No painter here: the font atlas's first upload is dropped on purpose.
+        output.textures_delta.clear();
+    }
+    (doc, tool)
+}
+
+/// The depth along the view of the plane a small outline drawn over the default cumulus's
+/// middle lands on, in front or behind.
+fn outline_depth(behind: bool) -> f32 {
+    let scene = crate::scene::Scene::default();
+    let camera = scene.camera.clone();
+    let mut tool = Toolbox {
+        tool: Tool::Sketch,
+        ..Default::default()
+    };
+    tool.sketch.behind = behind;
+    let (doc, _) = draw_circle(Document::new(scene), tool, 5, 40.0);
+    let plane = doc.scene().planes.last().expect("a plane").clone();
+    (plane.origin - camera.eye()).dot(camera.forward())
+}
+
+#[test]
+fn an_outline_over_the_cloud_lands_in_front_or_behind_it() {
+    let target = {
+        let c = crate::scene::Scene::default().camera;
+        (c.target - c.eye()).dot(c.forward())
+    };
+    let (front, back) = (outline_depth(false), outline_depth(true));
+    // In front: nearer than the focus point (the cloud's near side); behind: beyond it.
+    assert!(front < target - 0.5, "front {front} vs focus {target}");
+    assert!(back > target + 0.5, "behind {back} vs focus {target}");
+}
+
+#[test]
+fn a_view_near_level_draws_on_vertical_planes() {
+    let mut camera = crate::scene::Scene::default().camera;
+    assert!((camera.pitch_deg - 8.0).abs() < 1e-3, "the default view");
+    let (_, up, normal) = drawing_axes(&camera);
+    assert_eq!(up, Vec3::Y);
+    assert!(normal.y.abs() < 1e-6, "{normal}");
+    // The plane of an outline drawn in the default view stands upright.
+    let doc = Document::new(crate::scene::Scene::preset(crate::scene::Preset::Empty));
+    let tool = Toolbox {
+        tool: Tool::Sketch,
+        ..Default::default()
+    };
+    let (doc, _) = draw_circle(doc, tool, 3, 120.0);
+    let plane_up = doc.scene().planes[0].rotation * Vec3::Y;
+    assert!(plane_up.abs_diff_eq(Vec3::Y, 1e-5), "{plane_up}");
+    // Looking down steeply, the plane faces the view.
+    camera.pitch_deg = 40.0;
+    let (_, up, normal) = drawing_axes(&camera);
+    assert!(up.abs_diff_eq(camera.up(), 1e-6));
+    assert!(normal.abs_diff_eq(-camera.forward(), 1e-6));
+}
+
+#[test]
+fn a_stroke_keeps_every_sample_however_its_events_fall_into_frames() {
+    // 61 samples (the press and 60 moves), all kept: within one frame and over two egui
+    // sees no drag (the press record draws it), over more the drag starts a frame after
+    // the press (and begins with every sample since it).
+    for frames in [1, 2, 3, 5, 31, 63] {
+        assert_eq!(stroke_over_frames(frames), [61], "over {frames} frames");
+    }
+}
