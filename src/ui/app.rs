@@ -517,14 +517,12 @@ impl eframe::App for CloudApp {
                     m.surrender_focus(id);
                 }
             });
-            raw.events.retain(|e| {
-                !matches!(
-                    e,
-                    Event::Key {
-                        key: Key::Space | Key::Enter,
-                        ..
-                    }
-                )
+            // During a modal G, R or S, Enter confirms it.
+            let modal = self.tool.modal_active();
+            raw.events.retain(|e| match e {
+                Event::Key { key: Key::Space, .. } => false,
+                Event::Key { key: Key::Enter, .. } => modal,
+                _ => true,
             });
         }
     }
@@ -717,13 +715,15 @@ mod tests {
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
-    /// Runs one frame of the real app with these raw events.
+    /// Runs one frame of the real app with these raw events, through its input hook as eframe
+    /// runs it.
     fn frame_events(ctx: &egui::Context, app: &mut CloudApp, events: Vec<Event>) {
-        let raw = RawInput {
+        let mut raw = RawInput {
             screen_rect: Some(crate::ui::test_view()),
             events,
             ..Default::default()
         };
+        eframe::App::raw_input_hook(app, ctx, &mut raw);
         let mut eframe_frame = eframe::Frame::_new_kittest();
         let mut output = ctx.run_ui(raw, |ui| eframe::App::ui(app, ui, &mut eframe_frame));
         output.textures_delta.clear();

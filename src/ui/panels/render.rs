@@ -65,7 +65,7 @@ fn filter_combo(ui: &mut Ui, id: &str, filter: &mut NoiseFilter) {
 fn tiers(ui: &mut Ui, r: &mut RenderSettings) {
     // Its id does not follow its label: adding a tier changes the count it shows, and a new
     // id would close the group under the pointer.
-    egui::CollapsingHeader::new(format!("Tiers ({})", r.tiers.len()))
+    let shown = egui::CollapsingHeader::new(format!("Tiers ({})", r.tiers.len()))
         .id_salt("tiers")
         .default_open(false)
         .show(ui, |ui| {
@@ -88,14 +88,15 @@ fn tiers(ui: &mut Ui, r: &mut RenderSettings) {
             if let Some(k) = remove {
                 r.tiers.remove(k);
             }
-            if r.tiers.len() < limits::MAX_TIERS
-                && ui
-                    .button("Add a tier")
-                    .on_hover_text(
-                        "Higher air with its own noise: wisps above a billowing base, faster wind aloft",
-                    )
-                    .clicked()
-            {
+            let add = (r.tiers.len() < limits::MAX_TIERS).then(|| {
+                ui.button("Add a tier").on_hover_text(
+                    "Higher air with its own noise: wisps above a billowing base, faster wind aloft",
+                )
+            });
+            if let Some(add) = &add {
+                crate::ui::widgets::mark(ui, "button:Add a tier", add.rect);
+            }
+            if add.is_some_and(|a| a.clicked()) {
                 let floor = r.tiers.last().map_or(limits::TIER_FLOOR.default as f32, |t| t.floor + 4.0);
                 r.tiers.push(Tier {
                     floor,
@@ -108,4 +109,5 @@ fn tiers(ui: &mut Ui, r: &mut RenderSettings) {
                 r.tiers[k].floor = r.tiers[k].floor.max(r.tiers[k - 1].floor);
             }
         });
+    crate::ui::widgets::mark(ui, "group:Tiers", shown.header_response.rect);
 }
