@@ -1294,3 +1294,77 @@ fn marched_slices_give_the_rasterised_slices_image() {
     // Both paths ran: they round differently somewhere.
     assert!(!identical, "marching changed no pixel of any image");
 }
+
+/// Means of `image`'s 8×8 blocks (red, green, blue): what the eye sees of the shafts' light
+/// once their fine grain is averaged.
+fn block_means(image: &Image) -> Vec<[f64; 3]> {
+    let mut out = Vec::new();
+    for by in 0..image.height / 8 {
+        for bx in 0..image.width / 8 {
+            let mut m = [0.0; 3];
+            for y in by * 8..by * 8 + 8 {
+                for x in bx * 8..bx * 8 + 8 {
+                    let p = image.pixel(x, y);
+                    for i in 0..3 {
+                        m[i] += p[i] as f64 / 64.0;
+                    }
+                }
+            }
+            out.push(m);
+        }
+    }
+    out
+}
+
+#[test]
+fn the_viewport_draws_shafts_around_the_clouds_box_as_the_whole_view_draws_them() {
+    // The viewport slices only the cloud's box on screen and draws the shafts of light over
+    // the rest of the view apart, at a quarter of the size: the same image as the whole view
+    // drawn with every shell among the slices, within the shafts' grain. The baseline: the
+    // shafts off, which the split image must not resemble where the air is lit.
+    for (name, scene) in [
+        ("behind", shafts_behind_a_cloud()),
+        ("default", Scene::default()),
+    ] {
+        let on = with(
+            &scene,
+            &[
+                "/light/shafts=true",
+                "/light/shaft_density=0.004",
+                "/light/ground=true",
+            ],
+        );
+        let whole = render(&on);
+        let split = offscreen().render_cropped(&on, W, H).expect("render");
+        let off = render(&with(&on, &["/light/shafts=false"]));
+        if let Ok(dir) = std::env::var("CLOUDSKETCH_TEST_IMAGES") {
+            std::fs::write(
+                format!("{dir}/shafts_{name}_whole.png"),
+                whole.to_png().unwrap(),
+            )
+            .unwrap();
+            std::fs::write(
+                format!("{dir}/shafts_{name}_split.png"),
+                split.to_png().unwrap(),
+            )
+            .unwrap();
+        }
+        let (a, b, c) = (block_means(&whole), block_means(&split), block_means(&off));
+        let worst = |u: &[[f64; 3]], v: &[[f64; 3]]| {
+            u.iter()
+                .zip(v)
+                .flat_map(|(p, q)| (0..3).map(move |i| (p[i] - q[i]).abs()))
+                .fold(0.0f64, f64::max)
+        };
+        let (agree, shafts) = (worst(&a, &b), worst(&a, &c));
+        let (mean, _) = image_difference(&whole, &split);
+        assert!(
+            shafts > 12.0,
+            "{name}: the shafts show ({shafts:.1} at most off)"
+        );
+        assert!(
+            agree < 4.0 && mean < 2.0,
+            "{name}: the split image's 8×8 means differ by {agree:.1} at most, {mean:.2} on average (the shafts add up to {shafts:.1})"
+        );
+    }
+}

@@ -7,11 +7,14 @@
 //! - [`field_gpu`]: the field evaluated on the GPU, the baseline of the CPU bake in `bench`;
 //! - [`shaders`]: WGSL sources, composed;
 //! - [`progressive`]: the frame-time budget that picks preview and refinement work (pure);
+//! - [`crop`]: the pixels the cloud's box covers on screen, which the viewport draws the
+//!   volume over;
 //! - [`capture`]: the view rendered at a chosen size and read back (the app's PNG export);
 //! - [`viewport`]: the egui paint callback that runs the renderer inside the app;
 //! - `offscreen` (native): headless rendering for the CLI, benchmarks and tests.
 
 pub mod capture;
+pub mod crop;
 pub mod field_gpu;
 pub mod gpu_types;
 pub mod passes;

@@ -349,6 +349,50 @@ impl Offscreen {
         }
     }
 
+    /// Renders `scene` over its sky as the app's viewport draws it: the volume over the
+    /// cloud's box on screen alone, the shafts of light around it drawn apart at a fraction of
+    /// the size ([`super::VolumeRenderer::render_image_cropped`]).
+    pub fn render_cropped(
+        &mut self,
+        scene: &Scene,
+        width: u32,
+        height: u32,
+    ) -> Result<Image, OffscreenError> {
+        check_size(width, height)?;
+        let job = self.full_job(scene, width, height);
+        let Some((lo, hi)) = self.renderer.density_box() else {
+            return self.draw(&job, Some(scene.light.background));
+        };
+        let Some(ndc) = scene.camera.ndc_bounds(lo, hi, job.view.aspect) else {
+            return self.draw(&job, Some(scene.light.background));
+        };
+        let crop = super::crop::PixelCrop::snap(ndc, [width, height]);
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("offscreen cropped"),
+            });
+        let output = self.renderer.render_image_cropped(
+            &self.device,
+            &self.queue,
+            &mut encoder,
+            &job,
+            Some(scene.light.background),
+            &crop,
+            super::crop::OUTSIDE_SHAFTS_DIVISOR,
+        );
+        let (readback, row) =
+            copy_for_readback(&self.device, &mut encoder, &output, [width, height]);
+        self.queue.submit([encoder.finish()]);
+        self.map_for_reading(&readback)?;
+        let rgba = read_rows(&readback, [width, height], row).map_err(OffscreenError::Readback)?;
+        Ok(Image {
+            width,
+            height,
+            rgba,
+        })
+    }
+
     /// The density the slices' shader gives `scene`'s media at each probe, a world point and
     /// the field's value there ([`super::probe`]): what the CPU's media (`field::media`, which
     /// the exports bake) must agree with.

@@ -46,6 +46,9 @@ pub struct VolumeRenderer {
     march: Option<(MarchPass, Option<wgpu::BindGroup>)>,
     /// The media probe's pipeline, created at its first use (tests only use it).
     probe: Option<super::probe::ProbePass>,
+    /// The shafts of light outside the cloud's box on screen (the viewport's), drawn by
+    /// [`VolumeRenderer::draw_outside_shafts`].
+    outside: Option<Target>,
 }
 
 /// The light volume on the GPU. Each z-slice is rendered into `slice` (2D) and copied into
@@ -103,6 +106,7 @@ impl VolumeRenderer {
             textures: VolumeTextures::new(),
             bind_group: None,
             targets: Default::default(),
+            outside: None,
             light_pass: LightPass::new(device),
             light: None,
             light_placeholder: placeholder,
@@ -446,6 +450,100 @@ impl VolumeRenderer {
         }
     }
 
+    /// The shafts of light where no cloud can lie in front of them: every shell of `view`'s
+    /// image of `total` slices (as [`Shells::new`] counts them), with no slice among them, into
+    /// a target of its own `size` pixels (the light is soft: a fraction of the view's size
+    /// does). The viewport draws the cloud's box with its slices and shells interleaved, and
+    /// lays this over the rest of the view ([`VolumeRenderer::composite_outside_shafts`]), so
+    /// shafts no longer make every slice cover the whole view. Returns whether there are
+    /// shafts to lay.
+    pub fn draw_outside_shafts(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        view: &View,
+        total: u32,
+        size: [u32; 2],
+    ) -> bool {
+        let volume = self.textures.density_volume.clone();
+        let Some(shells) = Shells::new(view, &volume, total) else {
+            self.outside = None;
+            return false;
+        };
+        let size = [size[0].max(1), size[1].max(1)];
+        if self.outside.as_ref().is_none_or(|t| t.size != size) {
+            let cloud = accumulation_texture(device, size, self.accum_format);
+            let light = accumulation_texture(device, size, self.accum_format);
+            let composite = self
+                .composite
+                .bind_group(device, &cloud, None, &self.clamp_sampler);
+            let group =
+                self.composite
+                    .bind_group(device, &cloud, Some(&light), &self.clamp_sampler);
+            self.outside = Some(Target {
+                size,
+                view: cloud,
+                composite,
+                shafts: Some((light, group)),
+                has_shafts: true,
+                marched: None,
+            });
+        }
+        let (Some(target), Some(bind_group)) = (&self.outside, &self.bind_group) else {
+            return false;
+        };
+        // Every shell, no slice: vs_main makes each instance a shell over the whole view.
+        let mut uniforms = VolumeUniforms::new(view, &volume, total, 0..total, Some(&shells));
+        uniforms.shells[2] = 0.0;
+        let offset = self.slices.write(queue, &uniforms);
+        let clear = |view| {
+            Some(wgpu::RenderPassColorAttachment {
+                view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                    store: wgpu::StoreOp::Store,
+                },
+            })
+        };
+        let Some((light, _)) = &target.shafts else {
+            return false;
+        };
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("shafts outside the cloud"),
+            color_attachments: &[clear(&target.view), clear(light)],
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&self.slices.shafts_pipeline);
+        pass.set_bind_group(0, bind_group, &[offset]);
+        pass.draw(0..6, 0..shells.count);
+        true
+    }
+
+    /// Lays the shafts of light [`VolumeRenderer::draw_outside_shafts`] drew over the current
+    /// render pass's viewport (the whole view; its scissor keeps them off the cloud's box);
+    /// over a `transparent` image with alpha of their own.
+    pub fn composite_outside_shafts(&self, pass: &mut wgpu::RenderPass<'_>, transparent: bool) {
+        if let Some(Target {
+            shafts: Some((_, group)),
+            ..
+        }) = &self.outside
+        {
+            pass.set_pipeline(if transparent {
+                &self.composite.shafts_transparent_pipeline
+            } else {
+                &self.composite.shafts_pipeline
+            });
+            pass.set_bind_group(0, group, &[]);
+            pass.draw(0..3, 0..1);
+        }
+    }
+
     /// A pipeline for the benchmark baseline, for [`VolumeRenderer::draw_slices`].
     pub fn baseline_pipeline(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
         self.slices.baseline(device)
@@ -576,21 +674,7 @@ impl VolumeRenderer {
         background: Option<[f32; 3]>,
         pipeline: Option<&wgpu::RenderPipeline>,
     ) -> wgpu::Texture {
-        let [width, height] = job.plan.size;
-        let output = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("image"),
-            size: wgpu::Extent3d {
-                width,
-                height,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: self.output_format,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
+        let output = self.output_texture(device, job.plan.size);
         let view = output.create_view(&wgpu::TextureViewDescriptor::default());
         self.update_light(device, queue, encoder, &job.view);
         self.draw_slices(device, queue, encoder, job, pipeline);
@@ -629,6 +713,130 @@ impl VolumeRenderer {
         self.composite(&mut pass, job.plan.target, background.is_none());
         drop(pass);
         output
+    }
+
+    /// The density's box (its lowest and highest corners), while there is one.
+    pub fn density_box(&self) -> Option<(glam::Vec3, glam::Vec3)> {
+        let volume = &self.textures.density_volume;
+        (!volume.is_empty()).then(|| (volume.min, volume.min + volume.size))
+    }
+
+    /// Records `job`'s image (the whole view, full quality) as the viewport draws it: the
+    /// slices, with the shafts of light's shells among them, over `crop` alone (the cloud's box
+    /// on screen), the shafts elsewhere drawn apart at 1/`divisor` of the size and laid around
+    /// it ([`VolumeRenderer::draw_outside_shafts`]), over `background` and its sky as
+    /// [`VolumeRenderer::render_image`] lays them. The same image within the shafts' grain:
+    /// `tests/render.rs` compares the two.
+    pub fn render_image_cropped(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        job: &SliceJob,
+        background: Option<[f32; 3]>,
+        crop: &super::crop::PixelCrop,
+        divisor: u32,
+    ) -> wgpu::Texture {
+        let [width, height] = job.plan.size;
+        let output = self.output_texture(device, job.plan.size);
+        let view = output.create_view(&wgpu::TextureViewDescriptor::default());
+        self.update_light(device, queue, encoder, &job.view);
+        let cropped = SliceJob {
+            plan: super::progressive::JobPlan {
+                size: crop.size(),
+                ..job.plan.clone()
+            },
+            view: View {
+                crop: crop.ndc(job.plan.size),
+                ..job.view.clone()
+            },
+        };
+        self.draw_slices(device, queue, encoder, &cropped, None);
+        let outside = self.draw_outside_shafts(
+            device,
+            queue,
+            encoder,
+            &job.view,
+            job.plan.total,
+            job.plan.size.map(|v| v.div_ceil(divisor.max(1))),
+        );
+        let sky = (job.view.light.sky_gradient || job.view.light.ground) && background.is_some();
+        if sky {
+            self.prepare_sky(queue, &job.view);
+        }
+        let clear = match background {
+            Some([r, g, b]) => wgpu::Color {
+                r: r as f64,
+                g: g as f64,
+                b: b as f64,
+                a: 1.0,
+            },
+            None => wgpu::Color::TRANSPARENT,
+        };
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("cropped image composite"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(clear),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        if sky {
+            self.draw_sky(&mut pass);
+        }
+        let [x0, y0, x1, y1] = crop.px;
+        if outside {
+            // The strips around the crop: above, below, left, right.
+            for [x, y, w, h] in [
+                [0, 0, width, y0],
+                [0, y1, width, height - y1],
+                [0, y0, x0, y1 - y0],
+                [x1, y0, width - x1, y1 - y0],
+            ] {
+                if w > 0 && h > 0 {
+                    pass.set_scissor_rect(x, y, w, h);
+                    self.composite_outside_shafts(&mut pass, background.is_none());
+                }
+            }
+            pass.set_scissor_rect(0, 0, width, height);
+        }
+        pass.set_viewport(
+            x0 as f32,
+            y0 as f32,
+            (x1 - x0) as f32,
+            (y1 - y0) as f32,
+            0.0,
+            1.0,
+        );
+        self.composite(&mut pass, job.plan.target, background.is_none());
+        drop(pass);
+        output
+    }
+
+    /// A new output-format texture `size` pixels, to render into and copy from.
+    fn output_texture(&self, device: &wgpu::Device, [width, height]: [u32; 2]) -> wgpu::Texture {
+        device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("image"),
+            size: wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: self.output_format,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        })
     }
 
     /// Sets the sky gradient of `view` (call before [`VolumeRenderer::draw_sky`]).

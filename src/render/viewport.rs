@@ -189,6 +189,43 @@ impl RendererPaint for ViewportPaint {
     }
 }
 
+/// The shafts of light over the part of the view outside the cloud's box on screen, where no
+/// cloud lies in front of them. Drawn (when `redraw`) into a target of `size` pixels, then laid
+/// over the view under each callback's scissor: the viewport adds one callback per strip of the
+/// view around the box, only the first of which redraws.
+pub struct OutsideShaftsPaint {
+    /// The derived volumes (uploaded here too: the cloud's box may be out of view).
+    pub volumes: Volumes,
+    /// The whole view ([`super::FULL_VIEW`]).
+    pub view: super::gpu_types::View,
+    /// Slices of the image the shells are counted for.
+    pub total: u32,
+    /// The target's size in pixels.
+    pub size: [u32; 2],
+    /// Whether this callback draws the shafts (the view changed) or only lays them.
+    pub redraw: bool,
+}
+
+impl RendererPaint for OutsideShaftsPaint {
+    fn prepare(&self, renderer: &mut VolumeRenderer, frame: FrameGpu<'_>) {
+        if !self.redraw {
+            return;
+        }
+        let FrameGpu {
+            device,
+            queue,
+            commands,
+        } = frame;
+        renderer.upload(device, queue, &self.volumes);
+        renderer.update_light(device, queue, commands, &self.view);
+        renderer.draw_outside_shafts(device, queue, commands, &self.view, self.total, self.size);
+    }
+
+    fn paint(&self, renderer: &VolumeRenderer, pass: &mut wgpu::RenderPass<'static>) {
+        renderer.composite_outside_shafts(pass, false);
+    }
+}
+
 /// The sky gradient behind the cloud, over the whole view (drawn before [`ViewportPaint`]).
 pub struct SkyPaint {
     /// Camera, light (its colours) and aspect of the view.

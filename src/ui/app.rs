@@ -520,8 +520,12 @@ impl eframe::App for CloudApp {
             // During a modal G, R or S, Enter confirms it.
             let modal = self.tool.modal_active();
             raw.events.retain(|e| match e {
-                Event::Key { key: Key::Space, .. } => false,
-                Event::Key { key: Key::Enter, .. } => modal,
+                Event::Key {
+                    key: Key::Space, ..
+                } => false,
+                Event::Key {
+                    key: Key::Enter, ..
+                } => modal,
                 _ => true,
             });
         }
@@ -745,7 +749,8 @@ mod tests {
         std::fs::create_dir_all(&dir).unwrap();
         let ctx = egui::Context::default();
         let mut app = app_with_two_edits(&ctx, &dir.join("modal.json"));
-        app.selection.set(super::super::selection::Item::Ellipsoid(0));
+        app.selection
+            .set(super::super::selection::Item::Ellipsoid(0));
         let before = app.doc.scene().ellipsoids.clone();
         let undo = app.doc.undo_len();
         let at = |x: f32, y: f32| Event::PointerMoved(egui::pos2(x, y));
@@ -757,15 +762,27 @@ mod tests {
             vec![press(Key::G), at(940.0, 420.0), at(980.0, 380.0)],
         );
         assert!(app.tool.modal_active());
-        assert_ne!(app.doc.scene().ellipsoids, before, "the grab follows the mouse");
+        assert_ne!(
+            app.doc.scene().ellipsoids,
+            before,
+            "the grab follows the mouse"
+        );
         frame_events(
             &ctx,
             &mut app,
-            vec![press(Key::X), press(Key::Num2), at(1000.0, 300.0), press(Key::Enter)],
+            vec![
+                press(Key::X),
+                press(Key::Num2),
+                at(1000.0, 300.0),
+                press(Key::Enter),
+            ],
         );
         assert!(!app.tool.modal_active(), "Enter confirms");
         let moved = &app.doc.scene().ellipsoids;
-        assert_eq!(moved[0].center, before[0].center + glam::Vec3::new(2.0, 0.0, 0.0));
+        assert_eq!(
+            moved[0].center,
+            before[0].center + glam::Vec3::new(2.0, 0.0, 0.0)
+        );
         assert_eq!(moved[1..], before[1..], "only the selection moves");
         frame_events(&ctx, &mut app, vec![]);
         assert_eq!(app.doc.undo_len(), undo + 1, "one undo step");

@@ -12,13 +12,14 @@ use crate::derive::Derived;
 use crate::render::SliceJob;
 use crate::render::View;
 use crate::render::capture::{Capture, capture_chunks};
+use crate::render::crop::{OUTSIDE_SHAFTS_DIVISOR, PixelCrop};
 
 /// Seconds of a frame an export's capture may take (the rest is the view's: a drag during an
 /// export keeps its frames).
 const CAPTURE_BUDGET: f64 = 0.04;
 use crate::render::progressive::{Budget, Progressive};
 use crate::render::viewport::{JobFence, ReportPoll};
-use crate::render::viewport::{SkyPaint, ViewportPaint, paint_callback};
+use crate::render::viewport::{OutsideShaftsPaint, SkyPaint, ViewportPaint, paint_callback};
 use crate::scene::Document;
 
 /// How often a viewport whose refinement waits for the GPU looks again without word from it.
@@ -47,6 +48,8 @@ pub struct Viewport {
     capture: Option<Capture>,
     /// A finished capture: its size and pixels (straight-alpha RGBA), or why it failed.
     pub captured: Option<([u32; 2], Result<Vec<u8>, String>)>,
+    /// What the shafts of light outside the cloud's box were last drawn for.
+    outside_key: Option<u64>,
 }
 
 impl Viewport {
@@ -89,6 +92,7 @@ impl Viewport {
             capture_request: None,
             capture: None,
             captured: None,
+            outside_key: None,
         }
     }
 
@@ -185,20 +189,38 @@ impl Viewport {
             ui.ctx().request_repaint();
         }
         // Draw the volume only over the part of the view its box covers: fewer pixels to
-        // slice, refine and composite on every frame. Shafts of light fill the whole view.
+        // slice, refine and composite on every frame. Shafts of light there are drawn among
+        // the slices; over the rest of the view, where no cloud lies in front of them, apart
+        // (see `outside_shafts`).
         let density = &volumes.density.data;
         let crop = (!density.is_empty())
             .then(|| {
-                if scene.light.shafts {
-                    Some(crate::render::FULL_VIEW)
-                } else {
-                    scene
-                        .camera
-                        .ndc_bounds(density.min, density.min + density.size, view.aspect)
-                }
+                scene
+                    .camera
+                    .ndc_bounds(density.min, density.min + density.size, view.aspect)
             })
             .flatten()
             .map(|ndc| PixelCrop::snap(ndc, px));
+        let crop_area = crop.map(|c| {
+            let [x0, y0, x1, y1] = c.px;
+            egui::Rect::from_min_max(
+                rect.min + egui::vec2(x0 as f32, y0 as f32) / ppp,
+                rect.min + egui::vec2(x1 as f32, y1 as f32) / ppp,
+            )
+        });
+        let dragging = response.is_pointer_button_down_on();
+        let outside = (scene.light.shafts && !density.is_empty() && self.stats.backend.is_some())
+            .then(|| OutsideShaftsPaint {
+                volumes: volumes.clone(),
+                view: view.clone(),
+                total: if dragging {
+                    OUTSIDE_PREVIEW_SLICES.min(scene.render.slices)
+                } else {
+                    scene.render.slices
+                },
+                size: px.map(|v| v.div_ceil(OUTSIDE_SHAFTS_DIVISOR * if dragging { 2 } else { 1 })),
+                redraw: false,
+            });
         let key = view_key(cx.doc, px, crop.map(|c| c.px));
         let now = ui.input(|i| i.time);
         let crop_size = crop.map_or([1, 1], |c| c.size());
@@ -284,12 +306,7 @@ impl Viewport {
                     ..view.clone()
                 },
             });
-            if self.stats.backend.is_some() {
-                let [x0, y0, x1, y1] = crop.px;
-                let area = egui::Rect::from_min_max(
-                    rect.min + egui::vec2(x0 as f32, y0 as f32) / ppp,
-                    rect.min + egui::vec2(x1 as f32, y1 as f32) / ppp,
-                );
+            if let Some(area) = crop_area.filter(|_| self.stats.backend.is_some()) {
                 painter.add(paint_callback(
                     area,
                     ViewportPaint {
@@ -304,6 +321,11 @@ impl Viewport {
                 ));
             }
         }
+        if let Some(paint) = outside {
+            self.outside_shafts(ui, rect, crop_area, cx.doc, paint);
+        } else {
+            self.outside_key = None;
+        }
         if plan.repaint {
             ui.ctx().request_repaint();
         } else if plan.waiting_for_gpu {
@@ -316,6 +338,43 @@ impl Viewport {
         // H (hide guides) hides the sun handle with the other overlays.
         if self.stats.backend.is_some() && !tool.hide_guides {
             super::sun_handle::show(ui, rect, cx.doc);
+        }
+    }
+
+    /// The shafts of light over the view around the cloud's box `area` (all of it without
+    /// one): one callback per strip, each under its own scissor, the first redrawing them when
+    /// the view, the light, the clouds or the size changed (or a drag began or ended: a drag
+    /// counts fewer shells).
+    fn outside_shafts(
+        &mut self,
+        ui: &egui::Ui,
+        rect: egui::Rect,
+        area: Option<egui::Rect>,
+        doc: &Document,
+        paint: OutsideShaftsPaint,
+    ) {
+        let strips = strips_around(rect, area);
+        if strips.is_empty() {
+            return;
+        }
+        let key = {
+            use std::hash::{Hash, Hasher};
+            let mut h = std::collections::hash_map::DefaultHasher::new();
+            (view_key(doc, paint.size, None), paint.total).hash(&mut h);
+            h.finish()
+        };
+        let redraw = self.outside_key != Some(key);
+        self.outside_key = Some(key);
+        for (k, strip) in strips.into_iter().enumerate() {
+            ui.painter_at(strip).add(paint_callback(
+                rect,
+                OutsideShaftsPaint {
+                    volumes: paint.volumes.clone(),
+                    view: paint.view.clone(),
+                    redraw: redraw && k == 0,
+                    ..paint
+                },
+            ));
         }
     }
 
@@ -395,43 +454,26 @@ impl Viewport {
     }
 }
 
-/// The part of the viewport the volume is drawn in, in whole pixels (x0, y0, x1, y1; y down).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-struct PixelCrop {
-    px: [u32; 4],
+/// The strips of `rect` around `area` (top, bottom, left, right; the whole of `rect` without
+/// an area), leaving out empty ones.
+fn strips_around(rect: egui::Rect, area: Option<egui::Rect>) -> Vec<egui::Rect> {
+    let Some(a) = area.map(|a| a.intersect(rect)).filter(|a| a.is_positive()) else {
+        return vec![rect];
+    };
+    let r = rect;
+    [
+        egui::Rect::from_x_y_ranges(r.x_range(), r.top()..=a.top()),
+        egui::Rect::from_x_y_ranges(r.x_range(), a.bottom()..=r.bottom()),
+        egui::Rect::from_x_y_ranges(r.left()..=a.left(), a.y_range()),
+        egui::Rect::from_x_y_ranges(a.right()..=r.right(), a.y_range()),
+    ]
+    .into_iter()
+    .filter(|s| s.width() >= 0.5 && s.height() >= 0.5)
+    .collect()
 }
 
-impl PixelCrop {
-    /// The pixels covering a rectangle of normalised device coordinates, one pixel of margin.
-    fn snap(ndc: [f32; 4], view: [u32; 2]) -> Self {
-        let [w, h] = view.map(|v| v as f32);
-        let [x0, y0, x1, y1] = ndc;
-        let px = |v: f32, max: u32| (v.max(0.0) as u32).min(max);
-        let left = px(((x0 + 1.0) * 0.5 * w).floor() - 1.0, view[0] - 1);
-        let right = px(((x1 + 1.0) * 0.5 * w).ceil() + 1.0, view[0]).max(left + 1);
-        let top = px(((1.0 - y1) * 0.5 * h).floor() - 1.0, view[1] - 1);
-        let bottom = px(((1.0 - y0) * 0.5 * h).ceil() + 1.0, view[1]).max(top + 1);
-        Self {
-            px: [left, top, right, bottom],
-        }
-    }
-
-    fn size(&self) -> [u32; 2] {
-        [self.px[2] - self.px[0], self.px[3] - self.px[1]]
-    }
-
-    /// The crop in normalised device coordinates of a `view`-sized viewport (y up).
-    fn ndc(&self, view: [u32; 2]) -> [f32; 4] {
-        let [w, h] = view.map(|v| v as f32);
-        let [x0, y0, x1, y1] = self.px.map(|v| v as f32);
-        [
-            x0 / w * 2.0 - 1.0,
-            1.0 - y1 / h * 2.0,
-            x1 / w * 2.0 - 1.0,
-            1.0 - y0 / h * 2.0,
-        ]
-    }
-}
+/// While a drag is under way they are counted for an image of this many slices (fewer shells).
+const OUTSIDE_PREVIEW_SLICES: u32 = 32;
 
 /// Identifies everything that changes the viewport's image: the revisions of the parts the
 /// image depends on, the viewport's size and the crop (no hashing of the scene itself).

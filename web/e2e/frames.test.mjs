@@ -92,6 +92,12 @@ for (const backend of ['webgpu', 'webgl2']) {
           assert.ok(intervals.length > 0, `${name}: no frame was drawn during the drag`);
         };
         await measure('default_orbit', vw * 0.5, vh * 0.5, 220, 40);
+        // The same orbit with the ground and the shafts of light on (the shafts around the
+        // cloud's box are drawn apart, at a fraction of the size), then off again.
+        await page.evaluate(() => { window.cloudsketch.set('/light/ground=true'); window.cloudsketch.set('/light/shafts=true'); });
+        await until(page, (s) => s.scene.light.ground && s.scene.light.shafts, 'ground and shafts on');
+        await measure('ground_shafts_orbit', vw * 0.5, vh * 0.5, -220, 30);
+        await page.evaluate(() => { window.cloudsketch.set('/light/ground=false'); window.cloudsketch.set('/light/shafts=false'); });
 
         // Ten strokes drawn as a user would, then an orbit and a plane move.
         await page.mouse.click(vw * 0.05, vh * 0.95);
@@ -146,8 +152,15 @@ for (const backend of ['webgpu', 'webgl2']) {
         await outline(page, vw * 0.3, vh * 0.75, vw * 0.06);
         await until(page, (s) => s.scene.planes.length === 1, 'a stroke');
         const stroke = await waitForFullQuality(page, 60_000);
+        // Full quality with the ground and the shafts of light on.
+        const t0 = Date.now();
+        await page.evaluate(() => { window.cloudsketch.set('/light/ground=true'); window.cloudsketch.set('/light/shafts=true'); });
+        await waitForBody(page, 'data-quality', (v) => typeof v === 'string' && !v.startsWith('full'), 3_000).catch(() => {});
+        const lit = await waitForFullQuality(page, 120_000);
+        lit.seconds = (Date.now() - t0) / 1000;
         record[`${viewport.width}x${viewport.height}`] = {
           orbit_s: orbit.seconds, orbit_quality: orbit.quality, stroke_s: stroke.seconds, stroke_quality: stroke.quality,
+          ground_shafts_s: lit.seconds, ground_shafts_quality: lit.quality,
         };
         assert.deepEqual(errors, []);
       } finally {
