@@ -798,4 +798,123 @@ mod tests {
         assert_eq!(app.doc.scene().ellipsoids, before);
         std::fs::remove_dir_all(&dir).unwrap();
     }
+
+    #[test]
+    fn no_text_of_the_side_panel_runs_past_its_edge() {
+        // Every group open, a drawing plane and an ellipsoid selected (their controls shown),
+        // at the window sizes people have: each piece of text the panel draws lies within its
+        // clip (the panel), else the label is cut at the edge.
+        let titles = [
+            "Sketch",
+            "Reference image",
+            "Render",
+            "Light",
+            "Scene",
+            "View",
+            "Simulation",
+            "Export",
+        ];
+        let open: std::collections::BTreeMap<&str, bool> =
+            titles.iter().map(|t| (*t, true)).collect();
+        let json = serde_json::json!({ "open": open }).to_string();
+        for size in [egui::vec2(1280.0, 800.0), egui::vec2(1920.0, 1080.0)] {
+            let ctx = egui::Context::default();
+            let dir = std::env::temp_dir().join(format!("cloudsketch-edge-{}", std::process::id()));
+            std::fs::create_dir_all(&dir).unwrap();
+            let cc = eframe::CreationContext::_new_kittest(ctx.clone());
+            let mut app = CloudApp::new(
+                &cc,
+                StartOptions {
+                    scene: Scene::preset(Preset::Cumulus),
+                    file: Some(dir.join("edge.json").display().to_string()),
+                    ..Default::default()
+                },
+            );
+            let mut scene = Scene::preset(Preset::Cumulus);
+            let plane = crate::share::fixture::every_part().planes[0].clone();
+            scene.planes.push(plane);
+            app.doc.apply(Edit::Replace(Box::new(scene)), None);
+            app.selection.set(super::super::selection::Item::Plane(0));
+            app.selection
+                .toggle(super::super::selection::Item::Ellipsoid(0));
+            super::super::widgets::install_groups(
+                &ctx,
+                super::super::widgets::Groups::from_json(&json),
+            );
+            let mut cut = Vec::new();
+            // The panel is scrolled through (egui draws only what is in view), and the nested
+            // groups (the media, the tiers) open by a click on their headers, as a person opens
+            // them: each header is found in the frame before, clicked in a frame of its own.
+            let mut clicks: Vec<egui::Pos2> = Vec::new();
+            let mut opened = Vec::new();
+            let over_panel = egui::pos2(size.x - 150.0, size.y * 0.5);
+            let mut seen_last_group = false;
+            for frame in 0..100 {
+                let mut events = vec![Event::PointerMoved(over_panel)];
+                if let Some(pos) = clicks.pop() {
+                    let button = |pressed| Event::PointerButton {
+                        pos,
+                        button: egui::PointerButton::Primary,
+                        pressed,
+                        modifiers: Modifiers::NONE,
+                    };
+                    events = vec![Event::PointerMoved(pos), button(true), button(false)];
+                } else if frame % 2 == 1 {
+                    events.push(Event::MouseWheel {
+                        unit: egui::MouseWheelUnit::Point,
+                        delta: egui::vec2(0.0, -300.0),
+                        modifiers: Modifiers::NONE,
+                        phase: egui::TouchPhase::Move,
+                        source: egui::MouseWheelSource::Wheel,
+                    });
+                }
+                let raw = RawInput {
+                    screen_rect: Some(egui::Rect::from_min_size(egui::Pos2::ZERO, size)),
+                    time: Some(frame as f64 * 0.1),
+                    events,
+                    ..Default::default()
+                };
+                let mut eframe_frame = eframe::Frame::_new_kittest();
+                let mut output =
+                    ctx.run_ui(raw, |ui| eframe::App::ui(&mut app, ui, &mut eframe_frame));
+                output.textures_delta.clear();
+                for clipped in &output.shapes {
+                    let egui::epaint::Shape::Text(text) = &clipped.shape else {
+                        continue;
+                    };
+                    let r = text.visual_bounding_rect();
+                    let words = text.galley.text();
+                    seen_last_group |= words == "noise media as shown";
+                    for header in ["Media:", "Tiers ("] {
+                        if words.starts_with(header)
+                            && !opened.contains(&header)
+                            && r.max.y < size.y - 20.0
+                        {
+                            opened.push(header);
+                            clicks.push(r.center());
+                        }
+                    }
+                    // Text of the side panel (the view's own lines are centred over it).
+                    if clipped.clip_rect.min.x > size.x * 0.5
+                        && r.max.x > clipped.clip_rect.max.x + 0.5
+                        && !cut.iter().any(|(t, _, _)| t == words)
+                    {
+                        cut.push((words.to_owned(), r.max.x, clipped.clip_rect.max.x));
+                    }
+                }
+            }
+            assert_eq!(
+                super::super::widgets::open_groups(&ctx).len(),
+                titles.len(),
+                "every group open"
+            );
+            assert_eq!(opened.len(), 2, "the media and tiers headers clicked");
+            assert!(seen_last_group, "scrolled down to the Export group's body");
+            assert!(
+                cut.is_empty(),
+                "at {size:?}, text cut at the panel's edge: {cut:?}"
+            );
+            std::fs::remove_dir_all(&dir).ok();
+        }
+    }
 }

@@ -184,7 +184,9 @@ impl Guide {
                 });
             if !files::HAS_PICKER {
                 ui.horizontal(|ui| {
-                    ui.text_edit_singleline(&mut self.path)
+                    // The field leaves room for its button within the panel.
+                    let width = (ui.available_width() - 56.0).max(60.0);
+                    ui.add(egui::TextEdit::singleline(&mut self.path).desired_width(width))
                         .on_hover_text("path of a PNG or JPEG; or drop one on the view");
                     if ui.button("Load").clicked() {
                         self.load(files::read_path(self.path.trim()));
