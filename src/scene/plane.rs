@@ -249,8 +249,9 @@ pub fn grid_exponent(points: &[Vec2]) -> i64 {
                 .all(|&x| (steps(x, step) as f64 * step) as f32 == x)
         })
     };
-    // Snapping can widen the stroke by a step, which may have moved it to the next grid.
-    [e - 1, e]
+    // Snapping can widen the stroke by a step, which may have moved it to the next grid, or
+    // narrow it, which may have moved it to the one before: a stroke on either stays there.
+    [e - 1, e, e + 1]
         .into_iter()
         .filter(|e| (-MAX_GRID_EXPONENT..=MAX_GRID_EXPONENT).contains(e))
         .find(|&e| on_grid(e))
@@ -279,4 +280,34 @@ pub fn centre_of(points: &[DVec2]) -> DVec2 {
         |(a, b), &q| (a.min(q), b.max(q)),
     );
     (lo + hi) * 0.5
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_snapped_stroke_stays_where_it_is_when_snapped_again() {
+        // Snapping moves points by up to half a step, which can narrow or widen the stroke
+        // across a grid boundary; a second snap (the next link's encoding) must move nothing.
+        // Strokes of every size, their extents spread over many grid boundaries.
+        let mut rng = crate::seeded::SplitMix::new(7);
+        for case in 0..3000 {
+            let scale = 10f64.powf(rng.next_f64() * 6.0 - 3.0) as f32;
+            let n = 3 + (rng.next_u64() % 60) as usize;
+            let points: Vec<Vec2> = (0..n)
+                .map(|_| {
+                    Vec2::new(rng.next_f64() as f32 - 0.5, rng.next_f64() as f32 - 0.3) * scale
+                })
+                .collect();
+            let mut once = DrawingPlane {
+                points,
+                ..DrawingPlane::default()
+            };
+            once.snap_to_grid();
+            let mut twice = once.clone();
+            twice.snap_to_grid();
+            assert_eq!(once.points, twice.points, "case {case}: scale {scale}");
+        }
+    }
 }
