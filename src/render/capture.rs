@@ -77,6 +77,20 @@ impl Capture {
         }
     }
 
+    /// The same capture from its first chunk again (the clouds changed while it was drawn:
+    /// its chunks would show two different clouds).
+    pub fn restart(&self) -> Self {
+        Self::new(&self.view, self.size, self.transparent, self.chunks)
+    }
+
+    /// Whether it is still drawing (not yet reading back).
+    pub fn drawing(&self) -> bool {
+        matches!(
+            *self.state.lock().unwrap_or_else(|e| e.into_inner()),
+            State::Drawing { .. }
+        )
+    }
+
     /// The share of the capture drawn, 0–1 (reading back is the last step).
     pub fn progress(&self) -> f32 {
         self.drawn.load(Ordering::Relaxed) as f32 / (self.chunks + 1) as f32

@@ -44,8 +44,10 @@ pub struct Viewport {
     pub rect: egui::Rect,
     /// A capture asked for by the Export group: size in pixels, transparent background.
     pub capture_request: Option<([u32; 2], bool)>,
-    /// The capture under way (advanced by the paint callback every frame).
+    /// The capture under way (advanced by the paint callback every frame), and the clouds'
+    /// revision it draws.
     capture: Option<Capture>,
+    capture_geometry: u64,
     /// A finished capture: its size and pixels (straight-alpha RGBA), or why it failed.
     pub captured: Option<([u32; 2], Result<Vec<u8>, String>)>,
     /// What the shafts of light outside the cloud's box were last drawn for.
@@ -91,6 +93,7 @@ impl Viewport {
             rect: egui::Rect::NOTHING,
             capture_request: None,
             capture: None,
+            capture_geometry: 0,
             captured: None,
             outside_key: None,
         }
@@ -268,6 +271,21 @@ impl Viewport {
                 CAPTURE_BUDGET,
             );
             self.capture = Some(Capture::new(&view, size, transparent, chunks));
+            self.capture_geometry = cx.doc.revisions().geometry;
+        }
+        // The clouds changed while the capture was drawn (a move, a stroke, the simulation):
+        // its chunks would show two different clouds, so it starts over with the change (with
+        // the camera and the light it was asked with).
+        let geometry = cx.doc.revisions().geometry;
+        if let Some(capture) = self.capture.as_ref().filter(|c| c.drawing())
+            && geometry != self.capture_geometry
+        {
+            self.capture = Some(capture.restart());
+            self.capture_geometry = geometry;
+            cx.notices.note(
+                now,
+                "The clouds changed during the PNG export: it starts over with the change",
+            );
         }
         if let Some(capture) = &self.capture {
             if let Some(result) = capture.take() {

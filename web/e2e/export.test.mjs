@@ -102,7 +102,8 @@ for (const backend of ['webgpu', 'webgl2']) {
 
 // A PNG export no longer holds the page: its slices are drawn a chunk a frame (it froze the
 // page for 35 s at 1920×1566 on a CPU adapter, its progress stuck at a half). While it runs the
-// progress moves, a drag orbits the camera, and Cancel stops it with no download.
+// progress moves, a drag orbits the camera, an edit of the clouds starts it over, and Cancel
+// stops it with no download.
 for (const backend of ['webgpu', 'webgl2']) {
   test(`a PNG export draws over frames: a drag orbits meanwhile, Cancel leaves no download (${backend})`, { timeout: 300_000 }, async () => {
     await withApp({ base: server.url, webgpu: backend === 'webgpu', viewport: { width: 1280, height: 800 } }, async (page) => {
@@ -133,6 +134,12 @@ for (const backend of ['webgpu', 'webgl2']) {
       s = await until(page, (s) => s.scene.camera.yaw_deg !== yaw, 'the camera orbited');
       recordTiming({ test: 'export_drag', backend, drag_answered_ms: Date.now() - t0, progress: s.view.export.progress });
       assert.ok(s.view.export.progress != null, 'the export was still running during the drag');
+      // An edit of the clouds during the export starts it over: its chunks would otherwise
+      // show two different clouds. (An orbit does not: the export keeps its own camera.)
+      assert.doesNotMatch(s.view.notice?.text ?? '', /starts over/, 'the orbit did not restart it');
+      await page.evaluate(() => window.cloudsketch.set('/ellipsoids=[{"center":[0,2,0],"radii":[3,2,3]}]'));
+      s = await until(page, (s) => /starts over/.test(s.view.notice?.text ?? ''), 'the export starting over');
+      assert.ok(s.view.export.progress != null, 'the export goes on after the edit');
       await click('export:cancel');
       s = await until(page, (s) => s.view.export.progress == null, 'the export stopped');
       assert.match(s.view.notice.text, /Export cancelled/);
