@@ -7,7 +7,7 @@ use std::time::Instant;
 use serde::Serialize;
 
 use crate::derive::Derived;
-use crate::render::offscreen::{Clock, Offscreen};
+use crate::render::offscreen::{Clock, Drawing, Offscreen};
 use crate::scene::{Document, DrawingPlane, Edit, Preset, Scene};
 
 /// One measurement.
@@ -66,9 +66,18 @@ fn wall_frames(
     plain: bool,
 ) -> Result<Vec<f64>, String> {
     offscreen
-        .time_frames(scene, [w, h], frames, plain, Clock::Wall)
+        .time_frames(scene, [w, h], frames, drawing(plain), Clock::Wall)
         .map(Option::unwrap_or_default)
         .map_err(|e| e.to_string())
+}
+
+/// The whole view with the app's slice shader, or with the plain baseline shader.
+fn drawing(plain: bool) -> Drawing {
+    if plain {
+        Drawing::Plain
+    } else {
+        Drawing::Whole
+    }
 }
 
 /// Offscreen frame time at 1280×720 with 128 slices (median of several frames), against the
@@ -527,7 +536,7 @@ fn device_timed(offscreen: &mut Offscreen) -> Result<Vec<BenchResult>, String> {
     let mut out = Vec::new();
     // The first frame compiles and uploads; the median of the rest.
     let frame = |o: &mut Offscreen, scene: &Scene, (w, h): (u32, u32), plain: bool| {
-        o.time_frames(scene, [w, h], frames + 1, plain, Clock::Device)
+        o.time_frames(scene, [w, h], frames + 1, drawing(plain), Clock::Device)
             .map(|t| t.map(|mut t| median(t.split_off(1))))
             .map_err(|e| e.to_string())
     };
@@ -592,6 +601,26 @@ fn device_timed(offscreen: &mut Offscreen) -> Result<Vec<BenchResult>, String> {
             "gpu_frame_1920x1080_128_slices_4_octaves",
             without * 1e3,
         ));
+        // As the viewport draws it: the cloud's box sliced, the shafts around it apart.
+        let cropped = offscreen
+            .time_frames(
+                &shafts,
+                [1920, 1080],
+                frames + 1,
+                Drawing::Cropped,
+                Clock::Device,
+            )
+            .map(|t| t.map(|mut t| median(t.split_off(1))))
+            .map_err(|e| e.to_string())?;
+        if let Some(cropped) = cropped {
+            out.push(result(
+                "gpu_ground_and_shafts_viewport_1920x1080",
+                cropped * 1e3,
+                "ms",
+                "gpu_ground_and_shafts_frame_1920x1080",
+                with * 1e3,
+            ));
+        }
     }
     let mut light = |octaves: u32| {
         let mut s = Scene::default();

@@ -107,6 +107,18 @@ pub struct Offscreen {
     can_march: bool,
 }
 
+/// How a timed frame is drawn.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Drawing {
+    /// The whole view, as exports and offscreen renders draw it.
+    Whole,
+    /// The whole view with the plain benchmark slice shader (the baseline).
+    Plain,
+    /// As the app's viewport draws it: the slices over the cloud's box on screen, the shafts
+    /// of light around it apart ([`Offscreen::render_cropped`]).
+    Cropped,
+}
+
 /// Which clock times the bench's GPU work.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Clock {
@@ -360,13 +372,9 @@ impl Offscreen {
     ) -> Result<Image, OffscreenError> {
         check_size(width, height)?;
         let job = self.full_job(scene, width, height);
-        let Some((lo, hi)) = self.renderer.density_box() else {
+        let Some(crop) = self.viewport_crop(scene, [width, height]) else {
             return self.draw(&job, Some(scene.light.background));
         };
-        let Some(ndc) = scene.camera.ndc_bounds(lo, hi, job.view.aspect) else {
-            return self.draw(&job, Some(scene.light.background));
-        };
-        let crop = super::crop::PixelCrop::snap(ndc, [width, height]);
         let mut encoder = self
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
@@ -430,36 +438,61 @@ impl Offscreen {
         Ok(densities)
     }
 
-    /// Times `frames` full-quality frames of `scene` (slices and composite, no readback), each
-    /// waited for on the device, by `clock`; `None` for the device's clock where the adapter
-    /// has no timestamp queries. With `baseline`, the slices use the plain benchmark shader.
+    /// Times `frames` full-quality frames of `scene` (slices and composite, no readback) drawn
+    /// as `drawing` says, each waited for on the device, by `clock`; `None` for the device's
+    /// clock where the adapter has no timestamp queries.
     pub fn time_frames(
         &mut self,
         scene: &Scene,
         [width, height]: [u32; 2],
         frames: usize,
-        baseline: bool,
+        drawing: Drawing,
         clock: Clock,
     ) -> Result<Option<Vec<f64>>, OffscreenError> {
         check_size(width, height)?;
         let job = self.full_job(scene, width, height);
-        let pipeline = baseline.then(|| self.renderer.baseline_pipeline(&self.device));
+        let pipeline =
+            (drawing == Drawing::Plain).then(|| self.renderer.baseline_pipeline(&self.device));
+        let crop = (drawing == Drawing::Cropped)
+            .then(|| self.viewport_crop(scene, [width, height]))
+            .flatten();
         let background = Some(scene.light.background);
         (0..frames)
             .map(|_| {
                 self.renderer.begin_frame();
-                self.timed(clock, |o, encoder| {
-                    o.renderer.render_image(
-                        &o.device,
-                        &o.queue,
-                        encoder,
-                        &job,
-                        background,
-                        pipeline.as_ref(),
-                    );
+                self.timed(clock, |o, encoder| match &crop {
+                    Some(crop) => {
+                        o.renderer.render_image_cropped(
+                            &o.device,
+                            &o.queue,
+                            encoder,
+                            &job,
+                            background,
+                            crop,
+                            super::crop::OUTSIDE_SHAFTS_DIVISOR,
+                        );
+                    }
+                    None => {
+                        o.renderer.render_image(
+                            &o.device,
+                            &o.queue,
+                            encoder,
+                            &job,
+                            background,
+                            pipeline.as_ref(),
+                        );
+                    }
                 })
             })
             .collect()
+    }
+
+    /// The pixels of a `size` view the app's viewport would draw the uploaded clouds over.
+    fn viewport_crop(&self, scene: &Scene, size: [u32; 2]) -> Option<super::crop::PixelCrop> {
+        let (lo, hi) = self.renderer.density_box()?;
+        let aspect = size[0] as f32 / size[1].max(1) as f32;
+        let ndc = scene.camera.ndc_bounds(lo, hi, aspect)?;
+        Some(super::crop::PixelCrop::snap(ndc, size))
     }
 
     /// Times `runs` computations of `scene`'s light volume on the GPU (every slice marched
