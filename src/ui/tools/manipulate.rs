@@ -117,11 +117,11 @@ impl ViewTool for MoveTool {
 
     fn hint(&self, _: &Document, selection: &Selection, shared: &Shared) -> Option<String> {
         Some(if selection.is_empty() {
-            "Click a drawing plane or the cloud (Shift adds), or drag a box round several, to move them · G grabs without the arrows".to_owned()
+            "Move (Shift+G): click a drawing plane or the cloud (Shift adds), or drag a box round several · G grabs without the arrows".to_owned()
         } else {
             lock_hint(
                 shared,
-                "Drag an arrow to move along it, elsewhere to move in the view (Shift: toward you) · X/Y/Z lock · Esc cancels · G grabs",
+                "Move (Shift+G): drag an arrow to move along it, elsewhere in the view (Shift: toward you) · X/Y/Z lock · Esc cancels · G grabs",
             )
         })
     }
@@ -156,11 +156,11 @@ impl ViewTool for RotateTool {
 
     fn hint(&self, _: &Document, selection: &Selection, shared: &Shared) -> Option<String> {
         Some(if selection.is_empty() {
-            "Click a drawing plane or the cloud (Shift adds), or drag a box round several, to turn them · R rotates without the rings".to_owned()
+            "Rotate (Shift+R): click a drawing plane or the cloud (Shift adds), or drag a box round several · R rotates without the rings".to_owned()
         } else {
             lock_hint(
                 shared,
-                "Drag a ring to turn about its axis, elsewhere to turn freely · Ctrl snaps to 15° · Esc cancels · R rotates",
+                "Rotate (Shift+R): drag a ring to turn about its axis, elsewhere freely · Ctrl snaps to 15° · Esc cancels · R rotates",
             )
         })
     }
@@ -187,11 +187,11 @@ impl ViewTool for ScaleTool {
 
     fn hint(&self, _: &Document, selection: &Selection, shared: &Shared) -> Option<String> {
         Some(if selection.ellipsoid().is_none() {
-            "Scale works on ellipsoids: click the cloud (or pick one in the list) · S scales without the boxes".to_owned()
+            "Scale (Shift+S) works on ellipsoids: click the cloud (or pick one in the list) · S scales without the boxes".to_owned()
         } else {
             lock_hint(
                 shared,
-                "Drag a box to scale one axis, elsewhere right or up to grow · Ctrl snaps to tenths · Esc cancels · S scales",
+                "Scale (Shift+S): drag a box to scale one axis, elsewhere right or up to grow · Ctrl snaps to tenths · Esc cancels · S scales",
             )
         })
     }

@@ -406,13 +406,18 @@ impl Toolbox {
             self.active().hint(doc, selection, &self.shared())
         };
         if let Some(hint) = hint {
-            painter.text(
-                rect.center_top() + egui::vec2(0.0, 36.0),
-                egui::Align2::CENTER_TOP,
+            // Wrapped to the view clear of the sun orb in its top-right corner (a narrow window
+            // breaks it into lines), each line centred.
+            let color = Color32::from_white_alpha(200);
+            let mut job = egui::text::LayoutJob::simple(
                 hint,
                 egui::FontId::proportional(15.0),
-                Color32::from_white_alpha(200),
+                color,
+                (rect.width() - 200.0).max(160.0),
             );
+            job.halign = egui::Align::Center;
+            let galley = painter.layout_job(job);
+            painter.galley(rect.center_top() + egui::vec2(0.0, 36.0), galley, color);
         }
     }
 }
