@@ -389,16 +389,7 @@ impl Offscreen {
             &crop,
             super::crop::OUTSIDE_SHAFTS_DIVISOR,
         );
-        let (readback, row) =
-            copy_for_readback(&self.device, &mut encoder, &output, [width, height]);
-        self.queue.submit([encoder.finish()]);
-        self.map_for_reading(&readback)?;
-        let rgba = read_rows(&readback, [width, height], row).map_err(OffscreenError::Readback)?;
-        Ok(Image {
-            width,
-            height,
-            rgba,
-        })
+        self.read_back(encoder, &output, [width, height])
     }
 
     /// The density the slices' shader gives `scene`'s media at each probe, a world point and
@@ -702,9 +693,18 @@ impl Offscreen {
         job: &SliceJob,
         background: Option<[f32; 3]>,
     ) -> Result<Image, OffscreenError> {
-        let size = job.plan.size;
-        let (mut encoder, output) = self.encode(job, background, None);
-        let (readback, row) = copy_for_readback(&self.device, &mut encoder, &output, size);
+        let (encoder, output) = self.encode(job, background, None);
+        self.read_back(encoder, &output, job.plan.size)
+    }
+
+    /// Submits `encoder` with a copy of `output` (`size` pixels) and reads the image back.
+    fn read_back(
+        &self,
+        mut encoder: wgpu::CommandEncoder,
+        output: &wgpu::Texture,
+        size: [u32; 2],
+    ) -> Result<Image, OffscreenError> {
+        let (readback, row) = copy_for_readback(&self.device, &mut encoder, output, size);
         self.queue.submit([encoder.finish()]);
         self.map_for_reading(&readback)?;
         let rgba = read_rows(&readback, size, row).map_err(OffscreenError::Readback)?;

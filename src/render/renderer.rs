@@ -678,38 +678,14 @@ impl VolumeRenderer {
         let view = output.create_view(&wgpu::TextureViewDescriptor::default());
         self.update_light(device, queue, encoder, &job.view);
         self.draw_slices(device, queue, encoder, job, pipeline);
-        let sky = (job.view.light.sky_gradient || job.view.light.ground) && background.is_some();
-        if sky {
-            self.prepare_sky(queue, &job.view);
-        }
-        let clear = match background {
-            Some([r, g, b]) => wgpu::Color {
-                r: r as f64,
-                g: g as f64,
-                b: b as f64,
-                a: 1.0,
-            },
-            None => wgpu::Color::TRANSPARENT,
-        };
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("image composite"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(clear),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: None,
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        if sky {
-            self.draw_sky(&mut pass);
-        }
+        let mut pass = self.backdrop_pass(
+            queue,
+            encoder,
+            &view,
+            &job.view,
+            background,
+            "image composite",
+        );
         self.composite(&mut pass, job.plan.target, background.is_none());
         drop(pass);
         output
@@ -760,38 +736,14 @@ impl VolumeRenderer {
             job.plan.total,
             job.plan.size.map(|v| v.div_ceil(divisor.max(1))),
         );
-        let sky = (job.view.light.sky_gradient || job.view.light.ground) && background.is_some();
-        if sky {
-            self.prepare_sky(queue, &job.view);
-        }
-        let clear = match background {
-            Some([r, g, b]) => wgpu::Color {
-                r: r as f64,
-                g: g as f64,
-                b: b as f64,
-                a: 1.0,
-            },
-            None => wgpu::Color::TRANSPARENT,
-        };
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("cropped image composite"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(clear),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: None,
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        if sky {
-            self.draw_sky(&mut pass);
-        }
+        let mut pass = self.backdrop_pass(
+            queue,
+            encoder,
+            &view,
+            &job.view,
+            background,
+            "cropped image composite",
+        );
         let [x0, y0, x1, y1] = crop.px;
         if outside {
             // The strips around the crop: above, below, left, right.
@@ -819,6 +771,52 @@ impl VolumeRenderer {
         self.composite(&mut pass, job.plan.target, background.is_none());
         drop(pass);
         output
+    }
+
+    /// Begins the render pass that lays an image over `target`: cleared to `background`
+    /// (transparent without one) with `view`'s sky gradient or ground drawn over it.
+    fn backdrop_pass<'e>(
+        &self,
+        queue: &wgpu::Queue,
+        encoder: &'e mut wgpu::CommandEncoder,
+        target: &wgpu::TextureView,
+        view: &View,
+        background: Option<[f32; 3]>,
+        label: &str,
+    ) -> wgpu::RenderPass<'e> {
+        let sky = (view.light.sky_gradient || view.light.ground) && background.is_some();
+        if sky {
+            self.prepare_sky(queue, view);
+        }
+        let clear = match background {
+            Some([r, g, b]) => wgpu::Color {
+                r: r as f64,
+                g: g as f64,
+                b: b as f64,
+                a: 1.0,
+            },
+            None => wgpu::Color::TRANSPARENT,
+        };
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some(label),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: target,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(clear),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        if sky {
+            self.draw_sky(&mut pass);
+        }
+        pass
     }
 
     /// A new output-format texture `size` pixels, to render into and copy from.

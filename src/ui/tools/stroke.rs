@@ -42,24 +42,13 @@ pub struct CutTool {
 
 impl ViewTool for SketchTool {
     fn input(&mut self, view: &ViewInput<'_>, tc: &mut ToolContext<'_>, _: &Shared) -> bool {
-        if let Some((stroke, pressure, clipped)) = self.capture.input(view, tc) {
-            let now = view.ui.input(|i| i.time);
-            let placement = if self.behind {
-                Placement::Behind
-            } else {
-                Placement::Front
-            };
-            let kind = StrokeKind::Outline;
-            finish_stroke(
-                now,
-                view.rect,
-                (&stroke, &pressure),
-                clipped,
-                kind,
-                placement,
-                tc,
-            );
-        }
+        let placement = if self.behind {
+            Placement::Behind
+        } else {
+            Placement::Front
+        };
+        self.capture
+            .input_into_plane(view, tc, StrokeKind::Outline, placement);
         true
     }
 
@@ -79,19 +68,8 @@ impl ViewTool for SketchTool {
 
 impl ViewTool for CutTool {
     fn input(&mut self, view: &ViewInput<'_>, tc: &mut ToolContext<'_>, _: &Shared) -> bool {
-        if let Some((stroke, pressure, clipped)) = self.capture.input(view, tc) {
-            let now = view.ui.input(|i| i.time);
-            let kind = StrokeKind::Cut;
-            finish_stroke(
-                now,
-                view.rect,
-                (&stroke, &pressure),
-                clipped,
-                kind,
-                Placement::Front,
-                tc,
-            );
-        }
+        self.capture
+            .input_into_plane(view, tc, StrokeKind::Cut, Placement::Front);
         true
     }
 
@@ -141,6 +119,22 @@ fn pen_pressure(samples: &[Option<f32>]) -> Vec<f32> {
 type Finished = (Vec<Pos2>, Vec<f32>, Option<String>);
 
 impl StrokeCapture {
+    /// Takes this frame's pointer samples; once the stroke is finished, places it as a
+    /// drawing plane of `kind` on the `placement` side of the cloud.
+    fn input_into_plane(
+        &mut self,
+        view: &ViewInput<'_>,
+        tc: &mut ToolContext<'_>,
+        kind: StrokeKind,
+        placement: Placement,
+    ) {
+        if let Some((stroke, pressure, clipped)) = self.input(view, tc) {
+            let now = view.ui.input(|i| i.time);
+            let stroke = (&stroke[..], &pressure[..]);
+            finish_stroke(now, view.rect, stroke, clipped, kind, placement, tc);
+        }
+    }
+
     /// Drops the stroke being drawn; returns whether there was one.
     fn cancel(&mut self) -> bool {
         let had = !self.stroke.is_empty();
