@@ -263,10 +263,13 @@ struct ShaftsOut {
 fn fs_shafts(in: VsOut) -> ShaftsOut {
     var out: ShaftsOut;
     if in.shell >= 0 {
-        out.cloud = vec4<f32>(0.0);
         let a = in.near.xyz / in.near.w;
         let b = in.far.xyz / in.far.w;
-        out.shafts = vec4<f32>(shaft(a, b, in.clip.xy, in.shell), 0.0);
+        let light = vec4<f32>(shaft(a, b, in.clip.xy, in.shell), 0.0);
+        out.shafts = light;
+        // The shells drawn apart (beyond the clouds' box, only ever drawn with no slice) also
+        // into the first target, which the viewport lays under its cloud's box.
+        out.cloud = select(vec4<f32>(0.0), light, f32(in.shell) < u.air.z);
         return out;
     }
     out.cloud = cloud_at(in.world);
@@ -274,5 +277,30 @@ fn fs_shafts(in: VsOut) -> ShaftsOut {
         discard;
     }
     out.shafts = vec4<f32>(0.0, 0.0, 0.0, out.cloud.a);
+    return out;
+}
+
+// The shafts of light apart from the clouds' box (VolumeRenderer::draw_outside_shafts): every
+// shell of the image summed in one pass over the view (one instance, a shell's triangle), into
+// target 1, and those set apart beyond the box (the first u.air.z) into target 0 too. The same
+// light as one instance per shell, for a fraction of the cost where fragments are dear (a CPU
+// adapter's blending and rasterising of each shell's triangle was most of it).
+@fragment
+fn fs_outside_shafts(in: VsOut) -> ShaftsOut {
+    let a = in.near.xyz / in.near.w;
+    let b = in.far.xyz / in.far.w;
+    let apart = i32(u.air.z);
+    var beyond = vec3<f32>(0.0);
+    var all = vec3<f32>(0.0);
+    for (var k = 0; k < i32(u.shells.w); k = k + 1) {
+        let light = shaft(a, b, in.clip.xy, k);
+        all = all + light;
+        if k < apart {
+            beyond = beyond + light;
+        }
+    }
+    var out: ShaftsOut;
+    out.cloud = vec4<f32>(beyond, 0.0);
+    out.shafts = vec4<f32>(all, 0.0);
     return out;
 }

@@ -53,7 +53,8 @@ struct Volume {
     // x: distance of the farthest shell's outer boundary from the eye, y: the shells'
     // spacing, z: the air's extinction per world unit, w: the shafts' intensity.
     shafts: vec4<f32>,
-    // x: the ground's height (the air below it is hidden), y: the air's phase asymmetry g.
+    // x: the ground's height (the air below it is hidden), y: the air's phase asymmetry g,
+    // z: the shells drawn apart (Shells::apart), whose light also goes to the first target.
     air: vec4<f32>,
 };
 

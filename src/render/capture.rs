@@ -167,6 +167,7 @@ impl Capture {
                 clear: k == 0,
             },
             view: self.view.clone(),
+            shells_apart: false,
         }
     }
 

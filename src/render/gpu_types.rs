@@ -72,7 +72,8 @@ pub struct VolumeUniforms {
     /// spacing, z: the air's extinction per world unit, w: the shafts' intensity.
     pub shafts: [f32; 4],
     /// x: the ground's height (the air below it is hidden; very low without a ground),
-    /// y: the air's phase asymmetry g.
+    /// y: the air's phase asymmetry g, z: the shells drawn apart ([`Shells::apart`]), whose
+    /// light also goes to the first target.
     pub air: [f32; 4],
 }
 
@@ -95,6 +96,9 @@ pub struct Shells {
     pub far: f32,
     /// Distance between neighbouring shells.
     pub spacing: f32,
+    /// The farthest shells, beyond the clouds' box, that a cropped view draws apart (see
+    /// [`Shells::apart_beyond_the_box`]): 0 where the slices' draws hold every shell.
+    pub apart: u32,
 }
 
 impl Shells {
@@ -137,7 +141,25 @@ impl Shells {
             count,
             far,
             spacing: far / count as f32,
+            apart: 0,
         })
+    }
+
+    /// These shells with those beyond the far side of `volume`'s box (as `view` sees it) drawn
+    /// apart: no slice lies behind them, so every slice of the image hides them alike and they
+    /// can be drawn once, at a fraction of the view's size, with the shafts around the box
+    /// (the viewport's [`super::renderer::VolumeRenderer::draw_outside_shafts`]), instead of
+    /// in the first chunk of every refinement (most of the shells when the shafts reach down
+    /// to a distant ground).
+    pub fn apart_beyond_the_box(self, view: &View, volume: &DensityVolume) -> Self {
+        let (center, _) = volume.bounding_sphere();
+        let forward = view.camera.forward();
+        let (_, far) = box_depths(volume, center, forward);
+        let boundary = (center - view.camera.eye()).dot(forward) + far;
+        Self {
+            apart: self.beyond(boundary),
+            ..self
+        }
     }
 
     /// How many shells lie farther from the eye than `depth` (the shader's `shells_beyond`).
@@ -391,15 +413,16 @@ impl VolumeUniforms {
         let (shell_range, shafts) = match shells {
             Some(s) => {
                 let boundary = |j: u32| (center - eye).dot(forward) + far - j as f32 * spacing;
+                // The shells drawn apart are in no draw of slices.
                 let k0 = if first == 0 {
-                    0
+                    s.apart
                 } else {
-                    s.beyond(boundary(first))
+                    s.beyond(boundary(first)).max(s.apart)
                 };
                 let k1 = if range.end >= total {
                     s.count
                 } else {
-                    s.beyond(boundary(range.end))
+                    s.beyond(boundary(range.end)).max(k0)
                 };
                 (
                     [k0 as f32, k1.saturating_sub(k0) as f32, s.count as f32],
@@ -461,7 +484,12 @@ impl VolumeUniforms {
                 shell_range[2],
             ],
             shafts,
-            air: [ground, AIR_ASYMMETRY, 0.0, 0.0],
+            air: [
+                ground,
+                AIR_ASYMMETRY,
+                shells.map_or(0.0, |s| s.apart as f32),
+                0.0,
+            ],
         }
     }
 }
@@ -554,6 +582,46 @@ mod tests {
         };
         assert!(Shells::new(&off, &volume, total).is_none());
         assert!(Shells::new(&view, &DensityVolume::default(), total).is_none());
+    }
+
+    #[test]
+    fn shells_drawn_apart_are_those_beyond_the_box_and_no_chunk_draws_them() {
+        // The default view with the ground far below: most shells lie beyond the cloud's box
+        // (the shafts reach down to the ground), and the first chunk used to draw them all.
+        let mut scene = Scene::default();
+        scene.light.shafts = true;
+        scene.light.ground = true;
+        scene.light.ground_height = -20.0;
+        let (view, volume) = view_and_volume(&scene);
+        let total = 128;
+        let shells = Shells::new(&view, &volume, total)
+            .expect("shells")
+            .apart_beyond_the_box(&view, &volume);
+        let (center, _) = volume.bounding_sphere();
+        let forward = scene.camera.forward();
+        let (_, far) = box_depths(&volume, center, forward);
+        let back = (center - scene.camera.eye()).dot(forward) + far;
+        assert!(
+            shells.apart > 0 && shells.apart < shells.count,
+            "{shells:?}"
+        );
+        for k in 0..shells.count {
+            let r = shells.far - (k as f32 + 0.5) * shells.spacing;
+            assert_eq!(
+                k < shells.apart,
+                r > back,
+                "shell {k} at {r} (box's back {back})"
+            );
+        }
+        // The chunks share out the rest once each; the outside pass is told which to set apart.
+        let mut next = shells.apart;
+        for range in [0..1, 1..60, 60..128] {
+            let u = VolumeUniforms::new(&view, &volume, total, range.clone(), Some(&shells));
+            assert_eq!(u.shells[0] as u32, next, "chunk {range:?}");
+            next += u.shells[1] as u32;
+            assert_eq!(u.air[2] as u32, shells.apart);
+        }
+        assert_eq!(next, shells.count);
     }
 
     #[test]

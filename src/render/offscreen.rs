@@ -662,6 +662,7 @@ impl Offscreen {
                 aspect: width as f32 / height as f32,
                 crop: FULL_VIEW,
             },
+            shells_apart: false,
         }
     }
 

@@ -164,6 +164,9 @@ pub struct SlicePass {
     /// The slices with the shafts of light's shells among them, into two targets: the cloud
     /// and the shafts (`fs_shafts`).
     pub shafts_pipeline: wgpu::RenderPipeline,
+    /// Every shell's light in one pass over the view, no slice (`fs_outside_shafts`), into the
+    /// same two targets.
+    pub outside_pipeline: wgpu::RenderPipeline,
     /// Layout of its bind group (uniforms, volume, sampler, noise, sampler).
     pub layout: wgpu::BindGroupLayout,
     /// Uniform ring, [`MAX_SLICE_DRAWS_PER_FRAME`] slots of `stride` bytes.
@@ -204,6 +207,15 @@ impl SlicePass {
                 shaders::VOLUME,
                 &[&layout],
                 "fs_shafts",
+                &[format, format],
+                Some(PREMULTIPLIED_OVER),
+            ),
+            outside_pipeline: targets_pipeline(
+                device,
+                "shafts of light apart from the clouds",
+                shaders::VOLUME,
+                &[&layout],
+                "fs_outside_shafts",
                 &[format, format],
                 Some(PREMULTIPLIED_OVER),
             ),
@@ -260,6 +272,14 @@ pub struct CompositePass {
     pub shafts_transparent_pipeline: wgpu::RenderPipeline,
     /// Layout of their bind group (source texture, sampler, shafts texture).
     pub shafts_layout: wgpu::BindGroupLayout,
+    /// The composite of a cropped target with its shafts and those of the shells beyond the
+    /// box drawn apart (`fs_shafts_beyond`), and over a transparent background.
+    pub beyond_pipeline: wgpu::RenderPipeline,
+    /// The same over a transparent background (`fs_shafts_beyond_transparent`).
+    pub beyond_transparent_pipeline: wgpu::RenderPipeline,
+    /// Layout of their bind group: the shafts layout's, then the beyond light's texture and
+    /// where the target lies in it (a uniform `vec4`).
+    pub beyond_layout: wgpu::BindGroupLayout,
 }
 
 impl CompositePass {
@@ -280,7 +300,36 @@ impl CompositePass {
                 texture_entry(2, wgpu::TextureViewDimension::D2),
             ],
         });
+        let beyond_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("composite with shafts beyond"),
+            entries: &[
+                texture_entry(0, wgpu::TextureViewDimension::D2),
+                sampler_entry(1),
+                texture_entry(2, wgpu::TextureViewDimension::D2),
+                texture_entry(3, wgpu::TextureViewDimension::D2),
+                uniform_entry(4, wgpu::ShaderStages::FRAGMENT, 16, false),
+            ],
+        });
+        let beyond = |label, entry| {
+            targets_pipeline(
+                device,
+                label,
+                shaders::COMPOSITE,
+                &[&beyond_layout],
+                entry,
+                &[output_format],
+                Some(PREMULTIPLIED_OVER),
+            )
+        };
+        let beyond_pipeline = beyond("volume composite with shafts beyond", "fs_shafts_beyond");
+        let beyond_transparent_pipeline = beyond(
+            "volume composite with shafts beyond, transparent",
+            "fs_shafts_beyond_transparent",
+        );
         Self {
+            beyond_pipeline,
+            beyond_transparent_pipeline,
+            beyond_layout,
             pipeline: pipeline(
                 device,
                 "volume composite",
@@ -344,6 +393,39 @@ impl CompositePass {
             label: Some(label),
             layout,
             entries: &entries,
+        })
+    }
+
+    /// The bind group that composites `source` with its `shafts` and the light of the shells
+    /// beyond the box in `beyond`, where `place` (a 16-byte uniform: xy + uv · zw) says where
+    /// the source lies in it.
+    pub fn beyond_bind_group(
+        &self,
+        device: &wgpu::Device,
+        [source, shafts, beyond]: [&wgpu::TextureView; 3],
+        sampler: &wgpu::Sampler,
+        place: &wgpu::Buffer,
+    ) -> wgpu::BindGroup {
+        let texture = |binding, view| wgpu::BindGroupEntry {
+            binding,
+            resource: wgpu::BindingResource::TextureView(view),
+        };
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("composite with shafts beyond"),
+            layout: &self.beyond_layout,
+            entries: &[
+                texture(0, source),
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::Sampler(sampler),
+                },
+                texture(2, shafts),
+                texture(3, beyond),
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: place.as_entire_binding(),
+                },
+            ],
         })
     }
 }

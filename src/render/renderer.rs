@@ -19,6 +19,10 @@ pub struct SliceJob {
     pub plan: JobPlan,
     /// Camera, light and media of the image.
     pub view: View,
+    /// Whether the shafts of light's shells beyond the clouds' box are left out, drawn apart
+    /// ([`VolumeRenderer::draw_outside_shafts`]) and added by
+    /// [`VolumeRenderer::composite_cropped`]: the viewport's cropped image.
+    pub shells_apart: bool,
 }
 
 /// Pipelines, samplers, textures and the accumulation targets.
@@ -47,8 +51,14 @@ pub struct VolumeRenderer {
     /// The media probe's pipeline, created at its first use (tests only use it).
     probe: Option<super::probe::ProbePass>,
     /// The shafts of light outside the cloud's box on screen (the viewport's), drawn by
-    /// [`VolumeRenderer::draw_outside_shafts`].
+    /// [`VolumeRenderer::draw_outside_shafts`]: its first texture holds the light of the
+    /// shells beyond the box alone ([`Shells::apart`]), its second that of every shell.
     outside: Option<Target>,
+    /// Where a cropped target lies in the whole view, for its composite (xy + uv · zw).
+    beyond_place: wgpu::Buffer,
+    /// The composite group of a cropped target with the shafts beyond the box (see
+    /// [`VolumeRenderer::prepare_cropped_composite`]), and the target's index.
+    beyond: Option<(usize, wgpu::BindGroup)>,
 }
 
 /// The light volume on the GPU. Each z-slice is rendered into `slice` (2D) and copied into
@@ -107,6 +117,13 @@ impl VolumeRenderer {
             bind_group: None,
             targets: Default::default(),
             outside: None,
+            beyond_place: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("where a cropped image lies in the view"),
+                size: 16,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+            beyond: None,
             light_pass: LightPass::new(device),
             light: None,
             light_placeholder: placeholder,
@@ -467,7 +484,9 @@ impl VolumeRenderer {
         size: [u32; 2],
     ) -> bool {
         let volume = self.textures.density_volume.clone();
-        let Some(shells) = Shells::new(view, &volume, total) else {
+        let Some(shells) =
+            Shells::new(view, &volume, total).map(|s| s.apart_beyond_the_box(view, &volume))
+        else {
             self.outside = None;
             return false;
         };
@@ -493,8 +512,11 @@ impl VolumeRenderer {
         let (Some(target), Some(bind_group)) = (&self.outside, &self.bind_group) else {
             return false;
         };
-        // Every shell, no slice: vs_main makes each instance a shell over the whole view.
+        // No slice and one instance, a shell's triangle over the whole view, in which
+        // fs_outside_shafts sums every shell's light.
         let mut uniforms = VolumeUniforms::new(view, &volume, total, 0..total, Some(&shells));
+        uniforms.shells[0] = 0.0;
+        uniforms.shells[1] = 1.0;
         uniforms.shells[2] = 0.0;
         let offset = self.slices.write(queue, &uniforms);
         let clear = |view| {
@@ -519,9 +541,9 @@ impl VolumeRenderer {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_pipeline(&self.slices.shafts_pipeline);
+        pass.set_pipeline(&self.slices.outside_pipeline);
         pass.set_bind_group(0, bind_group, &[offset]);
-        pass.draw(0..6, 0..shells.count);
+        pass.draw(0..6, 0..1);
         true
     }
 
@@ -563,7 +585,15 @@ impl VolumeRenderer {
         let index = plan.target.min(TARGETS - 1);
         let volume = self.textures.density_volume.clone();
         // The bench's baseline draws the plain slices alone.
-        let shells = Shells::new(&job.view, &volume, plan.total).filter(|_| pipeline.is_none());
+        let shells = Shells::new(&job.view, &volume, plan.total)
+            .filter(|_| pipeline.is_none())
+            .map(|s| {
+                if job.shells_apart {
+                    s.apart_beyond_the_box(&job.view, &volume)
+                } else {
+                    s
+                }
+            });
         self.ensure_target(device, index, plan.size, shells.is_some());
         let (Some(target), Some(bind_group)) = (&mut self.targets[index], &self.bind_group) else {
             return;
@@ -726,6 +756,7 @@ impl VolumeRenderer {
                 crop: crop.ndc(job.plan.size),
                 ..job.view.clone()
             },
+            shells_apart: true,
         };
         self.draw_slices(device, queue, encoder, &cropped, None);
         let outside = self.draw_outside_shafts(
@@ -736,6 +767,7 @@ impl VolumeRenderer {
             job.plan.total,
             job.plan.size.map(|v| v.div_ceil(divisor.max(1))),
         );
+        self.prepare_cropped_composite(device, queue, job.plan.target, cropped.view.crop);
         let mut pass = self.backdrop_pass(
             queue,
             encoder,
@@ -768,7 +800,7 @@ impl VolumeRenderer {
             0.0,
             1.0,
         );
-        self.composite(&mut pass, job.plan.target, background.is_none());
+        self.composite_cropped(&mut pass, job.plan.target, background.is_none());
         drop(pass);
         output
     }
@@ -857,6 +889,72 @@ impl VolumeRenderer {
     /// Fills the current render pass's viewport with `colour` (the values the target stores).
     pub fn draw_fill(&self, pass: &mut wgpu::RenderPass<'_>, colour: wgpu::Color) {
         self.fill.draw(pass, colour);
+    }
+
+    /// Readies the composite of target `index`, drawn of a view cropped to `crop` (normalised
+    /// device coordinates, x0, y0, x1, y1; y up), with the light of the shafts' shells beyond
+    /// the clouds' box, which [`VolumeRenderer::draw_outside_shafts`] drew apart (call after
+    /// it, before [`VolumeRenderer::composite_cropped`]).
+    pub fn prepare_cropped_composite(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        index: usize,
+        crop: [f32; 4],
+    ) {
+        self.beyond = None;
+        let Some(Target { view: beyond, .. }) = &self.outside else {
+            return;
+        };
+        let Some(Target {
+            view: source,
+            shafts: Some((shafts, _)),
+            has_shafts: true,
+            ..
+        }) = self.targets.get(index).and_then(|t| t.as_ref())
+        else {
+            return;
+        };
+        // NDC (y up) to texture coordinates (y down).
+        let [x0, y0, x1, y1] = crop;
+        let place = [
+            0.5 * (x0 + 1.0),
+            0.5 * (1.0 - y1),
+            0.5 * (x1 - x0),
+            0.5 * (y1 - y0),
+        ];
+        queue.write_buffer(&self.beyond_place, 0, bytemuck::cast_slice(&place));
+        let group = self.composite.beyond_bind_group(
+            device,
+            [source, shafts, beyond],
+            &self.clamp_sampler,
+            &self.beyond_place,
+        );
+        self.beyond = Some((index, group));
+    }
+
+    /// Draws accumulation target `index` of a cropped view as
+    /// [`VolumeRenderer::composite`] does, with the light of the shafts' shells beyond the
+    /// clouds' box seen through the cloud, where
+    /// [`VolumeRenderer::prepare_cropped_composite`] readied it.
+    pub fn composite_cropped(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        index: usize,
+        transparent: bool,
+    ) {
+        match &self.beyond {
+            Some((i, group)) if *i == index => {
+                pass.set_pipeline(if transparent {
+                    &self.composite.beyond_transparent_pipeline
+                } else {
+                    &self.composite.beyond_pipeline
+                });
+                pass.set_bind_group(0, group, &[]);
+                pass.draw(0..3, 0..1);
+            }
+            _ => self.composite(pass, index, transparent),
+        }
     }
 
     /// Draws accumulation target `index` over the current render pass's viewport; over a

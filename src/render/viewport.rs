@@ -131,6 +131,9 @@ pub struct ViewportPaint {
     pub fence: Option<JobFence>,
     /// The job's number ([`super::progressive::FramePlan::job_id`]).
     pub job_id: u64,
+    /// Where the shown image lies in the whole view (normalised device coordinates, x0, y0,
+    /// x1, y1; y up): the cloud's box on screen.
+    pub crop: [f32; 4],
     /// Whether the job goes to the GPU on its own, ahead of the frame, timed by the fence
     /// ([`super::progressive::FramePlan::own_submission`]); else with the frame's commands.
     pub own_submission: bool,
@@ -182,17 +185,25 @@ impl RendererPaint for ViewportPaint {
         }
     }
 
+    fn finish_prepare(&self, renderer: &mut VolumeRenderer, frame: FrameGpu<'_>) {
+        // Every callback's `prepare` is done: the shafts beyond the box are drawn by now.
+        if let Some(target) = self.display {
+            renderer.prepare_cropped_composite(frame.device, frame.queue, target, self.crop);
+        }
+    }
+
     fn paint(&self, renderer: &VolumeRenderer, pass: &mut wgpu::RenderPass<'static>) {
         if let Some(target) = self.display {
-            renderer.composite(pass, target, false);
+            renderer.composite_cropped(pass, target, false);
         }
     }
 }
 
 /// The shafts of light over the part of the view outside the cloud's box on screen, where no
-/// cloud lies in front of them. Drawn (when `redraw`) into a target of `size` pixels, then laid
-/// over the view under each callback's scissor: the viewport adds one callback per strip of the
-/// view around the box, only the first of which redraws.
+/// cloud lies in front of them (and those of the shells beyond the box, which the box's
+/// composite adds). Drawn (when `redraw`) into a target of `size` pixels, then laid over the
+/// view under each callback's scissor: the viewport adds one callback per strip of the view
+/// around the box, only the first of which redraws.
 pub struct OutsideShaftsPaint {
     /// The derived volumes (uploaded here too: the cloud's box may be out of view).
     pub volumes: Volumes,
@@ -264,6 +275,8 @@ impl RendererPaint for FillPaint {
 pub trait RendererPaint: Send + Sync + 'static {
     /// Uploads and records what the draw needs (nothing, unless implemented).
     fn prepare(&self, _renderer: &mut VolumeRenderer, _frame: FrameGpu<'_>) {}
+    /// Records what depends on every callback's `prepare` (nothing, unless implemented).
+    fn finish_prepare(&self, _renderer: &mut VolumeRenderer, _frame: FrameGpu<'_>) {}
     /// Draws into egui's render pass, clipped to the callback's rectangle.
     fn paint(&self, renderer: &VolumeRenderer, pass: &mut wgpu::RenderPass<'static>);
 }
@@ -305,6 +318,24 @@ impl<P: RendererPaint> egui_wgpu::CallbackTrait for OnRenderer<P> {
                 commands: encoder,
             };
             self.0.prepare(renderer, frame);
+        }
+        Vec::new()
+    }
+
+    fn finish_prepare(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        resources: &mut egui_wgpu::CallbackResources,
+    ) -> Vec<wgpu::CommandBuffer> {
+        if let Some(renderer) = resources.get_mut::<VolumeRenderer>() {
+            let frame = FrameGpu {
+                device,
+                queue,
+                commands: encoder,
+            };
+            self.0.finish_prepare(renderer, frame);
         }
         Vec::new()
     }

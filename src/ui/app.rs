@@ -419,7 +419,7 @@ impl CloudApp {
             .as_ref()
             .map(|(_, json)| json.as_str())
             .unwrap_or("null");
-        let view = serde_json::json!({
+        let mut view = serde_json::json!({
             "viewport": stats.viewport_px,
             "quality": quality,
             "frame_ms": stats.frame_seconds.map(|s| (s * 1000.0).round()),
@@ -482,6 +482,10 @@ impl CloudApp {
             "guide_error": self.guide.error,
             "notice": self.notices.latest.as_ref().map(|n| serde_json::json!({"text": n.text, "error": n.error})),
         });
+        // Frames drawn and volume jobs planned so far: how many a refinement or an export took.
+        view["frames"] = ctx.cumulative_frame_nr().into();
+        view["jobs"] = stats.jobs.into();
+        view["late"] = stats.late.into();
         let state = format!("{{\"scene\":{scene_json},\"view\":{view}}}");
         let status = PageStatus {
             ready: self.viewport.ready,

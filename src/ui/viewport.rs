@@ -22,8 +22,14 @@ use crate::render::viewport::{JobFence, ReportPoll};
 use crate::render::viewport::{OutsideShaftsPaint, SkyPaint, ViewportPaint, paint_callback};
 use crate::scene::Document;
 
-/// How often a viewport whose refinement waits for the GPU looks again without word from it.
-const FENCE_POLL: std::time::Duration = std::time::Duration::from_millis(100);
+/// How often a viewport whose refinement waits for the GPU looks again without word from it
+/// (the GPU's report of a chunk wakes it: this is in case none comes).
+const FENCE_POLL: std::time::Duration = std::time::Duration::from_millis(400);
+
+/// How soon a report of the GPU wakes the app. Not zero: egui answers an immediate request
+/// with two frames, and on a CPU adapter the second, which shows nothing new, took the CPU
+/// from the next chunk (a refinement drew twice the frames it needed).
+const WAKE: std::time::Duration = std::time::Duration::from_millis(1);
 
 /// The viewport's own state.
 pub struct Viewport {
@@ -231,7 +237,10 @@ impl Viewport {
             .fence
             .get_or_insert_with(|| {
                 let ctx = ui.ctx().clone();
-                let fence = JobFence::new(move || ctx.request_repaint(), super::platform::now);
+                let fence = JobFence::new(
+                    move || ctx.request_repaint_after(WAKE),
+                    super::platform::now,
+                );
                 // A fenced chunk waits for the report of the one before: where reports need
                 // polling, poll while a job is out, between frames (a report wakes the app).
                 if let Some(reports) = self.reports.clone().filter(ReportPoll::needed)
@@ -258,6 +267,8 @@ impl Viewport {
         self.stats.shown = plan.shown;
         self.stats.refining = plan.refining;
         self.stats.frame_seconds = self.progressive.last_frame_seconds();
+        self.stats.late = self.progressive.late();
+        self.stats.jobs = self.progressive.jobs();
         if plan.shown.is_some_and(|q| q.full) {
             self.ready = true;
         }
@@ -308,6 +319,7 @@ impl Viewport {
                     fence: Some(fence.clone()),
                     job_id: 0,
                     own_submission: false,
+                    crop: crate::render::FULL_VIEW,
                 },
             ));
         }
@@ -323,6 +335,8 @@ impl Viewport {
                     crop: crop.ndc(px),
                     ..view.clone()
                 },
+                // The shafts around the box hold those beyond it.
+                shells_apart: outside.is_some(),
             });
             if let Some(area) = crop_area.filter(|_| self.stats.backend.is_some()) {
                 painter.add(paint_callback(
@@ -335,10 +349,14 @@ impl Viewport {
                         fence: Some(fence),
                         job_id: plan.job_id,
                         own_submission: plan.own_submission,
+                        crop: crop.ndc(px),
                     },
                 ));
             }
         }
+        // The shafts apart from the cloud's box: around it, and those beyond it, which the
+        // box's composite adds (after every callback's `prepare`, so the callback that redraws
+        // them may come after the box's, which starts the frame's uniforms).
         if let Some(paint) = outside {
             self.outside_shafts(ui, rect, crop_area, cx.doc, paint);
         } else {
@@ -360,9 +378,9 @@ impl Viewport {
     }
 
     /// The shafts of light over the view around the cloud's box `area` (all of it without
-    /// one): one callback per strip, each under its own scissor, the first redrawing them when
-    /// the view, the light, the clouds or the size changed (or a drag began or ended: a drag
-    /// counts fewer shells).
+    /// one): one callback per strip, each under its own scissor, the first redrawing them (and
+    /// those beyond the box, which the box's composite adds) when the view, the light, the
+    /// clouds or the size changed (or a drag began or ended: a drag counts fewer shells).
     fn outside_shafts(
         &mut self,
         ui: &egui::Ui,

@@ -27,6 +27,10 @@ pub struct ViewStats {
     pub refining: Option<f32>,
     /// Interval of the last frame that drew volume work, in seconds.
     pub frame_seconds: Option<f64>,
+    /// How much longer refinements have taken than the planner's model predicted.
+    pub late: f64,
+    /// Volume jobs planned so far.
+    pub jobs: u64,
     /// Viewport size in pixels.
     pub viewport_px: [u32; 2],
     /// The last geometry update of the density volume: how many there have been, its wall time
