@@ -1,7 +1,9 @@
 // The light volume (Schpok's shadows, past the paper's per-vertex ones): at every texel of a
 // coarse grid over the cloud's box, the transmittance toward the sun through the density the
 // slices draw — the field *with its noise* (fewer octaves: `LightSlice.slice.z`) — marched in
-// steps toward the sun. One render pass per z-slice of the 3D texture (WebGL2 can render into
+// steps toward the sun (red), and how much of the sky's light the cloud above lets through
+// (green: the transmittance toward the zenith, diffuse light seeing SKY_EXTINCTION of the
+// extinction), so the sky lights tops and open sides, not bases and hollows. One render pass per z-slice of the 3D texture (WebGL2 can render into
 // 3D texture slices; it has no compute). Composed after volume_common.wgsl and
 // volume_noise.wgsl; `LightSlice` mirrors `LightSliceUniforms` in src/render/gpu_types.rs.
 
@@ -43,7 +45,32 @@ fn fs_main(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
         tau = tau + density_at(p, octaves) * h;
         p = p + dir * h;
     }
+    // The sky's light, from straight above: through the texels above this one, a step of two
+    // texels each (the same heights in every column of a parity: no jitter, and no bands
+    // between neighbouring columns either; soft light needs no finer steps), and this texel's
+    // own half step.
+    let step = 2.0 * size.y / ls.dims.y;
+    var tau_up = 0.5 * density_at(start, octaves) * step;
+    var q = start + vec3<f32>(0.0, step, 0.0);
+    let top = u.grid_min.y + size.y;
+    for (var i = 0u; i < u32(ls.dims.y); i = i + 2u) {
+        if q.y > top {
+            break;
+        }
+        tau_up = tau_up + density_at(q, octaves) * step;
+        q.y = q.y + step;
+    }
     // Stored as T^(1/8) = exp(−τ/8): 8 bits keep deep shadow (T far below 1/255) that
     // multiple scattering brings back (volume.wgsl raises it to 8·k for T^k).
-    return vec4<f32>(exp(-u.media.x * tau / 8.0), 0.0, 0.0, 1.0);
+    return vec4<f32>(
+        exp(-u.media.x * tau / 8.0),
+        exp(-SKY_EXTINCTION * u.media.x * tau_up),
+        0.0,
+        1.0,
+    );
 }
+
+// The share of the extinction the sky's diffuse light sees on its way down: it comes from the
+// whole upper hemisphere and much of it is scattered forward on through, so it reaches deeper
+// than the sun's direct beam.
+const SKY_EXTINCTION: f32 = 0.35;

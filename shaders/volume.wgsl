@@ -206,9 +206,11 @@ fn cloud_at(world: vec3<f32>) -> vec4<f32> {
     // own resolution and octaves: light_march.wgsl). Dirtiness scales the optical depth:
     // T^d = exp(−d·τ). The phase angle is between the sun's light (−sun_dir) and the light
     // going to the eye (−view_dir).
-    let t = textureSampleLevel(light_tex, clamp_smp, uvw, 0.0).r;
-    let sun = sun_light(t, dot(view_dir, u.sun_dir.xyz));
-    let light = u.sun_color.rgb * sun + u.sky_color.rgb;
+    // The sky's light comes through the cloud above (the light volume's green): bases and
+    // hollows get less of it than tops and open sides.
+    let lv = textureSampleLevel(light_tex, clamp_smp, uvw, 0.0);
+    let sun = sun_light(lv.r, dot(view_dir, u.sun_dir.xyz));
+    let light = u.sun_color.rgb * sun + u.sky_color.rgb * lv.g;
     return vec4<f32>(light * alpha, alpha);
 }
 

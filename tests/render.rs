@@ -737,7 +737,9 @@ fn a_broken_layer_casts_a_dappled_shadow_when_the_light_volume_sees_the_noise() 
     // The sun behind the camera lights the face in view (so its own relief casts little
     // shadow there); a thin, weak layer between the sun and that face, out of view above and
     // behind the camera, shades it. The noise breaks the layer into puffs and gaps, so the
-    // shadow has sunlit gaps in it, if the light volume sees the noise.
+    // shadow has sunlit gaps in it, if the light volume sees the noise. No sky light: it
+    // comes through the cloud above too, and its own detail (the relief the noise gives the
+    // face, lit from above) would be in both images.
     let scene = with(
         &Scene::preset(Preset::Empty),
         &[
@@ -749,7 +751,7 @@ fn a_broken_layer_casts_a_dappled_shadow_when_the_light_volume_sees_the_noise() 
             "/camera/distance=9",
             "/light/sun_azimuth_deg=90",
             "/light/sun_elevation_deg=35",
-            "/light/ambient=0.15",
+            "/light/ambient=0",
             "/light/multiple_scattering=0",
             "/render/noise_amount=1",
             "/render/noise_octaves=4",
@@ -1367,4 +1369,52 @@ fn the_viewport_draws_shafts_around_the_clouds_box_as_the_whole_view_draws_them(
             "{name}: the split image's 8×8 means differ by {agree:.1} at most, {mean:.2} on average (the shafts add up to {shafts:.1})"
         );
     }
+}
+
+/// Mean luminance of the nearly opaque pixels of a transparent `image` in the top and the
+/// bottom quarter of their rows.
+fn top_and_base(image: &Image) -> (f64, f64) {
+    let opaque: Vec<(u32, u32)> = (0..image.height)
+        .flat_map(|y| (0..image.width).map(move |x| (x, y)))
+        .filter(|&(x, y)| image.pixel(x, y)[3] >= 250)
+        .collect();
+    let (y0, y1) = opaque
+        .iter()
+        .fold((u32::MAX, 0), |(a, b), &(_, y)| (a.min(y), b.max(y)));
+    let quarter = (y1 - y0) / 4;
+    let mean = |rows: std::ops::RangeInclusive<u32>| {
+        let v: Vec<f64> = opaque
+            .iter()
+            .filter(|(_, y)| rows.contains(y))
+            .map(|&(x, y)| luminance(image.pixel(x, y)))
+            .collect();
+        v.iter().sum::<f64>() / v.len().max(1) as f64
+    };
+    (mean(y0..=y0 + quarter), mean(y1 - quarter..=y1))
+}
+
+#[test]
+fn the_sky_lights_the_clouds_top_and_the_cloud_hides_it_from_its_base() {
+    // The sky's light alone (no sun): it comes from above, through the cloud, so the base of
+    // a cumulus gets far less of it than its top. An ambient term added everywhere alike (as
+    // this renderer had) lights both the same. With the sun too, the base stays the darker.
+    let transparent = |s: &Scene| {
+        offscreen()
+            .render(s, W, H, Backdrop::Transparent)
+            .expect("render")
+    };
+    let scene = Scene::default();
+    let sky_only = with(&scene, &["/light/sun_intensity=0", "/light/ambient=1.5"]);
+    let (top, base) = top_and_base(&transparent(&sky_only));
+    assert!(top > 40.0, "the sky lights the top: {top:.1}");
+    assert!(
+        base < 0.8 * top,
+        "under the sky alone the base ({base:.1}) is far darker than the top ({top:.1})"
+    );
+    let (top, base) = top_and_base(&transparent(&scene));
+    eprintln!(
+        "default light: base {base:.1}, top {top:.1}, ratio {:.2}",
+        base / top
+    );
+    assert!(base < top, "default light: base {base:.1}, top {top:.1}");
 }

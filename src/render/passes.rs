@@ -577,8 +577,9 @@ pub struct LightPass {
     stride: u64,
 }
 
-/// The light volume's format: transmittance in [0, 1], renderable and filterable everywhere.
-pub const LIGHT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R8Unorm;
+/// The light volume's format: transmittance toward the sun (stored as T^(1/8)) and the sky's light
+/// let through from above, in [0, 1]; renderable and filterable everywhere.
+pub const LIGHT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg8Unorm;
 
 impl LightPass {
     /// Creates the pass.

@@ -101,7 +101,7 @@ impl VolumeRenderer {
             "light placeholder",
             [1, 1, 1],
             LIGHT_FORMAT,
-            &[255],
+            &[255, 255],
         );
         let clamp_sampler = sampler(device, wgpu::AddressMode::ClampToEdge);
         Self {
