@@ -1324,16 +1324,19 @@ fn the_viewport_draws_shafts_around_the_clouds_box_as_the_whole_view_draws_them(
     // the rest of the view apart, at a quarter of the size: the same image as the whole view
     // drawn with every shell among the slices, within the shafts' grain. The baseline: the
     // shafts off, which the split image must not resemble where the air is lit.
-    for (name, scene) in [
-        ("behind", shafts_behind_a_cloud()),
-        ("default", Scene::default()),
+    // With a sky (the ground) its pass lays the shafts around the box; over a flat background
+    // the strips' own composites do.
+    for (name, scene, ground) in [
+        ("behind", shafts_behind_a_cloud(), true),
+        ("default", Scene::default(), true),
+        ("flat", Scene::default(), false),
     ] {
         let on = with(
             &scene,
             &[
                 "/light/shafts=true",
                 "/light/shaft_density=0.004",
-                "/light/ground=true",
+                &format!("/light/ground={ground}"),
             ],
         );
         let whole = render(&on);

@@ -215,6 +215,9 @@ pub struct OutsideShaftsPaint {
     pub size: [u32; 2],
     /// Whether this callback draws the shafts (the view changed) or only lays them.
     pub redraw: bool,
+    /// Whether it lays them (not where the box covers the whole view: it only draws those
+    /// beyond the box, for the box's composite).
+    pub lay: bool,
 }
 
 impl RendererPaint for OutsideShaftsPaint {
@@ -233,7 +236,9 @@ impl RendererPaint for OutsideShaftsPaint {
     }
 
     fn paint(&self, renderer: &VolumeRenderer, pass: &mut wgpu::RenderPass<'static>) {
-        renderer.composite_outside_shafts(pass, false);
+        if self.lay {
+            renderer.composite_outside_shafts(pass, false);
+        }
     }
 }
 

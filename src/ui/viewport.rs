@@ -229,6 +229,7 @@ impl Viewport {
                 },
                 size: px.map(|v| v.div_ceil(OUTSIDE_SHAFTS_DIVISOR * if dragging { 2 } else { 1 })),
                 redraw: false,
+                lay: true,
             });
         let key = view_key(cx.doc, px, crop.map(|c| c.px));
         let now = ui.input(|i| i.time);
@@ -381,6 +382,8 @@ impl Viewport {
     /// one): one callback per strip, each under its own scissor, the first redrawing them (and
     /// those beyond the box, which the box's composite adds) when the view, the light, the
     /// clouds or the size changed (or a drag began or ended: a drag counts fewer shells).
+    /// Where the box covers the whole view, one callback that only redraws them: the box's
+    /// composite still adds those beyond it.
     fn outside_shafts(
         &mut self,
         ui: &egui::Ui,
@@ -389,10 +392,6 @@ impl Viewport {
         doc: &Document,
         paint: OutsideShaftsPaint,
     ) {
-        let strips = strips_around(rect, area);
-        if strips.is_empty() {
-            return;
-        }
         let key = {
             use std::hash::{Hash, Hasher};
             let mut h = std::collections::hash_map::DefaultHasher::new();
@@ -401,6 +400,18 @@ impl Viewport {
         };
         let redraw = self.outside_key != Some(key);
         self.outside_key = Some(key);
+        let strips = strips_around(rect, area);
+        if strips.is_empty() {
+            ui.painter_at(rect).add(paint_callback(
+                rect,
+                OutsideShaftsPaint {
+                    redraw,
+                    lay: false,
+                    ..paint
+                },
+            ));
+            return;
+        }
         for (k, strip) in strips.into_iter().enumerate() {
             ui.painter_at(strip).add(paint_callback(
                 rect,

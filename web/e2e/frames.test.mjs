@@ -148,12 +148,14 @@ for (const backend of ['webgpu', 'webgl2']) {
         await waitForBody(page, 'data-quality', (v) => typeof v === 'string' && v.startsWith('preview'), 3_000).catch(() => {});
         const before = (await state(page)).view;
         const orbit = await waitForFullQuality(page, 60_000);
-        // One frame per refinement chunk (and a few for the preview and the notices): an
+        // One frame per refinement chunk (and a few for the preview and the notices, and one
+        // per 0.4 s in which no chunk's report came, where the viewport looks again): an
         // immediate repaint request gets two frames from egui, and the second, which showed
         // nothing new, took the CPU adapter from the next chunk.
         const after = (await state(page)).view;
         const [frames, jobs] = [after.frames - before.frames, after.jobs - before.jobs];
-        assert.ok(jobs > 1 && frames <= jobs + 4, `${frames} frames for ${jobs} volume jobs`);
+        const polls = Math.floor(orbit.seconds / 0.4);
+        assert.ok(jobs > 1 && frames <= jobs + 4 + polls, `${frames} frames for ${jobs} volume jobs in ${orbit.seconds} s`);
         orbit.frames = frames;
         orbit.jobs = jobs;
         await page.keyboard.press('d');
