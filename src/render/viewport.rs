@@ -307,6 +307,26 @@ pub fn paint_callback(rect: egui::Rect, paint: impl RendererPaint) -> egui::Pain
 /// resources.
 struct OnRenderer<P>(P);
 
+/// Runs `f` on the renderer among `resources` (nothing, before it exists) with the frame's GPU.
+fn on_renderer(
+    resources: &mut egui_wgpu::CallbackResources,
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    commands: &mut wgpu::CommandEncoder,
+    f: impl FnOnce(&mut VolumeRenderer, FrameGpu<'_>),
+) {
+    if let Some(renderer) = resources.get_mut::<VolumeRenderer>() {
+        f(
+            renderer,
+            FrameGpu {
+                device,
+                queue,
+                commands,
+            },
+        );
+    }
+}
+
 impl<P: RendererPaint> egui_wgpu::CallbackTrait for OnRenderer<P> {
     fn prepare(
         &self,
@@ -316,14 +336,9 @@ impl<P: RendererPaint> egui_wgpu::CallbackTrait for OnRenderer<P> {
         encoder: &mut wgpu::CommandEncoder,
         resources: &mut egui_wgpu::CallbackResources,
     ) -> Vec<wgpu::CommandBuffer> {
-        if let Some(renderer) = resources.get_mut::<VolumeRenderer>() {
-            let frame = FrameGpu {
-                device,
-                queue,
-                commands: encoder,
-            };
-            self.0.prepare(renderer, frame);
-        }
+        on_renderer(resources, device, queue, encoder, |r, frame| {
+            self.0.prepare(r, frame)
+        });
         Vec::new()
     }
 
@@ -334,14 +349,9 @@ impl<P: RendererPaint> egui_wgpu::CallbackTrait for OnRenderer<P> {
         encoder: &mut wgpu::CommandEncoder,
         resources: &mut egui_wgpu::CallbackResources,
     ) -> Vec<wgpu::CommandBuffer> {
-        if let Some(renderer) = resources.get_mut::<VolumeRenderer>() {
-            let frame = FrameGpu {
-                device,
-                queue,
-                commands: encoder,
-            };
-            self.0.finish_prepare(renderer, frame);
-        }
+        on_renderer(resources, device, queue, encoder, |r, frame| {
+            self.0.finish_prepare(r, frame)
+        });
         Vec::new()
     }
 
