@@ -165,12 +165,14 @@ pub const TORQUE: Param = Param::linear(
     90.0,
     0.0,
 );
-/// Texels along the longest side of the light volume (transmittance toward the sun).
+/// Texels along the longest side of the light volume (transmittance toward the sun and the
+/// sky's light let through from above), up to the light pass's
+/// 128 slices (`MAX_LIGHT_SLICES` in `render::passes`).
 pub const LIGHT_RESOLUTION: Param = Param::linear(
     "light grid",
-    "Resolution of the light volume the shadows come from: finer shows smaller shadow detail, costs more whenever the light, the shape or the moving noise changes",
+    "Resolution of the light volume the shadows and the sky's light come from: finer shows smaller shadow detail, costs more whenever the light, the shape or the moving noise changes",
     8.0,
-    96.0,
+    128.0,
     24.0,
 );
 /// Noise octaves the light volume sees.
