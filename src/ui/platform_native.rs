@@ -174,6 +174,9 @@ pub fn save_png(path: &str, width: u32, height: u32, rgba: Vec<u8>) -> Result<St
 /// No picker natively: Open reads the path typed in the File group.
 pub fn open_scene_picker() {}
 
+/// Whether Ctrl+O's picker is opened by a key listener of the platform's own (no picker here).
+pub const KEY_OPENS_PICKER: bool = false;
+
 /// Scene files picked with Open (none natively: Open reads the typed path at once).
 pub fn take_scene_files() -> Vec<Loaded> {
     Vec::new()

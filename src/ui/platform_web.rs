@@ -306,6 +306,11 @@ pub fn save_png(name: &str, width: u32, height: u32, rgba: Vec<u8>) -> Result<St
     Ok(format!("{name} (a download)"))
 }
 
+/// Whether Ctrl+O's picker is opened by the page's own key listener, in the key's event: from
+/// the app's frame after it, the browser refused it where that frame came late (its user
+/// activation lapses), and the key did nothing (a page test on a busy machine).
+pub const KEY_OPENS_PICKER: bool = true;
+
 /// Opens the browser's file picker for a scene file (called from a click or a key, so the
 /// browser allows it).
 pub fn open_scene_picker() {
@@ -319,7 +324,8 @@ pub fn open_scene_picker() {
 /// take 150 ms, so a stroke drawn from the per-frame moves alone loses its shape.
 /// Keeps the browser from acting on the app's own Ctrl/Cmd shortcuts that eframe lets through:
 /// Ctrl+D (duplicate) would open the bookmark dialog, Ctrl+S save the page, Ctrl+O open a
-/// file in the tab, Ctrl+L go to the address bar. Text fields keep every key.
+/// file in the tab, Ctrl+L go to the address bar. Text fields keep every key. Ctrl+O opens the
+/// scene picker here, in the key's own event ([`KEY_OPENS_PICKER`]).
 fn keep_browser_shortcuts() {
     let Some(document) = web_sys::window().and_then(|w| w.document()) else {
         return;
@@ -336,6 +342,9 @@ fn keep_browser_shortcuts() {
             .any(|k| e.key().eq_ignore_ascii_case(k));
         if !typing && (e.ctrl_key() || e.meta_key()) && ours {
             e.prevent_default();
+            if e.key().eq_ignore_ascii_case("o") && !e.shift_key() && !e.alt_key() && !e.repeat() {
+                open_scene_picker();
+            }
         }
     });
     // In the capture phase: eframe stops the event's propagation at the canvas.

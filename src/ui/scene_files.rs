@@ -172,6 +172,10 @@ impl SceneFiles {
     }
 
     fn ask_to_open(&mut self, notices: &mut Notices, now: f64) {
+        if platform::KEY_OPENS_PICKER {
+            // Opened already, in the key's own event.
+            return;
+        }
         if platform::HAS_PICKER {
             platform::open_scene_picker();
         } else {
