@@ -57,8 +57,35 @@ pub struct VolumeRenderer {
     /// Where a cropped target lies in the whole view, for its composite (xy + uv · zw).
     beyond_place: wgpu::Buffer,
     /// The composite group of a cropped target with the shafts beyond the box (see
-    /// [`VolumeRenderer::prepare_cropped_composite`]), and the target's index.
-    beyond: Option<(usize, wgpu::BindGroup)>,
+    /// [`VolumeRenderer::prepare_cropped_composite`]).
+    beyond: Option<BeyondComposite>,
+}
+
+/// A cropped target's composite group with the shafts beyond the box, and what it was made
+/// for: made again only when one of these changes (not on every frame).
+struct BeyondComposite {
+    index: usize,
+    crop: [f32; 4],
+    /// The target's two textures and the outside shafts' first.
+    views: [wgpu::TextureView; 3],
+    group: wgpu::BindGroup,
+}
+
+/// Draws a full-screen composite with `group`: the `transparent` pipeline of the pair over a
+/// transparent image, else the `opaque` one.
+fn lay(
+    pass: &mut wgpu::RenderPass<'_>,
+    [opaque, transparent_pipeline]: [&wgpu::RenderPipeline; 2],
+    transparent: bool,
+    group: &wgpu::BindGroup,
+) {
+    pass.set_pipeline(if transparent {
+        transparent_pipeline
+    } else {
+        opaque
+    });
+    pass.set_bind_group(0, group, &[]);
+    pass.draw(0..3, 0..1);
 }
 
 /// The light volume on the GPU. Each z-slice is rendered into `slice` (2D) and copied into
@@ -556,13 +583,13 @@ impl VolumeRenderer {
             ..
         }) = &self.outside
         {
-            pass.set_pipeline(if transparent {
-                &self.composite.shafts_transparent_pipeline
-            } else {
-                &self.composite.shafts_pipeline
-            });
-            pass.set_bind_group(0, group, &[]);
-            pass.draw(0..3, 0..1);
+            let c = &self.composite;
+            lay(
+                pass,
+                [&c.shafts_pipeline, &c.shafts_transparent_pipeline],
+                transparent,
+                group,
+            );
         }
     }
 
@@ -902,8 +929,8 @@ impl VolumeRenderer {
         index: usize,
         crop: [f32; 4],
     ) {
-        self.beyond = None;
         let Some(Target { view: beyond, .. }) = &self.outside else {
+            self.beyond = None;
             return;
         };
         let Some(Target {
@@ -913,8 +940,17 @@ impl VolumeRenderer {
             ..
         }) = self.targets.get(index).and_then(|t| t.as_ref())
         else {
+            self.beyond = None;
             return;
         };
+        let views = [source.clone(), shafts.clone(), beyond.clone()];
+        if self
+            .beyond
+            .as_ref()
+            .is_some_and(|b| b.index == index && b.crop == crop && b.views == views)
+        {
+            return;
+        }
         // NDC (y up) to texture coordinates (y down).
         let [x0, y0, x1, y1] = crop;
         let place = [
@@ -930,7 +966,12 @@ impl VolumeRenderer {
             &self.clamp_sampler,
             &self.beyond_place,
         );
-        self.beyond = Some((index, group));
+        self.beyond = Some(BeyondComposite {
+            index,
+            crop,
+            views,
+            group,
+        });
     }
 
     /// Draws accumulation target `index` of a cropped view as
@@ -943,16 +984,14 @@ impl VolumeRenderer {
         index: usize,
         transparent: bool,
     ) {
+        let c = &self.composite;
         match &self.beyond {
-            Some((i, group)) if *i == index => {
-                pass.set_pipeline(if transparent {
-                    &self.composite.beyond_transparent_pipeline
-                } else {
-                    &self.composite.beyond_pipeline
-                });
-                pass.set_bind_group(0, group, &[]);
-                pass.draw(0..3, 0..1);
-            }
+            Some(b) if b.index == index => lay(
+                pass,
+                [&c.beyond_pipeline, &c.beyond_transparent_pipeline],
+                transparent,
+                &b.group,
+            ),
             _ => self.composite(pass, index, transparent),
         }
     }
@@ -963,20 +1002,15 @@ impl VolumeRenderer {
         let Some(target) = self.targets.get(index).and_then(|t| t.as_ref()) else {
             return;
         };
+        let c = &self.composite;
         match &target.shafts {
-            Some((_, group)) if target.has_shafts => {
-                pass.set_pipeline(if transparent {
-                    &self.composite.shafts_transparent_pipeline
-                } else {
-                    &self.composite.shafts_pipeline
-                });
-                pass.set_bind_group(0, group, &[]);
-            }
-            _ => {
-                pass.set_pipeline(&self.composite.pipeline);
-                pass.set_bind_group(0, &target.composite, &[]);
-            }
+            Some((_, group)) if target.has_shafts => lay(
+                pass,
+                [&c.shafts_pipeline, &c.shafts_transparent_pipeline],
+                transparent,
+                group,
+            ),
+            _ => lay(pass, [&c.pipeline, &c.pipeline], false, &target.composite),
         }
-        pass.draw(0..3, 0..1);
     }
 }
