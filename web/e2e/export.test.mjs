@@ -30,9 +30,20 @@ function parseGlb(bytes) {
  */
 async function revealAtFoot(page, name) {
   const [vw, vh] = (await state(page)).view.viewport;
+  const same = (a, b) => a && b && a.every((v, k) => v === b[k]);
   for (let i = 0; i < 30; i++) {
-    const r = (await state(page)).view.widgets[name];
-    if (r && r[1] >= 2 && r[1] + r[3] <= vh - 2) return r;
+    const before = await state(page);
+    const r = before.view.widgets[name];
+    if (r && r[1] >= 2 && r[1] + r[3] <= vh - 2) {
+      // Only where a frame drawn after it shows the widget in the same place: on a busy
+      // machine the state read after a wheel may be the frame before the scroll, and the
+      // click then landed on whatever the scroll had moved there.
+      // (a pointer move over the panel asks for a frame).
+      await page.mouse.move(vw + 100 + (i % 2), vh / 2);
+      const after = await until(page, (s) => s.view.frames > before.view.frames, 'a frame', 10_000).catch(() => null);
+      if (after && same(after.view.widgets[name], r)) return r;
+      continue;
+    }
     await page.mouse.move(vw + 100, vh / 2);
     await page.mouse.wheel(0, r && r[1] < 10 ? -200 : 200);
     await page.waitForTimeout(150);
