@@ -362,6 +362,34 @@ pub const BLEND: Param = Param::linear(
     0.4,
 );
 
+/// Billows: levels of puffs on puffs (Bouthors & Neyret 2004).
+pub const BILLOW_LEVELS: Param = Param::linear(
+    "billow levels",
+    "Levels of smaller puffs on the surface of larger ones: the cauliflower of a cumulus (0: a smooth body)",
+    0.0,
+    4.0,
+    3.0,
+);
+/// Billows: each level's puff size over the size of what it sits on.
+pub const BILLOW_RATIO: Param = Param::linear(
+    "billow size",
+    "How large each level's puffs are next to the puff they sit on",
+    0.25,
+    0.6,
+    0.45,
+);
+/// Billows: the share of each puff's surface the next level covers.
+pub const BILLOW_COVERAGE: Param = Param::linear(
+    "billow coverage",
+    "How much of each puff's surface the next, smaller puffs cover",
+    0.0,
+    1.0,
+    0.8,
+);
+/// Most puffs the billows of one document make; a document asking for more gets fewer levels
+/// (and a message).
+pub const MAX_PUFFS: usize = 16_000;
+
 /// The cores work may be shared out among: the machine's (1 where threads are not available,
 /// as in the browser). Asked once: on Linux the answer reads cgroup files, tens of µs, which
 /// is a few percent of an automaton step.
@@ -394,6 +422,9 @@ mod tests {
             INFLATE,
             COPIES,
             BLEND,
+            BILLOW_LEVELS,
+            BILLOW_RATIO,
+            BILLOW_COVERAGE,
             SHARPNESS,
             DIRTINESS,
             WIND,

@@ -4,10 +4,12 @@
 //! renderer's GPU light volume). Everything here is a deterministic function of the document;
 //! the renderer, the CLI, the exporters and the app all consume [`Volumes`].
 
+mod billows;
 mod planes;
 
 use std::sync::Arc;
 
+pub use billows::{PuffCache, min_radius};
 pub use planes::{PlaneCache, Shape};
 
 use crate::field::{
@@ -56,6 +58,9 @@ pub struct Work {
     pub bake_work: u64,
     /// Texels re-evaluated by all bakes (a partial update copies the others).
     pub baked_texels: u64,
+    /// Primitives whose billows were grown (a billowed primitive whose shape and billows did
+    /// not change keeps its puffs).
+    pub puff_growths: u64,
 }
 
 /// The planes' drawing-plane placement applied to their shapes: the field of a document.
@@ -69,6 +74,7 @@ fn assemble(scene: &Scene, shapes: &[Arc<Shape>]) -> Field {
             .collect(),
         groups: Vec::new(),
         clips: Vec::new(),
+        puffs_left_out: 0,
     };
     field.blobs.truncate(MAX_PRIMITIVES);
     let mut budget = MAX_PRIMITIVES.saturating_sub(field.blobs.len());
@@ -117,10 +123,17 @@ fn clip(plane: &DrawingPlane, line: Vec<glam::Vec2>) -> Clip {
 /// and the change returned in words; when even that is over, the document is refused.
 pub fn check_cost(scene: &mut Scene) -> Result<Option<String>, String> {
     let field = field_of(scene);
+    let left_out = (field.puffs_left_out > 0).then(|| {
+        format!(
+            "billows: the finest level of puffs is left out ({} puffs over the cap of {})",
+            field.puffs_left_out,
+            crate::limits::MAX_PUFFS
+        )
+    });
     let wanted = scene.render.field_resolution;
     let work = bake_work(&field, wanted);
     if work <= MAX_BAKE_WORK {
-        return Ok(None);
+        return Ok(left_out);
     }
     let (fits, fitted_work) = resolution_within(&field, wanted, MAX_BAKE_WORK);
     if fits < MIN_LOADED_GRID.min(wanted) || fitted_work > MAX_BAKE_WORK {
@@ -135,9 +148,13 @@ pub fn check_cost(scene: &mut Scene) -> Result<Option<String>, String> {
         ));
     }
     scene.render.field_resolution = fits;
-    Ok(Some(format!(
+    let coarser = format!(
         "/render/field_resolution: {wanted} → {fits}, so the scene builds in about a second"
-    )))
+    );
+    Ok(Some(match left_out {
+        Some(puffs) => format!("{coarser}; {puffs}"),
+        None => coarser,
+    }))
 }
 
 /// The field a document describes, derived from scratch (no cache).
@@ -155,6 +172,7 @@ struct GeometryKey {
 #[derive(Default)]
 pub struct Derived {
     planes: PlaneCache,
+    puffs: PuffCache,
     field: Option<(u64, Arc<Field>)>,
     density: Option<(GeometryKey, Versioned<DensityVolume>)>,
     baker: Baker,
@@ -178,7 +196,10 @@ impl Derived {
         }
         let shapes = self.planes.shapes(&scene.planes);
         self.work.interpretations = self.planes.interpretations();
-        let field = Arc::new(assemble(scene, &shapes));
+        let mut field = assemble(scene, &shapes);
+        self.puffs.add(scene, &shapes, &mut field);
+        self.work.puff_growths = self.puffs.grown_count;
+        let field = Arc::new(field);
         if let Some(rev) = revision {
             self.field = Some((rev, field.clone()));
         }

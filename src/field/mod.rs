@@ -7,6 +7,7 @@
 //! surface is the iso-level [`ISO`] = 0.5, and w(1/4) = 0.5 exactly, so an isolated primitive of
 //! visible radius r gets R = 2r: its surface lies exactly at r.
 
+pub mod billows;
 mod inside;
 pub mod media;
 pub mod noise;
@@ -363,6 +364,8 @@ pub struct Field {
     pub groups: Vec<Group>,
     /// Hard clips.
     pub clips: Vec<Clip>,
+    /// Puffs of billows the document asked for but the cap left out (the finest levels).
+    pub puffs_left_out: usize,
 }
 
 impl Field {
@@ -585,6 +588,7 @@ mod tests {
             blobs: vec![Blob::sphere(Vec3::ZERO, 1.0)],
             groups: vec![],
             clips: vec![clip],
+            ..Default::default()
         };
         assert!(!f.inside(Vec3::new(0.0, -0.5, 0.0)));
         assert!(f.inside(Vec3::new(0.0, 0.5, 0.0)));

@@ -897,6 +897,7 @@ mod tests {
                 up: Vec3::Y,
                 line: vec![glam::Vec2::new(-1.0, -1.2), glam::Vec2::new(1.0, -1.2)],
             }],
+            ..Default::default()
         };
         let v = bake(&f, 24);
         let h = v.texel_size();
@@ -978,6 +979,7 @@ mod tests {
                 inside: None,
             }],
             clips: vec![clip],
+            ..Default::default()
         };
         let mut baker = Baker::default();
         let first = baker.update(&Arc::new(field.clone()), 64, u64::MAX);
@@ -1182,6 +1184,7 @@ mod tests {
                 },
             ],
             clips: vec![],
+            ..Default::default()
         };
         let (worst, _) = bake_error(&f, 40);
         assert!(worst < 1e-5, "{worst}");
@@ -1232,6 +1235,7 @@ mod tests {
                 blobs,
                 groups: vec![],
                 clips: vec![],
+                ..Default::default()
             };
             let (worst, peak) = bake_error(&f, 96);
             assert!(peak > 0.5, "nothing baked");

@@ -64,6 +64,7 @@ pub fn describe_change(from: &Scene, to: &Scene, label: &str) -> String {
                 ("rotate", a.rotation != b.rotation),
                 ("scale", a.radii != b.radii),
                 ("change the strength of", a.strength != b.strength),
+                ("change the billows of", a.billows != b.billows),
                 (if b.hidden { "hide" } else { "show" }, a.hidden != b.hidden),
             ]
         },
@@ -84,6 +85,7 @@ pub fn describe_change(from: &Scene, to: &Scene, label: &str) -> String {
                     "change",
                     a.sketch != b.sketch || a.name != b.name || a.seed != b.seed,
                 ),
+                ("change the billows of", a.billows != b.billows),
                 (if b.hidden { "hide" } else { "show" }, a.hidden != b.hidden),
             ]
         },
@@ -116,7 +118,7 @@ fn list_change<T: PartialEq>(
     from: &[Arc<T>],
     to: &[Arc<T>],
     (one, many): (&str, &str),
-    kinds: impl Fn(&T, &T) -> [(&'static str, bool); 5],
+    kinds: impl Fn(&T, &T) -> [(&'static str, bool); 6],
 ) -> Option<String> {
     let count = |n: usize| {
         if n == 1 {

@@ -3,6 +3,7 @@
 //! Plain serde data, versioned, with no GPU or UI types. Everything the app shows (the
 //! blended field, sphere primitives, GPU buffers) is derived from it deterministically.
 
+mod billows;
 mod camera;
 mod capped;
 mod document;
@@ -14,6 +15,7 @@ mod presets;
 mod reference;
 
 pub use crate::limits::{MAX_ELLIPSOIDS, MAX_PLANE_POINTS, MAX_PLANES};
+pub use billows::Billows;
 pub use camera::{OrbitCamera, Ray, StandardView};
 pub use document::{Document, Revisions};
 pub use edit::Edit;
@@ -35,7 +37,9 @@ use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
 /// Version written by this build. Older documents are upgraded on load; newer ones are refused.
-pub const SCENE_VERSION: u32 = 1;
+/// Version 2 added billows and stable ids to ellipsoids and drawing planes (a version 1
+/// document has no billows, and its primitives get ids in order when it is read).
+pub const SCENE_VERSION: u32 = 2;
 
 /// Errors when reading a scene document.
 #[derive(Debug, thiserror::Error)]
@@ -195,7 +199,42 @@ impl Scene {
             repairs.truncate(SHOWN);
             repairs.push(format!("and {more} more values repaired"));
         }
+        // Ids are given, not repaired: a document from before them gets them silently.
+        self.assign_ids();
         Ok(repairs)
+    }
+
+    /// Gives every ellipsoid and drawing plane without an id (0), or with one an earlier
+    /// primitive already holds, a fresh id: one more than the largest in the document, in
+    /// document order (ellipsoids first), so the same document always gets the same ids.
+    pub fn assign_ids(&mut self) {
+        let mut next = self
+            .ellipsoids
+            .iter()
+            .map(|e| e.id)
+            .chain(self.planes.iter().map(|p| p.id))
+            .max()
+            .unwrap_or(0);
+        let mut seen = std::collections::HashSet::new();
+        let mut fresh = |id: u64| {
+            if id != 0 && seen.insert(id) {
+                None
+            } else {
+                next += 1;
+                seen.insert(next);
+                Some(next)
+            }
+        };
+        for e in &mut self.ellipsoids {
+            if let Some(id) = fresh(e.id) {
+                Arc::make_mut(e).id = id;
+            }
+        }
+        for p in &mut self.planes {
+            if let Some(id) = fresh(p.id) {
+                Arc::make_mut(p).id = id;
+            }
+        }
     }
 
     fn check_and_repair(&mut self) -> Result<(), SceneError> {
@@ -224,6 +263,11 @@ impl Scene {
         for e in &mut self.ellipsoids {
             if let Some(r) = unit_rotation(e.rotation) {
                 Arc::make_mut(e).rotation = r;
+            }
+            let mut billows = e.billows;
+            billows.sanitize();
+            if billows != e.billows {
+                Arc::make_mut(e).billows = billows;
             }
         }
         if self.planes.len() > MAX_PLANES {
@@ -272,6 +316,18 @@ pub struct Ellipsoid {
     pub strength: f32,
     /// Hidden: kept in the document, left out of the cloud.
     pub hidden: bool,
+    /// Stable id, unique among the document's ellipsoids and planes (0: not yet given one;
+    /// [`Scene::assign_ids`]). Seeds the billows, so a primitive keeps its puffs when others
+    /// are added or removed.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub id: u64,
+    /// Puffs on its surface.
+    #[serde(skip_serializing_if = "Billows::is_off")]
+    pub billows: Billows,
+}
+
+fn is_zero(v: &u64) -> bool {
+    *v == 0
 }
 
 impl Default for Ellipsoid {
@@ -289,6 +345,16 @@ impl Ellipsoid {
             rotation: Quat::IDENTITY,
             strength: 1.0,
             hidden: false,
+            id: 0,
+            billows: Billows::default(),
+        }
+    }
+
+    /// This ellipsoid with billows as a new one gets ([`Billows::NEW`]).
+    pub fn billowed(self) -> Self {
+        Self {
+            billows: Billows::NEW,
+            ..self
         }
     }
 }

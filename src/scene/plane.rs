@@ -4,6 +4,7 @@
 use glam::{DVec2, Quat, Vec2, Vec3};
 use serde::{Deserialize, Serialize};
 
+use super::Billows;
 use crate::limits::MAX_PLANE_POINTS;
 use crate::sketch::SketchParams;
 
@@ -50,6 +51,17 @@ pub struct DrawingPlane {
     pub pressure: Vec<f32>,
     /// Hidden: kept in the document, left out of the cloud (its stroke is drawn faintly).
     pub hidden: bool,
+    /// Stable id, unique among the document's ellipsoids and planes (0: not yet given one;
+    /// [`super::Scene::assign_ids`]). Seeds the billows.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub id: u64,
+    /// Puffs on the outline's spheres.
+    #[serde(skip_serializing_if = "Billows::is_off")]
+    pub billows: Billows,
+}
+
+fn is_zero(v: &u64) -> bool {
+    *v == 0
 }
 
 impl Default for DrawingPlane {
@@ -65,6 +77,8 @@ impl Default for DrawingPlane {
             seed: 1,
             pressure: Vec::new(),
             hidden: false,
+            id: 0,
+            billows: Billows::default(),
         }
     }
 }
@@ -179,6 +193,7 @@ impl DrawingPlane {
             *v = if v.is_nan() { 0.5 } else { v.clamp(0.0, 1.0) };
         }
         self.sketch.sanitize();
+        self.billows.sanitize();
         Ok(())
     }
 }

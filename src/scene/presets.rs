@@ -124,6 +124,11 @@ fn cumulonimbus() -> Vec<Ellipsoid> {
 
 /// Each preset's camera, light and media by name: the values an artist tunes, kept as data
 /// (what a preset leaves out keeps its default).
+/// The presets of heaped clouds carry billows, as new ellipsoids do.
+fn billowed(ellipsoids: Vec<Ellipsoid>) -> Vec<Ellipsoid> {
+    ellipsoids.into_iter().map(Ellipsoid::billowed).collect()
+}
+
 const STAGING: &str = include_str!("presets.json");
 
 /// A preset's camera, light and media, as [`STAGING`] gives them.
@@ -162,11 +167,11 @@ impl Scene {
         let mut simulation = None;
         let mut time = 0.0;
         let ellipsoids = match preset {
-            Preset::Cumulus => cumulus(),
+            Preset::Cumulus => billowed(cumulus()),
             Preset::Stratus => layer(28, 30.0, 10.0, 3.0, Vec3::new(3.2, 0.7, 2.6), 11),
             Preset::Cirrus => layer(9, 22.0, 12.0, 9.0, Vec3::new(6.0, 0.35, 0.9), 23),
-            Preset::Cumulonimbus => cumulonimbus(),
-            Preset::Sunset => layer(14, 20.0, 8.0, 3.5, Vec3::new(2.6, 1.3, 2.2), 37),
+            Preset::Cumulonimbus => billowed(cumulonimbus()),
+            Preset::Sunset => billowed(layer(14, 20.0, 8.0, 3.5, Vec3::new(2.6, 1.3, 2.2), 37)),
             Preset::Empty => Vec::new(),
             Preset::Simulated => {
                 simulation = Some(Arc::new(crate::simulate::Settings::default()));
@@ -182,7 +187,7 @@ impl Scene {
                 .collect()
             }
         };
-        Scene {
+        let mut scene = Scene {
             version: SCENE_VERSION,
             seed: 1,
             camera,
@@ -193,7 +198,9 @@ impl Scene {
             reference: None,
             time,
             simulation,
-        }
+        };
+        scene.assign_ids();
+        scene
     }
 }
 

@@ -56,6 +56,7 @@ pub fn hand_drawn() -> Scene {
         plane.snap_to_grid();
         scene.planes.push(std::sync::Arc::new(plane));
     }
+    scene.assign_ids();
     scene
 }
 
@@ -140,12 +141,17 @@ pub fn every_part() -> Scene {
         p.hidden = true;
         p.sketch.inflate = 0.6;
         p.sketch.blend = 0.25;
+        p.billows = crate::scene::Billows::NEW;
     }
     scene.ellipsoids = vec![
-        Arc::new(Ellipsoid::new(
-            Vec3::new(0.0, 1.0, 0.0),
-            Vec3::new(4.0, 2.0, 3.0),
-        )),
+        Arc::new(Ellipsoid {
+            billows: crate::scene::Billows {
+                levels: 2,
+                ratio: 0.4,
+                coverage: 0.6,
+            },
+            ..Ellipsoid::new(Vec3::new(0.0, 1.0, 0.0), Vec3::new(4.0, 2.0, 3.0))
+        }),
         Arc::new(Ellipsoid {
             rotation: Quat::from_rotation_z(0.4),
             strength: -0.5,
@@ -163,5 +169,6 @@ pub fn every_part() -> Scene {
         in_front: true,
         ..Default::default()
     }));
+    scene.assign_ids();
     scene
 }

@@ -33,8 +33,9 @@ use crate::scene::{
 
 /// Format version written by this build; older ones keep opening (see docs/scene-format.md).
 /// Version 2 is version 1 on a newer base (the ground's default height moved from 0 to -5):
-/// the payload's layout is the same.
-pub const LINK_VERSION: u8 = 2;
+/// the payload's layout is the same. Version 3 is the same again on the base of scene format 2
+/// (billows and stable ids; a primitive's billows and id are written where it has them).
+pub const LINK_VERSION: u8 = 3;
 
 /// Longest token accepted or written (characters after `#s=`). Browsers take URLs of
 /// megabytes, but mail and chat tools cut them far sooner.
@@ -235,6 +236,7 @@ impl Bases {
 const BASES: [&str; LINK_VERSION as usize] = [
     include_str!("link/base_v1.json"),
     include_str!("link/base_v2.json"),
+    include_str!("link/base_v3.json"),
 ];
 
 /// The base of link format `version` (1 to [`LINK_VERSION`]; others take the current one).

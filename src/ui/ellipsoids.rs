@@ -84,7 +84,7 @@ pub fn add_at(
         (PUFF_SHARE * s).clamp(0.05 * view_size, 2.0 * view_size)
     });
     // Wider than tall, as the puffs of a cumulus are.
-    let e = Ellipsoid::new(center, Vec3::new(1.4 * r, r, 1.2 * r));
+    let e = Ellipsoid::new(center, Vec3::new(1.4 * r, r, 1.2 * r)).billowed();
     let mut list = doc.scene().ellipsoids.clone();
     list.push(Arc::new(e));
     let index = list.len() - 1;

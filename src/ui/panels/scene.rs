@@ -175,6 +175,7 @@ fn ellipsoid_list(ui: &mut Ui, doc: &mut Document, selection: &mut Selection) {
     e.radii = e.radii.max(glam::Vec3::splat(0.01));
     ui.add(egui::Slider::new(&mut e.strength, -2.0..=2.0).text("strength"))
         .on_hover_text("How much it adds to the cloud; below zero it carves the cloud away");
+    super::sketch::billows_controls(ui, &mut e.billows);
     ui.checkbox(&mut e.hidden, "hidden")
         .on_hover_text("Shift+H: leave it out of the cloud, kept in the scene (Alt+H shows all)");
     if e != *doc.scene().ellipsoids[i] {

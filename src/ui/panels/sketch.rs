@@ -142,6 +142,15 @@ impl SketchPanel {
     }
 }
 
+/// The billows sliders of one primitive (a plane's outline or an ellipsoid).
+pub(super) fn billows_controls(ui: &mut Ui, billows: &mut crate::scene::Billows) {
+    param(ui, &mut billows.levels, &limits::BILLOW_LEVELS);
+    ui.add_enabled_ui(billows.levels > 0, |ui| {
+        param(ui, &mut billows.ratio, &limits::BILLOW_RATIO);
+        param(ui, &mut billows.coverage, &limits::BILLOW_COVERAGE);
+    });
+}
+
 fn plane_controls(ui: &mut Ui, doc: &mut Document, i: usize) {
     let mut plane = (*doc.scene().planes[i]).clone();
     ui.label(egui::RichText::new(&plane.name).strong());
@@ -156,6 +165,7 @@ fn plane_controls(ui: &mut Ui, doc: &mut Document, i: usize) {
             param(ui, &mut s.copies, &limits::COPIES);
         });
         param(ui, &mut s.blend, &limits::BLEND);
+        billows_controls(ui, &mut plane.billows);
     }
     vec3_fields(ui, "move", &mut plane.origin, 0.05);
     rotation_fields(ui, &mut plane.rotation);

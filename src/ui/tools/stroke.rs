@@ -303,6 +303,10 @@ fn finish_stroke(
     };
     let seed = hash64(scene.seed ^ ((scene.planes.len() as u64) << 32) ^ world.len() as u64);
     let mut plane = DrawingPlane::facing(name, kind, anchor, right, up, &world, seed);
+    if kind == StrokeKind::Outline {
+        // A new user's first cloud looks like a cloud.
+        plane.billows = crate::scene::Billows::NEW;
+    }
     plane.pressure = pressure.into_iter().flatten().collect();
     if plane.pressure.len() != plane.points.len() {
         plane.pressure.clear();
