@@ -25,9 +25,10 @@ pub struct PuffCache {
     pub grown_count: u64,
 }
 
-/// The seed of a primitive's puffs: the document's seed and the primitive's stable id.
-fn seed_of(scene: &Scene, id: u64) -> u64 {
-    hash64(scene.seed ^ hash64(id))
+/// The seed of a primitive's puffs: its stable id alone (the document's seed moves the noise,
+/// not the shape).
+fn seed_of(id: u64) -> u64 {
+    hash64(id ^ 0xB111_0775)
 }
 
 /// Puffs smaller than this would not show on the field grid: about 0.6 of a texel of the
@@ -109,7 +110,7 @@ impl PuffCache {
             let key = {
                 let mut h = std::collections::hash_map::DefaultHasher::new();
                 (0u8, Arc::as_ptr(shape) as usize, plane.billows.key()).hash(&mut h);
-                (seed_of(scene, plane.id), min_r.to_bits()).hash(&mut h);
+                (seed_of(plane.id), min_r.to_bits()).hash(&mut h);
                 h.finish()
             };
             let bases = || {
@@ -121,7 +122,7 @@ impl PuffCache {
                     })
                     .collect()
             };
-            let seed = seed_of(scene, plane.id);
+            let seed = seed_of(plane.id);
             sources.push(Source::Plane {
                 group: g,
                 origin: plane.origin,
@@ -141,7 +142,7 @@ impl PuffCache {
             if e.billows.is_off() || e.strength <= 0.0 || blob >= field.blobs.len() {
                 continue;
             }
-            let seed = seed_of(scene, e.id);
+            let seed = seed_of(e.id);
             let key = {
                 let mut h = std::collections::hash_map::DefaultHasher::new();
                 (1u8, e.radii.to_array().map(f32::to_bits), e.billows.key()).hash(&mut h);
