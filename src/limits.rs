@@ -356,7 +356,7 @@ pub const COPIES: Param = Param::linear(
 /// Sketch: width of the smooth blend between an outline's spheres, inside the outline.
 pub const BLEND: Param = Param::linear(
     "soft blend",
-    "Smooth the creases where the cloud's spheres meet (inside the outline: its silhouette stays as drawn); 0 is the plain union",
+    "Smooth the creases where the cloud's spheres meet (inside the outline: its silhouette stays as drawn); 0 is the plain union. Under billows it acts at a quarter of its width, so the puffs keep their scallops",
     0.0,
     1.0,
     0.4,

@@ -16,6 +16,9 @@ use crate::limits::{MAX_PRIMITIVES, MAX_PUFFS};
 use crate::scene::{Billows, Scene};
 use crate::seeded::hash64;
 
+/// The share of an outline's soft blend kept under its billows.
+pub const BILLOWED_BLEND: f32 = 0.25;
+
 /// Grown puffs by what they depend on, with the pass that last used them.
 #[derive(Default)]
 pub struct PuffCache {
@@ -203,17 +206,22 @@ impl PuffCache {
                     puffs,
                 } => {
                     let g = &mut field.groups[*group];
+                    if levels > 0 {
+                        // The soft blend lifts the cores between their spheres back out to
+                        // where the puffs reach, filling the scallops: under billows it acts at
+                        // a quarter of its width, smoothing creases between cores only.
+                        g.blend *= BILLOWED_BLEND;
+                    }
                     let place = |c: Vec3| *origin + *rotation * c;
                     for (i, blob) in g.blobs.iter_mut().enumerate() {
                         let whole = Vec3::splat(blob.extent.x);
                         let r = puffs.base_radii(i, whole, levels).x;
                         *blob = Blob::sphere(blob.center, r);
                     }
-                    g.blobs.extend(
-                        puffs
-                            .spheres(levels)
-                            .map(|(c, r)| Blob::sphere(place(c), r)),
-                    );
+                    g.puffs = puffs
+                        .spheres(levels)
+                        .map(|(c, r)| Blob::sphere(place(c), r))
+                        .collect();
                 }
                 Source::Ellipsoid {
                     blob,
@@ -231,12 +239,16 @@ impl PuffCache {
                         strength: *strength,
                         ..Default::default()
                     };
-                    let mut blobs = vec![Blob::ellipsoid(&core)];
-                    blobs.extend(puffs.spheres(levels).map(|(c, r)| Blob {
-                        strength: *strength,
-                        ..Blob::sphere(*center + *rotation * c, r)
-                    }));
-                    groups.push(Group::hard(blobs));
+                    groups.push(Group {
+                        puffs: puffs
+                            .spheres(levels)
+                            .map(|(c, r)| Blob {
+                                strength: *strength,
+                                ..Blob::sphere(*center + *rotation * c, r)
+                            })
+                            .collect(),
+                        ..Group::hard(vec![Blob::ellipsoid(&core)])
+                    });
                 }
             }
         }

@@ -94,6 +94,7 @@ fn assemble(scene: &Scene, shapes: &[Arc<Shape>]) -> Field {
                 budget -= blobs.len();
                 field.groups.push(Group {
                     blobs,
+                    puffs: Vec::new(),
                     blend: plane.sketch.blend as f32,
                     inside: inside.clone().map(|map| PlacedInside {
                         map,

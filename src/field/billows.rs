@@ -36,6 +36,8 @@ pub struct Puff {
     pub radius: f32,
     /// Visible radius of its core under its own puffs.
     pub core: f32,
+    /// Its point farthest out: on the surface of what it sits on, before that shrank to its core.
+    pub outer: Vec3,
 }
 
 impl Puff {
@@ -120,6 +122,12 @@ pub fn grow(
     let ratio = billows.ratio;
     let mut rng = SplitMix::new(hash64(seed ^ 0xB111_0775));
     let mut cover = Cover::new(bases);
+    // The surface the current level grows on: puffs whose outer point lies deep inside it
+    // would sit under a neighbour's surface (the spheres of an outline overlap by far).
+    let mut envelope = Cover::new(bases);
+    for b in bases {
+        envelope.add_ellipsoid(b.center, b.radii);
+    }
     // Level 1: on each base's core.
     let mut level = Vec::new();
     for (i, b) in bases.iter().enumerate() {
@@ -133,7 +141,7 @@ pub fn grow(
         place(b.center, core, r, depth, billows, &mut rng, &mut level);
     }
     for _ in 0..billows.levels {
-        level = spread(level, &cover);
+        level = spread(level, &cover, &envelope);
         if level.is_empty() || out.count() + level.len() > cap {
             break;
         }
@@ -161,6 +169,10 @@ pub fn grow(
                     cover.add_sphere(p.center, p.core);
                 }
             }
+        }
+        envelope = Cover::with_cell(level.iter().map(|p| p.radius).fold(0.0, f32::max));
+        for p in &level {
+            envelope.add_sphere(p.center, p.radius);
         }
         out.levels.push(std::mem::take(&mut level));
         level = next;
@@ -223,14 +235,18 @@ fn place(
             center: c + on + normal * (depth * r - radius),
             radius,
             core: radius,
+            outer: c + on + normal * (depth * r),
         });
     }
 }
 
-/// The puffs of one level that show: those not hidden inside the cores, and of two puffs much
-/// closer than their radii (neighbouring spheres of an outline share their surface) only the
-/// first.
-fn spread(level: Vec<Puff>, cover: &Cover) -> Vec<Puff> {
+/// How deep (in its radii) a puff's outer point may lie under the surface its level grows on.
+const UNDER: f32 = 0.3;
+
+/// The puffs of one level that show: those not hidden inside the cores, those whose outer point
+/// lies on the surface they grow on (not under a neighbour's), and of two puffs much closer
+/// than their radii (neighbouring spheres of an outline share their surface) only the first.
+fn spread(level: Vec<Puff>, cover: &Cover, envelope: &Cover) -> Vec<Puff> {
     let reach = level.iter().map(|p| p.radius).fold(0.0, f32::max) * 1.2;
     let cell = reach.max(1e-6);
     let key = |p: Vec3| (p / cell).floor().as_ivec3();
@@ -251,7 +267,10 @@ fn spread(level: Vec<Puff>, cover: &Cover) -> Vec<Puff> {
                 })
             })
         });
-        if crowded || cover.hides(p.center, p.radius) {
+        if crowded
+            || envelope.deeper_than(p.outer, UNDER * p.radius)
+            || cover.hides(p.center, p.radius)
+        {
             continue;
         }
         cells.entry(k).or_default().push(kept.len() as u32);
@@ -301,13 +320,29 @@ impl Cover {
     fn new(bases: &[Base]) -> Self {
         let mut radii: Vec<f32> = bases.iter().map(|b| b.radii.max_element()).collect();
         radii.sort_by(f32::total_cmp);
-        let median = radii.get(radii.len() / 2).copied().unwrap_or(1.0);
+        Self::with_cell(radii.get(radii.len() / 2).copied().unwrap_or(1.0))
+    }
+
+    fn with_cell(cell: f32) -> Self {
         Self {
-            cell: median.max(1e-4),
+            cell: cell.max(1e-4),
             cells: HashMap::new(),
             spheres: Vec::new(),
             ellipsoids: Vec::new(),
         }
+    }
+
+    /// Whether `p` lies inside one of the shapes by more than `margin`.
+    fn deeper_than(&self, p: Vec3, margin: f32) -> bool {
+        self.ellipsoids.iter().any(|&(c, r)| {
+            let r = r - Vec3::splat(margin);
+            r.min_element() > 0.0 && ((p - c) / r).length_squared() < 1.0
+        }) || self.cells.get(&self.key(p)).is_some_and(|list| {
+            list.iter().any(|&i| {
+                let (c, r) = self.spheres[i as usize];
+                r > margin && (p - c).length_squared() < (r - margin) * (r - margin)
+            })
+        })
     }
 
     fn key(&self, p: Vec3) -> IVec3 {

@@ -281,6 +281,9 @@ pub struct Group {
     pub blend: f32,
     /// Where the blend may act, and how far inside the outline it reaches full width.
     pub inside: Option<PlacedInside>,
+    /// Billows' puffs over the spheres: combined by their plain maximum with the blended
+    /// spheres, so the soft blend never fills the scallops between them.
+    pub puffs: Vec<Blob>,
 }
 
 /// Polynomial smooth maximum of `a ≥ b` of width `k`: `a` where they differ by `k` or more,
@@ -337,7 +340,8 @@ impl Group {
             .iter()
             .map(|b| b.value(p))
             .fold((0.0, 0.0), top_two);
-        self.combine(a, b, p)
+        let puffs = self.puffs.iter().map(|b| b.value(p)).fold(0.0, f32::max);
+        self.combine(a, b, p).max(puffs)
     }
 }
 
@@ -379,9 +383,11 @@ impl Field {
 
     /// Every primitive, summed ones and grouped ones.
     pub fn all_blobs(&self) -> impl Iterator<Item = &Blob> {
-        self.blobs
-            .iter()
-            .chain(self.groups.iter().flat_map(|g| &g.blobs))
+        self.blobs.iter().chain(
+            self.groups
+                .iter()
+                .flat_map(|g| g.blobs.iter().chain(&g.puffs)),
+        )
     }
 
     /// Field value at `p`.

@@ -413,18 +413,29 @@ fn add_groups_and_clip(
         // only the box it reaches.
         let mut first = vec![0f32; values.len()];
         let mut second = vec![0f32; values.len()];
+        // Each group's puffs' maximum (billows), where it has puffs.
+        let mut puffs = if field.groups.iter().any(|g| !g.puffs.is_empty()) {
+            vec![0f32; values.len()]
+        } else {
+            Vec::new()
+        };
         for group in &field.groups {
             let Some(bx) = group
                 .blobs
                 .iter()
+                .chain(&group.puffs)
                 .filter_map(|b| grid.texel_box(b))
                 .reduce(|(a, b), (c, d)| (a.min(c), b.max(d)))
             else {
                 continue;
             };
+            let puffed = !group.puffs.is_empty();
             dirty.each_row(dims, bx, |Row { at: row, xs, .. }| {
                 first[row + xs.start..row + xs.end].fill(0.0);
                 second[row + xs.start..row + xs.end].fill(0.0);
+                if puffed {
+                    puffs[row + xs.start..row + xs.end].fill(0.0);
+                }
             });
             for blob in &group.blobs {
                 if let Some(bx) = reach(blob) {
@@ -434,8 +445,20 @@ fn add_groups_and_clip(
                     });
                 }
             }
+            for blob in &group.puffs {
+                if let Some(bx) = reach(blob) {
+                    splat(dirty, dims, centers, bx, &mut work, |at, p| {
+                        puffs[at] = puffs[at].max(blob.value(p));
+                    });
+                }
+            }
             splat(dirty, dims, centers, bx, &mut work, |at, p| {
-                values[at] += group.combine(first[at], second[at], p)
+                let blended = group.combine(first[at], second[at], p);
+                values[at] += if puffed {
+                    blended.max(puffs[at])
+                } else {
+                    blended
+                }
             });
         }
     }
@@ -596,6 +619,10 @@ fn blob_key(b: &Blob) -> [u32; 16] {
 fn group_key(group: &super::Group) -> u64 {
     let mut hasher = std::hash::DefaultHasher::new();
     for b in &group.blobs {
+        blob_key(b).hash(&mut hasher);
+    }
+    group.puffs.len().hash(&mut hasher);
+    for b in &group.puffs {
         blob_key(b).hash(&mut hasher);
     }
     group.blend.to_bits().hash(&mut hasher);
@@ -888,6 +915,11 @@ mod tests {
                     blobs: group(Vec3::new(-2.0, 0.0, 0.0)),
                     blend: 0.15,
                     inside: None,
+                    // Billows' puffs, combined by their maximum over the blended spheres.
+                    puffs: group(Vec3::new(-1.6, 0.4, 0.2))
+                        .into_iter()
+                        .map(|b| Blob::sphere(b.center, b.extent.x * 0.5))
+                        .collect(),
                 },
                 super::super::Group::hard(group(Vec3::new(1.0, -1.0, 0.5))),
             ],
@@ -977,6 +1009,7 @@ mod tests {
                 blobs: group.clone(),
                 blend: 0.15,
                 inside: None,
+                puffs: Vec::new(),
             }],
             clips: vec![clip],
             ..Default::default()
@@ -1181,6 +1214,7 @@ mod tests {
                     blobs: scatter(15, 13),
                     blend: 0.2,
                     inside: None,
+                    puffs: Vec::new(),
                 },
             ],
             clips: vec![],

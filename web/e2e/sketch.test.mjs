@@ -4,7 +4,7 @@
 // Screenshots: web/test-results/screenshots/sketch-*.png.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { serve, launch, openApp, waitForBody, waitForFullQuality, state, screenshot, countDiffering, countChanged, until, withApp, recordTiming } from './harness.mjs';
+import { serve, launch, openApp, waitForBody, waitForFullQuality, state, screenshot, countDiffering, countChanged, until, withApp, recordTiming, reveal } from './harness.mjs';
 
 let server;
 before(async () => { server = await serve(); });
@@ -60,6 +60,24 @@ test('draw an outline, then cut its base', { timeout: 300_000 }, async () => {
       const right = { x: Math.round(box.x + box.w + (vw - box.x - box.w) * 0.5), y: box.y, w: Math.round((vw - box.x - box.w) * 0.45), h: box.h };
       assert.equal(countDiffering(drawn, left, bg), 0, 'cloud left of the stroke');
       assert.equal(countDiffering(drawn, right, bg), 0, 'cloud right of the stroke');
+
+      // A new outline has billows (a new user's first cloud looks like a cloud). The plane's
+      // "billow levels" slider, pressed at its left end, smooths it in one undo step and the
+      // cloud changes; Ctrl+Z brings the billows back.
+      assert.equal(s.scene.planes[0].billows?.levels, 3, 'a new outline has billows');
+      const undoBefore = (await state(page)).view.undo;
+      const levels = await reveal(page, 'param:billow levels');
+      await page.mouse.click(levels[0] + 1, levels[1] + levels[3] / 2);
+      s = await until(page, (s) => !s.scene.planes[0].billows, 'billows off');
+      assert.equal(s.view.undo, undoBefore + 1, 'one undo step');
+      await page.mouse.move(vw * 0.05, vh * 0.95);
+      await waitForFullQuality(page);
+      const smooth = await screenshot(page, 'sketch-1a-no-billows');
+      const moved = countChanged(drawn, smooth, box);
+      assert.ok(moved > 0.03 * box.w * box.h, `billows off changed ${moved} px of the cloud's box`);
+      await page.keyboard.press('Control+z');
+      await until(page, (s) => s.scene.planes[0].billows?.levels === 3, 'billows back');
+      await waitForFullQuality(page);
 
       // K shows the selected outline's skeleton (yellow lines) and spheres (Figure 4 of the
       // paper) over the cloud; K again hides them.

@@ -234,11 +234,11 @@ fn brick_bounds(field: &Field, grid: &Grid) -> Vec<(f32, f32)> {
         });
     }
     for group in &field.groups {
-        // The group's value is at least its largest sphere's (at least 0) and at most that
-        // plus the smooth maximum's lift, a quarter of the blend width.
+        // The group's value is at least its largest sphere's or puff's (at least 0) and at most
+        // that plus the smooth maximum's lift, a quarter of the blend width.
         let lift = group.blend.max(0.0) * 0.25;
         let mut own: std::collections::HashMap<usize, (f32, f32)> = Default::default();
-        for blob in &group.blobs {
+        for blob in group.blobs.iter().chain(&group.puffs) {
             blob_bounds(blob, grid, &extents, |b, lo, hi| {
                 let s = own.entry(index(b)).or_insert((0.0, 0.0));
                 *s = (s.0.max(lo), s.1.max(hi));
@@ -494,6 +494,7 @@ mod tests {
                 .collect();
             field.groups.push(crate::field::Group {
                 blobs,
+                puffs: Vec::new(),
                 blend,
                 inside: crate::field::InsideMap::new(&outline).map(|map| {
                     crate::field::PlacedInside {
