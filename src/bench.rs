@@ -323,6 +323,43 @@ fn eleventh_stroke() -> Vec<BenchResult> {
     ]
 }
 
+/// Billows: a new billowed stroke (interpretation, its puffs and the field) against the same
+/// stroke smooth, and the default cumulus's whole derivation (field and bake) with its
+/// billows against without.
+fn billows_cost() -> Vec<BenchResult> {
+    let mut smooth = sketched_scene(1);
+    smooth.render.field_resolution = crate::limits::FIELD_RESOLUTION.default as u32;
+    let mut billowed = smooth.clone();
+    Arc::make_mut(&mut billowed.planes[0]).billows = crate::scene::Billows::NEW;
+    let derive = |scene: &Scene| {
+        time_median(5, &mut || {
+            let field = Derived::default().field(scene, None);
+            std::hint::black_box(crate::field::bake(&field, scene.render.field_resolution));
+        })
+    };
+    let cumulus = Scene::preset(Preset::Cumulus);
+    let mut plain = cumulus.clone();
+    for e in &mut plain.ellipsoids {
+        Arc::make_mut(e).billows.levels = 0;
+    }
+    vec![
+        result(
+            "derive_and_bake_billowed_stroke",
+            derive(&billowed) * 1e3,
+            "ms",
+            "derive_and_bake_smooth_stroke",
+            derive(&smooth) * 1e3,
+        ),
+        result(
+            "derive_and_bake_billowed_cumulus",
+            derive(&cumulus) * 1e3,
+            "ms",
+            "derive_and_bake_smooth_cumulus",
+            derive(&plain) * 1e3,
+        ),
+    ]
+}
+
 /// A bank of `n` ellipsoids (seeded), 24 × 5 × 24 world units, as a modeller using thousands of
 /// primitives builds one.
 pub fn ellipsoid_bank(n: usize) -> Scene {
@@ -737,6 +774,7 @@ pub fn run(json: bool, only: Option<&str>) -> Result<(), String> {
     }
     if wanted("stroke") {
         results.extend(eleventh_stroke());
+        results.extend(billows_cost());
     }
     if wanted("worst") {
         results.extend(worst_documents_bench());
