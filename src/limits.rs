@@ -381,10 +381,10 @@ pub const BILLOW_RATIO: Param = Param::linear(
 /// Billows: the share of each puff's surface the next level covers.
 pub const BILLOW_COVERAGE: Param = Param::linear(
     "billow coverage",
-    "How much of each puff's surface the next, smaller puffs cover",
+    "How densely the next, smaller puffs cover each puff (1: twice over, as they overlap)",
     0.0,
+    1.5,
     1.0,
-    0.8,
 );
 /// Most puffs the billows of one document make; a document asking for more gets fewer levels
 /// (and a message).

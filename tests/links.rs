@@ -137,3 +137,25 @@ fn the_fuzz_corpus_and_its_mutations_decode_safely() {
         cloudsketch::share::check_untrusted(input);
     }
 }
+
+/// Billows make many all-or-nothing choices from an ellipsoid's radii (how many puffs, which
+/// are hidden), so a link carries the radii of a billowed ellipsoid exactly: the documents
+/// settle them to the link's digits. The presets' puffs come back one for one.
+#[test]
+fn a_billowed_scene_comes_back_from_its_link_with_the_same_puffs() {
+    use cloudsketch::scene::Preset;
+    for preset in [Preset::Cumulus, Preset::Cumulonimbus, Preset::Sunset] {
+        let scene = Scene::preset(preset);
+        let (back, _) = decode_link(&format!("#s={}", encode_link(&scene).unwrap())).unwrap();
+        let radii = |s: &Scene| s.ellipsoids.iter().map(|e| e.radii).collect::<Vec<_>>();
+        assert_eq!(radii(&back), radii(&scene), "{preset:?}");
+        let (a, b) = (
+            cloudsketch::derive::field_of(&scene),
+            cloudsketch::derive::field_of(&back),
+        );
+        let puffs =
+            |f: &cloudsketch::field::Field| f.groups.iter().map(|g| g.puffs.len()).sum::<usize>();
+        assert!(puffs(&a) > 1000, "{preset:?}: {} puffs", puffs(&a));
+        assert_eq!(puffs(&a), puffs(&b), "{preset:?}");
+    }
+}

@@ -1486,19 +1486,10 @@ fn outline_dimension(image: &Image) -> (f64, f64) {
 #[test]
 fn billows_make_the_outline_rough_at_every_scale() {
     for preset in [Preset::Cumulus, Preset::Cumulonimbus] {
-        let mut on = with(
+        let on = with(
             &Scene::preset(preset),
             &["/render/noise_amount=0", "/render/field_resolution=128"],
         );
-        if let Ok(v) = std::env::var("CS_BILLOWS") {
-            let v: Vec<f32> = v.split(',').map(|x| x.parse().unwrap()).collect();
-            for e in &mut on.ellipsoids {
-                let b = &mut std::sync::Arc::make_mut(e).billows;
-                b.levels = v[0] as u32;
-                b.ratio = v[1];
-                b.coverage = v[2];
-            }
-        }
         let mut off = on.clone();
         for e in &mut off.ellipsoids {
             std::sync::Arc::make_mut(e).billows.levels = 0;

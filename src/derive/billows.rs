@@ -153,10 +153,13 @@ impl PuffCache {
                 h.finish()
             };
             let radii = e.radii.max(Vec3::splat(1e-4));
+            // An ellipsoid has no drawn outline to keep: its first puffs are centred on its
+            // surface (Bouthors & Neyret), so the body keeps its size, the puffs half out.
+            let out = 0.5 * e.billows.ratio * radii.min_element();
             let bases = || {
                 vec![Base {
                     center: Vec3::ZERO,
-                    radii,
+                    radii: radii + Vec3::splat(out),
                 }]
             };
             sources.push(Source::Ellipsoid {

@@ -553,7 +553,7 @@ fn a_document_asking_for_too_many_puffs_gets_fewer_with_a_message() {
             ..crate::scene::Ellipsoid::new(c, Vec3::splat(2.0 + u() * 2.0))
         }));
     }
-    scene.assign_ids();
+    scene.settle();
     let field = field_of(&scene);
     let primitives = field.all_blobs().count();
     assert!(field.puffs_left_out > 0);

@@ -205,7 +205,7 @@ impl Document {
             Edit::SetReference(r) => s.reference = r.map(Arc::new),
             Edit::Replace(new) => *s = *new,
         }
-        s.assign_ids();
+        s.settle();
         let merge = merge_key.is_some() && merge_key == self.last_key;
         if !merge {
             self.undo.push_back(Step {

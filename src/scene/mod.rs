@@ -36,6 +36,20 @@ use glam::{Quat, Vec3};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
+/// Significant digits a share link keeps of every setting (`share::link`).
+pub const LINK_DIGITS: usize = 5;
+
+/// `v` as a share link writes it and reads it back: rounded to [`LINK_DIGITS`] significant
+/// digits (of its value as a double, as the link's JSON holds it).
+pub fn as_linked(v: f32) -> f32 {
+    if !v.is_finite() {
+        return v;
+    }
+    format!("{:.*e}", LINK_DIGITS - 1, v as f64)
+        .parse::<f64>()
+        .map_or(v, |x| x as f32)
+}
+
 /// Version written by this build. Older documents are upgraded on load; newer ones are refused.
 /// Version 2 added billows and stable ids to ellipsoids and drawing planes (a version 1
 /// document has no billows, and its primitives get ids in order when it is read).
@@ -200,14 +214,23 @@ impl Scene {
             repairs.push(format!("and {more} more values repaired"));
         }
         // Ids are given, not repaired: a document from before them gets them silently.
-        self.assign_ids();
+        self.settle();
         Ok(repairs)
     }
 
-    /// Gives every ellipsoid and drawing plane without an id (0), or with one an earlier
-    /// primitive already holds, a fresh id: one more than the largest in the document, in
-    /// document order (ellipsoids first), so the same document always gets the same ids.
-    pub fn assign_ids(&mut self) {
+    /// Settles what the derivation keys on: gives every ellipsoid and drawing plane without an
+    /// id (0), or with one an earlier primitive already holds, a fresh id (one more than the
+    /// largest in the document, in document order, ellipsoids first, so the same document
+    /// always gets the same ids); and rounds a billowed ellipsoid's radii as a share link
+    /// writes them ([`as_linked`]: billows make many all-or-nothing choices from the radii, so a
+    /// link must carry them exactly for its cloud to be the sender's).
+    pub fn settle(&mut self) {
+        for e in &mut self.ellipsoids {
+            let radii = e.radii.map(as_linked);
+            if !e.billows.is_off() && radii != e.radii && radii.min_element() > 0.0 {
+                Arc::make_mut(e).radii = radii;
+            }
+        }
         let mut next = self
             .ellipsoids
             .iter()
@@ -317,7 +340,7 @@ pub struct Ellipsoid {
     /// Hidden: kept in the document, left out of the cloud.
     pub hidden: bool,
     /// Stable id, unique among the document's ellipsoids and planes (0: not yet given one;
-    /// [`Scene::assign_ids`]). Seeds the billows, so a primitive keeps its puffs when others
+    /// [`Scene::settle`]). Seeds the billows, so a primitive keeps its puffs when others
     /// are added or removed.
     #[serde(skip_serializing_if = "is_zero")]
     pub id: u64,

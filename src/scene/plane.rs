@@ -52,7 +52,7 @@ pub struct DrawingPlane {
     /// Hidden: kept in the document, left out of the cloud (its stroke is drawn faintly).
     pub hidden: bool,
     /// Stable id, unique among the document's ellipsoids and planes (0: not yet given one;
-    /// [`super::Scene::assign_ids`]). Seeds the billows.
+    /// [`super::Scene::settle`]). Seeds the billows.
     #[serde(skip_serializing_if = "is_zero")]
     pub id: u64,
     /// Puffs on the outline's spheres.

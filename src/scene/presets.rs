@@ -199,7 +199,7 @@ impl Scene {
             time,
             simulation,
         };
-        scene.assign_ids();
+        scene.settle();
         scene
     }
 }

@@ -56,7 +56,7 @@ pub fn hand_drawn() -> Scene {
         plane.snap_to_grid();
         scene.planes.push(std::sync::Arc::new(plane));
     }
-    scene.assign_ids();
+    scene.settle();
     scene
 }
 
@@ -169,6 +169,6 @@ pub fn every_part() -> Scene {
         in_front: true,
         ..Default::default()
     }));
-    scene.assign_ids();
+    scene.settle();
     scene
 }

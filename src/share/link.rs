@@ -48,7 +48,7 @@ pub const MAX_INFLATED: usize = 2 << 20;
 const MAX_JSON: usize = 1 << 20;
 
 /// Significant digits kept of each setting.
-pub const DIGITS: usize = 5;
+pub const DIGITS: usize = crate::scene::LINK_DIGITS;
 
 /// Where links point when no base is given: the app as `trunk serve` serves it.
 pub const DEFAULT_BASE: &str = "http://127.0.0.1:8080/";
