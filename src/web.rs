@@ -52,6 +52,7 @@ pub fn start() {
             Some("raster") => Some(false),
             _ => None,
         },
+        refine_whole: url_param("refine").as_deref() == Some("whole"),
     };
     wasm_bindgen_futures::spawn_local(async move {
         if let Err(message) = run(options).await {

@@ -68,6 +68,10 @@ pub struct StartOptions {
     /// Marched (`Some(true)`) or rasterised slices instead of the adapter's default (the
     /// page's `?slices=march|raster`).
     pub marching: Option<bool>,
+    /// Full quality at the view's whole resolution however long it takes, instead of the
+    /// resolution the planner fits in its budget from the measured speed (the page's
+    /// `?refine=whole`: images compared across page loads on a busy machine).
+    pub refine_whole: bool,
 }
 
 impl Default for StartOptions {
@@ -80,6 +84,7 @@ impl Default for StartOptions {
             file: None,
             autosave: false,
             marching: None,
+            refine_whole: false,
         }
     }
 }
@@ -156,6 +161,7 @@ impl CloudApp {
             derived: Derived::default(),
             viewport: Viewport::new(
                 options.initial_cost,
+                options.refine_whole,
                 ViewStats {
                     backend,
                     ..Default::default()

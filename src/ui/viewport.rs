@@ -87,9 +87,24 @@ pub struct ViewportContext<'a> {
 impl Viewport {
     /// A viewport whose planner starts from a guessed cost (seconds per pixel·slice);
     /// `reports` makes the GPU's reports of finished work arrive where they need polling.
-    pub fn new(initial_cost: f64, stats: ViewStats, reports: Option<ReportPoll>) -> Self {
+    /// `whole` refines at the view's whole resolution whatever the time (a page option for
+    /// image comparisons).
+    pub fn new(
+        initial_cost: f64,
+        whole: bool,
+        stats: ViewStats,
+        reports: Option<ReportPoll>,
+    ) -> Self {
+        let budget = Budget {
+            refine_total: if whole {
+                f64::INFINITY
+            } else {
+                Budget::default().refine_total
+            },
+            ..Budget::default()
+        };
         Self {
-            progressive: Progressive::new(initial_cost, Budget::default())
+            progressive: Progressive::new(initial_cost, budget)
                 .fenced(super::platform::FENCED_REFINEMENT),
             fence: None,
             reports,
