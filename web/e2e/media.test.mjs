@@ -102,8 +102,11 @@ for (const backend of ['webgpu', 'webgl2']) {
 }
 
 for (const backend of ['webgpu', 'webgl2']) {
-  test(`an upper tier changes the cloud above its floor only (${backend})`, { timeout: 180_000 }, async () => {
-    await withApp({ base: server.url, webgpu: backend === 'webgpu', viewport: { width: 1280, height: 800 } }, async (page) => {
+  test(`an upper tier changes the cloud above its floor only (${backend})`, { timeout: 240_000 }, async () => {
+    // Both images at the view's whole resolution (`refine=whole`): on a busy machine the
+    // planner fitted them to different resolutions, which changed the lower half too
+    // (4,012 px above, 1,247 below in a full run beside a cargo build).
+    await withApp({ base: server.url, webgpu: backend === 'webgpu', query: '?refine=whole', viewport: { width: 1280, height: 800 } }, async (page) => {
       const [vw, vh] = (await state(page)).view.viewport;
       await page.mouse.click(5, vh - 5);
       await page.evaluate(() => window.cloudsketch.set('/render/noise_amount=0.6'));
