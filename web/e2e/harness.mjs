@@ -88,6 +88,29 @@ export async function openApp(browser, base, query = '', viewport = { width: 900
 }
 
 /**
+ * Watches the page's file pickers from now on; `next()` resolves to the next one opened.
+ * Call it well before the action that opens one: Playwright turns on its interception of
+ * pickers without waiting for the browser, and a picker opened before that lands is cancelled
+ * unseen (`Promise.all([page.waitForEvent('filechooser'), press])` missed 1 in 10 beside a
+ * cargo build, though the page had opened it with the key's user activation).
+ */
+export function watchFileChoosers(page) {
+  const opened = [];
+  const waiting = [];
+  page.on('filechooser', (chooser) => { const w = waiting.shift(); if (w) w(chooser); else opened.push(chooser); });
+  return {
+    next(timeout = 30_000) {
+      if (opened.length) return Promise.resolve(opened.shift());
+      return new Promise((resolve, reject) => {
+        const timer = setTimeout(() => { waiting.splice(waiting.indexOf(done), 1); reject(new Error(`no file picker opened in ${timeout} ms`)); }, timeout);
+        const done = (c) => { clearTimeout(timer); resolve(c); };
+        waiting.push(done);
+      });
+    },
+  };
+}
+
+/**
  * The builds of the app (index.html: `webgpu`, `webgl`) whose wasm the page fetched, in order:
  * the file's size raw (`bytes`), its precompressed copies' sizes (`brotliBytes`, `gzipBytes`:
  * web/precompress.mjs, null where missing), and what the browser says it received
