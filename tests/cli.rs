@@ -235,6 +235,11 @@ fn sketch_makes_a_scene_and_spheres_that_fit_the_outline() {
             .unwrap()
             .0;
     assert_eq!(scene.planes.len(), 1);
+    assert_eq!(
+        scene.planes[0].billows,
+        cloudsketch::scene::Billows::NEW,
+        "billows, as the app gives a new stroke"
+    );
     let spheres: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&spheres_path).unwrap()).unwrap();
     let spheres = spheres["spheres"].as_array().unwrap();
@@ -270,8 +275,30 @@ fn sketch_makes_a_scene_and_spheres_that_fit_the_outline() {
         "--seed",
         "5",
         "--no-extend",
+        "--billows",
+        "0",
     ]);
     assert!(out.status.success(), "{}", stderr(&out));
+    let smooth = cloudsketch::scene::Scene::from_json(
+        &std::fs::read_to_string(temp("sketched-flat.json")).unwrap(),
+    )
+    .unwrap()
+    .0;
+    assert!(smooth.planes[0].billows.is_off());
+    let out = cloudsketch(&[
+        "sketch",
+        stroke.to_str().unwrap(),
+        "-o",
+        temp("sketched-bad.json").to_str().unwrap(),
+        "--billows",
+        "9",
+    ]);
+    assert!(!out.status.success());
+    assert!(
+        stderr(&out).contains("--billows 9 is outside 0..=4"),
+        "{}",
+        stderr(&out)
+    );
     let flat: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&flat_path).unwrap()).unwrap();
     let flat_depth = flat["spheres"]

@@ -109,6 +109,10 @@ enum Command {
         /// Seed of the 3D extension.
         #[arg(long, default_value_t = 1)]
         seed: u64,
+        /// Levels of billows on each outline (puffs on puffs), as the app gives a new stroke
+        /// (0: a smooth body).
+        #[arg(long, default_value_t = crate::scene::Billows::NEW.levels)]
+        billows: u32,
     },
     /// Print a share link for a scene (`link SCENE.json`), or decode one back into a scene
     /// file (`link --decode URL -o SCENE.json`).
@@ -221,6 +225,7 @@ pub fn main() -> ExitCode {
             inflate,
             no_extend,
             seed,
+            billows,
         }) => sketch::run(
             &strokes,
             &output,
@@ -228,6 +233,7 @@ pub fn main() -> ExitCode {
             inflate,
             !no_extend,
             seed,
+            billows,
         ),
         Some(Command::Export {
             scene,

@@ -30,12 +30,24 @@ pub fn run(
     inflate: f64,
     extend: bool,
     seed: u64,
+    billows: u32,
 ) -> Result<(), String> {
-    use crate::scene::{DrawingPlane, MAX_PLANES, StrokeKind};
+    use crate::scene::{Billows, DrawingPlane, MAX_PLANES, StrokeKind};
     use crate::sketch::{SketchParams, interpret};
     if !(0.0..=1.0).contains(&inflate) {
         return Err(format!("--inflate {inflate} is outside 0..=1"));
     }
+    let levels = crate::limits::BILLOW_LEVELS;
+    if !(levels.min..=levels.max).contains(&f64::from(billows)) {
+        return Err(format!(
+            "--billows {billows} is outside {}..={}",
+            levels.min, levels.max
+        ));
+    }
+    let billows = Billows {
+        levels: billows,
+        ..Billows::NEW
+    };
     if paths.len() > MAX_PLANES {
         return Err(format!("{} strokes (at most {MAX_PLANES})", paths.len()));
     }
@@ -114,6 +126,7 @@ pub fn run(
             closed: *closed,
             sketch: params.clone(),
             seed: seed.wrapping_add(i as u64),
+            billows,
             ..Default::default()
         }));
     }

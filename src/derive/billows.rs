@@ -22,7 +22,7 @@ pub const BILLOWED_BLEND: f32 = 0.25;
 /// Grown puffs by what they depend on, with the pass that last used them.
 #[derive(Default)]
 pub struct PuffCache {
-    grown: HashMap<u64, (Arc<Puffs>, u64, Option<Arc<Shape>>)>,
+    grown: HashMap<u64, Grown>,
     pass: u64,
     /// Primitives whose puffs were grown (for tests and benchmarks).
     pub grown_count: u64,
@@ -66,26 +66,53 @@ enum Source {
     },
 }
 
+/// One primitive's grown puffs in the cache.
+struct Grown {
+    puffs: Arc<Puffs>,
+    /// The last pass that used them.
+    used: u64,
+    /// The outline's shape they were grown on (kept so its pointer, part of the key, stays
+    /// unique while the entry lives).
+    _shape: Option<Arc<Shape>>,
+}
+
+/// How one primitive's puffs grow: its billows, how deep its cores sit, its seed and the
+/// smallest puff the field grid shows.
+struct Growth<'a> {
+    billows: &'a Billows,
+    depth: f32,
+    seed: u64,
+    min_r: f32,
+}
+
 impl PuffCache {
     fn get(
         &mut self,
         key: u64,
         shape: Option<&Arc<Shape>>,
         bases: impl FnOnce() -> Vec<Base>,
-        billows: &Billows,
-        depth: f32,
-        seed: u64,
-        min_r: f32,
+        how: Growth<'_>,
     ) -> Arc<Puffs> {
         let pass = self.pass;
         let grown = &mut self.grown_count;
         let entry = self.grown.entry(key).or_insert_with(|| {
             *grown += 1;
-            let puffs = grow(&bases(), billows, depth, seed, min_r, MAX_PUFFS);
-            (Arc::new(puffs), pass, shape.cloned())
+            let puffs = grow(
+                &bases(),
+                how.billows,
+                how.depth,
+                how.seed,
+                how.min_r,
+                MAX_PUFFS,
+            );
+            Grown {
+                puffs: Arc::new(puffs),
+                used: pass,
+                _shape: shape.cloned(),
+            }
         });
-        entry.1 = pass;
-        entry.0.clone()
+        entry.used = pass;
+        entry.puffs.clone()
     }
 
     /// Adds the billows of `scene`'s primitives to `field` (assembled without them, its
@@ -134,10 +161,12 @@ impl PuffCache {
                     key,
                     Some(shape),
                     bases,
-                    &plane.billows,
-                    OUTLINE_DEPTH,
-                    seed,
-                    min_r,
+                    Growth {
+                        billows: &plane.billows,
+                        depth: OUTLINE_DEPTH,
+                        seed,
+                        min_r,
+                    },
                 ),
             });
         }
@@ -168,12 +197,22 @@ impl PuffCache {
                 rotation: e.rotation.normalize(),
                 radii,
                 strength: e.strength,
-                puffs: self.get(key, None, bases, &e.billows, ELLIPSOID_DEPTH, seed, min_r),
+                puffs: self.get(
+                    key,
+                    None,
+                    bases,
+                    Growth {
+                        billows: &e.billows,
+                        depth: ELLIPSOID_DEPTH,
+                        seed,
+                        min_r,
+                    },
+                ),
             });
         }
         // Keep this pass's and the previous pass's puffs (undo is instant).
         let pass = self.pass;
-        self.grown.retain(|_, (_, used, _)| *used + 1 >= pass);
+        self.grown.retain(|_, g| g.used + 1 >= pass);
         if sources.is_empty() {
             return;
         }

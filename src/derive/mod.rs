@@ -119,6 +119,10 @@ fn clip(plane: &DrawingPlane, line: Vec<glam::Vec2>) -> Clip {
     }
 }
 
+/// How a message says that billows went over [`crate::limits::MAX_PUFFS`] (words the viewport
+/// looks for, so an opened document's notice is not said twice).
+pub const PUFFS_OVER_CAP: &str = "puffs over the cap";
+
 /// Checks what deriving a loaded document would cost, before anything is built: over
 /// [`MAX_BAKE_WORK`] at its field grid, the grid is made coarser (down to [`MIN_LOADED_GRID`])
 /// and the change returned in words; when even that is over, the document is refused.
@@ -126,7 +130,7 @@ pub fn check_cost(scene: &mut Scene) -> Result<Option<String>, String> {
     let field = field_of(scene);
     let left_out = (field.puffs_left_out > 0).then(|| {
         format!(
-            "billows: the finest level of puffs is left out ({} puffs over the cap of {})",
+            "billows: the finest level of puffs is left out ({} {PUFFS_OVER_CAP} of {})",
             field.puffs_left_out,
             crate::limits::MAX_PUFFS
         )
@@ -174,7 +178,9 @@ struct GeometryKey {
 pub struct Derived {
     planes: PlaneCache,
     puffs: PuffCache,
-    field: Option<(u64, Arc<Field>)>,
+    /// The last field, keyed on the geometry revision and the field grid's resolution (the
+    /// smallest puff billows grow is a fraction of a texel).
+    field: Option<((u64, u32), Arc<Field>)>,
     density: Option<(GeometryKey, Versioned<DensityVolume>)>,
     baker: Baker,
     /// The simulation run of a simulated scene, and its last density (keyed on the geometry
@@ -190,8 +196,9 @@ pub struct Derived {
 impl Derived {
     /// The field of `scene` at geometry revision `revision` (`None`: derive it afresh).
     pub fn field(&mut self, scene: &Scene, revision: Option<u64>) -> Arc<Field> {
-        if let (Some(rev), Some((cached, field))) = (revision, &self.field)
-            && rev == *cached
+        let key = revision.map(|rev| (rev, scene.render.field_resolution));
+        if let (Some(key), Some((cached, field))) = (key, &self.field)
+            && key == *cached
         {
             return field.clone();
         }
@@ -201,10 +208,15 @@ impl Derived {
         self.puffs.add(scene, &shapes, &mut field);
         self.work.puff_growths = self.puffs.grown_count;
         let field = Arc::new(field);
-        if let Some(rev) = revision {
-            self.field = Some((rev, field.clone()));
+        if let Some(key) = key {
+            self.field = Some((key, field.clone()));
         }
         field
+    }
+
+    /// Puffs the last derived field left out for [`crate::limits::MAX_PUFFS`] (0 before any).
+    pub fn puffs_left_out(&self) -> usize {
+        self.field.as_ref().map_or(0, |(_, f)| f.puffs_left_out)
     }
 
     /// The density volume of `scene`'s geometry at `revisions` (the geometry alone, without

@@ -536,10 +536,10 @@ fn a_document_from_before_billows_keeps_its_look_and_gets_ids() {
     assert_ne!(puffed, plain);
 }
 
-#[test]
-fn a_document_asking_for_too_many_puffs_gets_fewer_with_a_message() {
+/// 300 ellipsoids of 4 levels of billows, on a `resolution`³ field grid.
+fn puffy_scene(resolution: u32) -> Scene {
     let mut scene = Scene::preset(Preset::Empty);
-    scene.render.field_resolution = 128;
+    scene.render.field_resolution = resolution;
     let mut rng = crate::seeded::SplitMix::new(9);
     for _ in 0..300 {
         let mut u = || rng.next_f64() as f32;
@@ -554,10 +554,48 @@ fn a_document_asking_for_too_many_puffs_gets_fewer_with_a_message() {
         }));
     }
     scene.settle();
+    scene
+}
+
+#[test]
+fn a_document_asking_for_too_many_puffs_gets_fewer_with_a_message() {
+    let mut scene = puffy_scene(128);
     let field = field_of(&scene);
     let primitives = field.all_blobs().count();
     assert!(field.puffs_left_out > 0);
     assert!(primitives <= 300 + crate::limits::MAX_PUFFS, "{primitives}");
     let message = check_cost(&mut scene).unwrap().unwrap();
     assert!(message.contains("billows"), "{message}");
+}
+
+/// The smallest puff is a fraction of a field texel, so a finer grid grows finer puffs: the
+/// cached field follows the grid's resolution as a fresh derivation does (the cache was keyed
+/// on the geometry alone, and a finer grid kept the coarse grid's puffs), and the viewport can
+/// tell when an edit crosses the puff cap.
+#[test]
+fn a_finer_field_grid_grows_finer_puffs_in_the_cache_too() {
+    let mut doc = Document::new(puffy_scene(48));
+    let mut derived = Derived::default();
+    derived.density(doc.scene(), doc.revisions());
+    let coarse = derived.field(doc.scene(), Some(doc.revisions().geometry));
+    assert_eq!(
+        derived.puffs_left_out(),
+        0,
+        "the coarse grid is under the cap"
+    );
+    let mut r = doc.scene().render.clone();
+    r.field_resolution = 128;
+    doc.apply(Edit::SetRender(r), None);
+    derived.density(doc.scene(), doc.revisions());
+    let fine = derived.field(doc.scene(), Some(doc.revisions().geometry));
+    assert_eq!(
+        *fine,
+        field_of(doc.scene()),
+        "the cache gives what a fresh derivation gives"
+    );
+    assert!(fine.all_blobs().count() > coarse.all_blobs().count());
+    assert!(
+        derived.puffs_left_out() > 0,
+        "the fine grid is over the cap"
+    );
 }

@@ -207,9 +207,9 @@ fn place(
     let mut u = || rng.next_f64() as f32;
     let turn = Quat::from_euler(
         glam::EulerRot::ZYX,
-        u() * 6.283,
+        u() * std::f32::consts::TAU,
         (u() * 2.0 - 1.0).acos(),
-        u() * 6.283,
+        u() * std::f32::consts::TAU,
     );
     // The area element of the map from the unit sphere onto the ellipsoid, for acceptance.
     let cof = Vec3::new(core.y * core.z, core.x * core.z, core.x * core.y);

@@ -492,6 +492,7 @@ impl CloudApp {
         view["frames"] = ctx.cumulative_frame_nr().into();
         view["jobs"] = stats.jobs.into();
         view["late"] = stats.late.into();
+        view["puffs_left_out"] = stats.puffs_left_out.into();
         let state = format!("{{\"scene\":{scene_json},\"view\":{view}}}");
         let status = PageStatus {
             ready: self.viewport.ready,

@@ -17,6 +17,7 @@ use crate::render::crop::{OUTSIDE_SHAFTS_DIVISOR, PixelCrop};
 /// Seconds of a frame an export's capture may take (the rest is the view's: a drag during an
 /// export keeps its frames).
 const CAPTURE_BUDGET: f64 = 0.04;
+use crate::derive::PUFFS_OVER_CAP;
 use crate::render::progressive::{Budget, Progressive};
 use crate::render::viewport::{JobFence, ReportPoll};
 use crate::render::viewport::{OutsideShaftsPaint, SkyPaint, ViewportPaint, paint_callback};
@@ -208,6 +209,25 @@ impl Viewport {
             });
         }
         let volumes = cx.derived.update(scene, cx.doc.revisions());
+        // An edit that takes the billows over their cap (more puffs, a finer field grid) is
+        // told once, as opening such a document is (whose notice already says it).
+        let left_out = cx.derived.puffs_left_out();
+        let told = cx
+            .notices
+            .latest
+            .as_ref()
+            .is_some_and(|n| n.text.contains(PUFFS_OVER_CAP));
+        if left_out > 0 && self.stats.puffs_left_out == 0 && !told {
+            cx.notices.note(
+                ui.input(|i| i.time),
+                format!(
+                    "Billows: the finest level of puffs is left out ({left_out} {PUFFS_OVER_CAP} \
+                     of {})",
+                    crate::limits::MAX_PUFFS
+                ),
+            );
+        }
+        self.stats.puffs_left_out = left_out;
         if cx.derived.catching_up {
             // A simulation still stepping toward the scene's time: keep the frames coming.
             ui.ctx().request_repaint();

@@ -161,3 +161,37 @@ test('a link opens on WebGL2 too', { timeout: 180_000 }, async () => {
     await close();
   }
 });
+
+test('an edit that takes the billows over their cap says so once, and undo takes it back', { timeout: 240_000 }, async () => {
+  const { browser, close } = await launch({ webgpu: true });
+  try {
+    const { page, errors } = await openApp(browser, server.url, '?preset=empty', VIEW);
+    await waitForBody(page, 'data-ready', (v) => v === 'true');
+    // 300 ellipsoids with 4 levels of billows on a coarse field grid: its texels are too big
+    // for the finest puffs, so the document stays under the cap of puffs.
+    const doc = (await state(page)).scene;
+    let seed = 9;
+    const u = () => { seed = (seed * 1103515245 + 12345) % 2147483648; return seed / 2147483648; };
+    doc.render.field_resolution = 48;
+    doc.ellipsoids = Array.from({ length: 300 }, () => ({
+      center: [u() * 60, u() * 10, u() * 60], radii: Array(3).fill(2 + u() * 2), rotation: [0, 0, 0, 1],
+      strength: 1, hidden: false, billows: { levels: 4, ratio: 0.3, coverage: 1 },
+    }));
+    await page.setInputFiles('#scene_input', { name: 'puffy.json', mimeType: 'application/json', buffer: Buffer.from(JSON.stringify(doc)) });
+    let s = await until(page, (s) => s.scene.ellipsoids.length === 300, 'the file opened', 120_000);
+    assert.equal(s.view.puffs_left_out, 0, 'under the cap on the coarse grid');
+    assert.doesNotMatch(s.view.notice?.text ?? '', /puffs over the cap/);
+    // A finer grid grows finer puffs, over the cap: the finest level goes, and a notice says so.
+    await page.evaluate(() => window.cloudsketch.set('/render/field_resolution=128'));
+    s = await until(page, (s) => s.view.puffs_left_out > 0, 'over the cap', 120_000);
+    assert.match(s.view.notice.text, /^Billows: the finest level of puffs is left out \(\d+ puffs over the cap of 16000\)/);
+    assert.ok(!s.view.notice.error, 'a note, not a refusal: the edit is kept');
+    assert.equal(s.scene.render.field_resolution, 128);
+    await page.mouse.click(VIEW.width * 0.05, VIEW.height * 0.95);
+    await page.keyboard.press('Control+z');
+    s = await until(page, (s) => s.scene.render.field_resolution === 48 && s.view.puffs_left_out === 0, 'undone', 120_000);
+    assert.deepEqual(errors, []);
+  } finally {
+    await close();
+  }
+});

@@ -36,6 +36,8 @@ pub struct ViewStats {
     /// The last geometry update of the density volume: how many there have been, its wall time
     /// in milliseconds, the texels it re-evaluated and the grid's texels.
     pub geometry_update: Option<GeometryUpdate>,
+    /// Puffs the field leaves out for the cap on billows (0: none).
+    pub puffs_left_out: usize,
 }
 
 /// One geometry update of the density volume, as the viewport timed it.
