@@ -493,6 +493,7 @@ impl CloudApp {
         view["jobs"] = stats.jobs.into();
         view["late"] = stats.late.into();
         view["puffs_left_out"] = stats.puffs_left_out.into();
+        view["catching_up"] = stats.catching_up.into();
         let state = format!("{{\"scene\":{scene_json},\"view\":{view}}}");
         let status = PageStatus {
             ready: self.viewport.ready,

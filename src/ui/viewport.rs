@@ -228,6 +228,7 @@ impl Viewport {
             );
         }
         self.stats.puffs_left_out = left_out;
+        self.stats.catching_up = cx.derived.catching_up;
         if cx.derived.catching_up {
             // A simulation still stepping toward the scene's time: keep the frames coming.
             ui.ctx().request_repaint();
@@ -266,7 +267,7 @@ impl Viewport {
                 redraw: false,
                 lay: true,
             });
-        let key = view_key(cx.doc, px, crop.map(|c| c.px));
+        let key = view_key(cx.doc, volumes.density.generation, px, crop.map(|c| c.px));
         let now = ui.input(|i| i.time);
         let crop_size = crop.map_or([1, 1], |c| c.size());
         let fence = self
@@ -430,7 +431,8 @@ impl Viewport {
         let key = {
             use std::hash::{Hash, Hasher};
             let mut h = std::collections::hash_map::DefaultHasher::new();
-            (view_key(doc, paint.size, None), paint.total).hash(&mut h);
+            let density = paint.volumes.density.generation;
+            (view_key(doc, density, paint.size, None), paint.total).hash(&mut h);
             h.finish()
         };
         let redraw = self.outside_key != Some(key);
@@ -559,12 +561,15 @@ const OUTSIDE_PREVIEW_SLICES: u32 = 32;
 
 /// Identifies everything that changes the viewport's image: the revisions of the parts the
 /// image depends on, the viewport's size and the crop (no hashing of the scene itself).
-fn view_key(doc: &Document, px: [u32; 2], crop: Option<[u32; 4]>) -> u64 {
+fn view_key(doc: &Document, density: u64, px: [u32; 2], crop: Option<[u32; 4]>) -> u64 {
     use std::hash::{Hash, Hasher};
     let mut h = std::collections::hash_map::DefaultHasher::new();
-    // What the volume image shows: the reference image is drawn apart, every frame.
+    // What the volume image shows: the reference image is drawn apart, every frame. The
+    // density's generation too: a simulation catching up with a far jump in time changes it
+    // from frame to frame while the document stays as it is (its image kept the first
+    // frame's cloud, or chunks of several).
     let r = doc.revisions();
-    (r.geometry, r.light, r.render, r.camera).hash(&mut h);
+    (r.geometry, r.light, r.render, r.camera, density).hash(&mut h);
     px.hash(&mut h);
     crop.hash(&mut h);
     h.finish()

@@ -127,3 +127,33 @@ test('the page times the automaton as the native bench does (?bench=ca)', { time
     });
   });
 });
+
+// A far jump in time: the simulation catches up over frames while the document stays as it
+// is, and the image must show where it arrives (it kept the first frame's cloud, or chunks of
+// several, until something else changed). The jump goes to the automaton's last step, so the
+// catching up outlasts a refinement of the view at its whole resolution.
+test('after a far jump in time the image shows the cloud the simulation caught up with', { timeout: 420_000 }, async () => {
+  await withApp({ base: server.url, webgpu: true, query: '?preset=simulated&refine=whole', viewport: { width: 900, height: 560 } }, async (page) => {
+    await page.evaluate(() => window.cloudsketch.set('/light/ground=false'));
+    let s = await until(page, (s) => !s.scene.light.ground, 'no ground');
+    await waitForFullQuality(page);
+    const [vw, vh] = s.view.viewport;
+    const body = { x: 0, y: 130, w: vw - 320, h: vh - 160 };
+    await page.evaluate(() => window.cloudsketch.set('/time=86400'));
+    s = await until(page, (s) => s.scene.time === 86400 && s.view.catching_up, 'catching up');
+    const t0 = Date.now();
+    await until(page, (s) => !s.view.catching_up, 'caught up', 240_000);
+    console.log(`# caught up in ${(Date.now() - t0) / 1000} s`);
+    await waitForFullQuality(page);
+    const shown = await screenshot(page, 'simulation-jump-shown');
+    // The same view drawn afresh: a slice count there and back (two edits) redraws it.
+    await page.evaluate(() => window.cloudsketch.set('/render/slices=127'));
+    await until(page, (s) => s.scene.render.slices === 127, '127 slices');
+    await page.evaluate(() => window.cloudsketch.set('/render/slices=128'));
+    await until(page, (s) => s.scene.render.slices === 128, '128 slices');
+    await waitForFullQuality(page);
+    const fresh = await screenshot(page, 'simulation-jump-fresh');
+    const changed = countChanged(shown, fresh, body);
+    assert.ok(changed <= 50, `${changed} px differ from a fresh image of the same view`);
+  });
+});

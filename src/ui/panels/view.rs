@@ -38,6 +38,8 @@ pub struct ViewStats {
     pub geometry_update: Option<GeometryUpdate>,
     /// Puffs the field leaves out for the cap on billows (0: none).
     pub puffs_left_out: usize,
+    /// A simulation still stepping toward the scene's time (a far jump catches up over frames).
+    pub catching_up: bool,
 }
 
 /// One geometry update of the density volume, as the viewport timed it.
