@@ -295,6 +295,14 @@ pub const EXPOSURE: Param = Param::linear(
     4.0,
     0.0,
 );
+/// The document clock's frames per second ([`crate::scene::Clock`]).
+pub const FRAME_RATE: Param = Param::linear(
+    "frame rate",
+    "Frames per second of the scene's clock: what --frame and the frame range count in",
+    1.0,
+    120.0,
+    24.0,
+);
 /// The ground plane's height (world y).
 pub const GROUND_HEIGHT: Param = Param::linear(
     "ground height",
@@ -439,6 +447,7 @@ mod tests {
             GROUND_HEIGHT,
             SHAFT_INTENSITY,
             SHAFT_DENSITY,
+            FRAME_RATE,
         ] {
             assert!(
                 p.min < p.max && (p.min..=p.max).contains(&p.default),

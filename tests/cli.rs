@@ -791,3 +791,109 @@ fn long_work_shows_its_progress_on_a_terminal_and_nowhere_else() {
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(!stderr(&o).contains('%'), "{}", stderr(&o));
 }
+
+/// `--time` and `--frame` name the same moments on the scene's clock, in `render`, `export`
+/// and `simulate` alike (one or the other); a frame past the clock's last is refused.
+#[test]
+fn time_and_frame_name_the_same_moment_in_every_subcommand() {
+    let png = |name: &str, extra: &[&str]| {
+        let out = temp(name);
+        let mut args = vec!["render", "-o", out.to_str().unwrap(), "--size", "96x64"];
+        args.extend(["--set", "/render/slices=32", "--set", "/render/wind=[3,0]"]);
+        args.extend(extra);
+        let o = cloudsketch(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        read_rgb(&out)
+    };
+    let frame = png("frame48.png", &["--frame", "48"]);
+    assert_eq!(
+        frame,
+        png("time2.png", &["--time", "2"]),
+        "frame 48 at 24 fps is 2 s"
+    );
+    assert_ne!(
+        frame,
+        png("time0.png", &["--time", "0"]),
+        "the wind moved the noise"
+    );
+    // At the scene's own rate: 10 frames per second make frame 20 the same 2 s.
+    let ten = png("frame20.png", &["--set", "/clock/fps=10", "--frame", "20"]);
+    assert_eq!(ten, frame);
+
+    // export: a PNG of the view at a frame is the render at that time.
+    let view = temp("view48.png");
+    let o = cloudsketch(&[
+        "export",
+        "--format",
+        "png",
+        "-o",
+        view.to_str().unwrap(),
+        "--size",
+        "96x64",
+        "--frame",
+        "48",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let exported = read_rgb(&view);
+    let o = cloudsketch(&[
+        "render",
+        "-o",
+        temp("render48.png").to_str().unwrap(),
+        "--size",
+        "96x64",
+        "--time",
+        "2",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(exported, read_rgb(&temp("render48.png")));
+
+    // simulate: a moment is the step at or before it at the simulation's rate (the preset
+    // steps 4 times a second: frame 48 is step 8).
+    let (by_frame, by_steps) = (temp("f48.vol"), temp("s8.vol"));
+    let rate = cloudsketch::scene::Scene::preset(cloudsketch::scene::Preset::Simulated)
+        .simulation
+        .unwrap()
+        .rate;
+    let steps = cloudsketch::scene::steps_at(2.0, rate).to_string();
+    for (out, args) in [
+        (&by_frame, ["--frame", "48"]),
+        (&by_steps, ["--steps", steps.as_str()]),
+    ] {
+        let o = cloudsketch(&[&["simulate", "-o", out.to_str().unwrap()][..], &args[..]].concat());
+        assert!(o.status.success(), "{}", stderr(&o));
+    }
+    assert_eq!(
+        std::fs::read(&by_frame).unwrap(),
+        std::fs::read(&by_steps).unwrap()
+    );
+
+    // One or the other, and within the clock.
+    let o = cloudsketch(&[
+        "render",
+        "-o",
+        temp("both.png").to_str().unwrap(),
+        "--time",
+        "1",
+        "--frame",
+        "2",
+    ]);
+    assert!(
+        !o.status.success() && stderr(&o).contains("--frame"),
+        "{}",
+        stderr(&o)
+    );
+    let o = cloudsketch(&[
+        "render",
+        "-o",
+        temp("far.png").to_str().unwrap(),
+        "--frame",
+        "4000000",
+    ]);
+    assert!(!o.status.success(), "a frame past a day at 24 fps");
+    assert!(
+        stderr(&o).contains("--frame 4000000: 0 to 2073600"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!temp("far.png").exists());
+}

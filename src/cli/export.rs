@@ -31,6 +31,8 @@ pub struct Request<'a> {
     pub transparent: bool,
     /// Mitsuba's samples per pixel.
     pub samples: u32,
+    /// The moment to export (else the scene's time).
+    pub at: Option<crate::scene::Moment>,
 }
 
 /// Runs an export.
@@ -68,10 +70,13 @@ pub fn run(r: &Request) -> Result<(), String> {
         &r.scene.into_iter().collect::<Vec<_>>(),
         &paths.iter().map(PathBuf::as_path).collect::<Vec<_>>(),
     )?;
-    let scene = match r.scene {
+    let mut scene = match r.scene {
         Some(arg) => read_scene_or_link(arg)?,
         None => Scene::default(),
     };
+    if let Some(at) = r.at {
+        scene.time = at.seconds(&scene.clock)?;
+    }
     let start = std::time::Instant::now();
     if format == Format::Png {
         let mut offscreen = Offscreen::new().map_err(|e| e.to_string())?;

@@ -18,7 +18,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 use crate::limits::MAX_FILE_BYTES;
-use crate::scene::Scene;
+use crate::scene::{Moment, Scene};
 
 pub use render::parse_size;
 
@@ -71,17 +71,27 @@ enum Command {
         #[arg(long = "set", value_name = "PATH=VALUE")]
         set: Vec<String>,
         /// Render at this scene time in seconds (the media's wind, a simulation's steps).
-        #[arg(long)]
+        #[arg(long, conflicts_with = "frame")]
         time: Option<f32>,
+        /// Render at this frame of the scene's clock (its frames per second).
+        #[arg(long)]
+        frame: Option<u32>,
     },
     /// Run a scene's cloud simulation (the `simulated` preset without SCENE) and write the
     /// smoothed density after N steps as a Mitsuba .vol or an OpenVDB .vdb.
     Simulate {
         /// Scene JSON or share link with a simulation; the `simulated` preset when left out.
         scene: Option<String>,
-        /// Steps to run.
-        #[arg(long, default_value_t = 100)]
-        steps: u64,
+        /// Steps to run (100 unless --time or --frame says).
+        #[arg(long, conflicts_with_all = ["time", "frame"])]
+        steps: Option<u64>,
+        /// Run to this scene time in seconds: the step at or before it, at the simulation's
+        /// steps per second.
+        #[arg(long, conflicts_with = "frame")]
+        time: Option<f32>,
+        /// Run to this frame of the scene's clock.
+        #[arg(long)]
+        frame: Option<u32>,
         /// Seed of the random terms (else the scene's).
         #[arg(long)]
         seed: Option<u64>,
@@ -163,6 +173,12 @@ enum Command {
         /// Mitsuba's samples per pixel.
         #[arg(long, default_value_t = 64)]
         samples: u32,
+        /// Export the scene at this time in seconds (else the scene's own).
+        #[arg(long, conflicts_with = "frame")]
+        time: Option<f32>,
+        /// Export the scene at this frame of its clock.
+        #[arg(long)]
+        frame: Option<u32>,
     },
     /// Run the benchmark suite.
     Bench {
@@ -201,13 +217,18 @@ pub fn main() -> ExitCode {
             size,
             set,
             time,
-        }) => render::run(scene.as_deref(), &output, &size, &set, time),
+            frame,
+        }) => Moment::from_args(time, frame)
+            .and_then(|at| render::run(scene.as_deref(), &output, &size, &set, at)),
         Some(Command::Simulate {
             scene,
             steps,
+            time,
+            frame,
             seed,
             output,
-        }) => simulate::run(scene.as_deref(), steps, seed, &output),
+        }) => Moment::from_args(time, frame)
+            .and_then(|at| simulate::run(scene.as_deref(), steps, at, seed, &output)),
         Some(Command::Link {
             scene,
             decode,
@@ -246,17 +267,22 @@ pub fn main() -> ExitCode {
             size,
             transparent,
             samples,
-        }) => export::run(&export::Request {
-            scene: scene.as_deref(),
-            format: &format,
-            output: &output,
-            resolution,
-            up: &up,
-            scale,
-            no_noise,
-            size: &size,
-            transparent,
-            samples,
+            time,
+            frame,
+        }) => Moment::from_args(time, frame).and_then(|at| {
+            export::run(&export::Request {
+                scene: scene.as_deref(),
+                format: &format,
+                output: &output,
+                resolution,
+                up: &up,
+                scale,
+                no_noise,
+                size: &size,
+                transparent,
+                samples,
+                at,
+            })
         }),
         Some(Command::Bench { json, only }) => crate::bench::run(json, only.as_deref()),
     };

@@ -21,13 +21,13 @@ pub fn parse_size(text: &str) -> Result<(u32, u32), String> {
     Ok((w, h))
 }
 
-/// `cloudsketch render [SCENE|URL] -o OUT.png --size WxH --set PATH=VALUE… [--time T]`.
+/// `cloudsketch render [SCENE|URL] -o OUT.png --size WxH --set PATH=VALUE… [--time T | --frame N]`.
 pub fn run(
     scene: Option<&str>,
     output: &Path,
     size: &str,
     sets: &[String],
-    time: Option<f32>,
+    at: Option<crate::scene::Moment>,
 ) -> Result<(), String> {
     let (width, height) = parse_size(size)?;
     super::check_outputs(&scene.into_iter().collect::<Vec<_>>(), &[output])?;
@@ -42,14 +42,8 @@ pub fn run(
         }
         scene = set;
     }
-    if let Some(t) = time {
-        if !(t.is_finite() && (0.0..=crate::limits::MAX_TIME).contains(&t)) {
-            return Err(format!(
-                "--time {t}: 0 to {} seconds",
-                crate::limits::MAX_TIME
-            ));
-        }
-        scene.time = t;
+    if let Some(at) = at {
+        scene.time = at.seconds(&scene.clock)?;
     }
     let mut offscreen = Offscreen::new().map_err(|e| e.to_string())?;
     let start = std::time::Instant::now();

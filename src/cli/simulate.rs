@@ -11,10 +11,14 @@ use crate::simulate::{Simulation, parcels};
 /// Most steps one run may take.
 const MAX_STEPS: u64 = 100_000;
 
-/// `cloudsketch simulate [SCENE|URL] --steps N [--seed S] -o OUT.vol|OUT.vdb`.
+/// Steps a run takes when neither a step count nor a moment is given.
+const DEFAULT_STEPS: u64 = 100;
+
+/// `cloudsketch simulate [SCENE|URL] [--steps N | --time T | --frame F] [--seed S] -o OUT.vol|OUT.vdb`.
 pub fn run(
     scene: Option<&str>,
-    steps: u64,
+    steps: Option<u64>,
+    at: Option<crate::scene::Moment>,
     seed: Option<u64>,
     output: &Path,
 ) -> Result<(), String> {
@@ -34,6 +38,13 @@ pub fn run(
         return Err(
             "this scene has no simulation (try `cloudsketch new --preset simulated`)".into(),
         );
+    };
+    // A moment is a step count at the simulation's rate: the step at or before it, as the
+    // app's player reaches it.
+    let steps = match (steps, at) {
+        (Some(n), _) => n,
+        (None, Some(at)) => crate::scene::steps_at(at.seconds(&scene.clock)?, settings.rate),
+        (None, None) => DEFAULT_STEPS,
     };
     if steps > MAX_STEPS {
         return Err(format!("--steps {steps}: at most {MAX_STEPS}"));

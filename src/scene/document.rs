@@ -40,6 +40,8 @@ pub struct Revisions {
     pub camera: u64,
     /// The reference image.
     pub reference: u64,
+    /// The clock's frame rate and range (no image depends on them).
+    pub clock: u64,
 }
 
 impl Revisions {
@@ -50,6 +52,7 @@ impl Revisions {
             .max(self.render)
             .max(self.camera)
             .max(self.reference)
+            .max(self.clock)
     }
 }
 
@@ -61,11 +64,12 @@ struct Changed {
     render: bool,
     camera: bool,
     reference: bool,
+    clock: bool,
 }
 
 impl Changed {
     fn any(&self) -> bool {
-        self.geometry || self.light || self.render || self.camera || self.reference
+        self.geometry || self.light || self.render || self.camera || self.reference || self.clock
     }
 }
 
@@ -87,6 +91,7 @@ fn diff(a: &Scene, b: &Scene) -> Changed {
         render: a.render != b.render || a.time != b.time,
         camera: a.camera != b.camera,
         reference: a.reference != b.reference,
+        clock: a.clock != b.clock,
     }
 }
 
@@ -126,6 +131,7 @@ impl Document {
                 render: n,
                 camera: n,
                 reference: n,
+                clock: n,
             },
         }
     }
@@ -152,6 +158,7 @@ impl Document {
             (changed.render, &mut r.render),
             (changed.camera, &mut r.camera),
             (changed.reference, &mut r.reference),
+            (changed.clock, &mut r.clock),
         ] {
             if flag {
                 *rev = n;
@@ -172,6 +179,7 @@ impl Document {
                 changed.geometry = sim.as_ref() != s.simulation.as_deref();
             }
             Edit::SetRender(r) => changed.render = *r != s.render,
+            Edit::SetClock(c) => changed.clock = *c != s.clock,
             Edit::SetEllipsoids(e) => changed.geometry = !same(e, &s.ellipsoids),
             Edit::SetPlanes(p) => {
                 changed.geometry = p.len() <= MAX_PLANES && !same(p, &s.planes);
@@ -195,6 +203,10 @@ impl Document {
             Edit::SetLight(l) => s.light = l,
             Edit::SetSimulation(sim) => s.simulation = sim.map(Arc::new),
             Edit::SetRender(r) => s.render = r,
+            Edit::SetClock(mut c) => {
+                c.sanitize();
+                s.clock = c;
+            }
             Edit::SetEllipsoids(e) => s.ellipsoids = e,
             Edit::SetPlanes(p) => s.planes = p,
             Edit::SetPlane(i, p) => s.planes[i] = Arc::new(p),
@@ -432,6 +444,32 @@ mod tests {
         doc.undo();
         assert_eq!(doc.scene().camera.yaw_deg, 90.0);
         assert!(!doc.scene().ellipsoids.is_empty());
+    }
+
+    #[test]
+    fn the_clock_is_an_undo_step_that_touches_no_image() {
+        let mut doc = Document::default();
+        let r0 = doc.revisions();
+        let clock = crate::scene::Clock {
+            fps: 30.0,
+            start: 100,
+            end: 10,
+        };
+        assert!(doc.apply(Edit::SetClock(clock), Some("clock")));
+        let r1 = doc.revisions();
+        assert!(
+            r1.clock > r0.clock && r1.any() > r0.any(),
+            "the document changed"
+        );
+        assert_eq!(
+            (r1.geometry, r1.light, r1.render, r1.camera),
+            (r0.geometry, r0.light, r0.render, r0.camera),
+            "no image depends on the frame rate"
+        );
+        assert_eq!((doc.scene().clock.start, doc.scene().clock.end), (100, 100));
+        let said = doc.undo().unwrap();
+        assert!(said.contains("frame rate"), "{said}");
+        assert!(doc.scene().clock.is_default());
     }
 
     #[test]

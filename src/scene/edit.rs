@@ -14,6 +14,8 @@ pub enum Edit {
     SetLight(Lighting),
     /// Replace the render settings.
     SetRender(RenderSettings),
+    /// Replace the clock's frame rate and range.
+    SetClock(super::Clock),
     /// Replace the ellipsoid list.
     SetEllipsoids(Vec<Arc<Ellipsoid>>),
     /// Replace the whole list of drawing planes.
@@ -38,6 +40,7 @@ impl Edit {
         match self {
             Edit::SetLight(_) => "lighting",
             Edit::SetRender(_) => "render settings",
+            Edit::SetClock(_) => "frame rate and range",
             Edit::SetEllipsoids(_) => "ellipsoids",
             Edit::SetPlanes(_) => "drawing planes",
             Edit::SetPlane(..) => "drawing plane",

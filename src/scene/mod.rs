@@ -6,6 +6,7 @@
 mod billows;
 mod camera;
 mod capped;
+mod clock;
 mod document;
 mod edit;
 mod looks;
@@ -17,6 +18,7 @@ mod reference;
 pub use crate::limits::{MAX_ELLIPSOIDS, MAX_PLANE_POINTS, MAX_PLANES};
 pub use billows::Billows;
 pub use camera::{OrbitCamera, Ray, StandardView};
+pub use clock::{Clock, Moment, step_position, steps_at};
 pub use document::{Document, Revisions};
 pub use edit::Edit;
 pub use looks::{Look, Looks};
@@ -52,8 +54,9 @@ pub fn as_linked(v: f32) -> f32 {
 
 /// Version written by this build. Older documents are upgraded on load; newer ones are refused.
 /// Version 2 added billows and stable ids to ellipsoids and drawing planes (a version 1
-/// document has no billows, and its primitives get ids in order when it is read).
-pub const SCENE_VERSION: u32 = 2;
+/// document has no billows, and its primitives get ids in order when it is read). Version 3
+/// added the clock's frame rate and range (a document without them has the default clock).
+pub const SCENE_VERSION: u32 = 3;
 
 /// Errors when reading a scene document.
 #[derive(Debug, thiserror::Error)]
@@ -115,6 +118,9 @@ pub struct Scene {
     /// The scene clock in seconds: where the media's wind and torque have carried the noise.
     /// Playing advances it; like the camera it is not an undo step.
     pub time: f32,
+    /// Frames per second and the frame range (left out of a file while it is the default).
+    #[serde(default, skip_serializing_if = "Clock::is_default")]
+    pub clock: Clock,
     /// A cloud simulation (Dobashi et al. 2000): when present, the cloud is the automaton's
     /// smoothed cloud at the scene's time, and the ellipsoids are its parcels.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -283,6 +289,7 @@ impl Scene {
                 )));
             }
         }
+        self.clock.sanitize();
         for e in &mut self.ellipsoids {
             if let Some(r) = unit_rotation(e.rotation) {
                 Arc::make_mut(e).rotation = r;

@@ -41,6 +41,10 @@ pub fn set_by_pointer(scene: &Scene, assignment: &str) -> Result<(Scene, Vec<Str
         value: raw.to_string(),
         reason: e.to_string(),
     })?;
+    // A file leaves the default clock out; its values can still be set.
+    if let (Some(map), Ok(clock)) = (doc.as_object_mut(), serde_json::to_value(scene.clock)) {
+        map.entry("clock").or_insert(clock);
+    }
     let slot = doc
         .pointer_mut(path)
         .ok_or_else(|| SetError::UnknownPath(path.to_string()))?;

@@ -197,6 +197,7 @@ impl Scene {
             planes: Vec::new(),
             reference: None,
             time,
+            clock: super::Clock::default(),
             simulation,
         };
         scene.settle();

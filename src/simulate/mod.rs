@@ -466,7 +466,7 @@ impl Player {
     /// The density at scene time `time` (steps at the settings' rate, blended between two
     /// steps); and whether the run is still catching up with that time.
     pub fn density(&mut self, time: f32) -> (DensityVolume, bool) {
-        let target = ((time.max(0.0) * self.key.0.rate) as f64).min(MAX_STEP as f64);
+        let target = crate::scene::step_position(time, self.key.0.rate).min(MAX_STEP as f64);
         let n = target.floor() as u64;
         let t = (target - n as f64) as f32;
         let (a, qa) = self.smoothed_at(n);

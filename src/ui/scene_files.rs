@@ -27,7 +27,11 @@ pub struct SceneFiles {
 /// unsaved, as in Blender).
 fn content_revision(doc: &Document) -> u64 {
     let r = doc.revisions();
-    r.geometry.max(r.light).max(r.render).max(r.reference)
+    r.geometry
+        .max(r.light)
+        .max(r.render)
+        .max(r.reference)
+        .max(r.clock)
 }
 
 impl SceneFiles {

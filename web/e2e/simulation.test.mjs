@@ -155,5 +155,13 @@ test('after a far jump in time the image shows the cloud the simulation caught u
     const fresh = await screenshot(page, 'simulation-jump-fresh');
     const changed = countChanged(shown, fresh, body);
     assert.ok(changed <= 50, `${changed} px differ from a fresh image of the same view`);
+
+    // The clock's frame rate is the document's (an undo step that redraws nothing).
+    const undo = (await state(page)).view.undo;
+    assert.equal((await state(page)).scene.clock, undefined, 'a default clock is left out of the document');
+    await page.evaluate(() => window.cloudsketch.set('/clock/fps=30'));
+    s = await until(page, (s) => s.scene.clock?.fps === 30, 'a frame rate of 30');
+    assert.equal(s.view.undo, undo + 1);
+    assert.ok(s.view.quality.startsWith('full'), 'the image stays: no image depends on the frame rate');
   });
 });

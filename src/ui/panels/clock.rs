@@ -4,7 +4,7 @@
 
 use egui::Ui;
 
-use crate::scene::Document;
+use crate::scene::{Document, Edit};
 
 /// The clock's view state.
 pub struct ClockPanel {
@@ -74,6 +74,44 @@ impl ClockPanel {
                     .range(0.0..=10.0),
             )
             .on_hover_text("Speed");
+        });
+        self.frames_ui(ui, doc);
+    }
+
+    /// The clock's frame at the scene time, its rate and its frame range (an undo step).
+    fn frames_ui(&mut self, ui: &mut Ui, doc: &mut Document) {
+        ui.horizontal(|ui| {
+            let scene = doc.scene();
+            let mut clock = scene.clock;
+            ui.label(format!("frame {}", clock.frame(scene.time).floor()))
+                .on_hover_text("The frame at the scene time (--frame on the command line)");
+            let rate = crate::limits::FRAME_RATE;
+            let mut changed = ui
+                .add(
+                    egui::DragValue::new(&mut clock.fps)
+                        .speed(0.1)
+                        .suffix(" fps")
+                        .range(rate.min as f32..=rate.max as f32),
+                )
+                .on_hover_text(rate.tip)
+                .changed();
+            let last = clock.last_frame();
+            ui.label("frames");
+            changed |= ui
+                .add(egui::DragValue::new(&mut clock.start).range(0..=last))
+                .on_hover_text("First frame of the range")
+                .changed();
+            ui.label("–");
+            changed |= ui
+                .add(egui::DragValue::new(&mut clock.end).range(0..=last))
+                .on_hover_text("Last frame of the range (inclusive)")
+                .changed();
+            if changed {
+                if clock.end < clock.start {
+                    clock.end = clock.start;
+                }
+                doc.apply(Edit::SetClock(clock), Some("clock"));
+            }
         });
     }
 }
