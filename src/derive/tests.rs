@@ -599,3 +599,25 @@ fn a_finer_field_grid_grows_finer_puffs_in_the_cache_too() {
         "the fine grid is over the cap"
     );
 }
+
+/// Time is an input of its own: on a scene with nothing animated a new time derives nothing
+/// (only the noise moves, on the GPU), where a simulated scene's density follows it.
+#[test]
+fn a_new_time_derives_nothing_on_a_scene_that_does_not_move() {
+    let mut doc = ten_strokes();
+    let mut derived = Derived::default();
+    derived.update(doc.scene(), doc.revisions());
+    let w0 = derived.work();
+    for t in [0.5, 2.0, 600.0] {
+        doc.set_time(t);
+        derived.update(doc.scene(), doc.revisions());
+    }
+    assert_eq!(derived.work(), w0, "no stroke interpreted, no bake");
+
+    let mut sim = Document::new(Scene::preset(Preset::Simulated));
+    let mut derived = Derived::default();
+    let g0 = derived.update(sim.scene(), sim.revisions()).density.generation;
+    sim.set_time(sim.scene().time + 1.0);
+    let g1 = derived.update(sim.scene(), sim.revisions()).density.generation;
+    assert!(g1 > g0, "a simulated cloud moves with the time");
+}
