@@ -162,6 +162,19 @@ pub fn check_cost(scene: &mut Scene) -> Result<Option<String>, String> {
     }))
 }
 
+/// The density volume a document describes at its time, derived from scratch: a simulation
+/// played all the way to the time (the app spreads that over frames), with the outlines
+/// sketched in it.
+pub fn density_of(scene: &Scene) -> Arc<DensityVolume> {
+    let doc = crate::scene::Document::new(scene.clone());
+    let mut derived = Derived::default();
+    let mut volume = derived.density(doc.scene(), doc.revisions());
+    while derived.catching_up {
+        volume = derived.density(doc.scene(), doc.revisions());
+    }
+    volume.data
+}
+
 /// The field a document describes, derived from scratch (no cache).
 pub fn field_of(scene: &Scene) -> Field {
     Arc::unwrap_or_clone(Derived::default().field(scene, None))
@@ -187,6 +200,12 @@ pub struct Derived {
     /// revision and the time).
     player: Option<crate::simulate::Player>,
     simulated: Option<((u64, u32), Versioned<DensityVolume>)>,
+    /// A simulated scene's outlines, baked apart (its ellipsoids are the simulation's parcels,
+    /// not cloud), keyed on the geometry; and the simulated density united with them, keyed on
+    /// both generations.
+    strokes: Option<(GeometryKey, Versioned<DensityVolume>)>,
+    stroke_baker: Baker,
+    united: Option<((u64, u64), Versioned<DensityVolume>)>,
     /// The run has not yet reached the scene's time (a far jump catches up over frames).
     pub catching_up: bool,
     generation: u64,
@@ -223,8 +242,11 @@ impl Derived {
     /// its light); re-evaluates only what changed since the last call.
     pub fn density(&mut self, scene: &Scene, revisions: Revisions) -> Versioned<DensityVolume> {
         if let Some(settings) = &scene.simulation {
-            return self.simulated(settings, scene, revisions);
+            let simulated = self.simulated(settings, scene, revisions);
+            return self.with_outlines(scene, revisions, simulated);
         }
+        self.strokes = None;
+        self.united = None;
         self.player = None;
         self.catching_up = false;
         let gkey = GeometryKey {
@@ -292,6 +314,74 @@ impl Derived {
         v
     }
 
+    /// A simulated scene's cloud with its sketched outlines: one density volume holding both
+    /// (a stroke drawn in a simulated scene is cloud too). The outlines are baked apart, only
+    /// when the geometry changes; the union is redone when either side changes.
+    fn with_outlines(
+        &mut self,
+        scene: &Scene,
+        revisions: Revisions,
+        simulated: Versioned<DensityVolume>,
+    ) -> Versioned<DensityVolume> {
+        let drawn = scene
+            .planes
+            .iter()
+            .any(|p| !p.hidden && p.kind == crate::scene::StrokeKind::Outline);
+        if !drawn {
+            self.strokes = None;
+            self.united = None;
+            return simulated;
+        }
+        let gkey = GeometryKey {
+            geometry: revisions.geometry,
+            resolution: scene.render.field_resolution,
+        };
+        let strokes = match &self.strokes {
+            Some((k, v)) if *k == gkey => v.clone(),
+            _ => {
+                let outlines = Scene {
+                    ellipsoids: Vec::new(),
+                    simulation: None,
+                    ..scene.clone()
+                };
+                let shapes = self.planes.shapes(&outlines.planes);
+                self.work.interpretations = self.planes.interpretations();
+                let mut field = assemble(&outlines, &shapes);
+                self.puffs.add(&outlines, &shapes, &mut field);
+                self.work.puff_growths = self.puffs.grown_count;
+                let baked =
+                    self.stroke_baker
+                        .update(&Arc::new(field), gkey.resolution, MAX_BAKE_WORK);
+                self.generation += 1;
+                self.work.bakes += 1;
+                self.work.bake_work += baked.work;
+                self.work.baked_texels += baked.texels;
+                let v = Versioned {
+                    generation: self.generation,
+                    data: baked.volume,
+                };
+                self.strokes = Some((gkey, v.clone()));
+                v
+            }
+        };
+        let key = (simulated.generation, strokes.generation);
+        if let Some((k, v)) = &self.united
+            && *k == key
+        {
+            return v.clone();
+        }
+        self.generation += 1;
+        let united = simulated
+            .data
+            .union(&strokes.data, crate::limits::MAX_GRID_RESOLUTION);
+        let v = Versioned {
+            generation: self.generation,
+            data: Arc::new(united),
+        };
+        self.united = Some((key, v.clone()));
+        v
+    }
+
     /// The volumes of `scene` whose parts are at `revisions`; derives only what changed.
     pub fn update(&mut self, scene: &Scene, revisions: Revisions) -> Volumes {
         Volumes {
@@ -320,6 +410,9 @@ impl Derived {
         self.baker = Baker::default();
         self.density = None;
         self.simulated = None;
+        self.stroke_baker = Baker::default();
+        self.strokes = None;
+        self.united = None;
     }
 
     /// The work done so far.

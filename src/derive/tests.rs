@@ -616,8 +616,61 @@ fn a_new_time_derives_nothing_on_a_scene_that_does_not_move() {
 
     let mut sim = Document::new(Scene::preset(Preset::Simulated));
     let mut derived = Derived::default();
-    let g0 = derived.update(sim.scene(), sim.revisions()).density.generation;
+    let g0 = derived
+        .update(sim.scene(), sim.revisions())
+        .density
+        .generation;
     sim.set_time(sim.scene().time + 1.0);
-    let g1 = derived.update(sim.scene(), sim.revisions()).density.generation;
+    let g1 = derived
+        .update(sim.scene(), sim.revisions())
+        .density
+        .generation;
     assert!(g1 > g0, "a simulated cloud moves with the time");
+}
+
+/// An outline sketched in a simulated scene is cloud too: the density holds the simulated
+/// cloud and the stroke's, on one grid (before, a simulated scene dropped every stroke); the
+/// exporters' density is the same; a new time re-interprets no stroke.
+#[test]
+fn an_outline_in_a_simulated_scene_joins_the_simulated_cloud() {
+    let mut doc = Document::new(Scene::preset(Preset::Simulated));
+    let mut derived = Derived::default();
+    let alone = derived.update(doc.scene(), doc.revisions()).density.data;
+    // High above the parcels' clouds, where the simulation makes none.
+    let mut p = plane(StrokeKind::Outline, outline_at(0.0, 1.0));
+    p.origin = Vec3::new(0.0, 40.0, 0.0);
+    doc.apply(Edit::InsertPlane(0, p), None);
+    let both = derived.update(doc.scene(), doc.revisions()).density.data;
+    let stroke = field_of(&Scene {
+        ellipsoids: Vec::new(),
+        simulation: None,
+        ..doc.scene().clone()
+    });
+    let (lo, hi) = stroke.bounds().unwrap();
+    let centre = (lo + hi) * 0.5;
+    assert!(stroke.value(centre) > crate::field::ISO);
+    assert!(
+        alone.sample(centre) < crate::field::ISO,
+        "no simulated cloud up there"
+    );
+    assert!(
+        both.sample(centre) > crate::field::ISO,
+        "the stroke's cloud is in the density"
+    );
+    // The simulated cloud keeps its inside (sampled where it is densest).
+    let densest = (0..alone.values.len())
+        .max_by(|&a, &b| alone.values[a].total_cmp(&alone.values[b]))
+        .unwrap() as u32;
+    let (nx, ny) = (alone.dims.x, alone.dims.y);
+    let at = alone.center(densest % nx, densest / nx % ny, densest / (nx * ny));
+    assert!(both.sample(at) >= 0.9 * alone.sample(at) && alone.sample(at) > crate::field::ISO);
+    assert_eq!(
+        *density_of(doc.scene()),
+        *both,
+        "exports take the same density"
+    );
+    let interpreted = derived.work().interpretations;
+    doc.set_time(doc.scene().time + 0.5);
+    derived.update(doc.scene(), doc.revisions());
+    assert_eq!(derived.work().interpretations, interpreted);
 }

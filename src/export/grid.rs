@@ -4,6 +4,8 @@
 //! density nor the field away from its surface, so for it only the bricks the surface can
 //! cross are evaluated ([`bake_for_surface`]).
 
+use std::sync::Arc;
+
 use glam::{UVec3, Vec3};
 
 use crate::field::media::Media;
@@ -60,16 +62,9 @@ impl Sampling {
         let (resolution, noise) = (options.resolution, options.noise);
         let surface_only = format.is_mesh() && !noise && scene.simulation.is_none();
         let volume = match &scene.simulation {
-            // A simulated cloud: the run's smoothed cloud at the scene's time, on its own grid.
-            Some(settings) => {
-                let mut player =
-                    crate::simulate::Player::new(settings, crate::simulate::parcels(scene));
-                let mut got = player.density(scene.time);
-                while got.1 {
-                    got = player.density(scene.time);
-                }
-                got.0
-            }
+            // A simulated cloud: the run's smoothed cloud at the scene's time, on its own grid
+            // (with the outlines sketched in it, on one grid over both), as the app shows it.
+            Some(_) => Arc::unwrap_or_clone(crate::derive::density_of(scene)),
             None => {
                 let resolution = resolution.clamp(8, MAX_EXPORT_RESOLUTION);
                 let field = crate::derive::field_of(scene);

@@ -74,6 +74,67 @@ impl DensityVolume {
         (!self.is_empty() && t.cmpge(Vec3::ZERO).all() && t.cmplt(Vec3::ONE).all())
             .then(|| (t * self.dims.as_vec3()).as_uvec3().min(self.dims - 1))
     }
+
+    /// The value at world point `p` as the GPU samples the grid: trilinear between texel
+    /// centres, clamped to the edge texels within the box; 0 (no cloud) outside it.
+    pub fn sample(&self, p: Vec3) -> f32 {
+        let t = (p - self.min) / self.size;
+        if self.is_empty() || t.cmplt(Vec3::ZERO).any() || t.cmpgt(Vec3::ONE).any() {
+            return 0.0;
+        }
+        let top = (self.dims - 1).as_vec3();
+        let g = (t * self.dims.as_vec3() - 0.5).clamp(Vec3::ZERO, top);
+        let i = g.floor().as_uvec3().min(self.dims - 1);
+        let j = (i + 1).min(self.dims - 1);
+        let f = g - i.as_vec3();
+        let v = |x: u32, y: u32, z: u32| self.value(x, y, z);
+        let lerp = |a: f32, b: f32, t: f32| a + (b - a) * t;
+        let x00 = lerp(v(i.x, i.y, i.z), v(j.x, i.y, i.z), f.x);
+        let x10 = lerp(v(i.x, j.y, i.z), v(j.x, j.y, i.z), f.x);
+        let x01 = lerp(v(i.x, i.y, j.z), v(j.x, i.y, j.z), f.x);
+        let x11 = lerp(v(i.x, j.y, j.z), v(j.x, j.y, j.z), f.x);
+        lerp(lerp(x00, x10, f.y), lerp(x01, x11, f.y), f.z)
+    }
+
+    /// Both volumes on one grid, each texel the larger of their [`DensityVolume::sample`]s
+    /// (the union of their clouds): over both boxes, at the finer texel size, with at most
+    /// `max_side` texels along the longest side (coarser where the boxes lie far apart).
+    pub fn union(&self, other: &DensityVolume, max_side: u32) -> DensityVolume {
+        match (self.is_empty(), other.is_empty()) {
+            (true, _) => return other.clone(),
+            (_, true) => return self.clone(),
+            _ => {}
+        }
+        let min = self.min.min(other.min);
+        let need = (self.min + self.size).max(other.min + other.size) - min;
+        let finest = self
+            .texel_size()
+            .min_element()
+            .min(other.texel_size().min_element())
+            .max(need.max_element() / max_side.max(1) as f32);
+        let dims = (need / finest)
+            .ceil()
+            .as_uvec3()
+            .clamp(UVec3::ONE, UVec3::splat(max_side.max(1)));
+        // Cubic texels, as either side's (the exporters take one texel size).
+        let size = dims.as_vec3() * finest;
+        let mut out = DensityVolume {
+            dims,
+            min,
+            size,
+            values: vec![0.0; (dims.x * dims.y * dims.z) as usize],
+        };
+        for z in 0..dims.z {
+            for y in 0..dims.y {
+                for x in 0..dims.x {
+                    let p = out.center(x, y, z);
+                    let i = out.index(x, y, z);
+                    out.values[i] = self.sample(p).max(other.sample(p));
+                }
+            }
+        }
+        out
+    }
 }
 
 /// Smooth density of a field value: 0 outside, 1 inside, soft across the surface.
@@ -869,6 +930,53 @@ mod tests {
     use super::super::Blob;
     use super::*;
     use std::sync::Arc;
+
+    /// Sampling returns a texel's value at its centre and blends between centres; the union of
+    /// two clouds far apart holds each where it was (a brute-force check against the field).
+    #[test]
+    fn sampling_and_the_union_of_two_volumes_keep_each_cloud() {
+        let a = bake(&Field::of_blobs(vec![Blob::sphere(Vec3::ZERO, 2.0)]), 32);
+        let b = bake(
+            &Field::of_blobs(vec![Blob::sphere(Vec3::new(9.0, 1.0, 0.0), 1.0)]),
+            32,
+        );
+        for (x, y, z) in [(0, 0, 0), (5, 9, 13), (16, 16, 16)] {
+            assert!((a.sample(a.center(x, y, z)) - a.value(x, y, z)).abs() < 1e-5);
+        }
+        let mid = (a.center(3, 4, 5) + a.center(4, 4, 5)) * 0.5;
+        let want = (a.value(3, 4, 5) + a.value(4, 4, 5)) * 0.5;
+        assert!((a.sample(mid) - want).abs() < 1e-5);
+        assert_eq!(a.sample(Vec3::splat(100.0)), 0.0, "nothing outside the box");
+
+        let u = a.union(&b, 128);
+        assert!(u.dims.max_element() <= 128);
+        let fa = Field::of_blobs(vec![Blob::sphere(Vec3::ZERO, 2.0)]);
+        let fb = Field::of_blobs(vec![Blob::sphere(Vec3::new(9.0, 1.0, 0.0), 1.0)]);
+        let mut inside = [0, 0];
+        for z in 0..u.dims.z {
+            for y in 0..u.dims.y {
+                for x in 0..u.dims.x {
+                    let p = u.center(x, y, z);
+                    let (va, vb) = (fa.value(p), fb.value(p));
+                    let want = va.max(vb);
+                    // Within a texel's interpolation of the fields, where they are inside
+                    // their own grids.
+                    if a.texel_at(p).is_some() || b.texel_at(p).is_some() {
+                        assert!(
+                            (u.value(x, y, z) - want).abs() < 0.15,
+                            "{p}: {} vs {want}",
+                            u.value(x, y, z)
+                        );
+                    }
+                    if u.value(x, y, z) > ISO {
+                        inside[usize::from(vb > va)] += 1;
+                    }
+                }
+            }
+        }
+        assert!(inside[0] > 0 && inside[1] > 0, "both clouds: {inside:?}");
+        assert_eq!(a.union(&DensityVolume::default(), 128), a);
+    }
 
     #[test]
     fn empty_field_bakes_empty_volume() {

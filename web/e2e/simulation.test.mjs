@@ -165,3 +165,35 @@ test('after a far jump in time the image shows the cloud the simulation caught u
     assert.ok(s.view.quality.startsWith('full'), 'the image stays: no image depends on the frame rate');
   });
 });
+
+// An outline sketched in a simulated scene is cloud too, beside the simulation's (before, a
+// simulated scene drew no stroke at all).
+test('an outline sketched in the simulated preset becomes cloud beside the simulated ones', { timeout: 300_000 }, async () => {
+  await withApp({ base: server.url, webgpu: true, query: '?preset=simulated', viewport: { width: 1280, height: 800 } }, async (page) => {
+    await page.evaluate(() => window.cloudsketch.set('/light/ground=false'));
+    let s = await until(page, (s) => !s.scene.light.ground, 'no ground');
+    const [vw, vh] = s.view.viewport;
+    const bg = s.scene.light.background.map((v) => Math.round(v * 255));
+    await page.mouse.click(5, vh - 5);
+    await waitForFullQuality(page);
+    // An outline in the empty sky above the simulated clouds (top left of the view).
+    const [cx, cy, r] = [vw * 0.25, vh * 0.2, vh * 0.08];
+    const area = { x: Math.round(cx - r), y: Math.round(cy - r * 0.5), w: Math.round(2 * r), h: Math.round(r) };
+    const before = cloud(await screenshot(page, 'simulation-outline-0'), area, bg);
+    assert.ok(before.n < 50, `empty sky where the outline goes: ${before.n} px`);
+    await page.keyboard.press('d');
+    await until(page, (s) => s.view.tool === 'sketch', 'sketch tool');
+    await page.mouse.move(cx + r * 1.4, cy);
+    await page.mouse.down();
+    for (let i = 1; i <= 60; i++) {
+      const a = (i / 60) * 2 * Math.PI;
+      await page.mouse.move(cx + r * 1.4 * Math.cos(a), cy - r * Math.sin(a) * (1 + 0.15 * Math.sin(5 * a)));
+    }
+    await page.mouse.up();
+    s = await until(page, (s) => s.scene.planes.length === 1, 'the stroke became a plane');
+    assert.ok(s.scene.simulation, 'still a simulated scene');
+    await waitForFullQuality(page);
+    const after = cloud(await screenshot(page, 'simulation-outline-1'), area, bg);
+    assert.ok(after.n > 0.3 * area.w * area.h, `the outline is cloud: ${after.n} of ${area.w * area.h} px`);
+  });
+});
