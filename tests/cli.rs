@@ -847,14 +847,15 @@ fn time_and_frame_name_the_same_moment_in_every_subcommand() {
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(exported, read_rgb(&temp("render48.png")));
 
-    // simulate: a moment is the step at or before it at the simulation's rate (the preset
-    // steps 4 times a second: frame 48 is step 8).
+    // simulate: a moment is the step at or before it at the simulation's rate (frame 48 is
+    // 2 s: twice the preset's steps per second).
     let (by_frame, by_steps) = (temp("f48.vol"), temp("s8.vol"));
     let rate = cloudsketch::scene::Scene::preset(cloudsketch::scene::Preset::Simulated)
         .simulation
         .unwrap()
         .rate;
-    let steps = cloudsketch::scene::steps_at(2.0, rate).to_string();
+    assert_eq!(rate.fract(), 0.0, "a whole number of steps per second");
+    let steps = (2 * rate as u64).to_string();
     for (out, args) in [
         (&by_frame, ["--frame", "48"]),
         (&by_steps, ["--steps", steps.as_str()]),

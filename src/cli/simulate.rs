@@ -43,7 +43,9 @@ pub fn run(
     // app's player reaches it.
     let steps = match (steps, at) {
         (Some(n), _) => n,
-        (None, Some(at)) => crate::scene::steps_at(at.seconds(&scene.clock)?, settings.rate),
+        // The player stops at its last step; so does a moment past it.
+        (None, Some(at)) => crate::scene::steps_at(at.seconds(&scene.clock)?, settings.rate)
+            .min(crate::simulate::MAX_STEP),
         (None, None) => DEFAULT_STEPS,
     };
     if steps > MAX_STEPS {

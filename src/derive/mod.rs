@@ -123,11 +123,25 @@ fn clip(plane: &DrawingPlane, line: Vec<glam::Vec2>) -> Clip {
 /// looks for, so an opened document's notice is not said twice).
 pub const PUFFS_OVER_CAP: &str = "puffs over the cap";
 
+/// What of `scene` is baked into cloud: all of it, or for a simulated scene its outlines alone
+/// (its ellipsoids are the simulation's parcels, not cloud).
+fn baked_part(scene: &Scene) -> std::borrow::Cow<'_, Scene> {
+    if scene.simulation.is_some() {
+        std::borrow::Cow::Owned(Scene {
+            ellipsoids: Vec::new(),
+            simulation: None,
+            ..scene.clone()
+        })
+    } else {
+        std::borrow::Cow::Borrowed(scene)
+    }
+}
+
 /// Checks what deriving a loaded document would cost, before anything is built: over
 /// [`MAX_BAKE_WORK`] at its field grid, the grid is made coarser (down to [`MIN_LOADED_GRID`])
 /// and the change returned in words; when even that is over, the document is refused.
 pub fn check_cost(scene: &mut Scene) -> Result<Option<String>, String> {
-    let field = field_of(scene);
+    let field = field_of(&baked_part(scene));
     let left_out = (field.puffs_left_out > 0).then(|| {
         format!(
             "billows: the finest level of puffs is left out ({} {PUFFS_OVER_CAP} of {})",
@@ -206,6 +220,8 @@ pub struct Derived {
     strokes: Option<(GeometryKey, Versioned<DensityVolume>)>,
     stroke_baker: Baker,
     united: Option<((u64, u64), Versioned<DensityVolume>)>,
+    /// Puffs the field of the last density left out for the cap.
+    left_out: usize,
     /// The run has not yet reached the scene's time (a far jump catches up over frames).
     pub catching_up: bool,
     generation: u64,
@@ -233,9 +249,10 @@ impl Derived {
         field
     }
 
-    /// Puffs the last derived field left out for [`crate::limits::MAX_PUFFS`] (0 before any).
+    /// Puffs the field of the last density left out for [`crate::limits::MAX_PUFFS`] (0
+    /// before any).
     pub fn puffs_left_out(&self) -> usize {
-        self.field.as_ref().map_or(0, |(_, f)| f.puffs_left_out)
+        self.left_out
     }
 
     /// The density volume of `scene`'s geometry at `revisions` (the geometry alone, without
@@ -257,6 +274,7 @@ impl Derived {
             Some((k, v)) if *k == gkey => v.clone(),
             _ => {
                 let field = self.field(scene, Some(revisions.geometry));
+                self.left_out = field.puffs_left_out;
                 self.generation += 1;
                 self.work.bakes += 1;
                 // Only what the edit changed is re-evaluated; an edit that would bake for
@@ -330,6 +348,7 @@ impl Derived {
         if !drawn {
             self.strokes = None;
             self.united = None;
+            self.left_out = 0;
             return simulated;
         }
         let gkey = GeometryKey {
@@ -339,16 +358,13 @@ impl Derived {
         let strokes = match &self.strokes {
             Some((k, v)) if *k == gkey => v.clone(),
             _ => {
-                let outlines = Scene {
-                    ellipsoids: Vec::new(),
-                    simulation: None,
-                    ..scene.clone()
-                };
+                let outlines = baked_part(scene);
                 let shapes = self.planes.shapes(&outlines.planes);
                 self.work.interpretations = self.planes.interpretations();
                 let mut field = assemble(&outlines, &shapes);
                 self.puffs.add(&outlines, &shapes, &mut field);
                 self.work.puff_growths = self.puffs.grown_count;
+                self.left_out = field.puffs_left_out;
                 let baked =
                     self.stroke_baker
                         .update(&Arc::new(field), gkey.resolution, MAX_BAKE_WORK);

@@ -598,6 +598,13 @@ fn a_finer_field_grid_grows_finer_puffs_in_the_cache_too() {
         derived.puffs_left_out() > 0,
         "the fine grid is over the cap"
     );
+    // A simulated scene's parcels grow no puffs: the count is its outlines' (none here).
+    doc.apply(
+        Edit::Replace(Box::new(Scene::preset(Preset::Simulated))),
+        None,
+    );
+    derived.density(doc.scene(), doc.revisions());
+    assert_eq!(derived.puffs_left_out(), 0);
 }
 
 /// Time is an input of its own: on a scene with nothing animated a new time derives nothing

@@ -75,8 +75,9 @@ impl DensityVolume {
             .then(|| (t * self.dims.as_vec3()).as_uvec3().min(self.dims - 1))
     }
 
-    /// The value at world point `p` as the GPU samples the grid: trilinear between texel
-    /// centres, clamped to the edge texels within the box; 0 (no cloud) outside it.
+    /// The value at world point `p` as the GPU samples the grid: each texel clamped to
+    /// [0, 1] as the texture stores it (8-bit unorm), trilinear between texel centres, clamped
+    /// to the edge texels within the box; 0 (no cloud) outside it.
     pub fn sample(&self, p: Vec3) -> f32 {
         let t = (p - self.min) / self.size;
         if self.is_empty() || t.cmplt(Vec3::ZERO).any() || t.cmpgt(Vec3::ONE).any() {
@@ -87,7 +88,7 @@ impl DensityVolume {
         let i = g.floor().as_uvec3().min(self.dims - 1);
         let j = (i + 1).min(self.dims - 1);
         let f = g - i.as_vec3();
-        let v = |x: u32, y: u32, z: u32| self.value(x, y, z);
+        let v = |x: u32, y: u32, z: u32| self.value(x, y, z).clamp(0.0, 1.0);
         let lerp = |a: f32, b: f32, t: f32| a + (b - a) * t;
         let x00 = lerp(v(i.x, i.y, i.z), v(j.x, i.y, i.z), f.x);
         let x10 = lerp(v(i.x, j.y, i.z), v(j.x, j.y, i.z), f.x);
@@ -122,7 +123,7 @@ impl DensityVolume {
             dims,
             min,
             size,
-            values: vec![0.0; (dims.x * dims.y * dims.z) as usize],
+            values: vec![0.0; dims.x as usize * dims.y as usize * dims.z as usize],
         };
         for z in 0..dims.z {
             for y in 0..dims.y {
@@ -940,11 +941,12 @@ mod tests {
             &Field::of_blobs(vec![Blob::sphere(Vec3::new(9.0, 1.0, 0.0), 1.0)]),
             32,
         );
+        let at = |x, y, z| a.value(x, y, z).clamp(0.0, 1.0);
         for (x, y, z) in [(0, 0, 0), (5, 9, 13), (16, 16, 16)] {
-            assert!((a.sample(a.center(x, y, z)) - a.value(x, y, z)).abs() < 1e-5);
+            assert!((a.sample(a.center(x, y, z)) - at(x, y, z)).abs() < 1e-5);
         }
         let mid = (a.center(3, 4, 5) + a.center(4, 4, 5)) * 0.5;
-        let want = (a.value(3, 4, 5) + a.value(4, 4, 5)) * 0.5;
+        let want = (at(3, 4, 5) + at(4, 4, 5)) * 0.5;
         assert!((a.sample(mid) - want).abs() < 1e-5);
         assert_eq!(a.sample(Vec3::splat(100.0)), 0.0, "nothing outside the box");
 
@@ -958,7 +960,7 @@ mod tests {
                 for x in 0..u.dims.x {
                     let p = u.center(x, y, z);
                     let (va, vb) = (fa.value(p), fb.value(p));
-                    let want = va.max(vb);
+                    let want = va.max(vb).clamp(0.0, 1.0);
                     // Within a texel's interpolation of the fields, where they are inside
                     // their own grids.
                     if a.texel_at(p).is_some() || b.texel_at(p).is_some() {

@@ -37,14 +37,25 @@ impl Clock {
         *self == Self::default()
     }
 
-    /// The scene time of frame `frame`, in seconds (frame 0 is time 0).
-    pub fn seconds(&self, frame: u32) -> f32 {
-        (f64::from(frame) / f64::from(self.fps)) as f32
+    /// The rate, or the default where a clock that skipped [`Clock::sanitize`] holds none.
+    fn rate(&self) -> f64 {
+        if self.fps.is_finite() && self.fps > 0.0 {
+            f64::from(self.fps)
+        } else {
+            limits::FRAME_RATE.default
+        }
     }
 
-    /// The frame at scene time `seconds`, with its fraction (a time between two frames).
+    /// The scene time of frame `frame`, in seconds (frame 0 is time 0).
+    pub fn seconds(&self, frame: u32) -> f32 {
+        (f64::from(frame) / self.rate()) as f32
+    }
+
+    /// The frame at scene time `seconds`, with its fraction (a time between two frames); a
+    /// frame's own time ([`Clock::seconds`], rounded to the scene's f32 seconds) gives that
+    /// frame back whole.
     pub fn frame(&self, seconds: f32) -> f64 {
-        f64::from(seconds) * f64::from(self.fps)
+        snapped(seconds, self.rate())
     }
 
     /// The frames of the range, first to last.
@@ -54,7 +65,7 @@ impl Clock {
 
     /// The last frame whose time is within [`limits::MAX_TIME`] at this rate.
     pub fn last_frame(&self) -> u32 {
-        (f64::from(limits::MAX_TIME) * f64::from(self.fps)).floor() as u32
+        (f64::from(limits::MAX_TIME) * self.rate()).floor() as u32
     }
 
     /// Repairs what a document may hold: a rate outside its range, a range past the last
@@ -67,11 +78,36 @@ impl Clock {
     }
 }
 
+/// `seconds` × `per_second`, snapped to the whole number it lies within the rounding of an
+/// f32 time of (a frame's or a step's own time is stored as the nearest f32, often a hair
+/// under it: frame 21 at 30 fps is 0.69999999 s, which must still be frame 21, not 20).
+fn snapped(seconds: f32, per_second: f64) -> f64 {
+    let seconds = if seconds.is_finite() {
+        seconds.max(0.0)
+    } else {
+        0.0
+    };
+    let per_second = if per_second.is_finite() {
+        per_second.max(0.0)
+    } else {
+        0.0
+    };
+    let x = f64::from(seconds) * per_second;
+    // Half an f32 unit of the time, in units of the result, and a little more.
+    let tolerance = f64::from(seconds) * f64::from(f32::EPSILON) * per_second + 1e-9;
+    let whole = x.round();
+    if (x - whole).abs() <= tolerance {
+        whole
+    } else {
+        x
+    }
+}
+
 /// Where scene time `seconds` falls among the steps of an automaton stepping `rate` times a
 /// second, with the fraction toward the next step: the one conversion of time to steps (the
 /// app's player and the command line both use it).
 pub fn step_position(seconds: f32, rate: f32) -> f64 {
-    f64::from(seconds.max(0.0)) * f64::from(rate.max(0.0))
+    snapped(seconds, f64::from(rate))
 }
 
 /// The step at or before scene time `seconds` ([`step_position`]; the player blends toward
@@ -140,6 +176,31 @@ mod tests {
             );
         }
         assert_eq!(clock.frames().count(), 121, "inclusive");
+        // Every frame's own time gives it back whole, and the simulation's step at it is the
+        // exact one, at the common rates (frame 21 at 30 fps is 0.69999999 s as an f32).
+        for fps in [24.0, 25.0, 30.0, 29.97, 60.0, 120.0] {
+            let c = Clock {
+                fps,
+                ..Clock::default()
+            };
+            for f in (0..5000).chain([100_000, 1_000_000]) {
+                let t = c.seconds(f);
+                assert_eq!(c.frame(t).floor(), f64::from(f), "frame {f} at {fps} fps");
+                let exact = (f64::from(f) * 10.0 / f64::from(fps) + 1e-9).floor();
+                if f < 5000 {
+                    assert_eq!(steps_at(t, 10.0) as f64, exact, "frame {f} at {fps} fps");
+                }
+            }
+        }
+        assert!(clock.frame(f32::NAN) == 0.0 && steps_at(f32::INFINITY, 10.0) == 0);
+        let broken = Clock {
+            fps: 0.0,
+            ..Clock::default()
+        };
+        assert!(
+            broken.seconds(10).is_finite(),
+            "a clock without a rate takes the default"
+        );
         assert_eq!(steps_at(2.5, 4.0), 10);
         assert_eq!(steps_at(2.49, 4.0), 9);
         assert_eq!(steps_at(-1.0, 4.0), 0);

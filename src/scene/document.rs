@@ -179,7 +179,11 @@ impl Document {
                 changed.geometry = sim.as_ref() != s.simulation.as_deref();
             }
             Edit::SetRender(r) => changed.render = *r != s.render,
-            Edit::SetClock(c) => changed.clock = *c != s.clock,
+            Edit::SetClock(c) => {
+                let mut c = *c;
+                c.sanitize();
+                changed.clock = c != s.clock;
+            }
             Edit::SetEllipsoids(e) => changed.geometry = !same(e, &s.ellipsoids),
             Edit::SetPlanes(p) => {
                 changed.geometry = p.len() <= MAX_PLANES && !same(p, &s.planes);

@@ -96,7 +96,8 @@ pub fn describe_change(from: &Scene, to: &Scene, label: &str) -> String {
     let others = from.light != to.light
         || from.render != to.render
         || from.reference != to.reference
-        || from.simulation != to.simulation;
+        || from.simulation != to.simulation
+        || from.clock != to.clock;
     let parts: Vec<String> = ellipsoids.into_iter().chain(planes).collect();
     match (parts.as_slice(), others) {
         ([], _) | (_, true) => label.to_owned(),

@@ -212,14 +212,15 @@ impl Viewport {
         // An edit that takes the billows over their cap (more puffs, a finer field grid) is
         // told once, as opening such a document is (whose notice already says it).
         let left_out = cx.derived.puffs_left_out();
+        let now = ui.input(|i| i.time);
         let told = cx
             .notices
             .latest
             .as_ref()
-            .is_some_and(|n| n.text.contains(PUFFS_OVER_CAP));
+            .is_some_and(|n| n.text.contains(PUFFS_OVER_CAP) && now - n.at < 1.0);
         if left_out > 0 && self.stats.puffs_left_out == 0 && !told {
             cx.notices.note(
-                ui.input(|i| i.time),
+                now,
                 format!(
                     "Billows: the finest level of puffs is left out ({left_out} {PUFFS_OVER_CAP} \
                      of {})",
