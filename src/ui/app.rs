@@ -590,7 +590,12 @@ impl eframe::App for CloudApp {
             .resizable(false)
             .exact_size(PANEL_WIDTH)
             .show_collapsible(ui, &mut open, |ui| {
-                egui::ScrollArea::vertical().show(ui, |ui| self.side_panel(ui));
+                egui::ScrollArea::vertical().show(ui, |ui| {
+                    self.side_panel(ui);
+                    // Room under the last group, so scrolled to the end its header stands clear
+                    // of the window's edge.
+                    ui.add_space(16.0);
+                });
             });
         if let (Some(slot), Some(shown)) = (fill_slot, shown) {
             ui.painter().set(

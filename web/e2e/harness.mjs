@@ -209,18 +209,23 @@ export function recordTiming(entry) {
 export async function reveal(page, name) {
   const [vw, vh] = (await state(page)).view.viewport;
   let last = null;
-  for (let i = 0; i < 30; i++) {
+  for (let i = 0; i < 60; i++) {
     const r = (await state(page)).view.widgets[name];
     if (!r) throw new Error(`${name} is not drawn`);
     const inView = r[1] >= 10 && r[1] + r[3] <= vh - 10;
     // egui animates a wheel scroll over several frames: only a box that stayed put since the
-    // last look (150 ms earlier) is where a click will land.
-    if (inView && last && r.every((v, k) => v === last[k])) return r;
-    last = r;
-    if (!inView) {
+    // last look (150 ms earlier) is where a click will land, and only from there is the next
+    // wheel aimed (a wheel sent while the last one still played out overshot on a busy
+    // machine, back and forth, and the widget never settled in view).
+    const settled = last && r.every((v, k) => v === last[k]);
+    if (inView && settled) return r;
+    if (!inView && (settled || !last)) {
+      // As far as brings the widget to the middle of the view.
+      const dy = Math.max(-600, Math.min(600, r[1] + r[3] / 2 - vh / 2));
       await page.mouse.move(vw + 100, vh / 2);
-      await page.mouse.wheel(0, r[1] < 10 ? -200 : 200);
+      await page.mouse.wheel(0, Math.abs(dy) < 40 ? Math.sign(dy) * 40 : dy);
     }
+    last = r;
     await page.waitForTimeout(150);
   }
   throw new Error(`${name} never came into view`);
