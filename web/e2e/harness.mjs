@@ -150,7 +150,10 @@ export async function waitForFullQuality(page, timeout = 120_000) {
   // Give the app a frame to notice a change before trusting "full".
   await page.waitForTimeout(50);
   const quality = await waitForBody(page, 'data-quality', (v) => typeof v === 'string' && v.startsWith('full'), timeout);
-  return { quality, seconds: (Date.now() - t0) / 1000 };
+  const seconds = (Date.now() - t0) / 1000;
+  // Two animation frames more, so a screenshot shows the frame that drew the last chunk.
+  await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+  return { quality, seconds };
 }
 
 /** Screenshot saved under SCREENSHOTS/name.png, decoded to { width, height, data (RGBA) }. */
