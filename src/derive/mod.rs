@@ -275,17 +275,10 @@ impl Derived {
             _ => {
                 let field = self.field(scene, Some(revisions.geometry));
                 self.left_out = field.puffs_left_out;
-                self.generation += 1;
-                self.work.bakes += 1;
                 // Only what the edit changed is re-evaluated; an edit that would bake for
                 // seconds bakes a coarser grid instead.
                 let baked = self.baker.update(&field, gkey.resolution, MAX_BAKE_WORK);
-                self.work.bake_work += baked.work;
-                self.work.baked_texels += baked.texels;
-                let v = Versioned {
-                    generation: self.generation,
-                    data: baked.volume,
-                };
+                let v = self.counted(baked);
                 self.density = Some((gkey, v.clone()));
                 v
             }
@@ -368,14 +361,7 @@ impl Derived {
                 let baked =
                     self.stroke_baker
                         .update(&Arc::new(field), gkey.resolution, MAX_BAKE_WORK);
-                self.generation += 1;
-                self.work.bakes += 1;
-                self.work.bake_work += baked.work;
-                self.work.baked_texels += baked.texels;
-                let v = Versioned {
-                    generation: self.generation,
-                    data: baked.volume,
-                };
+                let v = self.counted(baked);
                 self.strokes = Some((gkey, v.clone()));
                 v
             }
@@ -396,6 +382,18 @@ impl Derived {
         };
         self.united = Some((key, v.clone()));
         v
+    }
+
+    /// A bake as a new generation of a density volume, its work counted.
+    fn counted(&mut self, baked: crate::field::Baked) -> Versioned<DensityVolume> {
+        self.generation += 1;
+        self.work.bakes += 1;
+        self.work.bake_work += baked.work;
+        self.work.baked_texels += baked.texels;
+        Versioned {
+            generation: self.generation,
+            data: baked.volume,
+        }
     }
 
     /// The volumes of `scene` whose parts are at `revisions`; derives only what changed.
