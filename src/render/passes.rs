@@ -559,6 +559,40 @@ impl FillPass {
     }
 }
 
+/// The view behind the cloud laid again from the texture it was drawn into
+/// (`shaders/backdrop.wgsl`): a texture read a pixel, replacing what lies under it.
+pub struct BackdropPass {
+    pipeline: wgpu::RenderPipeline,
+}
+
+impl BackdropPass {
+    /// Creates the pass writing into `output_format`, its group laid out as `layout` (a 2D
+    /// texture and a sampler: the composite's).
+    pub fn new(
+        device: &wgpu::Device,
+        output_format: wgpu::TextureFormat,
+        layout: &wgpu::BindGroupLayout,
+    ) -> Self {
+        Self {
+            pipeline: full_pipeline(
+                device,
+                "backdrop",
+                shaders::BACKDROP,
+                &[layout],
+                output_format,
+                None,
+            ),
+        }
+    }
+
+    /// Lays the texture of `group` over the current render pass's viewport.
+    pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>, group: &wgpu::BindGroup) {
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, group, &[]);
+        pass.draw(0..3, 0..1);
+    }
+}
+
 /// Light slices one light volume may have (its grid's cap per side).
 pub const MAX_LIGHT_SLICES: u32 = 128;
 

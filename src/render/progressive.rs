@@ -166,7 +166,14 @@ struct Finishing {
 #[derive(Clone, Debug)]
 pub struct Progressive {
     budget: Budget,
+    /// Seconds per pixel·slice as frame intervals tell it (previews; chunks where the GPU
+    /// does not time them): what sizes previews.
     cost: f64,
+    /// Seconds per pixel·slice as the GPU's timing of refinement chunks tells it, once it
+    /// has timed one: what sizes chunks and the refined image. Frame intervals after a drag's
+    /// previews count the frames' other work too: sizing chunks by them made them half as
+    /// big as they could be, twice as many, each with a frame's overhead.
+    chunk_cost: Option<f64>,
     /// Seconds every frame takes besides its volume work.
     overhead: f64,
     /// Recent frames with volume work: (pixel·slices, seconds).
@@ -221,6 +228,7 @@ impl Progressive {
         Self {
             budget,
             cost: initial_cost.max(1e-12),
+            chunk_cost: None,
             overhead: 0.0,
             samples: std::collections::VecDeque::new(),
             timed: std::collections::VecDeque::new(),
@@ -245,9 +253,10 @@ impl Progressive {
         self
     }
 
-    /// Current cost estimate in seconds per pixel·slice.
+    /// Current cost estimate in seconds per pixel·slice of refinement's work (the GPU's
+    /// timing of chunks where it has timed one, else frame intervals).
     pub fn cost(&self) -> f64 {
-        self.cost
+        self.chunk_cost.unwrap_or(self.cost)
     }
 
     /// How much longer refinements have taken than the model predicted (see
@@ -371,6 +380,7 @@ impl Progressive {
         }
         let (size, predicted) = self.refine_plan(viewport, full_slices);
         let chunk_seconds = self.chunk_seconds();
+        let cost = self.cost();
         let refine = match &mut self.refine {
             Some(r) if r.key == key => r,
             slot => slot.insert(Refine {
@@ -391,7 +401,7 @@ impl Progressive {
         } else {
             1.0
         };
-        let per_chunk = (vary * chunk_seconds / (self.cost * pixels))
+        let per_chunk = (vary * chunk_seconds / (cost * pixels))
             .floor()
             .clamp(1.0, u32::MAX as f64) as u32;
         let start = refine.next;
@@ -504,14 +514,18 @@ impl Progressive {
                 if let Some(intercept) = intercept {
                     self.delay = 0.5 * self.delay + 0.5 * intercept;
                 }
+                let cost = self.cost();
                 let sample = slope
                     .unwrap_or(((seconds - self.delay).max(0.25 * seconds)) / work)
-                    .min(self.cost * 20.0);
-                let w = if sample > self.cost { 0.6 } else { 0.25 };
-                self.cost = self.cost * (1.0 - w) + sample * w;
+                    .min(cost * 20.0);
+                let w = if sample > cost { 0.6 } else { 0.25 };
+                let cost = cost * (1.0 - w) + sample * w;
+                self.chunk_cost = Some(cost);
+                // A preview's frame costs at least its work.
+                self.cost = self.cost.max(cost);
                 // What a chunk costs in time besides its work, from its planning until the
                 // frame that saw its report: what refining at a resolution must count per chunk.
-                let beyond = (now - then - self.cost * work).max(0.0);
+                let beyond = (now - then - cost * work).max(0.0);
                 self.per_chunk = if self.per_chunk > 0.0 {
                     0.7 * self.per_chunk + 0.3 * beyond
                 } else {
@@ -540,14 +554,11 @@ impl Progressive {
         self.samples.push_back((work, dt));
         self.fit_overhead();
         let sample = ((dt - self.overhead).max(0.5 * dt) / work).min(self.cost * 20.0);
-        if !self.timed.is_empty() && !pending.chunk && sample < self.cost {
-            // A quick frame after a preview says little while the GPU is not behind (frames
-            // then come at the display's pace); the GPU's timing of chunks says more.
-            return;
-        }
-        // Rise fast (stay responsive), fall slowly (don't trust one quick frame).
+        // Rise fast (stay responsive), fall slowly (don't trust one quick frame), and never
+        // below the work's cost the GPU timed: a quick frame says little while the GPU is not
+        // behind (frames then come at the display's pace).
         let w = if sample > self.cost { 0.6 } else { 0.25 };
-        self.cost = self.cost * (1.0 - w) + sample * w;
+        self.cost = (self.cost * (1.0 - w) + sample * w).max(self.chunk_cost.unwrap_or(0.0));
     }
 
     /// Least squares of seconds on work over the recent frames, when their sizes differ enough
@@ -592,7 +603,7 @@ impl Progressive {
     /// [`Progressive::late`] (which the choice counts).
     fn refine_plan(&self, viewport: [u32; 2], full_slices: u32) -> ([u32; 2], f64) {
         let seconds = |scale: f64| {
-            let work = self.cost
+            let work = self.cost()
                 * (viewport[0] as f64 * scale).round().max(1.0)
                 * (viewport[1] as f64 * scale).round().max(1.0)
                 * full_slices as f64;

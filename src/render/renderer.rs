@@ -3,8 +3,8 @@
 
 use super::gpu_types::{LightSliceUniforms, Shells, SkyUniforms, View, VolumeUniforms};
 use super::passes::{
-    CompositePass, FillPass, LIGHT_FORMAT, LightPass, MARCH_WORKGROUP, MAX_LIGHT_SLICES, MarchPass,
-    SkyPass, SlicePass,
+    BackdropPass, CompositePass, FillPass, LIGHT_FORMAT, LightPass, MARCH_WORKGROUP,
+    MAX_LIGHT_SLICES, MarchPass, SkyPass, SlicePass,
 };
 use super::progressive::JobPlan;
 use super::resources::{
@@ -33,6 +33,10 @@ pub struct VolumeRenderer {
     composite: CompositePass,
     sky: SkyPass,
     fill: FillPass,
+    backdrop_pass: BackdropPass,
+    /// The view behind the cloud as the viewport last drew it
+    /// ([`VolumeRenderer::draw_backdrop`]).
+    backdrop: Option<Backdrop>,
     clamp_sampler: wgpu::Sampler,
     repeat_sampler: wgpu::Sampler,
     textures: VolumeTextures,
@@ -68,6 +72,14 @@ struct BeyondComposite {
     crop: [f32; 4],
     /// The target's two textures and the outside shafts' first.
     views: [wgpu::TextureView; 3],
+    group: wgpu::BindGroup,
+}
+
+/// The view behind the cloud in a texture of the viewport's size, and its group for
+/// [`BackdropPass::draw`].
+struct Backdrop {
+    size: [u32; 2],
+    view: wgpu::TextureView,
     group: wgpu::BindGroup,
 }
 
@@ -131,13 +143,17 @@ impl VolumeRenderer {
             &[255, 255],
         );
         let clamp_sampler = sampler(device, wgpu::AddressMode::ClampToEdge);
+        let composite = CompositePass::new(device, output_format);
+        let backdrop_pass = BackdropPass::new(device, output_format, &composite.layout);
         Self {
             accum_format,
             output_format,
             slices: SlicePass::new(device, accum_format),
-            composite: CompositePass::new(device, output_format),
             sky: SkyPass::new(device, output_format, &placeholder, &clamp_sampler),
+            composite,
             fill: FillPass::new(device, output_format),
+            backdrop_pass,
+            backdrop: None,
             clamp_sampler,
             repeat_sampler: sampler(device, wgpu::AddressMode::Repeat),
             textures: VolumeTextures::new(),
@@ -911,6 +927,69 @@ impl VolumeRenderer {
     /// Draws the sky gradient over the current render pass's viewport.
     pub fn draw_sky(&self, pass: &mut wgpu::RenderPass<'_>) {
         self.sky.draw(pass);
+    }
+
+    /// Draws the view behind the cloud into a texture `size` pixels (the viewport's), which
+    /// [`VolumeRenderer::lay_backdrop`] then lays on every frame until it changes: `background`
+    /// (sRGB-encoded, as egui's colours) with `view`'s sky gradient or ground drawn over it, and
+    /// the shafts of light [`VolumeRenderer::draw_outside_shafts`] drew (call it first) laid
+    /// over `strips`, the pixel rectangles (x0, y0, x1, y1) around the cloud's box. On CPU
+    /// adapters the ground's shading and the shafts' lay took over half of each refining frame.
+    #[allow(clippy::too_many_arguments)]
+    pub fn draw_backdrop(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        view: &View,
+        size: [u32; 2],
+        background: [f32; 3],
+        strips: &[[u32; 4]],
+    ) {
+        let size = [size[0].max(1), size[1].max(1)];
+        if self.backdrop.as_ref().is_none_or(|b| b.size != size) {
+            let texture = super::resources::render_texture(
+                device,
+                "view behind the cloud",
+                size,
+                self.output_format,
+            );
+            let group = self
+                .composite
+                .bind_group(device, &texture, None, &self.clamp_sampler);
+            self.backdrop = Some(Backdrop {
+                size,
+                view: texture,
+                group,
+            });
+        }
+        let Some(backdrop) = &self.backdrop else {
+            return;
+        };
+        let mut pass = self.backdrop_pass(
+            queue,
+            encoder,
+            &backdrop.view,
+            view,
+            Some(background),
+            "view behind the cloud",
+        );
+        for &[x0, y0, x1, y1] in strips {
+            let (x0, y0) = (x0.min(size[0]), y0.min(size[1]));
+            let (x1, y1) = (x1.clamp(x0, size[0]), y1.clamp(y0, size[1]));
+            if x1 > x0 && y1 > y0 {
+                pass.set_scissor_rect(x0, y0, x1 - x0, y1 - y0);
+                self.composite_outside_shafts(&mut pass, false);
+            }
+        }
+    }
+
+    /// Lays the view behind the cloud [`VolumeRenderer::draw_backdrop`] drew over the current
+    /// render pass's viewport (nothing before it is drawn).
+    pub fn lay_backdrop(&self, pass: &mut wgpu::RenderPass<'_>) {
+        if let Some(b) = &self.backdrop {
+            self.backdrop_pass.draw(pass, &b.group);
+        }
     }
 
     /// Fills the current render pass's viewport with `colour` (the values the target stores).

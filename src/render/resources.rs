@@ -202,8 +202,18 @@ pub fn accumulation_texture(
     size: [u32; 2],
     format: wgpu::TextureFormat,
 ) -> wgpu::TextureView {
+    render_texture(device, "volume accumulation", size, format)
+}
+
+/// Creates a 2D texture of `size` in `format` to render into and sample, and returns its view.
+pub fn render_texture(
+    device: &wgpu::Device,
+    label: &str,
+    size: [u32; 2],
+    format: wgpu::TextureFormat,
+) -> wgpu::TextureView {
     let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
-    image_2d(device, "volume accumulation", size, format, usage)
+    image_2d(device, label, size, format, usage)
 }
 
 /// Creates a 2D texture of `size` in `format` for `usage` and returns its view.

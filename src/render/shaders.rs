@@ -79,8 +79,14 @@ pub const FILL: &str = concat!(
     include_str!("../../shaders/fill.wgsl")
 );
 
+/// The view behind the cloud laid again from its texture: `fullscreen.wgsl` + `backdrop.wgsl`.
+pub const BACKDROP: &str = concat!(
+    include_str!("../../shaders/fullscreen.wgsl"),
+    include_str!("../../shaders/backdrop.wgsl")
+);
+
 /// Every shader module with the files it is composed of, in order.
-pub const MODULES: [(&str, &[&str], &str); 10] = [
+pub const MODULES: [(&str, &[&str], &str); 11] = [
     (
         "volume",
         &[
@@ -147,4 +153,5 @@ pub const MODULES: [(&str, &[&str], &str); 10] = [
         SKY,
     ),
     ("fill", &["fullscreen.wgsl", "fill.wgsl"], FILL),
+    ("backdrop", &["fullscreen.wgsl", "backdrop.wgsl"], BACKDROP),
 ];

@@ -199,29 +199,42 @@ impl RendererPaint for ViewportPaint {
     }
 }
 
-/// The shafts of light over the part of the view outside the cloud's box on screen, where no
-/// cloud lies in front of them (and those of the shells beyond the box, which the box's
-/// composite adds). Drawn (when `redraw`) into a target of `size` pixels, then laid over the
-/// view under each callback's scissor: the viewport adds one callback per strip of the view
-/// around the box, only the first of which redraws.
-pub struct OutsideShaftsPaint {
-    /// The derived volumes (uploaded here too: the cloud's box may be out of view).
-    pub volumes: Volumes,
+/// What lies behind the cloud in the viewport: the background colour, the sky gradient or the
+/// ground, and the shafts of light around the cloud's box, where no cloud lies in front of
+/// them. Drawn into a texture of its own when any of it changes (`redraw`), and laid from it
+/// on every frame, under everything else: on a CPU adapter the ground's shading and the
+/// shafts' lay, redone on every frame, took over half of each frame of a refinement.
+pub struct BackdropPaint {
     /// The whole view ([`super::FULL_VIEW`]).
     pub view: super::gpu_types::View,
-    /// Slices of the image the shells are counted for.
-    pub total: u32,
-    /// The target's size in pixels.
+    /// The background colour, sRGB-encoded (as egui's colours and the sky are).
+    pub background: [f32; 3],
+    /// The viewport's size in pixels.
     pub size: [u32; 2],
-    /// Whether this callback draws the shafts (the view changed) or only lays them.
+    /// The shafts of light drawn apart from the cloud's box, if the view has shafts.
+    pub shafts: Option<ShaftsApart>,
+    /// The pixel rectangles (x0, y0, x1, y1) around the cloud's box, where the shafts are laid
+    /// (the whole view when the box is out of view; none when it covers the view).
+    pub strips: Vec<[u32; 4]>,
+    /// Whether this frame draws it again (something in it changed) or only lays it.
     pub redraw: bool,
-    /// Whether it lays them (not where the box covers the whole view: it only draws those
-    /// beyond the box, for the box's composite).
-    pub lay: bool,
 }
 
-impl RendererPaint for OutsideShaftsPaint {
-    fn prepare(&self, renderer: &mut VolumeRenderer, frame: FrameGpu<'_>) {
+/// The shafts of light outside the cloud's box on screen, and those of the shells beyond it,
+/// which the box's composite adds ([`VolumeRenderer::draw_outside_shafts`]).
+pub struct ShaftsApart {
+    /// The derived volumes (uploaded here too: the cloud's box may be out of view).
+    pub volumes: Volumes,
+    /// Slices of the image the shells are counted for.
+    pub total: u32,
+    /// Their target's size in pixels (a fraction of the view's: the light is soft).
+    pub size: [u32; 2],
+}
+
+impl RendererPaint for BackdropPaint {
+    fn finish_prepare(&self, renderer: &mut VolumeRenderer, frame: FrameGpu<'_>) {
+        // After every callback's `prepare`: the box's starts the frame's uniforms. Before the
+        // box's `finish_prepare`, which binds the shafts beyond the box drawn here.
         if !self.redraw {
             return;
         }
@@ -230,31 +243,33 @@ impl RendererPaint for OutsideShaftsPaint {
             queue,
             commands,
         } = frame;
-        renderer.upload(device, queue, &self.volumes);
-        renderer.update_light(device, queue, commands, &self.view);
-        renderer.draw_outside_shafts(device, queue, commands, &self.view, self.total, self.size);
-    }
-
-    fn paint(&self, renderer: &VolumeRenderer, pass: &mut wgpu::RenderPass<'static>) {
-        if self.lay {
-            renderer.composite_outside_shafts(pass, false);
+        let mut laid = false;
+        if let Some(shafts) = &self.shafts {
+            renderer.upload(device, queue, &shafts.volumes);
+            renderer.update_light(device, queue, commands, &self.view);
+            laid = renderer.draw_outside_shafts(
+                device,
+                queue,
+                commands,
+                &self.view,
+                shafts.total,
+                shafts.size,
+            );
         }
-    }
-}
-
-/// The sky gradient behind the cloud, over the whole view (drawn before [`ViewportPaint`]).
-pub struct SkyPaint {
-    /// Camera, light (its colours) and aspect of the view.
-    pub view: super::gpu_types::View,
-}
-
-impl RendererPaint for SkyPaint {
-    fn prepare(&self, renderer: &mut VolumeRenderer, frame: FrameGpu<'_>) {
-        renderer.prepare_sky(frame.queue, &self.view);
+        let strips: &[[u32; 4]] = if laid { &self.strips } else { &[] };
+        renderer.draw_backdrop(
+            device,
+            queue,
+            commands,
+            &self.view,
+            self.size,
+            self.background,
+            strips,
+        );
     }
 
     fn paint(&self, renderer: &VolumeRenderer, pass: &mut wgpu::RenderPass<'static>) {
-        renderer.draw_sky(pass);
+        renderer.lay_backdrop(pass);
     }
 }
 

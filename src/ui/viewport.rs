@@ -19,8 +19,8 @@ use crate::render::crop::{OUTSIDE_SHAFTS_DIVISOR, PixelCrop};
 const CAPTURE_BUDGET: f64 = 0.04;
 use crate::derive::PUFFS_OVER_CAP;
 use crate::render::progressive::{Budget, Progressive};
+use crate::render::viewport::{BackdropPaint, ShaftsApart, ViewportPaint, paint_callback};
 use crate::render::viewport::{JobFence, ReportPoll};
-use crate::render::viewport::{OutsideShaftsPaint, SkyPaint, ViewportPaint, paint_callback};
 use crate::scene::Document;
 
 /// How often a viewport whose refinement waits for the GPU looks again without word from it
@@ -57,8 +57,9 @@ pub struct Viewport {
     capture_geometry: u64,
     /// A finished capture: its size and pixels (straight-alpha RGBA), or why it failed.
     pub captured: Option<([u32; 2], Result<Vec<u8>, String>)>,
-    /// What the shafts of light outside the cloud's box were last drawn for.
-    outside_key: Option<u64>,
+    /// What the view behind the cloud (sky, ground, the shafts around the box) was last drawn
+    /// for.
+    backdrop_key: Option<u64>,
 }
 
 impl Viewport {
@@ -117,7 +118,7 @@ impl Viewport {
             capture: None,
             capture_geometry: 0,
             captured: None,
-            outside_key: None,
+            backdrop_key: None,
         }
     }
 
@@ -171,9 +172,12 @@ impl Viewport {
         }
 
         // A flat background is the frame's clear colour (`CloudApp::clear_color`): no
-        // full-view fill of its own, one full-screen pass less on CPU adapters. A gradient is
-        // a pass over the view, under the reference image and the cloud.
+        // full-view pass of its own, one full-screen pass less on CPU adapters. A gradient, the
+        // ground or shafts of light are the view behind the cloud, drawn into a texture when
+        // they change and laid from it (under the reference image and the cloud): its place
+        // is kept here, and it is made once the cloud's box on screen is known.
         let painter = ui.painter_at(rect);
+        let backdrop_slot = painter.add(egui::Shape::Noop);
         let scene = cx.doc.scene();
         // What this frame shows, for the sky and the volume alike.
         let view = View {
@@ -184,9 +188,6 @@ impl Viewport {
             aspect: rect.aspect_ratio(),
             crop: crate::render::FULL_VIEW,
         };
-        if (scene.light.sky_gradient || scene.light.ground) && self.stats.backend.is_some() {
-            painter.add(paint_callback(rect, SkyPaint { view: view.clone() }));
-        }
         guide.paint(&painter, rect, cx.doc, false);
 
         let ppp = ui.ctx().pixels_per_point();
@@ -255,19 +256,24 @@ impl Viewport {
             )
         });
         let dragging = response.is_pointer_button_down_on();
-        let outside = (scene.light.shafts && !density.is_empty() && self.stats.backend.is_some())
-            .then(|| OutsideShaftsPaint {
-                volumes: volumes.clone(),
-                view: view.clone(),
-                total: if dragging {
-                    OUTSIDE_PREVIEW_SLICES.min(scene.render.slices)
-                } else {
-                    scene.render.slices
-                },
-                size: px.map(|v| v.div_ceil(OUTSIDE_SHAFTS_DIVISOR * if dragging { 2 } else { 1 })),
-                redraw: false,
-                lay: true,
-            });
+        let shafts = (scene.light.shafts && !density.is_empty()).then(|| ShaftsApart {
+            volumes: volumes.clone(),
+            total: if dragging {
+                OUTSIDE_PREVIEW_SLICES.min(scene.render.slices)
+            } else {
+                scene.render.slices
+            },
+            size: px.map(|v| v.div_ceil(OUTSIDE_SHAFTS_DIVISOR * if dragging { 2 } else { 1 })),
+        });
+        let shells_apart = shafts.is_some();
+        if (scene.light.sky_gradient || scene.light.ground || shafts.is_some())
+            && self.stats.backend.is_some()
+        {
+            let paint = self.backdrop(cx.doc, &view, px, crop.map(|c| c.px), shafts, dragging);
+            painter.set(backdrop_slot, paint_callback(rect, paint));
+        } else {
+            self.backdrop_key = None;
+        }
         let key = view_key(cx.doc, volumes.density.generation, px, crop.map(|c| c.px));
         let now = ui.input(|i| i.time);
         let crop_size = crop.map_or([1, 1], |c| c.size());
@@ -374,7 +380,7 @@ impl Viewport {
                     ..view.clone()
                 },
                 // The shafts around the box hold those beyond it.
-                shells_apart: outside.is_some(),
+                shells_apart,
             });
             if let Some(area) = crop_area.filter(|_| self.stats.backend.is_some()) {
                 painter.add(paint_callback(
@@ -392,14 +398,6 @@ impl Viewport {
                 ));
             }
         }
-        // The shafts apart from the cloud's box: around it, and those beyond it, which the
-        // box's composite adds (after every callback's `prepare`, so the callback that redraws
-        // them may come after the box's, which starts the frame's uniforms).
-        if let Some(paint) = outside {
-            self.outside_shafts(ui, rect, crop_area, cx.doc, paint);
-        } else {
-            self.outside_key = None;
-        }
         if plan.repaint {
             ui.ctx().request_repaint();
         } else if plan.waiting_for_gpu {
@@ -415,51 +413,44 @@ impl Viewport {
         }
     }
 
-    /// The shafts of light over the view around the cloud's box `area` (all of it without
-    /// one): one callback per strip, each under its own scissor, the first redrawing them (and
-    /// those beyond the box, which the box's composite adds) when the view, the light, the
-    /// clouds or the size changed (or a drag began or ended: a drag counts fewer shells).
-    /// Where the box covers the whole view, one callback that only redraws them: the box's
-    /// composite still adds those beyond it.
-    fn outside_shafts(
+    /// The view behind the cloud over a view of `px` pixels whose cloud's box on screen is
+    /// `crop` (pixels; none when out of view), with `shafts` of light around the box: drawn
+    /// again when the view, the light, the clouds or the size changed (or a drag began or
+    /// ended: a drag counts fewer shells), else laid as it was. While `dragging`, at half the
+    /// size: it is drawn again on every frame then, and on a CPU adapter the ground and the
+    /// shafts kept a drag's frames over its budget.
+    fn backdrop(
         &mut self,
-        ui: &egui::Ui,
-        rect: egui::Rect,
-        area: Option<egui::Rect>,
         doc: &Document,
-        paint: OutsideShaftsPaint,
-    ) {
+        view: &View,
+        px: [u32; 2],
+        crop: Option<[u32; 4]>,
+        shafts: Option<ShaftsApart>,
+        dragging: bool,
+    ) -> BackdropPaint {
+        let scale = if dragging { BACKDROP_DRAG_DIVISOR } else { 1 };
+        let size = px.map(|v| v.div_ceil(scale));
+        // The box rounded outward: no shafts are laid twice along its edges.
+        let crop = crop.map(|[x0, y0, x1, y1]| {
+            [x0 / scale, y0 / scale, x1.div_ceil(scale), y1.div_ceil(scale)]
+        });
         let key = {
             use std::hash::{Hash, Hasher};
             let mut h = std::collections::hash_map::DefaultHasher::new();
-            let density = paint.volumes.density.generation;
-            (view_key(doc, density, paint.size, None), paint.total).hash(&mut h);
+            let density = shafts.as_ref().map(|s| s.volumes.density.generation);
+            view_key(doc, density.unwrap_or(0), size, crop).hash(&mut h);
+            shafts.as_ref().map(|s| (s.total, s.size)).hash(&mut h);
             h.finish()
         };
-        let redraw = self.outside_key != Some(key);
-        self.outside_key = Some(key);
-        let strips = strips_around(rect, area);
-        if strips.is_empty() {
-            ui.painter_at(rect).add(paint_callback(
-                rect,
-                OutsideShaftsPaint {
-                    redraw,
-                    lay: false,
-                    ..paint
-                },
-            ));
-            return;
-        }
-        for (k, strip) in strips.into_iter().enumerate() {
-            ui.painter_at(strip).add(paint_callback(
-                rect,
-                OutsideShaftsPaint {
-                    volumes: paint.volumes.clone(),
-                    view: paint.view.clone(),
-                    redraw: redraw && k == 0,
-                    ..paint
-                },
-            ));
+        let redraw = self.backdrop_key != Some(key);
+        self.backdrop_key = Some(key);
+        BackdropPaint {
+            view: view.clone(),
+            background: doc.scene().light.background,
+            size,
+            shafts,
+            strips: strips_around(size, crop),
+            redraw,
         }
     }
 
@@ -541,21 +532,33 @@ impl Viewport {
 
 /// The strips of `rect` around `area` (top, bottom, left, right; the whole of `rect` without
 /// an area), leaving out empty ones.
-fn strips_around(rect: egui::Rect, area: Option<egui::Rect>) -> Vec<egui::Rect> {
-    let Some(a) = area.map(|a| a.intersect(rect)).filter(|a| a.is_positive()) else {
-        return vec![rect];
+/// The pixel rectangles (x0, y0, x1, y1) of a view `px` pixels around the box `area` (the
+/// whole view without one), leaving out the empty ones.
+fn strips_around([w, h]: [u32; 2], area: Option<[u32; 4]>) -> Vec<[u32; 4]> {
+    let Some([x0, y0, x1, y1]) = area.map(|[x0, y0, x1, y1]| {
+        [
+            x0.min(w),
+            y0.min(h),
+            x1.clamp(x0.min(w), w),
+            y1.clamp(y0.min(h), h),
+        ]
+    }) else {
+        return vec![[0, 0, w, h]];
     };
-    let r = rect;
     [
-        egui::Rect::from_x_y_ranges(r.x_range(), r.top()..=a.top()),
-        egui::Rect::from_x_y_ranges(r.x_range(), a.bottom()..=r.bottom()),
-        egui::Rect::from_x_y_ranges(r.left()..=a.left(), a.y_range()),
-        egui::Rect::from_x_y_ranges(a.right()..=r.right(), a.y_range()),
+        [0, 0, w, y0],
+        [0, y1, w, h],
+        [0, y0, x0, y1],
+        [x1, y0, w, y1],
     ]
     .into_iter()
-    .filter(|s| s.width() >= 0.5 && s.height() >= 0.5)
+    .filter(|[a, b, c, d]| c > a && d > b)
     .collect()
 }
+
+/// While a drag is under way the view behind the cloud is drawn at 1/this of the view's size
+/// (each side).
+const BACKDROP_DRAG_DIVISOR: u32 = 2;
 
 /// While a drag is under way they are counted for an image of this many slices (fewer shells).
 const OUTSIDE_PREVIEW_SLICES: u32 = 32;
@@ -579,6 +582,29 @@ fn view_key(doc: &Document, density: u64, px: [u32; 2], crop: Option<[u32; 4]>) 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_strips_around_the_box_cover_the_rest_of_the_view_once() {
+        let view = [40, 30];
+        let inside =
+            |[x0, y0, x1, y1]: [u32; 4], x: u32, y: u32| x >= x0 && x < x1 && y >= y0 && y < y1;
+        for area in [
+            None,
+            Some([5, 7, 20, 25]),
+            Some([0, 0, 40, 30]),
+            Some([0, 3, 12, 30]),
+            Some([30, 20, 60, 90]),
+        ] {
+            let strips = strips_around(view, area);
+            for y in 0..view[1] {
+                for x in 0..view[0] {
+                    let covered = strips.iter().filter(|&&s| inside(s, x, y)).count();
+                    let boxed = area.is_some_and(|a| inside(a, x, y));
+                    assert_eq!(covered, usize::from(!boxed), "{area:?} at {x}, {y}");
+                }
+            }
+        }
+    }
 
     #[test]
     fn a_pixel_crop_covers_its_rectangle_and_maps_back() {
