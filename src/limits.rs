@@ -170,19 +170,24 @@ pub const TORQUE: Param = Param::linear(
 /// 128 slices (`MAX_LIGHT_SLICES` in `render::passes`).
 pub const LIGHT_RESOLUTION: Param = Param::linear(
     "light grid",
-    "Resolution of the light volume the shadows and the sky's light come from: finer shows smaller shadow detail, costs more whenever the light, the shape or the moving noise changes",
+    "Resolution of the light volume the shadows and the sky's light come from: finer shows smaller shadow detail, costs more whenever the light, the shape or the moving noise changes (the view previews at most 24 on a CPU adapter; renders and exports use this)",
     8.0,
     128.0,
-    24.0,
+    96.0,
 );
 /// Noise octaves the light volume sees.
 pub const LIGHT_OCTAVES: Param = Param::linear(
     "light octaves",
-    "Octaves of noise the shadows see (0: shadows of the smooth shape only)",
+    "Octaves of noise the shadows see (0: shadows of the smooth shape only; the view previews at most 2 on a CPU adapter; renders and exports use this)",
     0.0,
     8.0,
-    2.0,
+    4.0,
 );
+/// The light the viewport previews at most on a CPU adapter (lavapipe, SwiftShader): light
+/// grid and light octaves. The light volume is recomputed whenever the light, the shape or
+/// the moving noise changes, and on a CPU it holds up the frame; renders and exports keep the
+/// document's.
+pub const CPU_PREVIEW_LIGHT: [u32; 2] = [24, 2];
 /// Altitude (world y) where an atmospheric tier begins.
 pub const TIER_FLOOR: Param = Param::linear(
     "floor",

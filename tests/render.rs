@@ -1511,3 +1511,55 @@ fn billows_make_the_outline_rough_at_every_scale() {
         assert!(d_off <= 1.12, "{preset:?} without billows: D {d_off:.3}");
     }
 }
+
+/// A new document's light volume is the finer one (96 texels, 4 octaves) that renders and
+/// exports use; the viewport on a CPU adapter previews it at `CPU_PREVIEW_LIGHT`. The renderer
+/// keeps the light volume before the current one, so a PNG export and the view it is made from
+/// do not recompute each other's: going back to the document's light draws what it drew
+/// before, not the preview's shadows (a cache that swapped volumes without binding them would).
+#[test]
+fn the_previewed_light_and_the_documents_each_draw_their_own_shadows() {
+    let scene = Scene::default();
+    assert_eq!(
+        [scene.render.light_resolution, scene.render.light_octaves],
+        [96, 4]
+    );
+    let mut preview = scene.clone();
+    preview.render = scene
+        .render
+        .with_light_at_most(cloudsketch::limits::CPU_PREVIEW_LIGHT);
+    assert_eq!(
+        [
+            preview.render.light_resolution,
+            preview.render.light_octaves
+        ],
+        cloudsketch::limits::CPU_PREVIEW_LIGHT
+    );
+    // Never above the document's.
+    let coarse = with(
+        &scene,
+        &["/render/light_resolution=16", "/render/light_octaves=1"],
+    );
+    let capped = coarse
+        .render
+        .with_light_at_most(cloudsketch::limits::CPU_PREVIEW_LIGHT);
+    assert_eq!([capped.light_resolution, capped.light_octaves], [16, 1]);
+
+    let mut o = offscreen();
+    let mut draw = |s: &Scene| o.render(s, W, H, Backdrop::Transparent).expect("render");
+    let (first, previewed, again) = (draw(&scene), draw(&preview), draw(&scene));
+    let differing = first
+        .rgba
+        .chunks(4)
+        .zip(previewed.rgba.chunks(4))
+        .filter(|(a, b)| a.iter().zip(b.iter()).any(|(x, y)| x.abs_diff(*y) > 8))
+        .count();
+    assert!(
+        differing > 500,
+        "the preview's coarser light changes the shading: {differing} pixels"
+    );
+    assert!(
+        first.rgba == again.rgba,
+        "the document's light, drawn again, is as it was"
+    );
+}

@@ -604,11 +604,15 @@ pub struct LightPass {
     pub pipeline: wgpu::RenderPipeline,
     /// Layout of group 0: the slice group without the light texture.
     pub volume_layout: wgpu::BindGroupLayout,
-    /// Per-slice uniforms (group 1), [`MAX_LIGHT_SLICES`] slots of `stride` bytes.
+    /// Per-slice uniforms (group 1): two banks of [`MAX_LIGHT_SLICES`] slots of `stride`
+    /// bytes, used in turn, so that two light volumes computed before one submission (the
+    /// viewport's and a PNG export's) keep their own.
     uniforms: wgpu::Buffer,
     /// Group 1.
     pub slice_group: wgpu::BindGroup,
     stride: u64,
+    /// The bank the next [`LightPass::write`] uses.
+    bank: u64,
 }
 
 /// The light volume's format: transmittance toward the sun (stored as T^(1/8)) and the sky's light
@@ -638,7 +642,7 @@ impl LightPass {
         let stride = size.div_ceil(align) * align;
         let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("light slices"),
-            size: stride * MAX_LIGHT_SLICES as u64,
+            size: 2 * stride * MAX_LIGHT_SLICES as u64,
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
@@ -668,11 +672,12 @@ impl LightPass {
             uniforms,
             slice_group,
             stride,
+            bank: 0,
         }
     }
 
-    /// Writes the slices' uniforms; returns each slice's dynamic offset.
-    pub fn write(&self, queue: &wgpu::Queue, slices: &[LightSliceUniforms]) -> Vec<u32> {
+    /// Writes the slices' uniforms into the next bank; returns each slice's dynamic offset.
+    pub fn write(&mut self, queue: &wgpu::Queue, slices: &[LightSliceUniforms]) -> Vec<u32> {
         let n = slices.len().min(MAX_LIGHT_SLICES as usize);
         let mut bytes = vec![0u8; (self.stride * n as u64) as usize];
         for (i, s) in slices[..n].iter().enumerate() {
@@ -680,8 +685,12 @@ impl LightPass {
             bytes[at..at + std::mem::size_of::<LightSliceUniforms>()]
                 .copy_from_slice(bytemuck::bytes_of(s));
         }
-        queue.write_buffer(&self.uniforms, 0, &bytes);
-        (0..n as u64).map(|i| (i * self.stride) as u32).collect()
+        let base = self.bank * self.stride * MAX_LIGHT_SLICES as u64;
+        self.bank = 1 - self.bank;
+        queue.write_buffer(&self.uniforms, base, &bytes);
+        (0..n as u64)
+            .map(|i| (base + i * self.stride) as u32)
+            .collect()
     }
 }
 

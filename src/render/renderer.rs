@@ -45,6 +45,10 @@ pub struct VolumeRenderer {
     light_pass: LightPass,
     /// The light volume: what it was computed for, its size, the texture.
     light: Option<LightVolume>,
+    /// The light volume before it, kept: the viewport on a CPU adapter previews the light at
+    /// less than the document's resolution while a PNG export draws it at the document's, and
+    /// each would otherwise recompute it whenever the other had drawn.
+    spare_light: Option<LightVolume>,
     /// Full transmittance, bound until a light volume exists.
     light_placeholder: wgpu::TextureView,
     /// Group 0 of the light pass (the slice group without the light texture).
@@ -169,6 +173,7 @@ impl VolumeRenderer {
             beyond: None,
             light_pass: LightPass::new(device),
             light: None,
+            spare_light: None,
             light_placeholder: placeholder,
             light_bind_group: None,
             march: None,
@@ -323,7 +328,10 @@ impl VolumeRenderer {
 
     /// Makes the next [`VolumeRenderer::update_light`] recompute the light volume (benchmarks).
     pub fn invalidate_light(&mut self) {
-        if let Some(light) = &mut self.light {
+        for light in [&mut self.light, &mut self.spare_light]
+            .into_iter()
+            .flatten()
+        {
             light.key = 0;
         }
     }
@@ -376,7 +384,17 @@ impl VolumeRenderer {
         if self.light.as_ref().is_some_and(|l| l.key == key) {
             return false;
         }
-        if self.light.as_ref().is_none_or(|l| l.dims != dims) {
+        if self.spare_light.as_ref().is_some_and(|l| l.key == key) {
+            std::mem::swap(&mut self.light, &mut self.spare_light);
+            self.rebuild_bind_groups(device);
+            return false;
+        }
+        // Computed into the spare volume's textures where they fit (the current one is kept
+        // as the spare), else into new ones.
+        let previous = self.light.take();
+        self.light = self.spare_light.take().filter(|l| l.dims == dims);
+        self.spare_light = previous;
+        if self.light.is_none() {
             let texture = device.create_texture(&wgpu::TextureDescriptor {
                 label: Some("light volume"),
                 size: wgpu::Extent3d {
@@ -417,6 +435,8 @@ impl VolumeRenderer {
                 slice,
                 slice_view,
             });
+            self.rebuild_bind_groups(device);
+        } else {
             self.rebuild_bind_groups(device);
         }
         let (Some(light), Some(group)) = (&mut self.light, &self.light_bind_group) else {

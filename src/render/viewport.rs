@@ -391,6 +391,9 @@ pub struct BackendInfo {
     pub adapter: String,
     /// How the slices are drawn: `marched` (a compute pass) or `rasterised`.
     pub slices: &'static str,
+    /// Whether the adapter is a CPU one (lavapipe, SwiftShader): the view previews the light
+    /// at less than the document asks ([`crate::limits::CPU_PREVIEW_LIGHT`]).
+    pub on_cpu: bool,
 }
 
 /// Makes the queue's reports of finished work arrive without new work: wgpu's GL backend
@@ -482,5 +485,6 @@ pub fn install(
         backend,
         adapter,
         slices,
+        on_cpu: info.device_type == wgpu::DeviceType::Cpu,
     }
 }

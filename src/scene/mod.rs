@@ -650,6 +650,17 @@ impl Default for RenderSettings {
 }
 
 impl RenderSettings {
+    /// These settings with the light previewed at no more than `cap` (light grid, light
+    /// octaves; [`limits::CPU_PREVIEW_LIGHT`]): what the viewport draws on a slow adapter. It
+    /// never goes above the document's.
+    pub fn with_light_at_most(&self, [resolution, octaves]: [u32; 2]) -> Self {
+        Self {
+            light_resolution: self.light_resolution.min(resolution),
+            light_octaves: self.light_octaves.min(octaves),
+            ..self.clone()
+        }
+    }
+
     fn sanitize(&mut self) {
         self.slices = limits::SLICES.fix_u32(self.slices);
         self.field_resolution = limits::FIELD_RESOLUTION.fix_u32(self.field_resolution);

@@ -407,6 +407,7 @@ impl CloudApp {
             backend: "none",
             adapter: String::new(),
             slices: "none",
+            on_cpu: false,
         });
         let quality = stats.shown.map(|q| q.to_string()).unwrap_or_default();
         // The document is serialised again only when a revision changed.
@@ -494,6 +495,7 @@ impl CloudApp {
         view["late"] = stats.late.into();
         view["puffs_left_out"] = stats.puffs_left_out.into();
         view["catching_up"] = stats.catching_up.into();
+        view["light_preview"] = serde_json::json!(stats.light_preview);
         let state = format!("{{\"scene\":{scene_json},\"view\":{view}}}");
         let status = PageStatus {
             ready: self.viewport.ready,

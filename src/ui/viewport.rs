@@ -179,8 +179,9 @@ impl Viewport {
         let painter = ui.painter_at(rect);
         let backdrop_slot = painter.add(egui::Shape::Noop);
         let scene = cx.doc.scene();
-        // What this frame shows, for the sky and the volume alike.
-        let view = View {
+        // What this frame shows, for the sky and the volume alike. A PNG export draws the
+        // document's own light; the view previews it coarser on a CPU adapter.
+        let exported = View {
             camera: scene.camera.clone(),
             light: scene.light.clone(),
             render: scene.render.clone(),
@@ -188,6 +189,20 @@ impl Viewport {
             aspect: rect.aspect_ratio(),
             crop: crate::render::FULL_VIEW,
         };
+        let on_cpu = self.stats.backend.as_ref().is_some_and(|b| b.on_cpu);
+        let view = View {
+            render: if on_cpu {
+                scene
+                    .render
+                    .with_light_at_most(crate::limits::CPU_PREVIEW_LIGHT)
+            } else {
+                scene.render.clone()
+            },
+            ..exported.clone()
+        };
+        self.stats.light_preview = (view.render.light_resolution != scene.render.light_resolution
+            || view.render.light_octaves != scene.render.light_octaves)
+            .then_some([view.render.light_resolution, view.render.light_octaves]);
         guide.paint(&painter, rect, cx.doc, false);
 
         let ppp = ui.ctx().pixels_per_point();
@@ -325,7 +340,7 @@ impl Viewport {
                 self.progressive.cost(),
                 CAPTURE_BUDGET,
             );
-            self.capture = Some(Capture::new(&view, size, transparent, chunks));
+            self.capture = Some(Capture::new(&exported, size, transparent, chunks));
             self.capture_geometry = cx.doc.revisions().geometry;
         }
         // The clouds changed while the capture was drawn (a move, a stroke, the simulation):
@@ -432,7 +447,12 @@ impl Viewport {
         let size = px.map(|v| v.div_ceil(scale));
         // The box rounded outward: no shafts are laid twice along its edges.
         let crop = crop.map(|[x0, y0, x1, y1]| {
-            [x0 / scale, y0 / scale, x1.div_ceil(scale), y1.div_ceil(scale)]
+            [
+                x0 / scale,
+                y0 / scale,
+                x1.div_ceil(scale),
+                y1.div_ceil(scale),
+            ]
         });
         let key = {
             use std::hash::{Hash, Hasher};
@@ -491,6 +511,9 @@ impl Viewport {
             }
             if let Some(s) = self.stats.frame_seconds {
                 status.push_str(&format!(" · {:.0} ms", s * 1000.0));
+            }
+            if let Some([grid, octaves]) = self.stats.light_preview {
+                status.push_str(&format!(" · light previewed at {grid}, {octaves} oct."));
             }
             painter.text(
                 rect.right_bottom() + egui::vec2(-8.0, -6.0),

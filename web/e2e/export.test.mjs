@@ -100,6 +100,26 @@ for (const backend of ['webgpu', 'webgl2']) {
       // runs would land on a disabled button or a panel about to reflow).
       await until(page, (s) => s.view.export.progress == null && s.view.export.last?.files?.[0] === 'untitled.png (a download)', 'the PNG is reported');
 
+      // On this CPU adapter the view previews the light coarser than the document's (96
+      // texels, 4 octaves), and says so; the PNG draws the document's. The baseline: the
+      // document set to the preview's light, whose export then differs from the first (an
+      // export drawn with the view's light would not).
+      s = await state(page);
+      assert.deepEqual([s.scene.render.light_resolution, s.scene.render.light_octaves], [96, 4]);
+      assert.deepEqual(s.view.light_preview, [24, 2]);
+      await page.evaluate(() => { window.cloudsketch.set('/render/light_resolution=24'); window.cloudsketch.set('/render/light_octaves=2'); });
+      s = await until(page, (s) => s.view.light_preview === null && s.scene.render.light_octaves === 2, 'the document at the preview light');
+      await waitForFullQuality(page);
+      const [coarse] = await Promise.all([page.waitForEvent('download', { timeout: DOWNLOAD_WAIT }), click('export:run')]);
+      const c = PNG.sync.read(fs.readFileSync(await coarse.path()));
+      let differing = 0;
+      for (let i = 0; i < c.data.length; i += 4) {
+        if ([0, 1, 2].some((k) => Math.abs(c.data[i + k] - img.data[i + k]) > 8)) differing += 1;
+      }
+      assert.ok(differing > 2000, `the export draws the document's light, not the preview's: ${differing} pixels differ`);
+      await until(page, (s) => s.view.export.progress == null, 'the second PNG is done');
+      await page.evaluate(() => { window.cloudsketch.set('/render/light_resolution=96'); window.cloudsketch.set('/render/light_octaves=4'); });
+
       await click('export:transparent');
       await until(page, (s) => s.view.export.transparent === true, 'transparent background ticked');
       const [clear] = await Promise.all([page.waitForEvent('download', { timeout: DOWNLOAD_WAIT }), click('export:run')]);

@@ -40,6 +40,9 @@ pub struct ViewStats {
     pub puffs_left_out: usize,
     /// A simulation still stepping toward the scene's time (a far jump catches up over frames).
     pub catching_up: bool,
+    /// The light grid and octaves the view previews at, where they are less than the
+    /// document's (a CPU adapter: [`crate::limits::CPU_PREVIEW_LIGHT`]).
+    pub light_preview: Option<[u32; 2]>,
 }
 
 /// One geometry update of the density volume, as the viewport timed it.
