@@ -61,6 +61,9 @@ pub struct Work {
     /// Primitives whose billows were grown (a billowed primitive whose shape and billows did
     /// not change keeps its puffs).
     pub puff_growths: u64,
+    /// Times a simulated scene's outlines were resampled onto the grid they share with the
+    /// simulation (when the outlines or that grid change, not at each of its steps).
+    pub outline_resamples: u64,
 }
 
 /// The planes' drawing-plane placement applied to their shapes: the field of a document.
@@ -220,6 +223,9 @@ pub struct Derived {
     strokes: Option<(GeometryKey, Versioned<DensityVolume>)>,
     stroke_baker: Baker,
     united: Option<((u64, u64), Versioned<DensityVolume>)>,
+    /// The outlines resampled onto the grid they share with the simulation: the outlines'
+    /// generation, that grid (its shape) and the values.
+    outlines_on_grid: Option<(u64, DensityVolume, Arc<Vec<f32>>)>,
     /// Puffs the field of the last density left out for the cap.
     left_out: usize,
     /// The run has not yet reached the scene's time (a far jump catches up over frames).
@@ -264,6 +270,7 @@ impl Derived {
         }
         self.strokes = None;
         self.united = None;
+        self.outlines_on_grid = None;
         self.player = None;
         self.catching_up = false;
         let gkey = GeometryKey {
@@ -341,6 +348,7 @@ impl Derived {
         if !drawn {
             self.strokes = None;
             self.united = None;
+            self.outlines_on_grid = None;
             self.left_out = 0;
             return simulated;
         }
@@ -373,9 +381,28 @@ impl Derived {
             return v.clone();
         }
         self.generation += 1;
-        let united = simulated
-            .data
-            .union(&strokes.data, crate::limits::MAX_GRID_RESOLUTION);
+        let (ours, theirs) = (&simulated.data, &strokes.data);
+        let united = if ours.is_empty() || theirs.is_empty() {
+            ours.union(theirs, crate::limits::MAX_GRID_RESOLUTION)
+        } else {
+            // The outlines keep their resampling while only the simulation steps.
+            let grid = ours.union_grid(theirs, crate::limits::MAX_GRID_RESOLUTION);
+            let kept = self.outlines_on_grid.as_ref().filter(|(g, on, _)| {
+                *g == strokes.generation
+                    && (on.dims, on.min, on.size) == (grid.dims, grid.min, grid.size)
+            });
+            let resampled = match kept {
+                Some((_, _, values)) => values.clone(),
+                None => {
+                    self.work.outline_resamples += 1;
+                    let values = Arc::new(theirs.resampled_onto(&grid));
+                    self.outlines_on_grid =
+                        Some((strokes.generation, grid.clone(), values.clone()));
+                    values
+                }
+            };
+            ours.union_with(&grid, &resampled)
+        };
         let v = Versioned {
             generation: self.generation,
             data: Arc::new(united),
@@ -427,6 +454,7 @@ impl Derived {
         self.stroke_baker = Baker::default();
         self.strokes = None;
         self.united = None;
+        self.outlines_on_grid = None;
     }
 
     /// The work done so far.

@@ -676,8 +676,17 @@ fn an_outline_in_a_simulated_scene_joins_the_simulated_cloud() {
         *both,
         "exports take the same density"
     );
-    let interpreted = derived.work().interpretations;
+    let (interpreted, resampled) = (
+        derived.work().interpretations,
+        derived.work().outline_resamples,
+    );
+    assert_eq!(resampled, 1);
     doc.set_time(doc.scene().time + 0.5);
-    derived.update(doc.scene(), doc.revisions());
+    let later = derived.update(doc.scene(), doc.revisions()).density;
     assert_eq!(derived.work().interpretations, interpreted);
+    // The simulation stepped; the outlines kept their resampling onto the shared grid, and
+    // the union is the one a fresh derivation makes.
+    assert_eq!(derived.work().outline_resamples, resampled);
+    assert_eq!(*later.data, *density_of(doc.scene()));
+    assert_ne!(*later.data, *both, "the simulated cloud moved");
 }

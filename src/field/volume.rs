@@ -98,14 +98,23 @@ impl DensityVolume {
     }
 
     /// Both volumes on one grid, each texel the larger of their [`DensityVolume::sample`]s
-    /// (the union of their clouds): over both boxes, at the finer texel size, with at most
-    /// `max_side` texels along the longest side (coarser where the boxes lie far apart).
+    /// (the union of their clouds): over both boxes ([`DensityVolume::union_grid`]).
     pub fn union(&self, other: &DensityVolume, max_side: u32) -> DensityVolume {
         match (self.is_empty(), other.is_empty()) {
             (true, _) => return other.clone(),
             (_, true) => return self.clone(),
             _ => {}
         }
+        let grid = self.union_grid(other, max_side);
+        let theirs = other.resampled_onto(&grid);
+        self.union_with(&grid, &theirs)
+    }
+
+    /// The grid [`DensityVolume::union`] lays both volumes on (its values empty): over both
+    /// boxes, at the finer texel size, with at most `max_side` texels along the longest side
+    /// (coarser where the boxes lie far apart), texels cubic (the exporters take one texel
+    /// size). Neither volume may be empty.
+    pub fn union_grid(&self, other: &DensityVolume, max_side: u32) -> DensityVolume {
         let min = self.min.min(other.min);
         let need = (self.min + self.size).max(other.min + other.size) - min;
         let finest = self
@@ -117,24 +126,49 @@ impl DensityVolume {
             .ceil()
             .as_uvec3()
             .clamp(UVec3::ONE, UVec3::splat(max_side.max(1)));
-        // Cubic texels, as either side's (the exporters take one texel size).
-        let size = dims.as_vec3() * finest;
-        let mut out = DensityVolume {
+        DensityVolume {
             dims,
             min,
-            size,
-            values: vec![0.0; dims.x as usize * dims.y as usize * dims.z as usize],
-        };
-        for z in 0..dims.z {
-            for y in 0..dims.y {
-                for x in 0..dims.x {
-                    let p = out.center(x, y, z);
-                    let i = out.index(x, y, z);
-                    out.values[i] = self.sample(p).max(other.sample(p));
+            size: dims.as_vec3() * finest,
+            values: Vec::new(),
+        }
+    }
+
+    /// This volume's [`DensityVolume::sample`] at every texel centre of `grid` (a grid's
+    /// shape; its values are not read): on this volume's own grid, its texels as the GPU
+    /// holds them.
+    pub fn resampled_onto(&self, grid: &DensityVolume) -> Vec<f32> {
+        if grid.dims == self.dims && grid.min == self.min && grid.size == self.size {
+            return self.values.iter().map(|v| v.clamp(0.0, 1.0)).collect();
+        }
+        let mut out = Vec::with_capacity(grid.len());
+        for z in 0..grid.dims.z {
+            for y in 0..grid.dims.y {
+                for x in 0..grid.dims.x {
+                    out.push(self.sample(grid.center(x, y, z)));
                 }
             }
         }
         out
+    }
+
+    /// Texels of the grid.
+    fn len(&self) -> usize {
+        self.dims.x as usize * self.dims.y as usize * self.dims.z as usize
+    }
+
+    /// The union of this volume and another already resampled onto `grid` (`theirs`, from
+    /// [`DensityVolume::resampled_onto`]; a simulated scene's outlines keep theirs while the
+    /// simulation steps).
+    pub fn union_with(&self, grid: &DensityVolume, theirs: &[f32]) -> DensityVolume {
+        let mut values = self.resampled_onto(grid);
+        for (v, t) in values.iter_mut().zip(theirs) {
+            *v = v.max(*t);
+        }
+        DensityVolume {
+            values,
+            ..grid.clone()
+        }
     }
 }
 
