@@ -493,6 +493,7 @@ impl CloudApp {
         view["frames"] = ctx.cumulative_frame_nr().into();
         view["jobs"] = stats.jobs.into();
         view["late"] = stats.late.into();
+        view["cost"] = stats.cost.into();
         view["puffs_left_out"] = stats.puffs_left_out.into();
         view["catching_up"] = stats.catching_up.into();
         view["light_preview"] = serde_json::json!(stats.light_preview);

@@ -327,6 +327,7 @@ impl Viewport {
         self.stats.refining = plan.refining;
         self.stats.frame_seconds = self.progressive.last_frame_seconds();
         self.stats.late = self.progressive.late();
+        self.stats.cost = self.progressive.cost();
         self.stats.jobs = self.progressive.jobs();
         if plan.shown.is_some_and(|q| q.full) {
             self.ready = true;

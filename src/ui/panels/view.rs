@@ -43,6 +43,8 @@ pub struct ViewStats {
     /// The light grid and octaves the view previews at, where they are less than the
     /// document's (a CPU adapter: [`crate::limits::CPU_PREVIEW_LIGHT`]).
     pub light_preview: Option<[u32; 2]>,
+    /// The planner's cost of refinement work, seconds per pixel·slice.
+    pub cost: f64,
 }
 
 /// One geometry update of the density volume, as the viewport timed it.
