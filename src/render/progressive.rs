@@ -256,7 +256,11 @@ impl Progressive {
     /// Current cost estimate in seconds per pixel·slice of refinement's work (the GPU's
     /// timing of chunks where it has timed one, else frame intervals).
     pub fn cost(&self) -> f64 {
-        self.chunk_cost.unwrap_or(self.cost)
+        match self.chunk_cost {
+            // Chunks no longer timed (the fence went silent) are measured as previews are.
+            Some(cost) if !self.fence_silent => cost,
+            _ => self.cost,
+        }
     }
 
     /// How much longer refinements have taken than the model predicted (see
@@ -558,7 +562,8 @@ impl Progressive {
         // below the work's cost the GPU timed: a quick frame says little while the GPU is not
         // behind (frames then come at the display's pace).
         let w = if sample > self.cost { 0.6 } else { 0.25 };
-        self.cost = (self.cost * (1.0 - w) + sample * w).max(self.chunk_cost.unwrap_or(0.0));
+        let timed = self.chunk_cost.filter(|_| !self.fence_silent);
+        self.cost = (self.cost * (1.0 - w) + sample * w).max(timed.unwrap_or(0.0));
     }
 
     /// Least squares of seconds on work over the recent frames, when their sizes differ enough
@@ -1048,6 +1053,30 @@ mod tests {
             p.late
         );
         assert!(p.late > 1.2, "late {:.2}", p.late);
+    }
+
+    #[test]
+    fn chunks_no_longer_timed_are_sized_by_the_frames_again() {
+        // The GPU timed chunks, then its reports stopped (the fence went silent) and the work
+        // became three times dearer: the cost follows the frames, not the last timing.
+        let cost = 6.0 / (800.0 * 600.0 * 128.0);
+        let mut b = Browser::new(cost, 0.05, false, 0.0);
+        let mut p = Progressive::new(cost, Budget::default());
+        for key in 1..4 {
+            b.refine(&mut p, key, VIEW);
+        }
+        assert!(p.chunk_cost.is_some());
+        p.fence_silent = true;
+        b.unfenced = true;
+        b.cost *= 3.0;
+        for key in 4..8 {
+            b.refine(&mut p, key, VIEW);
+        }
+        let learnt = p.cost() / b.cost;
+        assert!(
+            (learnt - 1.0).abs() < 0.5,
+            "learnt {learnt:.2} of the true cost"
+        );
     }
 
     #[test]

@@ -85,6 +85,8 @@ struct Backdrop {
     size: [u32; 2],
     view: wgpu::TextureView,
     group: wgpu::BindGroup,
+    /// What it was last drawn for ([`VolumeRenderer::draw_backdrop`]'s `key`).
+    key: Option<u64>,
 }
 
 /// Draws a full-screen composite with `group`: the `transparent` pipeline of the pair over a
@@ -953,8 +955,9 @@ impl VolumeRenderer {
     /// [`VolumeRenderer::lay_backdrop`] then lays on every frame until it changes: `background`
     /// (sRGB-encoded, as egui's colours) with `view`'s sky gradient or ground drawn over it, and
     /// the shafts of light [`VolumeRenderer::draw_outside_shafts`] drew (call it first) laid
-    /// over `strips`, the pixel rectangles (x0, y0, x1, y1) around the cloud's box. On CPU
-    /// adapters the ground's shading and the shafts' lay took over half of each refining frame.
+    /// over `strips`, the pixel rectangles (x0, y0, x1, y1) around the cloud's box; `key` is
+    /// what it is drawn for ([`VolumeRenderer::backdrop_key`]). On CPU adapters the ground's
+    /// shading and the shafts' lay took over half of each refining frame.
     #[allow(clippy::too_many_arguments)]
     pub fn draw_backdrop(
         &mut self,
@@ -965,6 +968,7 @@ impl VolumeRenderer {
         size: [u32; 2],
         background: [f32; 3],
         strips: &[[u32; 4]],
+        key: u64,
     ) {
         let size = [size[0].max(1), size[1].max(1)];
         if self.backdrop.as_ref().is_none_or(|b| b.size != size) {
@@ -981,7 +985,11 @@ impl VolumeRenderer {
                 size,
                 view: texture,
                 group,
+                key: None,
             });
+        }
+        if let Some(backdrop) = &mut self.backdrop {
+            backdrop.key = Some(key);
         }
         let Some(backdrop) = &self.backdrop else {
             return;
@@ -1002,6 +1010,12 @@ impl VolumeRenderer {
                 self.composite_outside_shafts(&mut pass, false);
             }
         }
+    }
+
+    /// What the view behind the cloud was last drawn for ([`VolumeRenderer::draw_backdrop`]'s
+    /// `key`; none before it is drawn).
+    pub fn backdrop_key(&self) -> Option<u64> {
+        self.backdrop.as_ref().and_then(|b| b.key)
     }
 
     /// Lays the view behind the cloud [`VolumeRenderer::draw_backdrop`] drew over the current

@@ -211,20 +211,22 @@ pub struct BackdropPaint {
     pub background: [f32; 3],
     /// The viewport's size in pixels.
     pub size: [u32; 2],
+    /// The derived volumes (uploaded here too: the cloud's box may be out of view), whose
+    /// light volume shades the ground and the shafts; none without a cloud.
+    pub volumes: Option<Volumes>,
     /// The shafts of light drawn apart from the cloud's box, if the view has shafts.
     pub shafts: Option<ShaftsApart>,
     /// The pixel rectangles (x0, y0, x1, y1) around the cloud's box, where the shafts are laid
     /// (the whole view when the box is out of view; none when it covers the view).
     pub strips: Vec<[u32; 4]>,
-    /// Whether this frame draws it again (something in it changed) or only lays it.
-    pub redraw: bool,
+    /// Everything it is drawn from: the renderer draws it again when this differs from what
+    /// it last drew (kept by the renderer, so a frame the GPU never got draws it again).
+    pub key: u64,
 }
 
 /// The shafts of light outside the cloud's box on screen, and those of the shells beyond it,
 /// which the box's composite adds ([`VolumeRenderer::draw_outside_shafts`]).
 pub struct ShaftsApart {
-    /// The derived volumes (uploaded here too: the cloud's box may be out of view).
-    pub volumes: Volumes,
     /// Slices of the image the shells are counted for.
     pub total: u32,
     /// Their target's size in pixels (a fraction of the view's: the light is soft).
@@ -233,9 +235,10 @@ pub struct ShaftsApart {
 
 impl RendererPaint for BackdropPaint {
     fn finish_prepare(&self, renderer: &mut VolumeRenderer, frame: FrameGpu<'_>) {
-        // After every callback's `prepare`: the box's starts the frame's uniforms. Before the
-        // box's `finish_prepare`, which binds the shafts beyond the box drawn here.
-        if !self.redraw {
+        // After every callback's `prepare`: the box's starts the frame's uniforms (and a PNG
+        // export's may leave its own light volume current). Before the box's
+        // `finish_prepare`, which binds the shafts beyond the box drawn here.
+        if renderer.backdrop_key() == Some(self.key) {
             return;
         }
         let FrameGpu {
@@ -243,19 +246,21 @@ impl RendererPaint for BackdropPaint {
             queue,
             commands,
         } = frame;
-        let mut laid = false;
-        if let Some(shafts) = &self.shafts {
-            renderer.upload(device, queue, &shafts.volumes);
+        if let Some(volumes) = &self.volumes {
+            renderer.upload(device, queue, volumes);
+            // The ground's shadows and the shafts come from this view's light volume.
             renderer.update_light(device, queue, commands, &self.view);
-            laid = renderer.draw_outside_shafts(
+        }
+        let laid = self.shafts.as_ref().is_some_and(|shafts| {
+            renderer.draw_outside_shafts(
                 device,
                 queue,
                 commands,
                 &self.view,
                 shafts.total,
                 shafts.size,
-            );
-        }
+            )
+        });
         let strips: &[[u32; 4]] = if laid { &self.strips } else { &[] };
         renderer.draw_backdrop(
             device,
@@ -265,6 +270,7 @@ impl RendererPaint for BackdropPaint {
             self.size,
             self.background,
             strips,
+            self.key,
         );
     }
 

@@ -57,9 +57,6 @@ pub struct Viewport {
     capture_geometry: u64,
     /// A finished capture: its size and pixels (straight-alpha RGBA), or why it failed.
     pub captured: Option<([u32; 2], Result<Vec<u8>, String>)>,
-    /// What the view behind the cloud (sky, ground, the shafts around the box) was last drawn
-    /// for.
-    backdrop_key: Option<u64>,
 }
 
 impl Viewport {
@@ -118,7 +115,6 @@ impl Viewport {
             capture: None,
             capture_geometry: 0,
             captured: None,
-            backdrop_key: None,
         }
     }
 
@@ -270,9 +266,9 @@ impl Viewport {
                 rect.min + egui::vec2(x1 as f32, y1 as f32) / ppp,
             )
         });
-        let dragging = response.is_pointer_button_down_on();
+        // A drag (not a press: a click would draw the view behind the cloud twice).
+        let dragging = response.dragged();
         let shafts = (scene.light.shafts && !density.is_empty()).then(|| ShaftsApart {
-            volumes: volumes.clone(),
             total: if dragging {
                 OUTSIDE_PREVIEW_SLICES.min(scene.render.slices)
             } else {
@@ -284,10 +280,17 @@ impl Viewport {
         if (scene.light.sky_gradient || scene.light.ground || shafts.is_some())
             && self.stats.backend.is_some()
         {
-            let paint = self.backdrop(cx.doc, &view, px, crop.map(|c| c.px), shafts, dragging);
+            let volumes = (!density.is_empty()).then(|| volumes.clone());
+            let paint = backdrop(
+                cx.doc,
+                &view,
+                px,
+                crop.map(|c| c.px),
+                volumes,
+                shafts,
+                dragging,
+            );
             painter.set(backdrop_slot, paint_callback(rect, paint));
-        } else {
-            self.backdrop_key = None;
         }
         let key = view_key(cx.doc, volumes.density.generation, px, crop.map(|c| c.px));
         let now = ui.input(|i| i.time);
@@ -429,52 +432,6 @@ impl Viewport {
         }
     }
 
-    /// The view behind the cloud over a view of `px` pixels whose cloud's box on screen is
-    /// `crop` (pixels; none when out of view), with `shafts` of light around the box: drawn
-    /// again when the view, the light, the clouds or the size changed (or a drag began or
-    /// ended: a drag counts fewer shells), else laid as it was. While `dragging`, at half the
-    /// size: it is drawn again on every frame then, and on a CPU adapter the ground and the
-    /// shafts kept a drag's frames over its budget.
-    fn backdrop(
-        &mut self,
-        doc: &Document,
-        view: &View,
-        px: [u32; 2],
-        crop: Option<[u32; 4]>,
-        shafts: Option<ShaftsApart>,
-        dragging: bool,
-    ) -> BackdropPaint {
-        let scale = if dragging { BACKDROP_DRAG_DIVISOR } else { 1 };
-        let size = px.map(|v| v.div_ceil(scale));
-        // The box rounded outward: no shafts are laid twice along its edges.
-        let crop = crop.map(|[x0, y0, x1, y1]| {
-            [
-                x0 / scale,
-                y0 / scale,
-                x1.div_ceil(scale),
-                y1.div_ceil(scale),
-            ]
-        });
-        let key = {
-            use std::hash::{Hash, Hasher};
-            let mut h = std::collections::hash_map::DefaultHasher::new();
-            let density = shafts.as_ref().map(|s| s.volumes.density.generation);
-            view_key(doc, density.unwrap_or(0), size, crop).hash(&mut h);
-            shafts.as_ref().map(|s| (s.total, s.size)).hash(&mut h);
-            h.finish()
-        };
-        let redraw = self.backdrop_key != Some(key);
-        self.backdrop_key = Some(key);
-        BackdropPaint {
-            view: view.clone(),
-            background: doc.scene().light.background,
-            size,
-            shafts,
-            strips: strips_around(size, crop),
-            redraw,
-        }
-    }
-
     fn status_line(
         &self,
         ui: &egui::Ui,
@@ -556,6 +513,55 @@ impl Viewport {
 
 /// The strips of `rect` around `area` (top, bottom, left, right; the whole of `rect` without
 /// an area), leaving out empty ones.
+/// The view behind the cloud over a view of `px` pixels whose cloud's box on screen is `crop`
+/// (pixels; none when out of view), shaded through `volumes`' light, with `shafts` of light
+/// around the box: drawn again when the view, the light, the clouds or the size changed (or a
+/// drag began or ended: a drag counts fewer shells), else laid as it was. While `dragging`, at
+/// a fraction of the size: it is drawn again on every frame then, and on a CPU adapter the
+/// ground and the shafts kept a drag's frames over its budget.
+fn backdrop(
+    doc: &Document,
+    view: &View,
+    px: [u32; 2],
+    crop: Option<[u32; 4]>,
+    volumes: Option<crate::derive::Volumes>,
+    shafts: Option<ShaftsApart>,
+    dragging: bool,
+) -> BackdropPaint {
+    let scale = if dragging { BACKDROP_DRAG_DIVISOR } else { 1 };
+    let size = px.map(|v| v.div_ceil(scale));
+    // The box rounded outward: no shafts are laid twice along its edges.
+    let crop = crop.map(|[x0, y0, x1, y1]| {
+        [
+            x0 / scale,
+            y0 / scale,
+            x1.div_ceil(scale),
+            y1.div_ceil(scale),
+        ]
+    });
+    let key = {
+        use std::hash::{Hash, Hasher};
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        // The density's generation too: the ground's shadows change with a simulation
+        // catching up, which bumps no revision.
+        let density = volumes.as_ref().map(|v| v.density.generation);
+        view_key(doc, density.unwrap_or(0), size, crop).hash(&mut h);
+        // The light the view is shaded with (previewed coarser on a CPU adapter).
+        (view.render.light_resolution, view.render.light_octaves).hash(&mut h);
+        shafts.as_ref().map(|s| (s.total, s.size)).hash(&mut h);
+        h.finish()
+    };
+    BackdropPaint {
+        view: view.clone(),
+        background: doc.scene().light.background,
+        size,
+        volumes,
+        shafts,
+        strips: strips_around(size, crop),
+        key,
+    }
+}
+
 /// The pixel rectangles (x0, y0, x1, y1) of a view `px` pixels around the box `area` (the
 /// whole view without one), leaving out the empty ones.
 fn strips_around([w, h]: [u32; 2], area: Option<[u32; 4]>) -> Vec<[u32; 4]> {
