@@ -1513,10 +1513,11 @@ fn billows_make_the_outline_rough_at_every_scale() {
 }
 
 /// A new document's light volume is the finer one (96 texels, 4 octaves) that renders and
-/// exports use; the viewport on a CPU adapter previews it at `CPU_PREVIEW_LIGHT`. The renderer
-/// keeps the light volume before the current one, so a PNG export and the view it is made from
-/// do not recompute each other's: going back to the document's light draws what it drew
-/// before, not the preview's shadows (a cache that swapped volumes without binding them would).
+/// exports use; the viewport on a CPU adapter previews it at `CPU_PREVIEW_LIGHT`, never above
+/// the document's, and the preview's shadows differ from the document's; the document's light
+/// drawn again after the preview is as it was. (Each offscreen render derives its volumes
+/// afresh, so the renderer's kept light volume is not reused here: `export.test.mjs` covers
+/// it, where the view's preview and the PNG export's light alternate.)
 #[test]
 fn the_previewed_light_and_the_documents_each_draw_their_own_shadows() {
     let scene = Scene::default();

@@ -437,10 +437,9 @@ impl VolumeRenderer {
                 slice,
                 slice_view,
             });
-            self.rebuild_bind_groups(device);
-        } else {
-            self.rebuild_bind_groups(device);
         }
+        // The current volume's textures changed either way.
+        self.rebuild_bind_groups(device);
         let (Some(light), Some(group)) = (&mut self.light, &self.light_bind_group) else {
             return false;
         };
