@@ -40,7 +40,8 @@ pub struct Revisions {
     pub camera: u64,
     /// The reference image.
     pub reference: u64,
-    /// The clock's frame rate and range (no image depends on them).
+    /// The clock's frame rate and range and the key frames (no image depends on them: a
+    /// keyed value's pose changes the part it belongs to).
     pub clock: u64,
 }
 
@@ -91,7 +92,7 @@ fn diff(a: &Scene, b: &Scene) -> Changed {
         render: a.render != b.render || a.time != b.time,
         camera: a.camera != b.camera,
         reference: a.reference != b.reference,
-        clock: a.clock != b.clock,
+        clock: a.clock != b.clock || a.animation != b.animation,
     }
 }
 
@@ -108,6 +109,8 @@ pub struct Document {
     /// Merge key of the last recorded edit; an edit with the same key folds into its step.
     last_key: Option<&'static str>,
     revisions: Revisions,
+    /// Every edit of a keyable value is recorded as a key at the document's time (auto-key).
+    auto_key: bool,
 }
 
 impl Default for Document {
@@ -133,7 +136,18 @@ impl Document {
                 reference: n,
                 clock: n,
             },
+            auto_key: false,
         }
+    }
+
+    /// Whether edits are keyed as they are made (auto-key).
+    pub fn auto_key(&self) -> bool {
+        self.auto_key
+    }
+
+    /// Turns auto-key on or off (view state, not an undo step).
+    pub fn set_auto_key(&mut self, on: bool) {
+        self.auto_key = on;
     }
 
     /// The scene as it stands.
@@ -171,6 +185,17 @@ impl Document {
     /// document changed (an edit that changes nothing or cannot apply records nothing).
     pub fn apply(&mut self, edit: Edit, merge_key: Option<&'static str>) -> bool {
         let label = edit.label();
+        let keys_edit = matches!(edit, Edit::SetAnimation(..));
+        // What auto-key records: the user's edits of values, not whole documents, the clock,
+        // the picture or the simulation.
+        let records = matches!(
+            edit,
+            Edit::SetLight(_)
+                | Edit::SetRender(_)
+                | Edit::SetEllipsoids(_)
+                | Edit::SetPlanes(_)
+                | Edit::SetPlane(..)
+        );
         let s = &self.scene;
         let mut changed = Changed::default();
         match &edit {
@@ -196,6 +221,7 @@ impl Document {
             }
             Edit::RemovePlane(i) => changed.geometry = *i < s.planes.len(),
             Edit::SetReference(r) => changed.reference = r.as_ref() != s.reference.as_deref(),
+            Edit::SetAnimation(a, _) => changed.clock = *a != s.animation,
             Edit::Replace(new) => changed = diff(s, new),
         }
         if !changed.any() {
@@ -219,9 +245,22 @@ impl Document {
                 s.planes.remove(i);
             }
             Edit::SetReference(r) => s.reference = r.map(Arc::new),
+            Edit::SetAnimation(a, _) => s.animation = a,
             Edit::Replace(new) => *s = *new,
         }
         s.settle();
+        if keys_edit {
+            // Keys moved or removed: the keyed values follow at the document's time.
+            let t = s.time;
+            s.pose(t);
+            changed = diff(&before, s);
+        } else if self.auto_key && records {
+            let mut animation = s.animation.clone();
+            if animation.record_changes(&before, s, s.time) > 0 {
+                s.animation = animation;
+                changed.clock = true;
+            }
+        }
         let merge = merge_key.is_some() && merge_key == self.last_key;
         if !merge {
             self.undo.push_back(Step {
@@ -249,7 +288,9 @@ impl Document {
         }
     }
 
-    /// Sets the scene clock (playing, scrubbing). Not an undo step; bumps the render revision.
+    /// Sets the scene clock (playing, scrubbing) and poses every keyed value there, which
+    /// drops an edit of a keyed value not keyed (as Blender does). Not an undo step; bumps the
+    /// render revision and those of the parts the pose moved.
     pub fn set_time(&mut self, time: f32) {
         let time = if time.is_finite() {
             time.clamp(0.0, crate::limits::MAX_TIME)
@@ -257,10 +298,12 @@ impl Document {
             0.0
         };
         if time != self.scene.time {
-            self.scene.time = time;
+            let posed = self.scene.posed_at(time);
+            let changed = diff(&self.scene, &posed);
+            self.scene = posed;
             self.bump(Changed {
                 render: true,
-                ..Default::default()
+                ..changed
             });
         }
     }
@@ -322,7 +365,10 @@ impl Document {
     fn restore(&mut self, step: Step) -> Step {
         let mut scene = step.scene;
         scene.camera = self.scene.camera.clone();
-        scene.time = self.scene.time;
+        if scene.time != self.scene.time {
+            // The step was made at another time: its keyed values are posed at this one.
+            scene = scene.posed_at(self.scene.time);
+        }
         let changed = diff(&self.scene, &scene);
         self.last_key = None;
         let previous = std::mem::replace(&mut self.scene, scene);

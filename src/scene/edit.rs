@@ -5,7 +5,7 @@
 
 use std::sync::Arc;
 
-use super::{DrawingPlane, Ellipsoid, Lighting, ReferenceImage, RenderSettings, Scene};
+use super::{Animation, DrawingPlane, Ellipsoid, Lighting, ReferenceImage, RenderSettings, Scene};
 
 /// One change to the document.
 #[derive(Clone, Debug, PartialEq)]
@@ -30,6 +30,9 @@ pub enum Edit {
     SetReference(Option<ReferenceImage>),
     /// Turn the simulation on (with these settings), change it, or turn it off.
     SetSimulation(Option<crate::simulate::Settings>),
+    /// Replace the key frames, said as the label ("insert keys", "retime keys"); the keyed
+    /// values are posed again at the document's time.
+    SetAnimation(Animation, &'static str),
     /// Replace the whole document (new, open, preset).
     Replace(Box<Scene>),
 }
@@ -48,6 +51,7 @@ impl Edit {
             Edit::RemovePlane(_) => "deleted drawing plane",
             Edit::SetReference(_) => "reference image",
             Edit::SetSimulation(_) => "simulation",
+            Edit::SetAnimation(_, label) => label,
             Edit::Replace(_) => "new scene",
         }
     }
@@ -99,6 +103,15 @@ pub fn describe_change(from: &Scene, to: &Scene, label: &str) -> String {
         || from.simulation != to.simulation
         || from.clock != to.clock;
     let parts: Vec<String> = ellipsoids.into_iter().chain(planes).collect();
+    // A key edit says what it did to the keys (a retime that moves an ellipsoid is no move);
+    // an edit that auto-key recorded says it was keyed.
+    if from.animation != to.animation {
+        if KEY_EDITS.contains(&label) || parts.is_empty() || others {
+            return label.to_owned();
+        }
+        let what = describe_change(&Scene { animation: to.animation.clone(), ..from.clone() }, to, label);
+        return format!("{what}, keyed");
+    }
     match (parts.as_slice(), others) {
         ([], _) | (_, true) => label.to_owned(),
         ([one], false) => one.clone(),
@@ -115,6 +128,9 @@ pub fn describe_change(from: &Scene, to: &Scene, label: &str) -> String {
         }
     }
 }
+
+/// The labels of the timeline's key edits ([`Edit::SetAnimation`]).
+pub const KEY_EDITS: [&str; 4] = ["insert keys", "delete keys", "retime keys", "change the ease of keys"];
 
 /// One list's change in words: items added, deleted, or changed (each changed item by the one
 /// kind of change `kinds` finds in it, or "edit" when several).

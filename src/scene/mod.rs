@@ -9,6 +9,7 @@ mod capped;
 mod clock;
 mod document;
 mod edit;
+mod keys;
 mod looks;
 mod plane;
 mod pointer;
@@ -21,6 +22,10 @@ pub use camera::{OrbitCamera, Ray, StandardView};
 pub use clock::{Clock, Moment, step_position, steps_at};
 pub use document::{Document, Revisions};
 pub use edit::Edit;
+pub use keys::{
+    Animation, Channel, Ease, EllipsoidProperty, Key, LightProperty, MAX_KEYS, MAX_TRACKS,
+    MediaProperty, PlaneProperty, Track,
+};
 pub use looks::{Look, Looks};
 pub use plane::{
     DrawingPlane, MAX_GRID_EXPONENT, MAX_GRID_STEPS, STROKE_GRID, StrokeKind, centre_of,
@@ -56,7 +61,8 @@ pub fn as_linked(v: f32) -> f32 {
 /// Version 2 added billows and stable ids to ellipsoids and drawing planes (a version 1
 /// document has no billows, and its primitives get ids in order when it is read). Version 3
 /// added the clock's frame rate and range (a document without them has the default clock).
-pub const SCENE_VERSION: u32 = 3;
+/// Version 4 added key frames (a document without them has none).
+pub const SCENE_VERSION: u32 = 4;
 
 /// Errors when reading a scene document.
 #[derive(Debug, thiserror::Error)]
@@ -125,6 +131,10 @@ pub struct Scene {
     /// smoothed cloud at the scene's time, and the ellipsoids are its parcels.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub simulation: Option<Arc<crate::simulate::Settings>>,
+    /// Key frames on the document's values (left out of a file while there are none). Every
+    /// keyed value above is its keys' pose at [`Scene::time`].
+    #[serde(default, skip_serializing_if = "Animation::is_empty")]
+    pub animation: Animation,
 }
 
 impl Default for Scene {
@@ -220,7 +230,11 @@ impl Scene {
             repairs.push(format!("and {more} more values repaired"));
         }
         // Ids are given, not repaired: a document from before them gets them silently.
-        self.settle();
+        self.settle_ids();
+        let mut animation = std::mem::take(&mut self.animation);
+        repairs.extend(animation.repair(self));
+        self.animation = animation;
+        self.pose(self.time);
         Ok(repairs)
     }
 
@@ -231,6 +245,14 @@ impl Scene {
     /// writes them ([`as_linked`]: billows make many all-or-nothing choices from the radii, so a
     /// link must carry them exactly for its cloud to be the sender's).
     pub fn settle(&mut self) {
+        self.settle_ids();
+        let mut animation = std::mem::take(&mut self.animation);
+        animation.forget_missing(self);
+        self.animation = animation;
+    }
+
+    /// [`Scene::settle`] but for the keys: ids given and billowed radii rounded.
+    fn settle_ids(&mut self) {
         for e in &mut self.ellipsoids {
             let radii = e.radii.map(as_linked);
             if !e.billows.is_off() && radii != e.radii && radii.min_element() > 0.0 {

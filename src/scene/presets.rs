@@ -199,6 +199,7 @@ impl Scene {
             time,
             clock: super::Clock::default(),
             simulation,
+            animation: Default::default(),
         };
         scene.settle();
         scene
