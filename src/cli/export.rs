@@ -75,7 +75,7 @@ pub fn run(r: &Request) -> Result<(), String> {
         None => Scene::default(),
     };
     if let Some(at) = r.at {
-        scene.time = at.seconds(&scene.clock)?;
+        scene = scene.posed_at(at.seconds(&scene.clock)?);
     }
     let start = std::time::Instant::now();
     if format == Format::Png {

@@ -43,7 +43,7 @@ pub fn run(
         scene = set;
     }
     if let Some(at) = at {
-        scene.time = at.seconds(&scene.clock)?;
+        scene = scene.posed_at(at.seconds(&scene.clock)?);
     }
     let mut offscreen = Offscreen::new().map_err(|e| e.to_string())?;
     let start = std::time::Instant::now();

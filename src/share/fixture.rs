@@ -170,5 +170,42 @@ pub fn every_part() -> Scene {
         ..Default::default()
     }));
     scene.settle();
+    // Keys on each kind of item, with each ease, posed at the scene's time.
+    use crate::scene::{Channel, Ease, EllipsoidProperty, LightProperty, MediaProperty};
+    let (e0, e1, p0) = (scene.ellipsoids[0].id, scene.ellipsoids[1].id, scene.planes[0].id);
+    let mut a = crate::scene::Animation::default();
+    let center = Channel::Ellipsoid {
+        id: e0,
+        property: EllipsoidProperty::Center,
+    };
+    a.key(center, 0.0, vec![0.0, 1.0, 0.0]);
+    a.key(center, 20.0, vec![3.0, 2.0, -1.0]);
+    a.set_ease(&[center], 0.0, Ease::EaseInOut);
+    let visible = Channel::Ellipsoid {
+        id: e1,
+        property: EllipsoidProperty::Visible,
+    };
+    a.key(visible, 0.0, vec![1.0]);
+    a.key(visible, 10.0, vec![0.0]);
+    let origin = Channel::Plane {
+        id: p0,
+        property: crate::scene::PlaneProperty::Origin,
+    };
+    a.key(origin, 5.0, scene.planes[0].origin.to_array().to_vec());
+    a.key(origin, 15.0, (scene.planes[0].origin + Vec3::X).to_array().to_vec());
+    let azimuth = Channel::Light {
+        property: LightProperty::SunAzimuth,
+    };
+    a.key(azimuth, 0.0, vec![350.0]);
+    a.key(azimuth, 20.0, vec![30.0]);
+    let opacity = Channel::Media {
+        property: MediaProperty::Opacity,
+    };
+    a.key(opacity, 2.0, vec![3.0]);
+    a.key(opacity, 12.0, vec![2.0]);
+    a.set_ease(&[opacity], 2.0, Ease::Constant);
+    scene.animation = a;
+    let t = scene.time;
+    scene.pose(t);
     scene
 }
