@@ -5,7 +5,7 @@ use super::autosave::Autosave;
 use super::guide::Guide;
 use super::notice::Notices;
 use super::panels::{
-    ClockPanel, ExportPanel, LIGHT, RENDER, ScenePanel, SimulationPanel, SketchPanel, ViewPanel,
+    ExportPanel, LIGHT, RENDER, ScenePanel, SimulationPanel, SketchPanel, Timeline, ViewPanel,
     ViewStats,
 };
 use super::scene_files::SceneFiles;
@@ -95,7 +95,7 @@ const PANEL_WIDTH: f32 = 300.0;
 /// The side panel's views.
 #[derive(Default)]
 struct Panels {
-    clock: ClockPanel,
+    timeline: Timeline,
     export: ExportPanel,
     sketch: SketchPanel,
     scene: ScenePanel,
@@ -215,7 +215,31 @@ impl CloudApp {
             Shortcut::Frame => self.viewport.frame_request = true,
             Shortcut::TogglePanel => self.panel_open = !self.panel_open,
             // Alt+A plays and pauses (Blender's shortcut before Space took it over).
-            Shortcut::PlayPause => self.panels.clock.playing = !self.panels.clock.playing,
+            Shortcut::PlayPause => {
+                self.panels.timeline.playing = !self.panels.timeline.playing
+            }
+            Shortcut::InsertKey => {
+                let said = self.panels.timeline.insert_keys(&mut self.doc, &self.selection);
+                self.notices.note(now, said);
+            }
+            Shortcut::DeleteKeys => {
+                self.panels.timeline.selected.clear();
+                let said = self.panels.timeline.delete_keys(&mut self.doc, &self.selection);
+                self.notices.note(now, said);
+            }
+            // Delete over the timeline with keys selected deletes them, not the items.
+            Shortcut::Delete
+                if self.panels.timeline.hovered && !self.panels.timeline.selected.is_empty() =>
+            {
+                let said = self.panels.timeline.delete_keys(&mut self.doc, &self.selection);
+                self.notices.note(now, said);
+            }
+            Shortcut::StepFrame(by) => self.panels.timeline.step_frame(&mut self.doc, by.into()),
+            Shortcut::JumpKey(forward) => {
+                self.panels
+                    .timeline
+                    .jump_to_key(&mut self.doc, &self.selection, forward)
+            }
             Shortcut::View(view) => {
                 let mut camera = self.doc.scene().camera.clone();
                 camera.set_view(view);
@@ -304,7 +328,6 @@ impl CloudApp {
             &mut self.notices,
         );
         self.guide.ui(ui, &mut self.doc, &mut self.notices);
-        p.clock.ui(ui, &mut self.doc);
         RENDER.ui(ui, &mut self.doc);
         LIGHT.ui(ui, &mut self.doc);
         p.scene
@@ -324,6 +347,44 @@ impl CloudApp {
         if ask.cancel_capture {
             self.viewport.cancel_capture();
         }
+        self.selection.retain_valid(self.doc.scene());
+    }
+
+    /// The timeline under the view, or the button that shows it again.
+    fn timeline_strip(&mut self, ui: &mut egui::Ui, ctx: &egui::Context) {
+        let now = ctx.input(|i| i.time);
+        if !self.panels.timeline.open {
+            self.panels.timeline.hovered = false;
+            egui::Area::new(egui::Id::unique("show timeline"))
+                .anchor(egui::Align2::LEFT_BOTTOM, egui::vec2(8.0, -8.0))
+                .show(ctx, |ui| {
+                    let r = ui
+                        .button("Timeline")
+                        .on_hover_text("Show the timeline: play, scrub, keys");
+                    super::widgets::mark(ui, "timeline:toggle", r.rect);
+                    if r.clicked() {
+                        self.panels.timeline.open = true;
+                    }
+                });
+            return;
+        }
+        egui::Panel::bottom("timeline")
+            .resizable(false)
+            .show(ui, |ui| {
+                ui.add_space(2.0);
+                ui.horizontal(|ui| {
+                    let hide = ui.small_button("hide").on_hover_text("Hide the timeline");
+                    super::widgets::mark(ui, "timeline:toggle", hide.rect);
+                    if hide.clicked() {
+                        self.panels.timeline.open = false;
+                    }
+                    if let Some(said) = self.panels.timeline.ui(ui, &mut self.doc, &self.selection)
+                    {
+                        self.notices.note(now, said);
+                    }
+                });
+                ui.add_space(2.0);
+            });
         self.selection.retain_valid(self.doc.scene());
     }
 
@@ -473,7 +534,7 @@ impl CloudApp {
                 "kind": kind.name(), "axis": axis.map(|a| a.name()), "typed": typed,
             })),
             "behind": self.tool.behind(),
-            "playing": self.panels.clock.playing,
+            "playing": self.panels.timeline.playing,
             "guides_hidden": self.tool.hide_guides,
             "skeleton_shown": self.tool.show_skeleton,
             "panel_open": self.panel_open,
@@ -497,6 +558,7 @@ impl CloudApp {
         view["puffs_left_out"] = stats.puffs_left_out.into();
         view["catching_up"] = stats.catching_up.into();
         view["light_preview"] = serde_json::json!(stats.light_preview);
+        view["timeline"] = super::panels::timeline_state(&self.panels.timeline, &self.doc);
         let state = format!("{{\"scene\":{scene_json},\"view\":{view}}}");
         let status = PageStatus {
             ready: self.viewport.ready,
@@ -559,7 +621,7 @@ impl eframe::App for CloudApp {
         self.shortcuts(&ctx, &pressed.before_pointer);
         if self
             .panels
-            .clock
+            .timeline
             .tick(&mut self.doc, ctx.input(|i| i.stable_dt))
         {
             ctx.request_repaint();
@@ -620,6 +682,7 @@ impl eframe::App for CloudApp {
                     }
                 });
         }
+        self.timeline_strip(ui, &ctx);
         egui::CentralPanel::no_frame().show(ui, |ui| {
             self.viewport.show(
                 ui,

@@ -37,6 +37,14 @@ pub enum Shortcut {
     TogglePanel,
     /// Alt+A: play or pause.
     PlayPause,
+    /// I: key the selection (the sun with nothing selected) at the current frame.
+    InsertKey,
+    /// Alt+I: delete the shown keys at the current frame.
+    DeleteKeys,
+    /// ← and →: a frame back or on.
+    StepFrame(i8),
+    /// ↑ and ↓: the next or the previous key.
+    JumpKey(bool),
     /// 1, 3, 7 (Ctrl: the opposite side).
     View(StandardView),
     /// 5: orthographic on or off.
@@ -95,6 +103,12 @@ const TABLE: &[(Modifiers, Key, Shortcut)] = {
         (CMD, Key::Num3, S::View(StandardView::Left)),
         (CMD, Key::Num7, S::View(StandardView::Bottom)),
         (Modifiers::ALT, Key::A, S::PlayPause),
+        (Modifiers::ALT, Key::I, S::DeleteKeys),
+        (NONE, Key::I, S::InsertKey),
+        (NONE, Key::ArrowLeft, S::StepFrame(-1)),
+        (NONE, Key::ArrowRight, S::StepFrame(1)),
+        (NONE, Key::ArrowUp, S::JumpKey(true)),
+        (NONE, Key::ArrowDown, S::JumpKey(false)),
         (Modifiers::SHIFT, Key::H, S::HideSelected),
         (Modifiers::ALT, Key::H, S::ShowAll),
         (NONE, Key::F, S::Frame),

@@ -1,22 +1,22 @@
 //! The side panel: one view per collapsible group, each with its own `ui()` that takes only
 //! what it needs (the document, the selection, the tool state), as egui's demo app does.
 
-mod clock;
 mod export;
 mod light;
 mod render;
 mod scene;
 mod simulation;
 mod sketch;
+mod timeline;
 mod view;
 
-pub use clock::ClockPanel;
 pub use export::ExportPanel;
 pub use light::LIGHT;
 pub use render::RENDER;
 pub use scene::ScenePanel;
 pub use simulation::SimulationPanel;
 pub use sketch::SketchPanel;
+pub use timeline::{Timeline, state as timeline_state};
 pub use view::{GeometryUpdate, ViewPanel, ViewStats};
 
 use egui::Ui;

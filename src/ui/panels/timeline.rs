@@ -1,0 +1,593 @@
+//! The timeline strip under the view: play, pause and loop, the frame, a scrub bar whose one
+//! drag covers the whole frame range, the range and the rate, and the keys of what is selected
+//! as diamonds (drag to retime, Shift+click to select several, right-click for the ease,
+//! Delete over the strip removes them). I keys the selection (the sun with nothing selected);
+//! auto-key records every edit. The time lives in the document (renders and links reproduce
+//! it) but, like the camera, changing it is not an undo step; playing is view state.
+
+use egui::{Color32, Pos2, Sense, Stroke, Ui, vec2};
+
+use crate::scene::{
+    Animation, Channel, Clock, Document, Ease, Edit, EllipsoidProperty, LightProperty,
+    PlaneProperty, Scene,
+};
+use crate::ui::selection::{Item, Selection};
+use crate::ui::widgets::mark;
+
+/// Height of the scrub bar in points.
+const BAR_HEIGHT: f32 = 24.0;
+/// How near (points) a press must be to a diamond to take it.
+const DIAMOND_REACH: f32 = 7.0;
+
+/// A drag of selected keys along the bar, from where it began.
+struct KeyDrag {
+    /// The keys as they were when the drag began.
+    from: Animation,
+    /// The selected key times then.
+    times: Vec<f32>,
+    /// Where the press was (points).
+    x0: f32,
+    /// Frames moved so far.
+    moved: i64,
+}
+
+/// The timeline's view state.
+pub struct Timeline {
+    /// The strip is shown (its button or the view's "timeline" button toggles it).
+    pub open: bool,
+    /// The scene time advances with the frames.
+    pub playing: bool,
+    /// Playing goes back to the range's first frame after its last (off: the clock runs on,
+    /// as the noise's wind and torque need no range).
+    pub looping: bool,
+    /// Scene seconds per second.
+    pub speed: f32,
+    /// The selected keys' times (seconds), among the shown channels' keys.
+    pub selected: Vec<f32>,
+    /// The pointer is over the strip (Delete there removes keys, not items).
+    pub hovered: bool,
+    drag: Option<KeyDrag>,
+    /// Where the shown keys were drawn this frame (time, x), for the page state.
+    pub drawn: Vec<(f32, f32)>,
+}
+
+impl Default for Timeline {
+    fn default() -> Self {
+        Self {
+            open: true,
+            playing: false,
+            looping: false,
+            speed: 1.0,
+            selected: Vec::new(),
+            hovered: false,
+            drag: None,
+            drawn: Vec::new(),
+        }
+    }
+}
+
+/// The channels the timeline shows and deletes keys of: every keyable value of the selected
+/// ellipsoids and planes, or the light's and the media's with nothing selected.
+pub fn shown_channels(scene: &Scene, selection: &Selection) -> Vec<Channel> {
+    if selection.is_empty() {
+        return Channel::all(scene)
+            .filter(|c| matches!(c, Channel::Light { .. } | Channel::Media { .. }))
+            .collect();
+    }
+    let ids = selected_ids(scene, selection);
+    Channel::all(scene)
+        .filter(|c| c.id().is_some_and(|id| ids.contains(&id)))
+        .collect()
+}
+
+fn selected_ids(scene: &Scene, selection: &Selection) -> Vec<u64> {
+    selection
+        .items()
+        .iter()
+        .filter_map(|item| match *item {
+            Item::Ellipsoid(i) => scene.ellipsoids.get(i).map(|e| e.id),
+            Item::Plane(i) => scene.planes.get(i).map(|p| p.id),
+        })
+        .collect()
+}
+
+/// What I keys: the selected ellipsoids' centre, radii, rotation and strength and the
+/// selected planes' origin and rotation (and any other of their values already keyed); with
+/// nothing selected, the sun's azimuth, elevation and intensity (and any light or media
+/// value already keyed).
+pub fn keyed_by_i(scene: &Scene, selection: &Selection) -> Vec<Channel> {
+    let animation = &scene.animation;
+    shown_channels(scene, selection)
+        .into_iter()
+        .filter(|c| {
+            animation.track(*c).is_some()
+                || matches!(
+                    c,
+                    Channel::Ellipsoid {
+                        property: EllipsoidProperty::Center
+                            | EllipsoidProperty::Radii
+                            | EllipsoidProperty::Rotation
+                            | EllipsoidProperty::Strength,
+                        ..
+                    } | Channel::Plane {
+                        property: PlaneProperty::Origin | PlaneProperty::Rotation,
+                        ..
+                    } | Channel::Light {
+                        property: LightProperty::SunAzimuth
+                            | LightProperty::SunElevation
+                            | LightProperty::SunIntensity
+                    }
+                )
+        })
+        .collect()
+}
+
+impl Timeline {
+    /// Advances the scene time by `dt` seconds of wall time while playing (back to the range's
+    /// start past its end when looping); returns whether it did (the caller asks for the next
+    /// frame).
+    pub fn tick(&mut self, doc: &mut Document, dt: f32) -> bool {
+        if !self.playing {
+            return false;
+        }
+        let clock = doc.scene().clock;
+        let mut t = doc.scene().time + dt.clamp(0.0, 0.25) * self.speed;
+        if self.looping {
+            let (start, end) = (clock.seconds(clock.start), clock.seconds(clock.end));
+            if t > end || t < start {
+                t = start;
+            }
+        }
+        doc.set_time(t);
+        true
+    }
+
+    /// I: keys the selection's values at the document's time (one undo step). Returns what
+    /// to tell the user.
+    pub fn insert_keys(&mut self, doc: &mut Document, selection: &Selection) -> String {
+        let scene = doc.scene();
+        let channels = keyed_by_i(scene, selection);
+        let mut animation = scene.animation.clone();
+        let t = scene.time;
+        let n = animation.key_all(scene, channels.iter().copied(), t);
+        let frame = scene.clock.frame(t);
+        let what = if selection.is_empty() {
+            "the sun".to_owned()
+        } else {
+            match selection.items().len() {
+                1 => "the selection".to_owned(),
+                k => format!("{k} items"),
+            }
+        };
+        if n == 0 {
+            return if channels.is_empty() {
+                "Nothing to key".into()
+            } else if animation.key_count() >= crate::scene::MAX_KEYS * crate::scene::MAX_TRACKS
+            {
+                "No more keys fit".into()
+            } else {
+                format!("{what} already keyed as it is at frame {frame:.0}")
+            };
+        }
+        doc.apply(Edit::SetAnimation(animation, "insert keys"), None);
+        self.selected = vec![t];
+        format!("Keyed {what} at frame {frame:.0} ({n} values)")
+    }
+
+    /// Alt+I, or Delete over the strip: removes the shown channels' selected keys, or those at
+    /// the document's time when none is selected (one undo step). Returns what to tell the
+    /// user.
+    pub fn delete_keys(&mut self, doc: &mut Document, selection: &Selection) -> String {
+        let scene = doc.scene();
+        let channels = shown_channels(scene, selection);
+        let times = if self.selected.is_empty() {
+            vec![scene.time]
+        } else {
+            std::mem::take(&mut self.selected)
+        };
+        let mut animation = scene.animation.clone();
+        let removed: usize = times
+            .iter()
+            .map(|t| animation.remove_at(&channels, *t))
+            .sum();
+        if removed == 0 {
+            return "No keys there to delete".into();
+        }
+        doc.apply(Edit::SetAnimation(animation, "delete keys"), None);
+        format!("Deleted {removed} keys")
+    }
+
+    /// Up and Down: the time of the next (or previous) key of the shown channels.
+    pub fn jump_to_key(&self, doc: &mut Document, selection: &Selection, forward: bool) {
+        let scene = doc.scene();
+        let channels = shown_channels(scene, selection);
+        let times = scene.animation.times(Some(&channels));
+        let t = scene.time;
+        let next = if forward {
+            times.into_iter().find(|k| *k > t)
+        } else {
+            times.into_iter().rev().find(|k| *k < t)
+        };
+        if let Some(k) = next {
+            doc.set_time(k);
+        }
+    }
+
+    /// Left and Right: one frame back or on.
+    pub fn step_frame(&self, doc: &mut Document, by: i64) {
+        let clock = doc.scene().clock;
+        let frame = (clock.frame(doc.scene().time).round() as i64 + by).max(0);
+        doc.set_time(clock.seconds(frame.min(u32::MAX as i64) as u32));
+    }
+
+    /// Draws the strip on one row.
+    pub fn ui(&mut self, ui: &mut Ui, doc: &mut Document, selection: &Selection) -> Option<String> {
+        let mut said = None;
+        self.hovered = ui.rect_contains_pointer(ui.max_rect());
+        ui.horizontal(|ui| {
+            let play = ui
+                .button(if self.playing { "Pause" } else { "Play" })
+                .on_hover_text("Alt+A: play or pause (the wind and torque of the media move the noise)");
+            mark(ui, "timeline:play", play.rect);
+            if play.clicked() {
+                self.playing = !self.playing;
+            }
+            let looping = ui
+                .selectable_label(self.looping, "Loop")
+                .on_hover_text("Loop: back to the first frame after the last");
+            mark(ui, "timeline:loop", looping.rect);
+            if looping.clicked() {
+                self.looping = !self.looping;
+            }
+            let scene = doc.scene();
+            let clock = scene.clock;
+            let mut frame = clock.frame(scene.time).round().max(0.0) as u32;
+            let r = ui
+                .add(
+                    egui::DragValue::new(&mut frame)
+                        .range(0..=clock.last_frame())
+                        .prefix("frame "),
+                )
+                .on_hover_text(format!(
+                    "The frame at the scene time ({:.2} s); Left and Right step a frame, Up and Down go to the next or previous key",
+                    scene.time
+                ));
+            mark(ui, "timeline:frame", r.rect);
+            if r.changed() {
+                doc.set_time(clock.seconds(frame));
+            }
+            let key = ui
+                .button("Key")
+                .on_hover_text("I: key the selection's place, size, turn and strength at this frame (the sun's with nothing selected); Alt+I deletes the keys here");
+            mark(ui, "timeline:key", key.rect);
+            if key.clicked() {
+                said = Some(self.insert_keys(doc, selection));
+            }
+            let mut auto = doc.auto_key();
+            let auto_r = ui
+                .toggle_value(&mut auto, "Auto-key")
+                .on_hover_text("Auto-key: every edit of a keyable value is keyed at this frame");
+            mark(ui, "timeline:auto", auto_r.rect);
+            if auto_r.changed() {
+                doc.set_auto_key(auto);
+            }
+            // The range and the rate at the right, the bar between.
+            let right = 230.0;
+            let bar_width = (ui.available_width() - right).max(80.0);
+            said = self.bar(ui, doc, selection, bar_width).or(said.take());
+            self.range_ui(ui, doc);
+        });
+        said
+    }
+
+    /// The frame range and the rate (one undo step each drag).
+    fn range_ui(&mut self, ui: &mut Ui, doc: &mut Document) {
+        let mut clock = doc.scene().clock;
+        let last = clock.last_frame();
+        let mut changed = ui
+            .add(egui::DragValue::new(&mut clock.start).range(0..=last))
+            .on_hover_text("First frame of the range")
+            .changed();
+        ui.label("–");
+        changed |= ui
+            .add(egui::DragValue::new(&mut clock.end).range(0..=last))
+            .on_hover_text("Last frame of the range (inclusive)")
+            .changed();
+        let rate = crate::limits::FRAME_RATE;
+        changed |= ui
+            .add(
+                egui::DragValue::new(&mut clock.fps)
+                    .speed(0.1)
+                    .suffix(" fps")
+                    .range(rate.min as f32..=rate.max as f32),
+            )
+            .on_hover_text(rate.tip)
+            .changed();
+        if changed {
+            if clock.end < clock.start {
+                clock.end = clock.start;
+            }
+            doc.apply(Edit::SetClock(clock), Some("clock"));
+        }
+    }
+
+    /// The scrub bar with its ticks, the playhead and the shown keys.
+    fn bar(
+        &mut self,
+        ui: &mut Ui,
+        doc: &mut Document,
+        selection: &Selection,
+        width: f32,
+    ) -> Option<String> {
+        let (rect, response) =
+            ui.allocate_exact_size(vec2(width, BAR_HEIGHT), Sense::click_and_drag());
+        mark(ui, "timeline:scrub", rect);
+        let scene = doc.scene();
+        let clock = scene.clock;
+        let (start, end) = (clock.start as f32, clock.end.max(clock.start + 1) as f32);
+        let inner = rect.shrink2(vec2(8.0, 0.0));
+        let x_of = |frame: f32| inner.left() + (frame - start) / (end - start) * inner.width();
+        let frame_of = |x: f32| start + (x - inner.left()) / inner.width() * (end - start);
+        let painter = ui.painter_at(rect);
+        painter.rect_filled(rect, 3.0, Color32::from_gray(32));
+        // Ticks at a step that keeps labels apart.
+        let per_px = (end - start) / inner.width().max(1.0);
+        let step = [1u32, 2, 5, 10, 12, 24, 48, 60, 120, 240, 600, 1200, 2400, 6000, 12000]
+            .into_iter()
+            .find(|s| *s as f32 / per_px >= 44.0)
+            .unwrap_or(24_000);
+        let font = egui::FontId::proportional(10.0);
+        let mut f = clock.start.div_ceil(step) * step;
+        while f as f32 <= end {
+            let x = x_of(f as f32);
+            painter.line_segment(
+                [Pos2::new(x, rect.bottom() - 6.0), Pos2::new(x, rect.bottom())],
+                Stroke::new(1.0, Color32::from_gray(110)),
+            );
+            painter.text(
+                Pos2::new(x + 2.0, rect.top() + 1.0),
+                egui::Align2::LEFT_TOP,
+                f.to_string(),
+                font.clone(),
+                Color32::from_gray(140),
+            );
+            f += step;
+        }
+        // The shown channels' keys.
+        let channels = shown_channels(scene, selection);
+        let times = scene.animation.times(Some(&channels));
+        self.selected.retain(|t| times.contains(t));
+        self.drawn = times
+            .iter()
+            .map(|t| (*t, x_of(clock.frame(*t) as f32)))
+            .collect();
+        let mut said = None;
+        // A press on a diamond takes it; anywhere else scrubs.
+        if response.drag_started() || response.clicked() {
+            let shift = ui.input(|i| i.modifiers.shift);
+            if let Some(p) = response.interact_pointer_pos() {
+                let hit = self
+                    .drawn
+                    .iter()
+                    .filter(|(_, x)| (x - p.x).abs() <= DIAMOND_REACH)
+                    .min_by(|a, b| (a.1 - p.x).abs().total_cmp(&(b.1 - p.x).abs()))
+                    .map(|(t, _)| *t);
+                match hit {
+                    Some(t) => {
+                        if shift {
+                            if let Some(i) = self.selected.iter().position(|s| *s == t) {
+                                self.selected.remove(i);
+                            } else {
+                                self.selected.push(t);
+                            }
+                        } else if !self.selected.contains(&t) {
+                            self.selected = vec![t];
+                        }
+                        if response.drag_started() && self.selected.contains(&t) {
+                            self.drag = Some(KeyDrag {
+                                from: scene.animation.clone(),
+                                times: self.selected.clone(),
+                                x0: p.x,
+                                moved: 0,
+                            });
+                        }
+                    }
+                    None => {
+                        if !shift {
+                            self.selected.clear();
+                        }
+                    }
+                }
+            }
+        }
+        if let Some(drag) = &mut self.drag {
+            if let Some(p) = response.interact_pointer_pos()
+                && response.dragged()
+            {
+                let moved = ((p.x - drag.x0) * per_px).round() as i64;
+                if moved != drag.moved {
+                    drag.moved = moved;
+                    let (animation, times) = retimed(&drag.from, &drag.times, &channels, &clock, moved);
+                    doc.apply(Edit::SetAnimation(animation, "retime keys"), Some("retime keys"));
+                    self.selected = times;
+                }
+            }
+            if response.drag_stopped() {
+                self.drag = None;
+                doc.end_merge();
+            }
+        } else if (response.dragged() || response.clicked())
+            && let Some(p) = response.interact_pointer_pos()
+        {
+            let frame = frame_of(p.x).round().clamp(start, end) as u32;
+            doc.set_time(clock.seconds(frame));
+        }
+        // Ease of the selected keys by right-click.
+        response.context_menu(|ui| {
+            if self.selected.is_empty() {
+                ui.label("Click a key first");
+                return;
+            }
+            for ease in Ease::ALL {
+                if ui.button(ease.label()).clicked() {
+                    let mut animation = doc.scene().animation.clone();
+                    let mut any = false;
+                    for t in &self.selected {
+                        any |= animation.set_ease(&channels, *t, ease);
+                    }
+                    if any {
+                        doc.apply(
+                            Edit::SetAnimation(animation, "change the ease of keys"),
+                            None,
+                        );
+                    }
+                    ui.close();
+                }
+            }
+            if ui.button("Delete keys").clicked() {
+                said = Some(self.delete_keys(doc, selection));
+                ui.close();
+            }
+        });
+        let painter = ui.painter_at(rect);
+        for (t, x) in &self.drawn {
+            let on = self.selected.contains(t);
+            let c = Pos2::new(*x, rect.center().y + 3.0);
+            let r = 5.0;
+            let diamond = vec![
+                c + vec2(0.0, -r),
+                c + vec2(r, 0.0),
+                c + vec2(0.0, r),
+                c + vec2(-r, 0.0),
+            ];
+            painter.add(egui::Shape::convex_polygon(
+                diamond,
+                if on {
+                    Color32::from_rgb(255, 170, 40)
+                } else {
+                    Color32::from_gray(220)
+                },
+                Stroke::new(1.0, Color32::BLACK),
+            ));
+        }
+        // The playhead.
+        let now = doc.scene().clock.frame(doc.scene().time) as f32;
+        let x = x_of(now.clamp(start, end));
+        painter.line_segment(
+            [Pos2::new(x, rect.top()), Pos2::new(x, rect.bottom())],
+            Stroke::new(2.0, Color32::from_rgb(90, 160, 255)),
+        );
+        if response.hovered() && self.drag.is_none() {
+            response.on_hover_text(
+                "Drag to scrub the whole range; drag a key to retime it, Shift+click to select several, right-click for its ease, Delete here removes the selected keys",
+            );
+        }
+        said
+    }
+}
+
+/// `from` with the keys of `channels` at `times` moved by `frames` (whole frames), and the
+/// times they moved to. Keys go in the order that never lands one on another still to move.
+fn retimed(
+    from: &Animation,
+    times: &[f32],
+    channels: &[Channel],
+    clock: &Clock,
+    frames: i64,
+) -> (Animation, Vec<f32>) {
+    let mut animation = from.clone();
+    let mut order: Vec<f32> = times.to_vec();
+    order.sort_by(f32::total_cmp);
+    if frames > 0 {
+        order.reverse();
+    }
+    let mut moved = Vec::with_capacity(order.len());
+    for t in order {
+        let frame = (clock.frame(t).round() as i64 + frames).max(0);
+        let to = clock.seconds(frame.min(u32::MAX as i64) as u32);
+        animation.retime(channels, t, to);
+        moved.push(to);
+    }
+    (animation, moved)
+}
+
+/// Where the strip's selected keys and drawn diamonds are, for the page state.
+pub fn state(timeline: &Timeline, doc: &Document) -> serde_json::Value {
+    serde_json::json!({
+        "open": timeline.open,
+        "playing": timeline.playing,
+        "looping": timeline.looping,
+        "auto_key": doc.auto_key(),
+        "frame": doc.scene().clock.frame(doc.scene().time),
+        "keys": timeline.drawn.iter().map(|(t, x)| serde_json::json!({"t": t, "x": x})).collect::<Vec<_>>(),
+        "selected_keys": timeline.selected,
+        "key_count": doc.scene().animation.key_count(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{Ellipsoid, Preset};
+    use glam::Vec3;
+    use std::sync::Arc;
+
+    #[test]
+    fn playing_advances_the_time_without_undo_steps_and_loops_within_the_range() {
+        let mut doc = Document::new(Scene::default());
+        let mut timeline = Timeline::default();
+        assert!(!timeline.tick(&mut doc, 0.1), "paused: nothing moves");
+        timeline.playing = true;
+        timeline.speed = 2.0;
+        let render = doc.revisions().render;
+        for _ in 0..10 {
+            timeline.tick(&mut doc, 0.1);
+        }
+        assert!((doc.scene().time - 2.0).abs() < 1e-5, "{}", doc.scene().time);
+        assert_eq!(doc.undo_len(), 0);
+        assert!(doc.revisions().render > render, "the image knows to change");
+        // A stalled frame does not jump the clock.
+        timeline.tick(&mut doc, 30.0);
+        assert!(doc.scene().time < 2.6);
+        // Looping: past the range's last frame, back to its first.
+        timeline.looping = true;
+        let end = doc.scene().clock.seconds(doc.scene().clock.end);
+        doc.set_time(end - 0.01);
+        timeline.tick(&mut doc, 0.1);
+        assert_eq!(doc.scene().time, doc.scene().clock.seconds(doc.scene().clock.start));
+    }
+
+    #[test]
+    fn i_keys_the_selection_and_delete_removes_its_keys() {
+        let mut scene = Scene::preset(Preset::Empty);
+        scene
+            .ellipsoids
+            .push(Arc::new(Ellipsoid::new(Vec3::ZERO, Vec3::ONE)));
+        scene.settle();
+        let mut doc = Document::new(scene);
+        let mut selection = Selection::default();
+        selection.set(Item::Ellipsoid(0));
+        let mut timeline = Timeline::default();
+        let said = timeline.insert_keys(&mut doc, &selection);
+        assert!(said.starts_with("Keyed the selection"), "{said}");
+        assert_eq!(doc.scene().animation.key_count(), 4);
+        // Again at the same values: nothing new, no undo step.
+        let steps = doc.undo_len();
+        timeline.insert_keys(&mut doc, &selection);
+        assert_eq!(doc.undo_len(), steps);
+        // Nothing selected: the sun.
+        let said = timeline.insert_keys(&mut doc, &Selection::default());
+        assert!(said.contains("the sun"), "{said}");
+        assert_eq!(doc.scene().animation.key_count(), 7);
+        // Retiming the ellipsoid's key by 24 frames moves its four keys, not the sun's.
+        let channels = shown_channels(doc.scene(), &selection);
+        let (a, times) = retimed(&doc.scene().animation, &[0.0], &channels, &doc.scene().clock, 24);
+        assert_eq!(times, vec![doc.scene().clock.seconds(24)]);
+        assert_eq!(a.times(Some(&channels)), times);
+        assert_eq!(a.times(None).len(), 2);
+        timeline.selected.clear();
+        let said = timeline.delete_keys(&mut doc, &selection);
+        assert_eq!(said, "Deleted 4 keys");
+        assert_eq!(doc.scene().animation.key_count(), 3);
+    }
+}
