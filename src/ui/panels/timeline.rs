@@ -15,7 +15,9 @@ use crate::ui::selection::{Item, Selection};
 use crate::ui::widgets::mark;
 
 /// Height of the scrub bar in points.
-const BAR_HEIGHT: f32 = 24.0;
+const BAR_HEIGHT: f32 = 28.0;
+/// Height of the ruler at the bar's top: a press there always scrubs, even over a key.
+const RULER: f32 = 12.0;
 /// How near (points) a press must be to a diamond to take it.
 const DIAMOND_REACH: f32 = 7.0;
 
@@ -49,6 +51,8 @@ pub struct Timeline {
     drag: Option<KeyDrag>,
     /// Where the shown keys were drawn this frame (time, x), for the page state.
     pub drawn: Vec<(f32, f32)>,
+    /// The height the keys were drawn at.
+    pub keys_y: f32,
 }
 
 impl Default for Timeline {
@@ -62,6 +66,7 @@ impl Default for Timeline {
             hovered: false,
             drag: None,
             drawn: Vec::new(),
+            keys_y: 0.0,
         }
     }
 }
@@ -242,8 +247,11 @@ impl Timeline {
             let scene = doc.scene();
             let clock = scene.clock;
             let mut frame = clock.frame(scene.time).round().max(0.0) as u32;
+            // Fixed width: a frame number growing a digit never shifts the bar under the
+            // pointer.
             let r = ui
-                .add(
+                .add_sized(
+                    [84.0, 20.0],
                     egui::DragValue::new(&mut frame)
                         .range(0..=clock.last_frame())
                         .prefix("frame "),
@@ -344,19 +352,23 @@ impl Timeline {
                 [Pos2::new(x, rect.bottom() - 6.0), Pos2::new(x, rect.bottom())],
                 Stroke::new(1.0, Color32::from_gray(110)),
             );
-            painter.text(
-                Pos2::new(x + 2.0, rect.top() + 1.0),
+            // A label that would run past the bar's end is left out.
+            if x + 24.0 < rect.right() {
+                painter.text(
+                    Pos2::new(x + 2.0, rect.top() + 1.0),
                 egui::Align2::LEFT_TOP,
-                f.to_string(),
-                font.clone(),
-                Color32::from_gray(140),
-            );
+                    f.to_string(),
+                    font.clone(),
+                    Color32::from_gray(140),
+                );
+            }
             f += step;
         }
         // The shown channels' keys.
         let channels = shown_channels(scene, selection);
         let times = scene.animation.times(Some(&channels));
         self.selected.retain(|t| times.contains(t));
+        self.keys_y = key_y(rect);
         self.drawn = times
             .iter()
             .map(|t| (*t, x_of(clock.frame(*t) as f32)))
@@ -365,11 +377,15 @@ impl Timeline {
         // A press on a diamond takes it; anywhere else scrubs.
         if response.drag_started() || response.clicked() {
             let shift = ui.input(|i| i.modifiers.shift);
-            if let Some(p) = response.interact_pointer_pos() {
+            // Where the press was: a drag starts once the pointer has gone a few points, by
+            // then off a diamond 10 points wide.
+            let origin = ui.input(|i| i.pointer.press_origin());
+            if let Some(p) = origin.or(response.interact_pointer_pos()) {
+                let on_keys = p.y >= rect.top() + RULER;
                 let hit = self
                     .drawn
                     .iter()
-                    .filter(|(_, x)| (x - p.x).abs() <= DIAMOND_REACH)
+                    .filter(|(_, x)| on_keys && (x - p.x).abs() <= DIAMOND_REACH)
                     .min_by(|a, b| (a.1 - p.x).abs().total_cmp(&(b.1 - p.x).abs()))
                     .map(|(t, _)| *t);
                 match hit {
@@ -400,9 +416,12 @@ impl Timeline {
                 }
             }
         }
+        // The release's frame counts too: pointer events come faster than frames, and the
+        // last move before a release often shares its frame.
+        let moving = response.dragged() || response.drag_stopped();
         if let Some(drag) = &mut self.drag {
             if let Some(p) = response.interact_pointer_pos()
-                && response.dragged()
+                && moving
             {
                 let moved = ((p.x - drag.x0) * per_px).round() as i64;
                 if moved != drag.moved {
@@ -416,7 +435,7 @@ impl Timeline {
                 self.drag = None;
                 doc.end_merge();
             }
-        } else if (response.dragged() || response.clicked())
+        } else if (moving || response.clicked())
             && let Some(p) = response.interact_pointer_pos()
         {
             let frame = frame_of(p.x).round().clamp(start, end) as u32;
@@ -452,7 +471,7 @@ impl Timeline {
         let painter = ui.painter_at(rect);
         for (t, x) in &self.drawn {
             let on = self.selected.contains(t);
-            let c = Pos2::new(*x, rect.center().y + 3.0);
+            let c = Pos2::new(*x, key_y(rect));
             let r = 5.0;
             let diamond = vec![
                 c + vec2(0.0, -r),
@@ -479,11 +498,16 @@ impl Timeline {
         );
         if response.hovered() && self.drag.is_none() {
             response.on_hover_text(
-                "Drag to scrub the whole range; drag a key to retime it, Shift+click to select several, right-click for its ease, Delete here removes the selected keys",
+                "Drag to scrub the whole range (on the numbers even over a key); drag a key to retime it, Shift+click to select several, right-click for its ease, Delete here removes the selected keys",
             );
         }
         said
     }
+}
+
+/// The height the keys are drawn at on the bar `rect`, under its ruler.
+fn key_y(rect: egui::Rect) -> f32 {
+    rect.top() + RULER + (rect.height() - RULER) / 2.0
 }
 
 /// `from` with the keys of `channels` at `times` moved by `frames` (whole frames), and the
@@ -519,7 +543,7 @@ pub fn state(timeline: &Timeline, doc: &Document) -> serde_json::Value {
         "looping": timeline.looping,
         "auto_key": doc.auto_key(),
         "frame": doc.scene().clock.frame(doc.scene().time),
-        "keys": timeline.drawn.iter().map(|(t, x)| serde_json::json!({"t": t, "x": x})).collect::<Vec<_>>(),
+        "keys": timeline.drawn.iter().map(|(t, x)| serde_json::json!({"t": t, "x": x, "y": timeline.keys_y})).collect::<Vec<_>>(),
         "selected_keys": timeline.selected,
         "key_count": doc.scene().animation.key_count(),
     })

@@ -1,0 +1,143 @@
+// Key frames in the browser, driven as a user drives them at 1280×800: select an ellipsoid,
+// press I, scrub the timeline, move it, press I, scrub between; the image changes between the
+// keys and returns at each key; undo removes the key; a key dragged along the bar retimes it.
+// Screenshots: test-results/screenshots/timeline-*.png.
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import { serve, state, screenshot, countChanged, until, withApp, waitForFullQuality } from './harness.mjs';
+
+let server;
+before(async () => { server = await serve(); });
+after(async () => { await server?.close(); });
+
+const toBytes = (rgb) => rgb.map((v) => Math.round(v * 255));
+
+/** Horizontal centroid and count of the pixels that differ from the sky (between the notice
+ * and hint lines at the top and the status line at the bottom of the view). */
+function cloud(img, [vw, vh], bg) {
+  let n = 0, sx = 0;
+  for (let y = 60; y < vh - 30; y++) {
+    for (let x = 0; x < vw; x++) {
+      const i = 4 * (y * img.width + x);
+      const d = Math.abs(img.data[i] - bg[0]) + Math.abs(img.data[i + 1] - bg[1]) + Math.abs(img.data[i + 2] - bg[2]);
+      if (d > 24) { n++; sx += x; }
+    }
+  }
+  return { n, x: n ? sx / n : NaN };
+}
+
+/** The page x of `frame` on the timeline's scrub bar (the bar's ends are 8 points in). */
+function frameX(s, frame) {
+  const [left, , width] = s.view.widgets['timeline:scrub'];
+  const { start, end } = s.scene.clock ?? { start: 0, end: 120 };
+  return left + 8 + ((frame - start) / (Math.max(end, start + 1) - start)) * (width - 16);
+}
+
+/** Drags along the scrub bar's ruler (its numbers: a press there scrubs even over a key)
+ * from where the playhead is to `frame`, with pointer moves at input rate (several a frame,
+ * none awaited per frame). */
+async function scrubTo(page, frame) {
+  const s = await state(page);
+  const [, top] = s.view.widgets['timeline:scrub'];
+  const y = top + 5;
+  const x0 = frameX(s, s.view.timeline.frame);
+  const x1 = frameX(s, frame);
+  await page.mouse.move(x0, y);
+  await page.mouse.down();
+  for (let i = 1; i <= 12; i++) await page.mouse.move(x0 + ((x1 - x0) * i) / 12, y);
+  await page.mouse.up();
+  // Off the bar: its tooltip is no part of the image compared.
+  await page.mouse.move(x1, top - 200);
+  return until(page, (s) => Math.round(s.view.timeline.frame) === frame, `frame ${frame}`);
+}
+
+for (const backend of ['webgpu', 'webgl2']) {
+  test(`I keys an ellipsoid, the scrub bar poses it between its keys, undo removes a key, a dragged key retimes (${backend})`, { timeout: 300_000 }, async () => {
+    await withApp({ base: server.url, webgpu: backend === 'webgpu', query: '?preset=empty', viewport: { width: 1280, height: 800 } }, async (page) => {
+      let s = await state(page);
+      const view = s.view.viewport;
+      const [vw, vh] = view;
+      const bg = toBytes(s.scene.light.background);
+      assert.equal(s.view.timeline.open, true, 'the timeline is shown');
+      // An ellipsoid where a click lands (the Ellipsoid tool selects it).
+      await page.mouse.click(vw * 0.05, vh * 0.95);
+      await page.keyboard.press('e');
+      await until(page, (s) => s.view.tool === 'ellipsoid', 'ellipsoid tool');
+      await page.mouse.click(vw * 0.35, vh * 0.5);
+      s = await until(page, (s) => s.scene.ellipsoids.length === 1 && s.view.selected_ellipsoid === 0, 'an ellipsoid');
+      await page.keyboard.press('h'); // the indicator off: the cloud alone
+      await page.keyboard.press('i');
+      s = await until(page, (s) => s.view.timeline.key_count === 4, 'keys at frame 0');
+      assert.match(s.view.notice.text, /Keyed the selection at frame 0/);
+      assert.deepEqual(s.view.timeline.keys.map((k) => k.t), [0]);
+      await waitForFullQuality(page);
+      const at0 = await screenshot(page, `timeline-1-frame0-${backend}`);
+      const c0 = cloud(at0, view, bg);
+      assert.ok(c0.n > 0.01 * vw * vh, `a cloud: ${c0.n} px`);
+
+      // Scrub to frame 48, move it right with the Move tool, key it there.
+      s = await scrubTo(page, 48);
+      const x0 = s.scene.ellipsoids[0].center[0];
+      await page.keyboard.press('Shift+G');
+      await until(page, (s) => s.view.tool === 'move', 'move tool');
+      await page.mouse.move(vw * 0.35, vh * 0.5);
+      await page.mouse.down();
+      for (let i = 1; i <= 15; i++) await page.mouse.move(vw * 0.35 + i * 20, vh * 0.5);
+      await page.mouse.up();
+      s = await until(page, (s) => s.scene.ellipsoids[0].center[0] > x0 + 1, 'moved right');
+      const x48 = s.scene.ellipsoids[0].center[0];
+      await page.keyboard.press('i');
+      s = await until(page, (s) => s.view.timeline.key_count === 8, 'keys at frame 48');
+      assert.equal(s.view.timeline.keys.length, 2);
+      await waitForFullQuality(page);
+      const at48 = await screenshot(page, `timeline-2-frame48-${backend}`);
+      const c48 = cloud(at48, view, bg);
+      assert.ok(c48.x > c0.x + 150, `moved: ${c0.x} → ${c48.x}`);
+
+      // Between the keys the cloud is between; at each key it is back where it was keyed.
+      s = await scrubTo(page, 24);
+      const x24 = s.scene.ellipsoids[0].center[0];
+      assert.ok(Math.abs(x24 - (x0 + x48) / 2) < 1e-3, `half way at frame 24: ${x0}, ${x24}, ${x48}`);
+      await waitForFullQuality(page);
+      const at24 = await screenshot(page, `timeline-3-frame24-${backend}`);
+      const c24 = cloud(at24, view, bg);
+      assert.ok(c24.x > c0.x + 50 && c24.x < c48.x - 50, `between: ${c0.x} < ${c24.x} < ${c48.x}`);
+      // The cloud's rows, clear of the hint and notice lines and the status line.
+      const body = { x: 0, y: 90, w: vw, h: vh - 180 };
+      for (const [frame, img, name] of [[0, at0, 'frame0'], [48, at48, 'frame48']]) {
+        await scrubTo(page, frame);
+        await waitForFullQuality(page);
+        const again = await screenshot(page, `timeline-4-back-${name}-${backend}`);
+        const off = countChanged(img, again, body);
+        const away = countChanged(img, at24, body);
+        assert.ok(off < 0.02 * away, `back at frame ${frame} the image is as keyed: ${off} px differ (${away} from frame 24)`);
+      }
+
+      // Undo removes the key at 48: the cloud then stays where the one key holds it.
+      await page.keyboard.press('Control+z');
+      s = await until(page, (s) => s.view.timeline.key_count === 4, 'the second key undone');
+      assert.match(s.view.notice.text, /Undid: insert keys/);
+      s = await scrubTo(page, 24);
+      assert.ok(Math.abs(s.scene.ellipsoids[0].center[0] - x0) < 1e-4, 'one key: no motion');
+      await page.keyboard.press('Control+Shift+z');
+      s = await until(page, (s) => s.view.timeline.key_count === 8, 'redone');
+
+      // Drag the diamond at frame 48 to frame 96: frame 48 is then half way.
+      s = await state(page);
+      const diamond = s.view.timeline.keys.find((k) => Math.abs(k.t - 2) < 1e-4);
+      assert.ok(diamond, `a diamond at 2 s: ${JSON.stringify(s.view.timeline.keys)}`);
+      const y = diamond.y;
+      const to = frameX(s, 96);
+      await page.mouse.move(diamond.x, y);
+      await page.mouse.down();
+      for (let i = 1; i <= 12; i++) await page.mouse.move(diamond.x + ((to - diamond.x) * i) / 12, y);
+      await page.mouse.up();
+      s = await until(page, (s) => s.view.timeline.keys.some((k) => Math.abs(k.t - 4) < 1e-4), 'retimed to frame 96');
+      assert.deepEqual(s.view.timeline.keys.map((k) => k.t), [0, 4]);
+      s = await scrubTo(page, 48);
+      assert.ok(Math.abs(s.scene.ellipsoids[0].center[0] - (x0 + x48) / 2) < 1e-3, 'half way at frame 48 after the retime');
+      await page.keyboard.press('Control+z');
+      s = await until(page, (s) => s.view.timeline.keys.some((k) => Math.abs(k.t - 2) < 1e-4), 'the retime undone in one step');
+    });
+  });
+}
