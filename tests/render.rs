@@ -1564,3 +1564,57 @@ fn the_previewed_light_and_the_documents_each_draw_their_own_shadows() {
         "the document's light, drawn again, is as it was"
     );
 }
+
+/// Horizontal centroid of the cloud's pixels.
+fn centroid_x(image: &Image, bg: [u8; 3]) -> f64 {
+    let (mut n, mut sx) = (0.0, 0.0);
+    for y in 0..image.height {
+        for x in 0..image.width {
+            if differs(image.pixel(x, y), bg) {
+                n += 1.0;
+                sx += x as f64;
+            }
+        }
+    }
+    assert!(n > 100.0, "a cloud: {n} px");
+    sx / n
+}
+
+#[test]
+fn a_keyed_ellipsoid_moves_the_rendered_cloud_the_way_its_keys_say() {
+    use cloudsketch::scene::{Animation, Channel, Ease, Ellipsoid, EllipsoidProperty};
+    use glam::Vec3;
+    let mut scene = with(
+        &Scene::preset(Preset::Empty),
+        &["/render/noise_amount=0", "/render/slices=64"],
+    );
+    scene.ellipsoids.push(std::sync::Arc::new(Ellipsoid::new(
+        Vec3::new(-4.0, 3.0, 0.0),
+        Vec3::new(2.0, 1.5, 1.5),
+    )));
+    scene.settle();
+    let center = Channel::Ellipsoid {
+        id: scene.ellipsoids[0].id,
+        property: EllipsoidProperty::Center,
+    };
+    let mut keys = Animation::default();
+    keys.key(center, 0.0, vec![-4.0, 3.0, 0.0]);
+    keys.key(center, 2.0, vec![4.0, 3.0, 0.0]);
+    scene.animation = keys.clone();
+    let bg = background(&scene);
+    let x_at = |s: &Scene, t: f32| centroid_x(&render(&s.posed_at(t)), bg);
+    let (x0, x1, x2) = (x_at(&scene, 0.0), x_at(&scene, 1.0), x_at(&scene, 2.0));
+    assert!(x2 > x0 + 40.0, "the keys move it across the view: {x0} → {x2}");
+    // Linear: half way in time, half way across (the view is nearly affine this far out).
+    let half = (x0 + x2) / 2.0;
+    assert!((x1 - half).abs() < 3.0, "at 1 s: {x1}, half way {half}");
+    // Ease in and out: a quarter of the time in, under a sixth of the way (smoothstep gives
+    // 0.156 where linear gives 0.25).
+    keys.set_ease(&[center], 0.0, Ease::EaseInOut);
+    scene.animation = keys;
+    let eased = x_at(&scene, 0.5);
+    let share = (eased - x0) / (x2 - x0);
+    assert!((0.1..0.21).contains(&share), "eased a quarter in: {share:.3} of the way");
+    // Past the last key the cloud stays where that key holds it.
+    assert_eq!(render(&scene.posed_at(2.0)), render(&scene.posed_at(5.0)));
+}
