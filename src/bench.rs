@@ -440,6 +440,70 @@ fn one_ellipsoid_moved(doc: &mut Document) -> (f64, Derived) {
     (moved, derived)
 }
 
+/// A new time for the viewport (pose, then the density): on the default scene with nothing
+/// keyed (it must derive nothing; the work counted is printed as a check), and with one of
+/// 2,000 ellipsoids keyed (a partial update), each against a full derivation of that scene.
+fn time_moves() -> Vec<BenchResult> {
+    use crate::scene::{Channel, EllipsoidProperty};
+    let mut out = Vec::new();
+    // Nothing keyed.
+    let mut doc = Document::new(Scene::default());
+    let mut derived = Derived::default();
+    derived.density(doc.scene(), doc.revisions());
+    let work = derived.work();
+    let mut t = 0.0;
+    let still = time_median(15, &mut || {
+        t += 0.5;
+        doc.set_time(t);
+        std::hint::black_box(derived.density(doc.scene(), doc.revisions()));
+    });
+    let full = time_median(3, &mut || {
+        std::hint::black_box(Derived::default().density(doc.scene(), doc.revisions()));
+    });
+    if derived.work() != work {
+        eprintln!("warning: a new time derived work on a scene with nothing keyed");
+    }
+    out.push(result(
+        "time_new_t_nothing_keyed",
+        still * 1e3,
+        "ms",
+        "time_full_derive_default_scene",
+        full * 1e3,
+    ));
+    // One of 2,000 keyed.
+    let mut scene = ellipsoid_bank(2_000);
+    scene.settle();
+    let e = scene.ellipsoids[1234].clone();
+    let center = Channel::Ellipsoid {
+        id: e.id,
+        property: EllipsoidProperty::Center,
+    };
+    scene.animation.key(center, 0.0, e.center.to_array().to_vec());
+    scene
+        .animation
+        .key(center, 10.0, (e.center + glam::Vec3::X * 3.0).to_array().to_vec());
+    let mut doc = Document::new(scene);
+    let mut derived = Derived::default();
+    derived.density(doc.scene(), doc.revisions());
+    let mut t = 0.0;
+    let keyed = time_median(15, &mut || {
+        t += 0.37;
+        doc.set_time(t);
+        std::hint::black_box(derived.density(doc.scene(), doc.revisions()));
+    });
+    let full = time_median(3, &mut || {
+        std::hint::black_box(Derived::default().density(doc.scene(), doc.revisions()));
+    });
+    out.push(result(
+        "time_new_t_one_of_2000_keyed",
+        keyed * 1e3,
+        "ms",
+        "time_full_derive_2000_ellipsoids",
+        full * 1e3,
+    ));
+    out
+}
+
 /// The other way to build the field (ARCHITECTURE.md, "The field at scale"): every texel
 /// evaluated on the GPU, one render pass per slice, against the CPU's full bake on the same
 /// grid and the CPU's partial update after one primitive moved (which the app uses).
@@ -733,9 +797,9 @@ fn links() -> Vec<BenchResult> {
 }
 
 /// The groups `--only` may name.
-pub const GROUPS: [&str; 15] = [
-    "sketch", "light", "stroke", "worst", "field", "link", "mesh", "simulate", "ca", "shafts",
-    "render", "march", "quality", "gpu", "all",
+pub const GROUPS: [&str; 16] = [
+    "sketch", "light", "stroke", "worst", "field", "time", "link", "mesh", "simulate", "ca",
+    "shafts", "render", "march", "quality", "gpu", "all",
 ];
 
 /// Runs the suite (or only the groups named in `only`, comma-separated) and prints it. A group
@@ -782,6 +846,9 @@ pub fn run(json: bool, only: Option<&str>) -> Result<(), String> {
     if wanted("field") {
         results.extend(field_at_scale());
         results.extend(field_gpu_baseline(&mut offscreen)?);
+    }
+    if wanted("time") {
+        results.extend(time_moves());
     }
     if wanted("link") {
         results.extend(links());

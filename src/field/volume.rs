@@ -215,6 +215,17 @@ impl Grid {
         })
     }
 
+    /// The grid the renderer bakes `field` on: [`Grid::of`]'s texel rounded up to a step of
+    /// 2^(1/4), so it is a function of the field alone that stays put while the cloud's extent
+    /// changes a little (edits then update the texels they reach and copy the others). About
+    /// 0.84–1 of `resolution` texels along the longest side.
+    fn stepped(field: &Field, resolution: u32) -> Option<Self> {
+        let h = Self::texel_for(field, resolution, MAX_RESOLUTION)?;
+        let stepped = (h.log2() * 4.0).ceil() / 4.0;
+        let h = stepped.exp2().max(h);
+        Self::over(field, h, MAX_RESOLUTION).or_else(|| Self::of(field, resolution))
+    }
+
     /// The grid with `resolution` texels along the longest side of `field`'s box.
     pub fn of(field: &Field, resolution: u32) -> Option<Self> {
         Self::capped(field, resolution, MAX_RESOLUTION)
@@ -801,10 +812,6 @@ fn changed_boxes(old: &Field, new: &Field) -> Option<Vec<(Vec3, Vec3)>> {
 struct LastBake {
     field: Arc<Field>,
     grid: Grid,
-    /// The resolution asked for.
-    resolution: u32,
-    /// The field's longest extent when the texel size was chosen.
-    extent: f32,
     volume: Arc<DensityVolume>,
 }
 
@@ -836,7 +843,19 @@ impl Baker {
     /// Bakes `field` with about `resolution` texels along its longest side, within `budget`
     /// kernel evaluations for a full bake (coarser otherwise).
     pub fn update(&mut self, field: &Arc<Field>, resolution: u32, budget: u64) -> Baked {
-        let Some((lo, hi)) = field.bounds() else {
+        if field.bounds().is_none() {
+            self.last = None;
+            return Baked {
+                volume: Arc::new(DensityVolume::default()),
+                work: 0,
+                texels: 0,
+            };
+        }
+        // The grid is the document's alone (what a fresh bake of this field takes), never
+        // the one baked before: a frame is the same wherever and after whatever it is made.
+        let (res, _) = resolution_within(field, resolution, budget);
+        let Some(grid) = Grid::stepped(field, res) else {
+            // Bounds no grid within the caps can hold (not a validated document).
             self.last = None;
             return Baked {
                 volume: Arc::new(DensityVolume::default()),
@@ -844,41 +863,22 @@ impl Baker {
                 texels: 0,
             };
         };
-        let extent = (hi - lo).max_element().max(1e-3);
-        // On the kept texel size, a partial update when only primitives changed: it copies
-        // what it can and re-evaluates the bricks the changes reach. Its work is checked
-        // against the budget only when those bricks are most of the grid (then it is nearly a
-        // full bake, and primitives reaching everything could make it a long one).
-        let partial = self.last.as_ref().and_then(|last| {
-            let ratio = extent / last.extent;
-            let grid = (last.resolution == resolution && (0.5..=2.0).contains(&ratio))
-                .then(|| Grid::over(field, last.grid.h, MAX_RESOLUTION))??;
-            let mut values = vec![0f32; grid.texels() as usize];
-            let dirty = changed_boxes(&last.field, field)
-                .map(|boxes| copy_unchanged(&grid, last, &boxes, &mut values))
-                .unwrap_or_else(|| Dirty::all(&grid));
-            let most = dirty.bounds.is_some_and(|(a, b)| {
-                2 * (b - a + UVec3::ONE).as_u64vec3().element_product() > grid.texels()
+        // On the same grid, a partial update when only primitives changed: it copies what it
+        // can and re-evaluates the bricks the changes reach. Texels sit on one lattice per
+        // texel size, so a copied texel is the one a full bake computes.
+        let partial = self
+            .last
+            .as_ref()
+            .filter(|last| last.grid.h.to_bits() == grid.h.to_bits())
+            .map(|last| {
+                let mut values = vec![0f32; grid.texels() as usize];
+                let dirty = changed_boxes(&last.field, field)
+                    .map(|boxes| copy_unchanged(&grid, last, &boxes, &mut values))
+                    .unwrap_or_else(|| Dirty::all(&grid));
+                (values, dirty)
             });
-            (!most || work_on(field, &grid) <= budget).then_some((grid, last.extent, values, dirty))
-        });
-        let (grid, chosen_for, mut values, dirty) = match partial {
-            Some(p) => p,
-            None => {
-                let (res, _) = resolution_within(field, resolution, budget);
-                let Some(grid) = Grid::of(field, res) else {
-                    // Bounds no grid within the caps can hold (not a validated document).
-                    self.last = None;
-                    return Baked {
-                        volume: Arc::new(DensityVolume::default()),
-                        work: 0,
-                        texels: 0,
-                    };
-                };
-                let values = vec![0f32; grid.texels() as usize];
-                (grid, extent, values, Dirty::all(&grid))
-            }
-        };
+        let (mut values, dirty) =
+            partial.unwrap_or_else(|| (vec![0f32; grid.texels() as usize], Dirty::all(&grid)));
         let mut texels = 0;
         dirty.each_row(grid.dims, (UVec3::ZERO, grid.dims - 1), |row| {
             texels += row.xs.len() as u64
@@ -888,8 +888,6 @@ impl Baker {
         self.last = Some(LastBake {
             field: field.clone(),
             grid,
-            resolution,
-            extent: chosen_for,
             volume: volume.clone(),
         });
         Baked {
@@ -1181,11 +1179,14 @@ mod tests {
             }
             field.blobs = blobs.clone();
             let arc = Arc::new(field.clone());
+            let h = baker.last.as_ref().unwrap().grid.h;
             let baked = baker.update(&arc, 64, u64::MAX);
             let want = full_on_same_grid(&baker, &field);
             assert_same(&baked.volume, &want, &format!("step {step}"));
+            // A change of the cloud's extent past a texel step bakes it afresh.
+            let same_texel = baker.last.as_ref().unwrap().grid.h == h;
             assert!(
-                baked.texels < want.values.len() as u64 / 2,
+                !same_texel || baked.texels < want.values.len() as u64 / 2,
                 "step {step}: {} of {} texels re-evaluated",
                 baked.texels,
                 want.values.len()
@@ -1223,30 +1224,31 @@ mod tests {
     }
 
     #[test]
-    fn the_texel_size_follows_the_extent_with_hysteresis() {
-        let at = |r: f32| Field::of_blobs(vec![Blob::sphere(Vec3::ZERO, r)]);
-        let mut baker = Baker::default();
+    fn the_texel_size_is_the_fields_alone_in_steps() {
+        let at = |r: f32| Arc::new(Field::of_blobs(vec![Blob::sphere(Vec3::ZERO, r)]));
         let h = |b: &Baker| b.last.as_ref().unwrap().grid.h;
-        baker.update(&Arc::new(at(1.0)), 32, u64::MAX);
-        let h0 = h(&baker);
-        // 1.8× larger, then back to 0.6×: the texel is kept (the grid has more or fewer texels).
-        let grown = baker.update(&Arc::new(at(1.8)), 32, u64::MAX);
-        assert_eq!(h(&baker), h0);
-        assert!(grown.volume.dims.x > 50);
-        baker.update(&Arc::new(at(0.6)), 32, u64::MAX);
-        assert_eq!(h(&baker), h0);
-        // Past 2× of the extent it was chosen for: a texel sized for the new cloud.
-        let small = baker.update(&Arc::new(at(0.4)), 32, u64::MAX);
-        assert!(h(&baker) < h0 * 0.5);
-        assert!(small.volume.dims.x <= 32);
-        // Past the cap per side, even within 2×: coarser at once.
+        let fresh = |r: f32| {
+            let mut b = Baker::default();
+            b.update(&at(r), 32, u64::MAX);
+            h(&b)
+        };
+        // Whatever was baked before, a field gets the texel a fresh bake gives it.
         let mut baker = Baker::default();
-        baker.update(&Arc::new(at(1.0)), 100, u64::MAX);
-        let big = baker.update(&Arc::new(at(1.9)), 100, u64::MAX);
+        for r in [1.0, 1.8, 0.6, 0.4, 1.05, 1.0] {
+            baker.update(&at(r), 32, u64::MAX);
+            assert_eq!(h(&baker), fresh(r), "radius {r}");
+        }
+        // A few per cent of growth keeps the texel (a step is 2^(1/4)), and the grid keeps
+        // near the resolution asked.
+        let mut hs: Vec<f32> = (0..=15).map(|i| fresh(1.0 + i as f32 * 0.01)).collect();
+        hs.dedup();
+        assert!(hs.len() <= 2, "15% of growth crosses at most one step: {hs:?}");
+        assert!(fresh(1.5) > fresh(1.0));
+        let v = baker.update(&at(1.0), 32, u64::MAX).volume;
+        assert!((26..=32).contains(&v.dims.x), "{}", v.dims.x);
+        // Past the cap per side: coarser.
+        let big = baker.update(&at(1.9), 140, u64::MAX);
         assert!(big.volume.dims.max_element() <= MAX_RESOLUTION);
-        // Another resolution asked: fresh texels.
-        let fine = baker.update(&Arc::new(at(1.9)), 120, u64::MAX);
-        assert!(fine.volume.dims.x > 110);
     }
 
     #[test]
