@@ -76,6 +76,9 @@ enum Command {
         /// Render at this frame of the scene's clock (its frames per second).
         #[arg(long)]
         frame: Option<u32>,
+        /// Render through the scene's shot camera (posed at the time) instead of its view.
+        #[arg(long)]
+        shot: bool,
     },
     /// Run a scene's cloud simulation (the `simulated` preset without SCENE) and write the
     /// smoothed density after N steps as a Mitsuba .vol or an OpenVDB .vdb.
@@ -218,8 +221,9 @@ pub fn main() -> ExitCode {
             set,
             time,
             frame,
+            shot,
         }) => Moment::from_args(time, frame)
-            .and_then(|at| render::run(scene.as_deref(), &output, &size, &set, at)),
+            .and_then(|at| render::run(scene.as_deref(), &output, &size, &set, at, shot)),
         Some(Command::Simulate {
             scene,
             steps,

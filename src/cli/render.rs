@@ -21,13 +21,15 @@ pub fn parse_size(text: &str) -> Result<(u32, u32), String> {
     Ok((w, h))
 }
 
-/// `cloudsketch render [SCENE|URL] -o OUT.png --size WxH --set PATH=VALUE… [--time T | --frame N]`.
+/// `cloudsketch render [SCENE|URL] -o OUT.png --size WxH --set PATH=VALUE… [--time T | --frame N]
+/// [--shot]`.
 pub fn run(
     scene: Option<&str>,
     output: &Path,
     size: &str,
     sets: &[String],
     at: Option<crate::scene::Moment>,
+    shot: bool,
 ) -> Result<(), String> {
     let (width, height) = parse_size(size)?;
     super::check_outputs(&scene.into_iter().collect::<Vec<_>>(), &[output])?;
@@ -44,6 +46,11 @@ pub fn run(
     }
     if let Some(at) = at {
         scene = scene.posed_at(at.seconds(&scene.clock)?);
+    }
+    if shot {
+        scene.camera = scene.shot.clone().ok_or(
+            "--shot: the scene has no shot camera (View › Set shot from view makes one)",
+        )?;
     }
     let mut offscreen = Offscreen::new().map_err(|e| e.to_string())?;
     let start = std::time::Instant::now();

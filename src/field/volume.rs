@@ -215,15 +215,17 @@ impl Grid {
         })
     }
 
-    /// The grid the renderer bakes `field` on: [`Grid::of`]'s texel rounded up to a step of
-    /// 2^(1/4), so it is a function of the field alone that stays put while the cloud's extent
-    /// changes a little (edits then update the texels they reach and copy the others). About
-    /// 0.84–1 of `resolution` texels along the longest side.
+    /// The grid the renderer bakes `field` on: [`Grid::of`]'s texel rounded to the nearest
+    /// step of 2^(1/4), so it is a function of the field alone that stays put while the
+    /// cloud's extent changes a little (edits then update the texels they reach and copy the
+    /// others). About 0.92–1.09 of `resolution` texels along the longest side (within the cap:
+    /// past it, the next coarser step).
     fn stepped(field: &Field, resolution: u32) -> Option<Self> {
         let h = Self::texel_for(field, resolution, MAX_RESOLUTION)?;
-        let stepped = (h.log2() * 4.0).ceil() / 4.0;
-        let h = stepped.exp2().max(h);
-        Self::over(field, h, MAX_RESOLUTION).or_else(|| Self::of(field, resolution))
+        let step = (h.log2() * 4.0).round();
+        Self::over(field, (step / 4.0).exp2(), MAX_RESOLUTION)
+            .or_else(|| Self::over(field, ((step + 1.0) / 4.0).exp2(), MAX_RESOLUTION))
+            .or_else(|| Self::of(field, resolution))
     }
 
     /// The grid with `resolution` texels along the longest side of `field`'s box.
@@ -1245,7 +1247,7 @@ mod tests {
         assert!(hs.len() <= 2, "15% of growth crosses at most one step: {hs:?}");
         assert!(fresh(1.5) > fresh(1.0));
         let v = baker.update(&at(1.0), 32, u64::MAX).volume;
-        assert!((26..=32).contains(&v.dims.x), "{}", v.dims.x);
+        assert!((29..=35).contains(&v.dims.x), "{}", v.dims.x);
         // Past the cap per side: coarser.
         let big = baker.update(&at(1.9), 140, u64::MAX);
         assert!(big.volume.dims.max_element() <= MAX_RESOLUTION);

@@ -40,8 +40,9 @@ pub struct Revisions {
     pub camera: u64,
     /// The reference image.
     pub reference: u64,
-    /// The clock's frame rate and range and the key frames (no image depends on them: a
-    /// keyed value's pose changes the part it belongs to).
+    /// The clock's frame rate and range, the key frames and the shot camera (no image depends
+    /// on them: a keyed value's pose changes the part it belongs to, and the view looking
+    /// through the shot moves the camera).
     pub clock: u64,
 }
 
@@ -92,7 +93,7 @@ fn diff(a: &Scene, b: &Scene) -> Changed {
         render: a.render != b.render || a.time != b.time,
         camera: a.camera != b.camera,
         reference: a.reference != b.reference,
-        clock: a.clock != b.clock || a.animation != b.animation,
+        clock: a.clock != b.clock || a.animation != b.animation || a.shot != b.shot,
     }
 }
 
@@ -195,6 +196,7 @@ impl Document {
                 | Edit::SetEllipsoids(_)
                 | Edit::SetPlanes(_)
                 | Edit::SetPlane(..)
+                | Edit::SetShot(_)
         );
         let s = &self.scene;
         let mut changed = Changed::default();
@@ -222,6 +224,7 @@ impl Document {
             Edit::RemovePlane(i) => changed.geometry = *i < s.planes.len(),
             Edit::SetReference(r) => changed.reference = r.as_ref() != s.reference.as_deref(),
             Edit::SetAnimation(a, _) => changed.clock = *a != s.animation,
+            Edit::SetShot(c) => changed.clock = *c != s.shot,
             Edit::Replace(new) => changed = diff(s, new),
         }
         if !changed.any() {
@@ -246,6 +249,7 @@ impl Document {
             }
             Edit::SetReference(r) => s.reference = r.map(Arc::new),
             Edit::SetAnimation(a, _) => s.animation = a,
+            Edit::SetShot(c) => s.shot = c,
             Edit::Replace(new) => *s = *new,
         }
         s.settle();

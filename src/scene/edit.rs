@@ -30,6 +30,8 @@ pub enum Edit {
     SetReference(Option<ReferenceImage>),
     /// Turn the simulation on (with these settings), change it, or turn it off.
     SetSimulation(Option<crate::simulate::Settings>),
+    /// Set, move or remove the shot camera.
+    SetShot(Option<super::OrbitCamera>),
     /// Replace the key frames, said as the label ("insert keys", "retime keys"); the keyed
     /// values are posed again at the document's time.
     SetAnimation(Animation, &'static str),
@@ -51,6 +53,7 @@ impl Edit {
             Edit::RemovePlane(_) => "deleted drawing plane",
             Edit::SetReference(_) => "reference image",
             Edit::SetSimulation(_) => "simulation",
+            Edit::SetShot(_) => "shot camera",
             Edit::SetAnimation(_, label) => label,
             Edit::Replace(_) => "new scene",
         }
@@ -101,7 +104,8 @@ pub fn describe_change(from: &Scene, to: &Scene, label: &str) -> String {
         || from.render != to.render
         || from.reference != to.reference
         || from.simulation != to.simulation
-        || from.clock != to.clock;
+        || from.clock != to.clock
+        || from.shot != to.shot;
     let parts: Vec<String> = ellipsoids.into_iter().chain(planes).collect();
     // A key edit says what it did to the keys (a retime that moves an ellipsoid is no move);
     // an edit that auto-key recorded says it was keyed.

@@ -123,6 +123,31 @@ pub enum MediaProperty {
     Dirtiness,
 }
 
+/// A keyed property of the shot camera (its orbit).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ShotProperty {
+    /// The point it looks at (x, y, z).
+    Target,
+    /// Its turn about the vertical in degrees (keys go the short way round).
+    Yaw,
+    /// Its angle above the horizon in degrees.
+    Pitch,
+    /// Its distance from the target.
+    Distance,
+    /// Its vertical field of view in degrees.
+    Fov,
+}
+
+/// The shot camera's keyable properties.
+pub const SHOT: [ShotProperty; 5] = [
+    ShotProperty::Target,
+    ShotProperty::Yaw,
+    ShotProperty::Pitch,
+    ShotProperty::Distance,
+    ShotProperty::Fov,
+];
+
 /// What a track keys.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(tag = "item", rename_all = "snake_case")]
@@ -150,6 +175,11 @@ pub enum Channel {
     Media {
         /// Which property.
         property: MediaProperty,
+    },
+    /// A property of the shot camera.
+    Shot {
+        /// Which property.
+        property: ShotProperty,
     },
 }
 
@@ -184,6 +214,10 @@ impl Channel {
                 _ => 1,
             },
             Channel::Media { .. } => 1,
+            Channel::Shot { property } => match property {
+                ShotProperty::Target => 3,
+                _ => 1,
+            },
         }
     }
 
@@ -203,6 +237,9 @@ impl Channel {
             } => Kind::Step,
             Channel::Light {
                 property: LightProperty::SunAzimuth,
+            }
+            | Channel::Shot {
+                property: ShotProperty::Yaw,
             } => Kind::Angle,
             _ => Kind::Plain,
         }
@@ -223,6 +260,7 @@ impl Channel {
             Channel::Plane { id, property } => format!("drawing plane {id}'s {property:?}"),
             Channel::Light { property } => format!("the light's {property:?}"),
             Channel::Media { property } => format!("the media's {property:?}"),
+            Channel::Shot { property } => format!("the shot camera's {property:?}"),
         }
         .to_lowercase()
     }
@@ -274,6 +312,16 @@ impl Channel {
                     MediaProperty::Sharpness => r.sharpness,
                     MediaProperty::Dirtiness => r.dirtiness,
                 }]
+            }
+            Channel::Shot { property } => {
+                let c = scene.shot.as_ref()?;
+                match property {
+                    ShotProperty::Target => v3(c.target),
+                    ShotProperty::Yaw => vec![c.yaw_deg],
+                    ShotProperty::Pitch => vec![c.pitch_deg],
+                    ShotProperty::Distance => vec![c.distance],
+                    ShotProperty::Fov => vec![c.fov_y_deg],
+                }
             }
         })
     }
@@ -334,6 +382,18 @@ impl Channel {
                 };
                 *slot = value[0];
             }
+            Channel::Shot { property } => {
+                let Some(c) = scene.shot.as_mut() else {
+                    return false;
+                };
+                match property {
+                    ShotProperty::Target => c.target = v3(),
+                    ShotProperty::Yaw => c.yaw_deg = value[0],
+                    ShotProperty::Pitch => c.pitch_deg = value[0],
+                    ShotProperty::Distance => c.distance = value[0],
+                    ShotProperty::Fov => c.fov_y_deg = value[0],
+                }
+            }
         }
         true
     }
@@ -371,6 +431,29 @@ impl Channel {
                 MediaProperty::Sharpness => param(value[0], limits::SHARPNESS),
                 MediaProperty::Dirtiness => param(value[0], limits::DIRTINESS),
             },
+            Channel::Shot { property } => {
+                // Within what a camera may hold (`OrbitCamera::sanitize`'s ranges).
+                let mut c = super::OrbitCamera::default();
+                match property {
+                    ShotProperty::Target => value.to_vec(),
+                    ShotProperty::Yaw => vec![value[0].rem_euclid(360.0)],
+                    ShotProperty::Pitch => {
+                        c.pitch_deg = value[0];
+                        c.sanitize();
+                        vec![c.pitch_deg]
+                    }
+                    ShotProperty::Distance => {
+                        c.distance = value[0];
+                        c.sanitize();
+                        vec![c.distance]
+                    }
+                    ShotProperty::Fov => {
+                        c.fov_y_deg = value[0];
+                        c.sanitize();
+                        vec![c.fov_y_deg]
+                    }
+                }
+            }
         })
     }
 
@@ -386,10 +469,17 @@ impl Channel {
             [PlaneProperty::Origin, PlaneProperty::Rotation]
                 .map(|property| Channel::Plane { id: p.id, property })
         });
+        let shot = scene
+            .shot
+            .is_some()
+            .then_some(SHOT.map(|property| Channel::Shot { property }))
+            .into_iter()
+            .flatten();
         ellipsoids
             .chain(planes)
             .chain(LIGHT.map(|property| Channel::Light { property }))
             .chain(MEDIA.map(|property| Channel::Media { property }))
+            .chain(shot)
     }
 }
 
@@ -1114,5 +1204,24 @@ mod tests {
         let after = doc.revisions();
         assert_eq!((before.geometry, before.light), (after.geometry, after.light));
         assert_ne!(before.render, after.render);
+    }
+
+    #[test]
+    fn the_shot_cameras_yaw_turns_the_short_way_and_its_keys_go_with_it() {
+        let mut scene = one_ellipsoid();
+        scene.shot = Some(crate::scene::OrbitCamera::default());
+        let yaw = Channel::Shot {
+            property: ShotProperty::Yaw,
+        };
+        scene.animation.key(yaw, 0.0, vec![350.0]);
+        scene.animation.key(yaw, 2.0, vec![10.0]);
+        let at = |t: f32| scene.posed_at(t).shot.unwrap().yaw_deg;
+        assert_eq!(at(0.0), 350.0);
+        assert!(at(1.0).abs() < 1e-3 || (at(1.0) - 360.0).abs() < 1e-3, "{}", at(1.0));
+        assert_eq!(at(2.0), 10.0);
+        // Without a shot its keys have nothing to hold.
+        scene.shot = None;
+        let mut animation = scene.animation.clone();
+        assert_eq!(animation.forget_missing(&scene), 1);
     }
 }

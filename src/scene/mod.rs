@@ -24,7 +24,7 @@ pub use document::{Document, Revisions};
 pub use edit::Edit;
 pub use keys::{
     Animation, Channel, Ease, EllipsoidProperty, Key, LightProperty, MAX_KEYS, MAX_TRACKS,
-    MediaProperty, PlaneProperty, Track,
+    MediaProperty, PlaneProperty, ShotProperty, Track,
 };
 pub use looks::{Look, Looks};
 pub use plane::{
@@ -131,6 +131,11 @@ pub struct Scene {
     /// smoothed cloud at the scene's time, and the ellipsoids are its parcels.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub simulation: Option<Arc<crate::simulate::Settings>>,
+    /// The shot camera: the view a shot is rendered from (`render --shot`), keyable, apart
+    /// from the free view the artist orbits with (`camera`); the view looks through it on
+    /// demand (numpad 0). Left out of a file while there is none.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub shot: Option<OrbitCamera>,
     /// Key frames on the document's values (left out of a file while there are none). Every
     /// keyed value above is its keys' pose at [`Scene::time`].
     #[serde(default, skip_serializing_if = "Animation::is_empty")]
@@ -223,18 +228,18 @@ impl Scene {
         if let (Some(before), Ok(after)) = (before, serde_json::to_value(&*self)) {
             describe_repairs("", &before, &after, &mut repairs);
         }
-        const SHOWN: usize = 12;
-        if repairs.len() > SHOWN {
-            let more = repairs.len() - SHOWN;
-            repairs.truncate(SHOWN);
-            repairs.push(format!("and {more} more values repaired"));
-        }
         // Ids are given, not repaired: a document from before them gets them silently.
         self.settle_ids();
         let mut animation = std::mem::take(&mut self.animation);
         repairs.extend(animation.repair(self));
         self.animation = animation;
         self.pose(self.time);
+        const SHOWN: usize = 12;
+        if repairs.len() > SHOWN {
+            let more = repairs.len() - SHOWN;
+            repairs.truncate(SHOWN);
+            repairs.push(format!("and {more} more values repaired"));
+        }
         Ok(repairs)
     }
 
@@ -338,6 +343,9 @@ impl Scene {
             Arc::make_mut(r).validate().map_err(SceneError::Invalid)?;
         }
         self.camera.sanitize();
+        if let Some(shot) = &mut self.shot {
+            shot.sanitize();
+        }
         self.light.sanitize();
         self.render.sanitize();
         if let Some(sim) = &mut self.simulation {

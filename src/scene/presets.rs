@@ -199,6 +199,7 @@ impl Scene {
             time,
             clock: super::Clock::default(),
             simulation,
+            shot: None,
             animation: Default::default(),
         };
         scene.settle();

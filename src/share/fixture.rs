@@ -204,6 +204,20 @@ pub fn every_part() -> Scene {
     a.key(opacity, 2.0, vec![3.0]);
     a.key(opacity, 12.0, vec![2.0]);
     a.set_ease(&[opacity], 2.0, Ease::Constant);
+    // A shot camera, its yaw keyed across north (the short way).
+    scene.shot = Some(crate::scene::OrbitCamera {
+        target: Vec3::new(0.0, 3.0, 0.0),
+        yaw_deg: 340.0,
+        pitch_deg: 5.0,
+        distance: 30.0,
+        fov_y_deg: 35.0,
+        orthographic: false,
+    });
+    let yaw = Channel::Shot {
+        property: crate::scene::ShotProperty::Yaw,
+    };
+    a.key(yaw, 0.0, vec![340.0]);
+    a.key(yaw, 20.0, vec![20.0]);
     scene.animation = a;
     let t = scene.time;
     scene.pose(t);

@@ -219,6 +219,7 @@ impl CloudApp {
                 self.panels.timeline.playing = !self.panels.timeline.playing
             }
             Shortcut::InsertKey => {
+                self.panels.timeline.shot_view = self.panels.view.through_shot;
                 let said = self.panels.timeline.insert_keys(&mut self.doc, &self.selection);
                 self.notices.note(now, said);
             }
@@ -244,6 +245,10 @@ impl CloudApp {
                 let mut camera = self.doc.scene().camera.clone();
                 camera.set_view(view);
                 self.doc.set_camera(camera);
+            }
+            Shortcut::ShotView => {
+                let said = self.panels.view.toggle_shot(&self.doc);
+                self.notices.note(now, said);
             }
             Shortcut::Orthographic => {
                 let mut camera = self.doc.scene().camera.clone();
@@ -559,6 +564,7 @@ impl CloudApp {
         view["catching_up"] = stats.catching_up.into();
         view["light_preview"] = serde_json::json!(stats.light_preview);
         view["timeline"] = super::panels::timeline_state(&self.panels.timeline, &self.doc);
+        view["through_shot"] = self.panels.view.through_shot.into();
         let state = format!("{{\"scene\":{scene_json},\"view\":{view}}}");
         let status = PageStatus {
             ready: self.viewport.ready,
@@ -628,6 +634,8 @@ impl eframe::App for CloudApp {
         }
         self.arrivals(&ctx);
         self.host_edits(&ctx);
+        self.panels.view.follow_shot(&mut self.doc);
+        self.panels.timeline.shot_view = self.panels.view.through_shot;
         let now = ctx.input(|i| i.time);
         if self.panels.export.step(&mut self.notices, now) {
             ctx.request_repaint();

@@ -49,6 +49,8 @@ pub enum Shortcut {
     View(StandardView),
     /// 5: orthographic on or off.
     Orthographic,
+    /// 0: look through the shot camera, or back to the free view.
+    ShotView,
     /// V, D, C, E, Shift+G, Shift+R, Shift+S: pick a tool.
     Tool(Tool),
     /// G, R, S: a modal grab, rotate or scale of the selection.
@@ -117,6 +119,7 @@ const TABLE: &[(Modifiers, Key, Shortcut)] = {
         (NONE, Key::Num3, S::View(StandardView::Right)),
         (NONE, Key::Num7, S::View(StandardView::Top)),
         (NONE, Key::Num5, S::Orthographic),
+        (NONE, Key::Num0, S::ShotView),
         (NONE, Key::V, S::Tool(Tool::Navigate)),
         (NONE, Key::D, S::Tool(Tool::Sketch)),
         (NONE, Key::C, S::Tool(Tool::Cut)),

@@ -4,7 +4,7 @@
 // Screenshots: test-results/screenshots/timeline-*.png.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { serve, state, screenshot, countChanged, until, withApp, waitForFullQuality } from './harness.mjs';
+import { serve, state, screenshot, countChanged, until, withApp, waitForFullQuality, openGroup, reveal } from './harness.mjs';
 
 let server;
 before(async () => { server = await serve(); });
@@ -138,6 +138,68 @@ for (const backend of ['webgpu', 'webgl2']) {
       assert.ok(Math.abs(s.scene.ellipsoids[0].center[0] - (x0 + x48) / 2) < 1e-3, 'half way at frame 48 after the retime');
       await page.keyboard.press('Control+z');
       s = await until(page, (s) => s.view.timeline.keys.some((k) => Math.abs(k.t - 2) < 1e-4), 'the retime undone in one step');
+    });
+  });
+}
+
+/** Clicks the widget marked `name` in the side panel (scrolled into view first). */
+async function press(page, name) {
+  const r = await reveal(page, name);
+  await page.mouse.click(r[0] + r[2] / 2, r[1] + r[3] / 2);
+}
+
+/** Drags in the view from its middle by (dx, 0): an orbit with the Navigate tool. */
+async function orbit(page, dx) {
+  const [vw, vh] = (await state(page)).view.viewport;
+  await page.mouse.move(vw / 2, vh / 2);
+  await page.mouse.down();
+  for (let i = 1; i <= 10; i++) await page.mouse.move(vw / 2 + (dx * i) / 10, vh / 2);
+  await page.mouse.up();
+}
+
+for (const backend of ['webgpu', 'webgl2']) {
+  test(`a shot camera keyed at two frames: the view looks through it between its keys, orbiting leaves it (${backend})`, { timeout: 300_000 }, async () => {
+    await withApp({ base: server.url, webgpu: backend === 'webgpu', viewport: { width: 1280, height: 800 } }, async (page) => {
+      let s = await state(page);
+      await page.keyboard.press('v'); // Navigate: a drag orbits
+      await openGroup(page, 'View');
+      // Frame 0: the shot takes the view; 0 looks through it; I keys it (nothing selected).
+      await press(page, 'shot:set');
+      s = await until(page, (s) => s.scene.shot != null, 'a shot camera');
+      const yaw0 = s.scene.shot.yaw_deg;
+      const [vw, vh] = s.view.viewport;
+      await page.mouse.move(vw / 2, vh / 2);
+      await page.keyboard.press('0');
+      s = await until(page, (s) => s.view.through_shot, 'looking through the shot');
+      await page.keyboard.press('i');
+      s = await until(page, (s) => s.view.timeline.key_count === 5, 'the shot keyed at frame 0');
+      assert.match(s.view.notice.text, /Keyed the shot camera at frame 0/);
+      // Orbiting leaves the shot; at frame 48 the shot takes the orbited view and is keyed.
+      await orbit(page, 200);
+      s = await until(page, (s) => !s.view.through_shot && Math.abs(s.scene.camera.yaw_deg - yaw0) > 10, 'orbited out of the shot');
+      await scrubTo(page, 48);
+      await press(page, 'shot:set');
+      await page.mouse.move(vw / 2, vh / 2);
+      await page.keyboard.press('0');
+      await page.keyboard.press('i');
+      s = await until(page, (s) => s.view.timeline.key_count === 10 && s.view.through_shot, 'the shot keyed at frame 48');
+      const yaw48 = s.scene.shot.yaw_deg;
+      const d = ((yaw48 - yaw0 + 540) % 360) - 180;
+      assert.ok(Math.abs(d) > 10, `the two keys differ in yaw: ${yaw0} → ${yaw48}`);
+      // Between the keys the view, through the shot, turns half way (the short way).
+      s = await scrubTo(page, 24);
+      const mid = ((yaw0 + d / 2) % 360 + 360) % 360;
+      assert.ok(Math.abs(s.scene.shot.yaw_deg - mid) < 0.01, `shot yaw at frame 24: ${s.scene.shot.yaw_deg}, want ${mid}`);
+      s = await until(page, (s) => Math.abs(s.scene.camera.yaw_deg - mid) < 0.01, 'the view follows the shot');
+      await waitForFullQuality(page);
+      await screenshot(page, `timeline-5-shot-frame24-${backend}`);
+      // 0 leaves the shot: the view stays free when the time moves.
+      await page.mouse.move(vw / 2, vh / 2);
+      await page.keyboard.press('0');
+      s = await until(page, (s) => !s.view.through_shot, 'free view');
+      s = await scrubTo(page, 0);
+      assert.ok(Math.abs(s.scene.camera.yaw_deg - mid) < 0.01, 'the free view stays where it was');
+      assert.ok(Math.abs(s.scene.shot.yaw_deg - yaw0) < 0.01, 'the shot is back at its first key');
     });
   });
 }

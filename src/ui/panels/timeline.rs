@@ -48,6 +48,9 @@ pub struct Timeline {
     pub selected: Vec<f32>,
     /// The pointer is over the strip (Delete there removes keys, not items).
     pub hovered: bool,
+    /// The view looks through the shot camera: with nothing selected, the keys shown and
+    /// made are the shot's.
+    pub shot_view: bool,
     drag: Option<KeyDrag>,
     /// Where the shown keys were drawn this frame (time, x), for the page state.
     pub drawn: Vec<(f32, f32)>,
@@ -64,6 +67,7 @@ impl Default for Timeline {
             speed: 1.0,
             selected: Vec::new(),
             hovered: false,
+            shot_view: false,
             drag: None,
             drawn: Vec::new(),
             keys_y: 0.0,
@@ -72,11 +76,18 @@ impl Default for Timeline {
 }
 
 /// The channels the timeline shows and deletes keys of: every keyable value of the selected
-/// ellipsoids and planes, or the light's and the media's with nothing selected.
-pub fn shown_channels(scene: &Scene, selection: &Selection) -> Vec<Channel> {
+/// ellipsoids and planes; with nothing selected, the shot camera's while the view looks
+/// through it, else the light's and the media's.
+pub fn shown_channels(scene: &Scene, selection: &Selection, shot_view: bool) -> Vec<Channel> {
     if selection.is_empty() {
         return Channel::all(scene)
-            .filter(|c| matches!(c, Channel::Light { .. } | Channel::Media { .. }))
+            .filter(|c| {
+                if shot_view {
+                    matches!(c, Channel::Shot { .. })
+                } else {
+                    matches!(c, Channel::Light { .. } | Channel::Media { .. })
+                }
+            })
             .collect();
     }
     let ids = selected_ids(scene, selection);
@@ -98,14 +109,15 @@ fn selected_ids(scene: &Scene, selection: &Selection) -> Vec<u64> {
 
 /// What I keys: the selected ellipsoids' centre, radii, rotation and strength and the
 /// selected planes' origin and rotation (and any other of their values already keyed); with
-/// nothing selected, the sun's azimuth, elevation and intensity (and any light or media
-/// value already keyed).
-pub fn keyed_by_i(scene: &Scene, selection: &Selection) -> Vec<Channel> {
+/// nothing selected, the shot camera's orbit while the view looks through it, else the sun's
+/// azimuth, elevation and intensity (and any light or media value already keyed).
+pub fn keyed_by_i(scene: &Scene, selection: &Selection, shot_view: bool) -> Vec<Channel> {
     let animation = &scene.animation;
-    shown_channels(scene, selection)
+    shown_channels(scene, selection, shot_view)
         .into_iter()
         .filter(|c| {
             animation.track(*c).is_some()
+                || matches!(c, Channel::Shot { .. })
                 || matches!(
                     c,
                     Channel::Ellipsoid {
@@ -151,12 +163,14 @@ impl Timeline {
     /// to tell the user.
     pub fn insert_keys(&mut self, doc: &mut Document, selection: &Selection) -> String {
         let scene = doc.scene();
-        let channels = keyed_by_i(scene, selection);
+        let channels = keyed_by_i(scene, selection, self.shot_view);
         let mut animation = scene.animation.clone();
         let t = scene.time;
         let n = animation.key_all(scene, channels.iter().copied(), t);
         let frame = scene.clock.frame(t);
-        let what = if selection.is_empty() {
+        let what = if selection.is_empty() && self.shot_view {
+            "the shot camera".to_owned()
+        } else if selection.is_empty() {
             "the sun".to_owned()
         } else {
             match selection.items().len() {
@@ -184,7 +198,7 @@ impl Timeline {
     /// user.
     pub fn delete_keys(&mut self, doc: &mut Document, selection: &Selection) -> String {
         let scene = doc.scene();
-        let channels = shown_channels(scene, selection);
+        let channels = shown_channels(scene, selection, self.shot_view);
         let times = if self.selected.is_empty() {
             vec![scene.time]
         } else {
@@ -205,7 +219,7 @@ impl Timeline {
     /// Up and Down: the time of the next (or previous) key of the shown channels.
     pub fn jump_to_key(&self, doc: &mut Document, selection: &Selection, forward: bool) {
         let scene = doc.scene();
-        let channels = shown_channels(scene, selection);
+        let channels = shown_channels(scene, selection, self.shot_view);
         let times = scene.animation.times(Some(&channels));
         let t = scene.time;
         let next = if forward {
@@ -365,7 +379,7 @@ impl Timeline {
             f += step;
         }
         // The shown channels' keys.
-        let channels = shown_channels(scene, selection);
+        let channels = shown_channels(scene, selection, self.shot_view);
         let times = scene.animation.times(Some(&channels));
         self.selected.retain(|t| times.contains(t));
         self.keys_y = key_y(rect);
@@ -604,7 +618,7 @@ mod tests {
         assert!(said.contains("the sun"), "{said}");
         assert_eq!(doc.scene().animation.key_count(), 7);
         // Retiming the ellipsoid's key by 24 frames moves its four keys, not the sun's.
-        let channels = shown_channels(doc.scene(), &selection);
+        let channels = shown_channels(doc.scene(), &selection, false);
         let (a, times) = retimed(&doc.scene().animation, &[0.0], &channels, &doc.scene().clock, 24);
         assert_eq!(times, vec![doc.scene().clock.seconds(24)]);
         assert_eq!(a.times(Some(&channels)), times);

@@ -4,7 +4,7 @@ use egui::Ui;
 
 use crate::render::progressive::Quality;
 use crate::render::viewport::BackendInfo;
-use crate::scene::{Document, StandardView};
+use crate::scene::{Document, Edit, StandardView};
 
 /// The standard views with their keys (the number row or the numpad; Ctrl: the opposite side).
 const VIEWS: [(StandardView, &str, &str); 6] = [
@@ -60,11 +60,53 @@ pub struct GeometryUpdate {
     pub of: u64,
 }
 
-/// The View group.
+/// The View group, and whether the view looks through the shot camera.
 #[derive(Default)]
-pub struct ViewPanel;
+pub struct ViewPanel {
+    /// The view looks through the document's shot camera (numpad 0), following it as its
+    /// keys move it; orbiting leaves it.
+    pub through_shot: bool,
+    /// The shot as the view last took it (a view that moved since was moved by the user).
+    taken: Option<crate::scene::OrbitCamera>,
+}
 
 impl ViewPanel {
+    /// Numpad 0: look through the shot camera, or back to the free view. Returns what to tell
+    /// the user.
+    pub fn toggle_shot(&mut self, doc: &Document) -> &'static str {
+        if doc.scene().shot.is_none() {
+            self.through_shot = false;
+            return "No shot camera: View › Set shot from view makes one";
+        }
+        self.through_shot = !self.through_shot;
+        if self.through_shot {
+            "Looking through the shot camera (orbit or 0 to leave)"
+        } else {
+            "Free view"
+        }
+    }
+
+    /// Once a frame, before the view: while looking through the shot, the camera is the
+    /// shot's (posed at the document's time); a view the user moved since leaves the shot.
+    pub fn follow_shot(&mut self, doc: &mut Document) {
+        let shot = doc.scene().shot.clone().filter(|_| self.through_shot);
+        let Some(shot) = shot else {
+            self.through_shot = false;
+            self.taken = None;
+            return;
+        };
+        if self
+            .taken
+            .as_ref()
+            .is_some_and(|taken| *taken != doc.scene().camera)
+        {
+            self.through_shot = false;
+            self.taken = None;
+            return;
+        }
+        doc.set_camera(shot.clone());
+        self.taken = Some(shot);
+    }
     /// Draws the group: standard views and the projection, then what the viewport draws.
     pub fn ui(&mut self, ui: &mut Ui, stats: &ViewStats, doc: &mut Document) {
         crate::ui::widgets::group(ui, "View", false, |ui| {
@@ -79,6 +121,35 @@ impl ViewPanel {
             ui.checkbox(&mut camera.orthographic, "orthographic")
                 .on_hover_text("5: parallel projection, as for drawing outlines");
             doc.set_camera(camera);
+            ui.horizontal_wrapped(|ui| {
+                ui.label("shot:");
+                let set = ui.button("Set from view").on_hover_text(
+                    "The shot camera (what `cloudsketch render --shot` renders, keyable with I while looking through it) takes this view",
+                );
+                crate::ui::widgets::mark(ui, "shot:set", set.rect);
+                if set.clicked() {
+                    let view = doc.scene().camera.clone();
+                    doc.apply(Edit::SetShot(Some(view.clone())), None);
+                    if self.through_shot {
+                        self.taken = Some(view);
+                    }
+                }
+                let has = doc.scene().shot.is_some();
+                let look = ui
+                    .add_enabled(has, egui::Button::selectable(self.through_shot, "Look through"))
+                    .on_hover_text("0: look through the shot camera (orbiting leaves it)");
+                crate::ui::widgets::mark(ui, "shot:look", look.rect);
+                if look.clicked() {
+                    self.toggle_shot(doc);
+                }
+                if ui
+                    .add_enabled(has, egui::Button::new("Clear"))
+                    .on_hover_text("Remove the shot camera and its keys")
+                    .clicked()
+                {
+                    doc.apply(Edit::SetShot(None), None);
+                }
+            });
             match &stats.backend {
                 Some(b) => ui.label(format!(
                     "backend: {}\nadapter: {}\nslices: {}",
