@@ -542,32 +542,6 @@ fn field_gpu_baseline(offscreen: &mut Offscreen) -> Result<Vec<BenchResult>, Str
     Ok(out)
 }
 
-/// Documents at the caps built to be slow (every primitive reaches every texel of the grid):
-/// what a crafted file or link could hold.
-pub fn worst_documents() -> Vec<(&'static str, Scene)> {
-    use crate::limits::{MAX_ELLIPSOIDS, MAX_PLANES};
-    use crate::scene::{Ellipsoid, StrokeKind};
-    let mut huge = Scene::preset(Preset::Empty);
-    for i in 0..MAX_ELLIPSOIDS {
-        let a = i as f32 * 0.37;
-        huge.ellipsoids.push(Arc::new(Ellipsoid {
-            center: glam::Vec3::new(a.cos(), a.sin(), (a * 0.3).sin()) * 50.0,
-            radii: glam::Vec3::splat(1_000.0),
-            ..Default::default()
-        }));
-    }
-    let mut cuts = Scene::preset(Preset::Cumulus);
-    for i in 0..MAX_PLANES {
-        let y = -3.0 + i as f32 * 0.001;
-        cuts.planes.push(Arc::new(DrawingPlane {
-            kind: StrokeKind::Cut,
-            closed: false,
-            points: vec![glam::Vec2::new(-400.0, y), glam::Vec2::new(400.0, y)],
-            ..Default::default()
-        }));
-    }
-    vec![("4096_huge_ellipsoids", huge), ("256_cuts", cuts)]
-}
 
 /// Deriving each of [`worst_documents`] from scratch, against deriving a 10-stroke scene.
 fn worst_documents_bench() -> Vec<BenchResult> {
@@ -578,7 +552,7 @@ fn worst_documents_bench() -> Vec<BenchResult> {
         })
     };
     let typical = derive(&sketched_scene(10));
-    worst_documents()
+    crate::share::fixture::worst_documents()
         .into_iter()
         .map(|(name, scene)| {
             result(

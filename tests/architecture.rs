@@ -95,6 +95,42 @@ fn the_pure_core_imports_no_ui_gpu_or_browser_crate() {
 }
 
 #[test]
+fn the_pure_core_names_no_module_above_it() {
+    // By `crate::` paths as well as crates: the core is what the app, the renderer, the CLI
+    // and the bench are built on, never the other way round (its unit tests included).
+    let mut bad = Vec::new();
+    for (path, code) in sources() {
+        if !PURE.iter().any(|p| path.starts_with(p)) {
+            continue;
+        }
+        for module in ["ui", "render", "cli", "bench", "web"] {
+            if code.contains(&format!("crate::{module}::")) || code.contains(&format!("crate::{module};")) {
+                bad.push(format!("{path} names crate::{module}"));
+            }
+        }
+    }
+    assert!(bad.is_empty(), "{bad:#?}");
+}
+
+#[test]
+fn egui_is_used_only_by_the_ui_the_viewports_paint_callbacks_and_the_two_windows() {
+    // The page (`web.rs`) and the desktop window start eframe; the viewport's paint callbacks
+    // are egui_wgpu's; everything else of egui is the UI's.
+    let allowed = |path: &str| {
+        path.starts_with("src/ui/")
+            || path == "src/render/viewport.rs"
+            || path == "src/cli/desktop.rs"
+            || path == "src/web.rs"
+    };
+    let bad: Vec<String> = sources()
+        .into_iter()
+        .filter(|(path, code)| !allowed(path) && (uses(code, "egui") || uses(code, "eframe")))
+        .map(|(path, _)| path)
+        .collect();
+    assert!(bad.is_empty(), "egui used elsewhere: {bad:?}");
+}
+
+#[test]
 fn only_render_uses_wgpu() {
     let bad: Vec<String> = sources()
         .into_iter()

@@ -228,7 +228,7 @@ fn the_ui_learns_which_planes_the_field_cannot_use() {
 #[test]
 fn the_worst_documents_the_caps_allow_stay_within_the_bake_budget() {
     use crate::limits::MAX_BAKE_WORK;
-    for (name, scene) in crate::bench::worst_documents() {
+    for (name, scene) in crate::share::fixture::worst_documents() {
         let at_full = crate::field::bake_work(&field_of(&scene), scene.render.field_resolution);
         let mut loaded = scene.clone();
         let repair = check_cost(&mut loaded).unwrap_or_else(|e| panic!("{name}: {e}"));
@@ -694,7 +694,17 @@ fn an_outline_in_a_simulated_scene_joins_the_simulated_cloud() {
 #[test]
 fn a_keyed_scene_derived_while_scrubbing_equals_a_fresh_derivation_at_each_time() {
     use crate::scene::{Channel, EllipsoidProperty};
-    let mut scene = crate::bench::ellipsoid_bank(120);
+    // 120 seeded ellipsoids over a 24 × 5 × 24 box.
+    let mut rng = crate::seeded::SplitMix::new(120);
+    let mut u = || rng.next_f64() as f32;
+    let mut scene = Scene::preset(Preset::Empty);
+    scene.ellipsoids = (0..120)
+        .map(|_| {
+            let center = Vec3::new(u() * 24.0 - 12.0, u() * 5.0, u() * 24.0 - 12.0);
+            let radii = Vec3::new(0.5 + u(), 0.3 + u() * 0.5, 0.5 + u());
+            Arc::new(crate::scene::Ellipsoid::new(center, radii))
+        })
+        .collect();
     scene.settle();
     for (k, i) in [3usize, 50, 99].into_iter().enumerate() {
         let e = scene.ellipsoids[i].clone();

@@ -223,3 +223,31 @@ pub fn every_part() -> Scene {
     scene.pose(t);
     scene
 }
+
+/// Documents at the caps built to be slow (every primitive reaches every texel of the grid):
+/// what a crafted file or link could hold.
+pub fn worst_documents() -> Vec<(&'static str, Scene)> {
+    use crate::limits::{MAX_ELLIPSOIDS, MAX_PLANES};
+    use crate::scene::{Ellipsoid, StrokeKind};
+    use std::sync::Arc;
+    let mut huge = Scene::preset(Preset::Empty);
+    for i in 0..MAX_ELLIPSOIDS {
+        let a = i as f32 * 0.37;
+        huge.ellipsoids.push(Arc::new(Ellipsoid {
+            center: glam::Vec3::new(a.cos(), a.sin(), (a * 0.3).sin()) * 50.0,
+            radii: glam::Vec3::splat(1_000.0),
+            ..Default::default()
+        }));
+    }
+    let mut cuts = Scene::preset(Preset::Cumulus);
+    for i in 0..MAX_PLANES {
+        let y = -3.0 + i as f32 * 0.001;
+        cuts.planes.push(Arc::new(DrawingPlane {
+            kind: StrokeKind::Cut,
+            closed: false,
+            points: vec![glam::Vec2::new(-400.0, y), glam::Vec2::new(400.0, y)],
+            ..Default::default()
+        }));
+    }
+    vec![("4096_huge_ellipsoids", huge), ("256_cuts", cuts)]
+}

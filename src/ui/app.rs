@@ -377,17 +377,9 @@ impl CloudApp {
             .resizable(false)
             .show(ui, |ui| {
                 ui.add_space(2.0);
-                ui.horizontal(|ui| {
-                    let hide = ui.small_button("hide").on_hover_text("Hide the timeline");
-                    super::widgets::mark(ui, "timeline:toggle", hide.rect);
-                    if hide.clicked() {
-                        self.panels.timeline.open = false;
-                    }
-                    if let Some(said) = self.panels.timeline.ui(ui, &mut self.doc, &self.selection)
-                    {
-                        self.notices.note(now, said);
-                    }
-                });
+                if let Some(said) = self.panels.timeline.ui(ui, &mut self.doc, &self.selection) {
+                    self.notices.note(now, said);
+                }
                 ui.add_space(2.0);
             });
         self.selection.retain_valid(self.doc.scene());

@@ -239,11 +239,19 @@ impl Timeline {
         doc.set_time(clock.seconds(frame.min(u32::MAX as i64) as u32));
     }
 
-    /// Draws the strip on one row.
+    /// Draws the strip: one row, or two where the view is narrow (the range and the rate on
+    /// the second), so nothing runs past the strip into the side panel.
     pub fn ui(&mut self, ui: &mut Ui, doc: &mut Document, selection: &Selection) -> Option<String> {
         let mut said = None;
         self.hovered = ui.rect_contains_pointer(ui.max_rect());
+        // The controls left of the bar take about 380 points, the range and rate 230.
+        let narrow = ui.available_width() < 380.0 + 240.0 + 230.0;
         ui.horizontal(|ui| {
+            let hide = ui.small_button("hide").on_hover_text("Hide the timeline");
+            mark(ui, "timeline:toggle", hide.rect);
+            if hide.clicked() {
+                self.open = false;
+            }
             let play = ui
                 .button(if self.playing { "Pause" } else { "Play" })
                 .on_hover_text("Alt+A: play or pause (the wind and torque of the media move the noise)");
@@ -293,12 +301,17 @@ impl Timeline {
             if auto_r.changed() {
                 doc.set_auto_key(auto);
             }
-            // The range and the rate at the right, the bar between.
-            let right = 230.0;
-            let bar_width = (ui.available_width() - right).max(80.0);
+            // The range and the rate at the right (or under it), the bar between.
+            let right = if narrow { 0.0 } else { 230.0 };
+            let bar_width = (ui.available_width() - right).max(60.0);
             said = self.bar(ui, doc, selection, bar_width).or(said.take());
-            self.range_ui(ui, doc);
+            if !narrow {
+                self.range_ui(ui, doc);
+            }
         });
+        if narrow {
+            ui.horizontal(|ui| self.range_ui(ui, doc));
+        }
         said
     }
 
