@@ -898,3 +898,59 @@ fn time_and_frame_name_the_same_moment_in_every_subcommand() {
     );
     assert!(!temp("far.png").exists());
 }
+
+#[test]
+fn render_poses_the_keys_at_the_frame_and_shot_renders_through_the_shot_camera() {
+    // One ellipsoid keyed from x = −5 at frame 0 to x = 5 at frame 48 (2 s at 24 fps); a shot
+    // camera from behind (yaw 180°: the view's left and right swap).
+    let scene = temp("keyed.json");
+    std::fs::write(
+        &scene,
+        r#"{"version": 4,
+            "render": {"noise_amount": 0, "slices": 32},
+            "ellipsoids": [{"center": [-5, 3, 0], "radii": [2, 1.5, 1.5], "id": 7}],
+            "shot": {"target": [0, 3, 0], "yaw_deg": 180, "pitch_deg": 5, "distance": 30,
+                     "fov_y_deg": 40, "orthographic": false},
+            "animation": [{"channel": {"item": "ellipsoid", "id": 7, "property": "center"},
+                           "keys": [{"t": 0, "v": [-5, 3, 0]}, {"t": 2, "v": [5, 3, 0]}]}]}"#,
+    )
+    .unwrap();
+    let at = |frame: &str, shot: bool| {
+        let png = temp(&format!("keyed-{frame}-{shot}.png"));
+        let mut args = vec![
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            png.to_str().unwrap(),
+            "--size",
+            "96x64",
+            "--frame",
+            frame,
+        ];
+        if shot {
+            args.push("--shot");
+        }
+        let out = cloudsketch(&args);
+        assert!(out.status.success(), "{}", stderr(&out));
+        cloud_centroid(&read_rgb(&png))
+    };
+    let (x0, x24, x48) = (at("0", false), at("24", false), at("48", false));
+    assert!(x0.1 > 30 && x48.1 > 30, "{x0:?} {x48:?}");
+    assert!(x48.0 > x0.0 + 20.0, "the keys move it right: {x0:?} → {x48:?}");
+    assert!(
+        (x24.0 - (x0.0 + x48.0) / 2.0).abs() < 4.0,
+        "half way at frame 24: {x0:?} {x24:?} {x48:?}"
+    );
+    let (s0, s48) = (at("0", true), at("48", true));
+    assert!(
+        s48.0 < s0.0 - 20.0,
+        "through the shot from behind it moves left: {s0:?} → {s48:?}"
+    );
+    // No shot camera: a clear error, no image.
+    let png = temp("no-shot.png");
+    let _ = std::fs::remove_file(&png);
+    let out = cloudsketch(&["render", "-o", png.to_str().unwrap(), "--shot"]);
+    assert!(!out.status.success());
+    assert!(stderr(&out).contains("no shot camera"), "{}", stderr(&out));
+    assert!(!png.exists());
+}
