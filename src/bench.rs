@@ -478,10 +478,14 @@ fn time_moves() -> Vec<BenchResult> {
         id: e.id,
         property: EllipsoidProperty::Center,
     };
-    scene.animation.key(center, 0.0, e.center.to_array().to_vec());
     scene
         .animation
-        .key(center, 10.0, (e.center + glam::Vec3::X * 3.0).to_array().to_vec());
+        .key(center, 0.0, e.center.to_array().to_vec());
+    scene.animation.key(
+        center,
+        10.0,
+        (e.center + glam::Vec3::X * 3.0).to_array().to_vec(),
+    );
     let mut doc = Document::new(scene);
     let mut derived = Derived::default();
     derived.density(doc.scene(), doc.revisions());
@@ -541,7 +545,6 @@ fn field_gpu_baseline(offscreen: &mut Offscreen) -> Result<Vec<BenchResult>, Str
     }
     Ok(out)
 }
-
 
 /// Deriving each of [`worst_documents`] from scratch, against deriving a 10-stroke scene.
 fn worst_documents_bench() -> Vec<BenchResult> {

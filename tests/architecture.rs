@@ -104,7 +104,9 @@ fn the_pure_core_names_no_module_above_it() {
             continue;
         }
         for module in ["ui", "render", "cli", "bench", "web"] {
-            if code.contains(&format!("crate::{module}::")) || code.contains(&format!("crate::{module};")) {
+            if code.contains(&format!("crate::{module}::"))
+                || code.contains(&format!("crate::{module};"))
+            {
                 bad.push(format!("{path} names crate::{module}"));
             }
         }

@@ -936,7 +936,10 @@ fn render_poses_the_keys_at_the_frame_and_shot_renders_through_the_shot_camera()
     };
     let (x0, x24, x48) = (at("0", false), at("24", false), at("48", false));
     assert!(x0.1 > 30 && x48.1 > 30, "{x0:?} {x48:?}");
-    assert!(x48.0 > x0.0 + 20.0, "the keys move it right: {x0:?} → {x48:?}");
+    assert!(
+        x48.0 > x0.0 + 20.0,
+        "the keys move it right: {x0:?} → {x48:?}"
+    );
     assert!(
         (x24.0 - (x0.0 + x48.0) / 2.0).abs() < 4.0,
         "half way at frame 24: {x0:?} {x24:?} {x48:?}"

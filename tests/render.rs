@@ -1604,7 +1604,10 @@ fn a_keyed_ellipsoid_moves_the_rendered_cloud_the_way_its_keys_say() {
     let bg = background(&scene);
     let x_at = |s: &Scene, t: f32| centroid_x(&render(&s.posed_at(t)), bg);
     let (x0, x1, x2) = (x_at(&scene, 0.0), x_at(&scene, 1.0), x_at(&scene, 2.0));
-    assert!(x2 > x0 + 40.0, "the keys move it across the view: {x0} → {x2}");
+    assert!(
+        x2 > x0 + 40.0,
+        "the keys move it across the view: {x0} → {x2}"
+    );
     // Linear: half way in time, half way across (the view is nearly affine this far out).
     let half = (x0 + x2) / 2.0;
     assert!((x1 - half).abs() < 3.0, "at 1 s: {x1}, half way {half}");
@@ -1614,7 +1617,38 @@ fn a_keyed_ellipsoid_moves_the_rendered_cloud_the_way_its_keys_say() {
     scene.animation = keys;
     let eased = x_at(&scene, 0.5);
     let share = (eased - x0) / (x2 - x0);
-    assert!((0.1..0.21).contains(&share), "eased a quarter in: {share:.3} of the way");
+    assert!(
+        (0.1..0.21).contains(&share),
+        "eased a quarter in: {share:.3} of the way"
+    );
     // Past the last key the cloud stays where that key holds it.
     assert_eq!(render(&scene.posed_at(2.0)), render(&scene.posed_at(5.0)));
+}
+
+#[test]
+fn a_keyed_wind_carries_the_noise_by_its_integral_not_its_value_times_the_time() {
+    use cloudsketch::scene::{Channel, MediaProperty};
+    let base = with(
+        &smooth_cumulus(),
+        &["/render/slices=64", "/render/noise_amount=0.6"],
+    );
+    // Wind keyed from calm at 0 s to 2 units/s at 2 s: by 2 s it has carried the noise 2
+    // units, as a steady wind of 1 does; its value times the time would be 4.
+    let mut keyed = base.clone();
+    let wind = Channel::Media {
+        property: MediaProperty::Wind,
+    };
+    keyed.animation.key(wind, 0.0, vec![0.0, 0.0]);
+    keyed.animation.key(wind, 2.0, vec![2.0, 0.0]);
+    let keyed = keyed.posed_at(2.0);
+    assert_eq!(keyed.render.wind, [2.0, 0.0]);
+    let steady = |w: f32| {
+        let mut s = with(&base, &[&format!("/render/wind=[{w},0]")]);
+        s.time = 2.0;
+        render(&s)
+    };
+    let image = render(&keyed);
+    assert_eq!(image, steady(1.0), "the integral: as far as a steady wind of 1");
+    let d = changed(&image, &steady(2.0));
+    assert!(d > 300, "value × time would carry it twice as far: {d} px differ");
 }

@@ -48,9 +48,10 @@ pub fn run(
         scene = scene.posed_at(at.seconds(&scene.clock)?);
     }
     if shot {
-        scene.camera = scene.shot.clone().ok_or(
-            "--shot: the scene has no shot camera (View › Set shot from view makes one)",
-        )?;
+        scene.camera = scene
+            .shot
+            .clone()
+            .ok_or("--shot: the scene has no shot camera (View › Set shot from view makes one)")?;
     }
     let mut offscreen = Offscreen::new().map_err(|e| e.to_string())?;
     let start = std::time::Instant::now();

@@ -717,7 +717,9 @@ fn a_keyed_scene_derived_while_scrubbing_equals_a_fresh_derivation_at_each_time(
             property: EllipsoidProperty::Radii,
         };
         let away = Vec3::new(2.0 + k as f32, 0.5, -1.0);
-        scene.animation.key(center, 0.0, e.center.to_array().to_vec());
+        scene
+            .animation
+            .key(center, 0.0, e.center.to_array().to_vec());
         scene
             .animation
             .key(center, 4.0, (e.center + away).to_array().to_vec());
@@ -744,9 +746,21 @@ fn a_keyed_scene_derived_while_scrubbing_equals_a_fresh_derivation_at_each_time(
         assert!(
             *incremental == *fresh,
             "at {t} s the scrubbed density differs from a fresh one: grids {:?} {:?} {:?} / {:?} {:?} {:?}, worst texel {worst}",
-            incremental.dims, incremental.min, incremental.size, fresh.dims, fresh.min, fresh.size
+            incremental.dims,
+            incremental.min,
+            incremental.size,
+            fresh.dims,
+            fresh.min,
+            fresh.size
         );
-        assert_eq!(*doc.scene(), doc.scene().posed_at(t), "the document is its pose at {t}");
+        assert_eq!(
+            *doc.scene(),
+            doc.scene().posed_at(t),
+            "the document is its pose at {t}"
+        );
     }
-    assert!(derived.work().bakes > bakes, "the keyed ellipsoids moved the density");
+    assert!(
+        derived.work().bakes > bakes,
+        "the keyed ellipsoids moved the density"
+    );
 }

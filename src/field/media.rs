@@ -11,38 +11,76 @@ use super::{ISO, density};
 use crate::limits::{MAX_OCTAVES, MAX_TIERS};
 use crate::scene::{NoiseBasis, NoiseFilter, RenderSettings, Scene};
 
-/// Transform of octave `i` at scene time `time`: world → noise-texture coordinates, scale ×
-/// rotate × translate with frequency `base × lacunarity^i`. Octaves are turned against each
-/// other so their lattices do not line up. The wind carries the noise along (world units per
-/// second) and the torque turns it about the vertical through the origin, each octave
-/// `1 + i/2` times as fast as the first (finer detail moves faster, as turbulence does).
-pub fn octave_transform(render: &RenderSettings, i: usize, time: f32) -> Mat4 {
-    moving_octave(render, render.wind, render.torque, i, time)
+/// How far the base media's wind has carried the noise (world units, x and z) and its torque
+/// turned it (degrees) by a scene time: the wind's and the torque's integrals over time, so
+/// keyed ones speed the noise up and slow it down without a jump.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Drift {
+    /// World units travelled along x and z.
+    pub travelled: [f32; 2],
+    /// Degrees turned about the vertical.
+    pub turned: f32,
 }
 
-/// [`octave_transform`] in atmospheric tier `tier` (1-based; 0 is the base media): its own
-/// wind and torque, except octave 0, which moves with the base everywhere (the paper's Base
-/// tier, which keeps the tiers one cloud).
-pub fn tier_octave_transform(render: &RenderSettings, tier: usize, i: usize, time: f32) -> Mat4 {
-    match render.tiers.get(tier.wrapping_sub(1)) {
-        Some(t) if i > 0 => moving_octave(render, t.wind, t.torque, i, time),
-        _ => octave_transform(render, i, time),
+impl Drift {
+    /// The drift of `scene`'s base media at its own time (its keys on wind and torque
+    /// integrated; without keys, the settings times the time).
+    pub fn of(scene: &Scene) -> Self {
+        let t = scene.time;
+        let r = &scene.render;
+        let keyed = |property| {
+            scene
+                .animation
+                .track(crate::scene::Channel::Media { property })
+                .and_then(|track| track.integral(t))
+        };
+        let travelled = keyed(crate::scene::MediaProperty::Wind)
+            .map_or([r.wind[0] * t, r.wind[1] * t], |v| [v[0], v[1]]);
+        let turned = keyed(crate::scene::MediaProperty::Torque).map_or(r.torque * t, |v| v[0]);
+        Self { travelled, turned }
+    }
+
+    /// A steady `wind` and `torque` for `time` seconds.
+    pub fn steady(wind: [f32; 2], torque: f32, time: f32) -> Self {
+        Self {
+            travelled: [wind[0] * time, wind[1] * time],
+            turned: torque * time,
+        }
     }
 }
 
-fn moving_octave(
+/// Transform of octave `i` with the base media carried by `drift`: world → noise-texture
+/// coordinates, scale × rotate × translate with frequency `base × lacunarity^i`. Octaves are
+/// turned against each other so their lattices do not line up. The wind carries the noise
+/// along and the torque turns it about the vertical through the origin, each octave `1 + i/2`
+/// times as far as the first (finer detail moves faster, as turbulence does).
+pub fn octave_transform(render: &RenderSettings, i: usize, drift: Drift) -> Mat4 {
+    moving_octave(render, drift, i)
+}
+
+/// [`octave_transform`] in atmospheric tier `tier` (1-based; 0 is the base media) at scene
+/// time `time`: its own steady wind and torque, except octave 0, which moves with the base
+/// everywhere (the paper's Base tier, which keeps the tiers one cloud).
+pub fn tier_octave_transform(
     render: &RenderSettings,
-    wind: [f32; 2],
-    torque: f32,
+    tier: usize,
     i: usize,
+    drift: Drift,
     time: f32,
 ) -> Mat4 {
+    match render.tiers.get(tier.wrapping_sub(1)) {
+        Some(t) if i > 0 => moving_octave(render, Drift::steady(t.wind, t.torque, time), i),
+        _ => octave_transform(render, i, drift),
+    }
+}
+
+fn moving_octave(render: &RenderSettings, drift: Drift, i: usize) -> Mat4 {
     let freq = render.detail.powi(i as i32) / render.noise_scale.max(1e-3);
     let turn = Quat::from_axis_angle(Vec3::new(0.3, 1.0, 0.2).normalize(), i as f32 * 0.9);
     let shift = Vec3::new(0.37, 0.11, 0.73) * i as f32;
-    let speed = time * (1.0 + 0.5 * i as f32);
-    let [wx, wz] = wind;
-    let drift = Mat4::from_rotation_y(-(torque * speed).to_radians())
+    let speed = 1.0 + 0.5 * i as f32;
+    let [wx, wz] = drift.travelled;
+    let drift = Mat4::from_rotation_y(-(drift.turned * speed).to_radians())
         * Mat4::from_translation(-Vec3::new(wx, 0.0, wz) * speed);
     Mat4::from_translation(shift)
         * Mat4::from_quat(turn)
@@ -96,13 +134,14 @@ impl Media {
             .map(|&b| b as f32 / 255.0)
             .collect();
         let time = scene.time;
+        let drift = Drift::of(scene);
         let tiers = r
             .tiers
             .iter()
             .take(MAX_TIERS)
             .enumerate()
             .map(|(k, t)| {
-                let m = std::array::from_fn(|i| tier_octave_transform(r, k + 1, i, time));
+                let m = std::array::from_fn(|i| tier_octave_transform(r, k + 1, i, drift, time));
                 (t.floor, t.filter, m)
             })
             .collect();
@@ -114,7 +153,7 @@ impl Media {
             softness: r.softness,
             filter: r.noise_filter,
             tiers,
-            base: std::array::from_fn(|i| octave_transform(r, i, time)),
+            base: std::array::from_fn(|i| octave_transform(r, i, drift)),
             blend: r.tier_blend,
         }
     }

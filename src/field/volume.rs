@@ -1244,7 +1244,10 @@ mod tests {
         // near the resolution asked.
         let mut hs: Vec<f32> = (0..=15).map(|i| fresh(1.0 + i as f32 * 0.01)).collect();
         hs.dedup();
-        assert!(hs.len() <= 2, "15% of growth crosses at most one step: {hs:?}");
+        assert!(
+            hs.len() <= 2,
+            "15% of growth crosses at most one step: {hs:?}"
+        );
         assert!(fresh(1.5) > fresh(1.0));
         let v = baker.update(&at(1.0), 32, u64::MAX).volume;
         assert!((29..=35).contains(&v.dims.x), "{}", v.dims.x);

@@ -7,6 +7,7 @@ use std::mem::offset_of;
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
 
+pub use crate::field::media::Drift;
 use crate::field::media::{octave_transform, tier_octave_transform};
 use crate::field::{DensityVolume, ISO};
 use crate::scene::{Lighting, NoiseBasis, NoiseFilter, OrbitCamera, RenderSettings};
@@ -310,8 +311,11 @@ pub struct View {
     pub light: Lighting,
     /// Media and quality.
     pub render: RenderSettings,
-    /// The scene clock (seconds): how far wind and torque have carried the noise.
+    /// The scene clock (seconds): how far the tiers' wind and torque have carried the noise.
     pub time: f32,
+    /// How far the base media's wind and torque (keyed ones integrated) have carried the
+    /// noise by then ([`Drift::of`]).
+    pub drift: Drift,
     /// Width / height of the whole view.
     pub aspect: f32,
     /// The part of the view this image covers, in normalised device coordinates
@@ -469,12 +473,18 @@ impl VolumeUniforms {
                 if octaves == 0 { 0.0 } else { r.noise_amount },
             ],
             noise: [0.5, octaves as f32, filter, basis],
-            octaves: std::array::from_fn(|i| octave_transform(r, i, view.time).to_cols_array_2d()),
+            octaves: std::array::from_fn(|i| octave_transform(r, i, view.drift).to_cols_array_2d()),
             tiers: [floor(0), floor(1), r.tier_blend, tiers.len() as f32],
             tier_filters: [tier_filter(0), tier_filter(1), 0.0, 0.0],
             tier_octaves: std::array::from_fn(|j| {
-                tier_octave_transform(r, 1 + j / MAX_OCTAVES, j % MAX_OCTAVES, view.time)
-                    .to_cols_array_2d()
+                tier_octave_transform(
+                    r,
+                    1 + j / MAX_OCTAVES,
+                    j % MAX_OCTAVES,
+                    view.drift,
+                    view.time,
+                )
+                .to_cols_array_2d()
             }),
             inv_view_proj: view_proj.inverse().to_cols_array_2d(),
             shells: [
@@ -520,6 +530,7 @@ mod tests {
             light: scene.light.clone(),
             render: scene.render.clone(),
             time: 0.0,
+            drift: Drift::default(),
             aspect: 1.5,
             crop: FULL_VIEW,
         };
@@ -645,9 +656,11 @@ mod tests {
         // After t seconds, the noise seen at p + wind·t·speed is what was at p at time 0.
         for i in [0, 3] {
             let speed = 1.0 + 0.5 * i as f32;
-            let before = octave_transform(&r, i, 0.0).transform_point3(p);
+            let before =
+                octave_transform(&r, i, Drift::steady(r.wind, r.torque, 0.0)).transform_point3(p);
             let moved = p + Vec3::new(2.0, 0.0, 0.0) * 1.5 * speed;
-            let after = octave_transform(&r, i, 1.5).transform_point3(moved);
+            let after = octave_transform(&r, i, Drift::steady(r.wind, r.torque, 1.5))
+                .transform_point3(moved);
             assert!(
                 before.abs_diff_eq(after, 1e-4),
                 "octave {i}: {before} vs {after}"
@@ -656,8 +669,8 @@ mod tests {
         // Without wind or torque, time changes nothing.
         let calm = RenderSettings::default();
         assert_eq!(
-            octave_transform(&calm, 2, 0.0),
-            octave_transform(&calm, 2, 9.0)
+            octave_transform(&calm, 2, Drift::steady(calm.wind, calm.torque, 0.0)),
+            octave_transform(&calm, 2, Drift::steady(calm.wind, calm.torque, 9.0))
         );
     }
 
@@ -666,7 +679,7 @@ mod tests {
         let r = RenderSettings::default();
         let p = Vec3::new(1.0, 0.0, 0.0);
         let len = |i| {
-            let m = octave_transform(&r, i, 0.0);
+            let m = octave_transform(&r, i, Drift::steady(r.wind, r.torque, 0.0));
             (m.transform_point3(p) - m.transform_point3(Vec3::ZERO)).length()
         };
         assert!((len(0) - 1.0 / r.noise_scale).abs() < 1e-5);

@@ -659,6 +659,7 @@ impl Offscreen {
                 light: scene.light.clone(),
                 render: scene.render.clone(),
                 time: scene.time,
+                drift: crate::render::gpu_types::Drift::of(scene),
                 aspect: width as f32 / height as f32,
                 crop: FULL_VIEW,
             },

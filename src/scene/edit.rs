@@ -113,7 +113,14 @@ pub fn describe_change(from: &Scene, to: &Scene, label: &str) -> String {
         if KEY_EDITS.contains(&label) || parts.is_empty() || others {
             return label.to_owned();
         }
-        let what = describe_change(&Scene { animation: to.animation.clone(), ..from.clone() }, to, label);
+        let what = describe_change(
+            &Scene {
+                animation: to.animation.clone(),
+                ..from.clone()
+            },
+            to,
+            label,
+        );
         return format!("{what}, keyed");
     }
     match (parts.as_slice(), others) {
@@ -134,7 +141,12 @@ pub fn describe_change(from: &Scene, to: &Scene, label: &str) -> String {
 }
 
 /// The labels of the timeline's key edits ([`Edit::SetAnimation`]).
-pub const KEY_EDITS: [&str; 4] = ["insert keys", "delete keys", "retime keys", "change the ease of keys"];
+pub const KEY_EDITS: [&str; 4] = [
+    "insert keys",
+    "delete keys",
+    "retime keys",
+    "change the ease of keys",
+];
 
 /// One list's change in words: items added, deleted, or changed (each changed item by the one
 /// kind of change `kinds` finds in it, or "edit" when several).

@@ -121,6 +121,10 @@ pub enum MediaProperty {
     Sharpness,
     /// Shadow magnitude.
     Dirtiness,
+    /// Wind (x, z): what carries the noise is its integral over time.
+    Wind,
+    /// Torque: what turns the noise is its integral over time.
+    Torque,
 }
 
 /// A keyed property of the shot camera (its orbit).
@@ -213,6 +217,9 @@ impl Channel {
                 LightProperty::SunColor => 3,
                 _ => 1,
             },
+            Channel::Media {
+                property: MediaProperty::Wind,
+            } => 2,
             Channel::Media { .. } => 1,
             Channel::Shot { property } => match property {
                 ShotProperty::Target => 3,
@@ -311,6 +318,8 @@ impl Channel {
                     MediaProperty::Detail => r.detail,
                     MediaProperty::Sharpness => r.sharpness,
                     MediaProperty::Dirtiness => r.dirtiness,
+                    MediaProperty::Wind => return Some(r.wind.to_vec()),
+                    MediaProperty::Torque => r.torque,
                 }]
             }
             Channel::Shot { property } => {
@@ -373,12 +382,18 @@ impl Channel {
             }
             Channel::Media { property } => {
                 let r = &mut scene.render;
+                if property == MediaProperty::Wind {
+                    r.wind = [value[0], value[1]];
+                    return true;
+                }
                 let slot = match property {
                     MediaProperty::Opacity => &mut r.opacity,
                     MediaProperty::NoiseAmount => &mut r.noise_amount,
                     MediaProperty::Detail => &mut r.detail,
                     MediaProperty::Sharpness => &mut r.sharpness,
                     MediaProperty::Dirtiness => &mut r.dirtiness,
+                    MediaProperty::Torque => &mut r.torque,
+                    MediaProperty::Wind => return false,
                 };
                 *slot = value[0];
             }
@@ -430,6 +445,8 @@ impl Channel {
                 MediaProperty::Detail => param(value[0], limits::DETAIL),
                 MediaProperty::Sharpness => param(value[0], limits::SHARPNESS),
                 MediaProperty::Dirtiness => param(value[0], limits::DIRTINESS),
+                MediaProperty::Wind => value.iter().map(|w| limits::WIND.fix_f32(*w)).collect(),
+                MediaProperty::Torque => param(value[0], limits::TORQUE),
             },
             Channel::Shot { property } => {
                 // Within what a camera may hold (`OrbitCamera::sanitize`'s ranges).
@@ -493,8 +510,18 @@ struct Index {
 impl Index {
     fn of(scene: &Scene) -> Self {
         Self {
-            ellipsoids: scene.ellipsoids.iter().enumerate().map(|(i, e)| (e.id, i)).collect(),
-            planes: scene.planes.iter().enumerate().map(|(i, p)| (p.id, i)).collect(),
+            ellipsoids: scene
+                .ellipsoids
+                .iter()
+                .enumerate()
+                .map(|(i, e)| (e.id, i))
+                .collect(),
+            planes: scene
+                .planes
+                .iter()
+                .enumerate()
+                .map(|(i, p)| (p.id, i))
+                .collect(),
         }
     }
 
@@ -524,12 +551,14 @@ pub const LIGHT: [LightProperty; 6] = [
 ];
 
 /// The media's keyable properties.
-pub const MEDIA: [MediaProperty; 5] = [
+pub const MEDIA: [MediaProperty; 7] = [
     MediaProperty::Opacity,
     MediaProperty::NoiseAmount,
     MediaProperty::Detail,
     MediaProperty::Sharpness,
     MediaProperty::Dirtiness,
+    MediaProperty::Wind,
+    MediaProperty::Torque,
 ];
 
 /// One key: a value at a time.
@@ -579,6 +608,45 @@ impl Track {
         };
         let u = ease.apply((t - a.t) / (b.t - a.t));
         Some(interpolate(self.channel.kind(), &a.value, &b.value, u))
+    }
+
+    /// The integral of the track's value from time 0 to `t` (per component; the value before
+    /// the first key is the first's, after the last the last's): how far a keyed wind has
+    /// carried the noise by `t`. Exact for every ease. `None` without keys.
+    pub fn integral(&self, t: f32) -> Option<Vec<f32>> {
+        let keys = &self.keys;
+        let first = keys.first()?;
+        let t = t.max(0.0) as f64;
+        let mut sum: Vec<f64> = vec![0.0; first.value.len()];
+        let add = |sum: &mut Vec<f64>, v: &[f32], dt: f64| {
+            for (s, v) in sum.iter_mut().zip(v) {
+                *s += *v as f64 * dt;
+            }
+        };
+        add(&mut sum, &first.value, t.min(first.t as f64));
+        for pair in keys.windows(2) {
+            let (a, b) = (&pair[0], &pair[1]);
+            let (t0, t1) = (a.t as f64, b.t as f64);
+            if t <= t0 {
+                break;
+            }
+            let span = t1 - t0;
+            let u = ((t.min(t1) - t0) / span).clamp(0.0, 1.0);
+            // ∫₀ᵘ ease: the area under the share of the way to the next key.
+            let area = match a.ease {
+                Ease::Linear => u * u / 2.0,
+                Ease::EaseInOut => u * u * u - u * u * u * u / 2.0,
+                Ease::Constant => 0.0,
+            };
+            for ((s, va), vb) in sum.iter_mut().zip(&a.value).zip(&b.value) {
+                *s += *va as f64 * u * span + (*vb as f64 - *va as f64) * area * span;
+            }
+        }
+        let last = keys.last()?;
+        if t > last.t as f64 {
+            add(&mut sum, &last.value, t - last.t as f64);
+        }
+        Some(sum.into_iter().map(|v| v as f32).collect())
     }
 
     /// The key at exactly `t`, if any.
@@ -782,8 +850,7 @@ impl Animation {
     pub fn set_ease(&mut self, channels: &[Channel], t: f32, ease: Ease) -> bool {
         let mut changed = false;
         for track in &mut self.tracks {
-            if channels.contains(&track.channel)
-                && track.key_at(t).is_some_and(|k| k.ease != ease)
+            if channels.contains(&track.channel) && track.key_at(t).is_some_and(|k| k.ease != ease)
             {
                 let track = Arc::make_mut(track);
                 if let Some(k) = track.keys.iter_mut().find(|k| k.t == t) {
@@ -980,7 +1047,10 @@ mod tests {
             (Ease::EaseInOut, 1.3125, 2.0),
             (Ease::Constant, 1.0, 1.0),
         ] {
-            let tr = track(STRENGTH, &[(2.0, &[1.0], ease), (4.0, &[3.0], Ease::Linear)]);
+            let tr = track(
+                STRENGTH,
+                &[(2.0, &[1.0], ease), (4.0, &[3.0], Ease::Linear)],
+            );
             assert_eq!(tr.sample(2.0), Some(vec![1.0]), "{ease:?} at its key");
             assert_eq!(tr.sample(4.0), Some(vec![3.0]), "{ease:?} at the next key");
             assert_eq!(tr.sample(2.5), Some(vec![at_quarter]), "{ease:?} a quarter");
@@ -995,7 +1065,10 @@ mod tests {
     fn keys_at_the_ends_of_time_hold_their_values() {
         let tr = track(
             STRENGTH,
-            &[(0.0, &[2.0], Ease::Linear), (limits::MAX_TIME, &[4.0], Ease::Linear)],
+            &[
+                (0.0, &[2.0], Ease::Linear),
+                (limits::MAX_TIME, &[4.0], Ease::Linear),
+            ],
         );
         assert_eq!(tr.sample(0.0), Some(vec![2.0]));
         assert_eq!(tr.sample(limits::MAX_TIME), Some(vec![4.0]));
@@ -1007,7 +1080,13 @@ mod tests {
         let az = Channel::Light {
             property: LightProperty::SunAzimuth,
         };
-        let tr = track(az, &[(0.0, &[170.0], Ease::Linear), (1.0, &[-170.0], Ease::Linear)]);
+        let tr = track(
+            az,
+            &[
+                (0.0, &[170.0], Ease::Linear),
+                (1.0, &[-170.0], Ease::Linear),
+            ],
+        );
         // 170 → 190 (−170), through 180, not back through 0.
         assert!((tr.sample(0.5).unwrap()[0] - 180.0).abs() < 1e-3);
         let rot = Channel::Ellipsoid {
@@ -1034,7 +1113,10 @@ mod tests {
             id: 1,
             property: EllipsoidProperty::Visible,
         };
-        let tr = track(vis, &[(0.0, &[1.0], Ease::Linear), (1.0, &[0.0], Ease::Linear)]);
+        let tr = track(
+            vis,
+            &[(0.0, &[1.0], Ease::Linear), (1.0, &[0.0], Ease::Linear)],
+        );
         assert_eq!(tr.sample(0.99), Some(vec![1.0]));
         assert_eq!(tr.sample(1.0), Some(vec![0.0]));
     }
@@ -1060,12 +1142,24 @@ mod tests {
         assert!(anim.key(center, 0.0, vec![0.0, 0.0, 0.0]));
         assert!(anim.key(center, 2.0, vec![4.0, 0.0, 0.0]));
         scene.animation = anim.clone();
-        assert_eq!(scene.posed_at(1.0).ellipsoids[0].center, Vec3::new(2.0, 0.0, 0.0));
+        assert_eq!(
+            scene.posed_at(1.0).ellipsoids[0].center,
+            Vec3::new(2.0, 0.0, 0.0)
+        );
         assert!(anim.retime(&[center], 2.0, 4.0));
-        assert_eq!(anim.track(center).unwrap().keys[1].value, vec![4.0, 0.0, 0.0]);
+        assert_eq!(
+            anim.track(center).unwrap().keys[1].value,
+            vec![4.0, 0.0, 0.0]
+        );
         scene.animation = anim;
-        assert_eq!(scene.posed_at(1.0).ellipsoids[0].center, Vec3::new(1.0, 0.0, 0.0));
-        assert_eq!(scene.posed_at(4.0).ellipsoids[0].center, Vec3::new(4.0, 0.0, 0.0));
+        assert_eq!(
+            scene.posed_at(1.0).ellipsoids[0].center,
+            Vec3::new(1.0, 0.0, 0.0)
+        );
+        assert_eq!(
+            scene.posed_at(4.0).ellipsoids[0].center,
+            Vec3::new(4.0, 0.0, 0.0)
+        );
         // A pose leaves unkeyed items shared and changes nothing where the keys already are.
         let at_four = scene.posed_at(4.0);
         let mut again = at_four.clone();
@@ -1109,9 +1203,18 @@ mod tests {
         let mut anim: Animation = serde_json::from_str(&json).unwrap();
         let said = anim.repair(&scene);
         let text = said.join("\n");
-        assert!(text.contains("animation[1]") && text.contains("no such item"), "{text}");
-        assert!(text.contains("animation[0]") && text.contains("time order"), "{text}");
-        assert!(text.contains("1 keys") && text.contains("dropped"), "{text}");
+        assert!(
+            text.contains("animation[1]") && text.contains("no such item"),
+            "{text}"
+        );
+        assert!(
+            text.contains("animation[0]") && text.contains("time order"),
+            "{text}"
+        );
+        assert!(
+            text.contains("1 keys") && text.contains("dropped"),
+            "{text}"
+        );
         assert_eq!(anim.tracks.len(), 2);
         let keys = &anim.tracks[0].keys;
         // −3 → 0, sorted, the later of the two keys at 5 kept.
@@ -1162,17 +1265,29 @@ mod tests {
         assert!(insert(&mut doc));
         doc.set_time(2.0);
         assert!(doc.apply(moved(&doc, Vec3::X * 4.0), None));
-        assert_eq!(doc.scene().ellipsoids[0].center, Vec3::X * 4.0, "the edit shows");
+        assert_eq!(
+            doc.scene().ellipsoids[0].center,
+            Vec3::X * 4.0,
+            "the edit shows"
+        );
         assert!(insert(&mut doc));
         doc.set_time(1.0);
-        assert_eq!(doc.scene().ellipsoids[0].center, Vec3::X * 2.0, "between the keys");
+        assert_eq!(
+            doc.scene().ellipsoids[0].center,
+            Vec3::X * 2.0,
+            "between the keys"
+        );
         // A move not keyed shows, then goes with the time.
         let geometry = doc.revisions().geometry;
         assert!(doc.apply(moved(&doc, Vec3::Y), None));
         assert_eq!(doc.scene().ellipsoids[0].center, Vec3::Y);
         doc.set_time(1.5);
         assert_eq!(doc.scene().ellipsoids[0].center, Vec3::X * 3.0);
-        assert_ne!(doc.revisions().geometry, geometry, "the pose moved the geometry");
+        assert_ne!(
+            doc.revisions().geometry,
+            geometry,
+            "the pose moved the geometry"
+        );
         // Undo of the key at 2 s, made at another time, poses at this one: one key left.
         assert_eq!(doc.undo().as_deref(), Some("move an ellipsoid"));
         assert_eq!(doc.undo().as_deref(), Some("insert keys"));
@@ -1202,7 +1317,10 @@ mod tests {
         let before = doc.revisions();
         doc.set_time(5.0);
         let after = doc.revisions();
-        assert_eq!((before.geometry, before.light), (after.geometry, after.light));
+        assert_eq!(
+            (before.geometry, before.light),
+            (after.geometry, after.light)
+        );
         assert_ne!(before.render, after.render);
     }
 
@@ -1217,11 +1335,46 @@ mod tests {
         scene.animation.key(yaw, 2.0, vec![10.0]);
         let at = |t: f32| scene.posed_at(t).shot.unwrap().yaw_deg;
         assert_eq!(at(0.0), 350.0);
-        assert!(at(1.0).abs() < 1e-3 || (at(1.0) - 360.0).abs() < 1e-3, "{}", at(1.0));
+        assert!(
+            at(1.0).abs() < 1e-3 || (at(1.0) - 360.0).abs() < 1e-3,
+            "{}",
+            at(1.0)
+        );
         assert_eq!(at(2.0), 10.0);
         // Without a shot its keys have nothing to hold.
         scene.shot = None;
         let mut animation = scene.animation.clone();
         assert_eq!(animation.forget_missing(&scene), 1);
+    }
+
+    #[test]
+    fn a_keyed_winds_integral_matches_a_fine_sum_for_each_ease() {
+        let wind = Channel::Media {
+            property: MediaProperty::Wind,
+        };
+        for ease in Ease::ALL {
+            let tr = track(
+                wind,
+                &[(1.0, &[2.0, 0.0], ease), (3.0, &[-1.0, 4.0], Ease::Linear)],
+            );
+            for t in [0.5, 1.0, 1.7, 3.0, 5.0] {
+                // Midpoint sum at a millisecond's step.
+                let n = (t * 10_000.0) as usize;
+                let dt = t / n as f32;
+                let mut want = [0.0f64; 2];
+                for k in 0..n {
+                    let v = tr.sample((k as f32 + 0.5) * dt).unwrap();
+                    want[0] += (v[0] * dt) as f64;
+                    want[1] += (v[1] * dt) as f64;
+                }
+                let got = tr.integral(t).unwrap();
+                for c in 0..2 {
+                    assert!(
+                        (got[c] as f64 - want[c]).abs() < 2e-3,
+                        "{ease:?} at {t}: {got:?} vs {want:?}"
+                    );
+                }
+            }
+        }
     }
 }

@@ -172,7 +172,11 @@ pub fn every_part() -> Scene {
     scene.settle();
     // Keys on each kind of item, with each ease, posed at the scene's time.
     use crate::scene::{Channel, Ease, EllipsoidProperty, LightProperty, MediaProperty};
-    let (e0, e1, p0) = (scene.ellipsoids[0].id, scene.ellipsoids[1].id, scene.planes[0].id);
+    let (e0, e1, p0) = (
+        scene.ellipsoids[0].id,
+        scene.ellipsoids[1].id,
+        scene.planes[0].id,
+    );
     let mut a = crate::scene::Animation::default();
     let center = Channel::Ellipsoid {
         id: e0,
@@ -192,7 +196,11 @@ pub fn every_part() -> Scene {
         property: crate::scene::PlaneProperty::Origin,
     };
     a.key(origin, 5.0, scene.planes[0].origin.to_array().to_vec());
-    a.key(origin, 15.0, (scene.planes[0].origin + Vec3::X).to_array().to_vec());
+    a.key(
+        origin,
+        15.0,
+        (scene.planes[0].origin + Vec3::X).to_array().to_vec(),
+    );
     let azimuth = Channel::Light {
         property: LightProperty::SunAzimuth,
     };

@@ -215,24 +215,31 @@ impl CloudApp {
             Shortcut::Frame => self.viewport.frame_request = true,
             Shortcut::TogglePanel => self.panel_open = !self.panel_open,
             // Alt+A plays and pauses (Blender's shortcut before Space took it over).
-            Shortcut::PlayPause => {
-                self.panels.timeline.playing = !self.panels.timeline.playing
-            }
+            Shortcut::PlayPause => self.panels.timeline.playing = !self.panels.timeline.playing,
             Shortcut::InsertKey => {
                 self.panels.timeline.shot_view = self.panels.view.through_shot;
-                let said = self.panels.timeline.insert_keys(&mut self.doc, &self.selection);
+                let said = self
+                    .panels
+                    .timeline
+                    .insert_keys(&mut self.doc, &self.selection);
                 self.notices.note(now, said);
             }
             Shortcut::DeleteKeys => {
                 self.panels.timeline.selected.clear();
-                let said = self.panels.timeline.delete_keys(&mut self.doc, &self.selection);
+                let said = self
+                    .panels
+                    .timeline
+                    .delete_keys(&mut self.doc, &self.selection);
                 self.notices.note(now, said);
             }
             // Delete over the timeline with keys selected deletes them, not the items.
             Shortcut::Delete
                 if self.panels.timeline.hovered && !self.panels.timeline.selected.is_empty() =>
             {
-                let said = self.panels.timeline.delete_keys(&mut self.doc, &self.selection);
+                let said = self
+                    .panels
+                    .timeline
+                    .delete_keys(&mut self.doc, &self.selection);
                 self.notices.note(now, said);
             }
             Shortcut::StepFrame(by) => self.panels.timeline.step_frame(&mut self.doc, by.into()),

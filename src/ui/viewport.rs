@@ -182,6 +182,7 @@ impl Viewport {
             light: scene.light.clone(),
             render: scene.render.clone(),
             time: scene.time,
+            drift: crate::render::gpu_types::Drift::of(scene),
             aspect: rect.aspect_ratio(),
             crop: crate::render::FULL_VIEW,
         };

@@ -181,8 +181,7 @@ impl Timeline {
         if n == 0 {
             return if channels.is_empty() {
                 "Nothing to key".into()
-            } else if animation.key_count() >= crate::scene::MAX_KEYS * crate::scene::MAX_TRACKS
-            {
+            } else if animation.key_count() >= crate::scene::MAX_KEYS * crate::scene::MAX_TRACKS {
                 "No more keys fit".into()
             } else {
                 format!("{what} already keyed as it is at frame {frame:.0}")
@@ -367,23 +366,28 @@ impl Timeline {
         painter.rect_filled(rect, 3.0, Color32::from_gray(32));
         // Ticks at a step that keeps labels apart.
         let per_px = (end - start) / inner.width().max(1.0);
-        let step = [1u32, 2, 5, 10, 12, 24, 48, 60, 120, 240, 600, 1200, 2400, 6000, 12000]
-            .into_iter()
-            .find(|s| *s as f32 / per_px >= 44.0)
-            .unwrap_or(24_000);
+        let step = [
+            1u32, 2, 5, 10, 12, 24, 48, 60, 120, 240, 600, 1200, 2400, 6000, 12000,
+        ]
+        .into_iter()
+        .find(|s| *s as f32 / per_px >= 44.0)
+        .unwrap_or(24_000);
         let font = egui::FontId::proportional(10.0);
         let mut f = clock.start.div_ceil(step) * step;
         while f as f32 <= end {
             let x = x_of(f as f32);
             painter.line_segment(
-                [Pos2::new(x, rect.bottom() - 6.0), Pos2::new(x, rect.bottom())],
+                [
+                    Pos2::new(x, rect.bottom() - 6.0),
+                    Pos2::new(x, rect.bottom()),
+                ],
                 Stroke::new(1.0, Color32::from_gray(110)),
             );
             // A label that would run past the bar's end is left out.
             if x + 24.0 < rect.right() {
                 painter.text(
                     Pos2::new(x + 2.0, rect.top() + 1.0),
-                egui::Align2::LEFT_TOP,
+                    egui::Align2::LEFT_TOP,
                     f.to_string(),
                     font.clone(),
                     Color32::from_gray(140),
@@ -453,8 +457,12 @@ impl Timeline {
                 let moved = ((p.x - drag.x0) * per_px).round() as i64;
                 if moved != drag.moved {
                     drag.moved = moved;
-                    let (animation, times) = retimed(&drag.from, &drag.times, &channels, &clock, moved);
-                    doc.apply(Edit::SetAnimation(animation, "retime keys"), Some("retime keys"));
+                    let (animation, times) =
+                        retimed(&drag.from, &drag.times, &channels, &clock, moved);
+                    doc.apply(
+                        Edit::SetAnimation(animation, "retime keys"),
+                        Some("retime keys"),
+                    );
                     self.selected = times;
                 }
             }
@@ -594,7 +602,11 @@ mod tests {
         for _ in 0..10 {
             timeline.tick(&mut doc, 0.1);
         }
-        assert!((doc.scene().time - 2.0).abs() < 1e-5, "{}", doc.scene().time);
+        assert!(
+            (doc.scene().time - 2.0).abs() < 1e-5,
+            "{}",
+            doc.scene().time
+        );
         assert_eq!(doc.undo_len(), 0);
         assert!(doc.revisions().render > render, "the image knows to change");
         // A stalled frame does not jump the clock.
@@ -605,7 +617,10 @@ mod tests {
         let end = doc.scene().clock.seconds(doc.scene().clock.end);
         doc.set_time(end - 0.01);
         timeline.tick(&mut doc, 0.1);
-        assert_eq!(doc.scene().time, doc.scene().clock.seconds(doc.scene().clock.start));
+        assert_eq!(
+            doc.scene().time,
+            doc.scene().clock.seconds(doc.scene().clock.start)
+        );
     }
 
     #[test]
@@ -632,7 +647,13 @@ mod tests {
         assert_eq!(doc.scene().animation.key_count(), 7);
         // Retiming the ellipsoid's key by 24 frames moves its four keys, not the sun's.
         let channels = shown_channels(doc.scene(), &selection, false);
-        let (a, times) = retimed(&doc.scene().animation, &[0.0], &channels, &doc.scene().clock, 24);
+        let (a, times) = retimed(
+            &doc.scene().animation,
+            &[0.0],
+            &channels,
+            &doc.scene().clock,
+            24,
+        );
         assert_eq!(times, vec![doc.scene().clock.seconds(24)]);
         assert_eq!(a.times(Some(&channels)), times);
         assert_eq!(a.times(None).len(), 2);
