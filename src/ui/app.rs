@@ -380,8 +380,10 @@ impl CloudApp {
                 });
             return;
         }
+        let height = self.panels.timeline.fit(ui.available_width());
         egui::Panel::bottom("timeline")
             .resizable(false)
+            .exact_size(height)
             .show(ui, |ui| {
                 ui.add_space(2.0);
                 if let Some(said) = self.panels.timeline.ui(ui, &mut self.doc, &self.selection) {

@@ -48,6 +48,8 @@ pub struct Timeline {
     pub selected: Vec<f32>,
     /// The pointer is over the strip (Delete there removes keys, not items).
     pub hovered: bool,
+    /// Two rows: the range and the rate under the bar ([`Timeline::fit`]).
+    narrow: bool,
     /// The view looks through the shot camera: with nothing selected, the keys shown and
     /// made are the shot's.
     pub shot_view: bool,
@@ -67,6 +69,7 @@ impl Default for Timeline {
             speed: 1.0,
             selected: Vec::new(),
             hovered: false,
+            narrow: false,
             shot_view: false,
             drag: None,
             drawn: Vec::new(),
@@ -238,13 +241,21 @@ impl Timeline {
         doc.set_time(clock.seconds(frame.min(u32::MAX as i64) as u32));
     }
 
+    /// Decides the strip's rows for a strip `width` points wide and returns its height, so
+    /// the panel is laid out at its height from the first frame (egui sizes a panel from the
+    /// frame before: the view's first frame was 38 points too tall under two rows).
+    pub fn fit(&mut self, width: f32) -> f32 {
+        // The controls left of the bar take about 380 points, the range and rate 230.
+        self.narrow = width < 380.0 + 240.0 + 230.0;
+        if self.narrow { 63.0 } else { 36.0 }
+    }
+
     /// Draws the strip: one row, or two where the view is narrow (the range and the rate on
     /// the second), so nothing runs past the strip into the side panel.
     pub fn ui(&mut self, ui: &mut Ui, doc: &mut Document, selection: &Selection) -> Option<String> {
         let mut said = None;
         self.hovered = ui.rect_contains_pointer(ui.max_rect());
-        // The controls left of the bar take about 380 points, the range and rate 230.
-        let narrow = ui.available_width() < 380.0 + 240.0 + 230.0;
+        let narrow = self.narrow;
         ui.horizontal(|ui| {
             let hide = ui.small_button("hide").on_hover_text("Hide the timeline");
             mark(ui, "timeline:toggle", hide.rect);
