@@ -1648,7 +1648,14 @@ fn a_keyed_wind_carries_the_noise_by_its_integral_not_its_value_times_the_time()
         render(&s)
     };
     let image = render(&keyed);
-    assert_eq!(image, steady(1.0), "the integral: as far as a steady wind of 1");
+    assert_eq!(
+        image,
+        steady(1.0),
+        "the integral: as far as a steady wind of 1"
+    );
     let d = changed(&image, &steady(2.0));
-    assert!(d > 300, "value × time would carry it twice as far: {d} px differ");
+    assert!(
+        d > 300,
+        "value × time would carry it twice as far: {d} px differ"
+    );
 }

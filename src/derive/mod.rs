@@ -306,7 +306,13 @@ impl Derived {
         {
             return v.clone();
         }
-        let parcels = crate::simulate::parcels(scene);
+        // The run starts from the parcels as they stand at time 0: keys that move them do not
+        // restart it at every frame (the run does not follow keyed parcels yet).
+        let parcels = if scene.animation.is_empty() {
+            crate::simulate::parcels(scene)
+        } else {
+            crate::simulate::parcels(&scene.posed_at(0.0))
+        };
         if self
             .player
             .as_ref()

@@ -856,7 +856,21 @@ impl Baker {
         // The grid is the document's alone (what a fresh bake of this field takes), never
         // the one baked before: a frame is the same wherever and after whatever it is made.
         let (res, _) = resolution_within(field, resolution, budget);
-        let Some(grid) = Grid::stepped(field, res) else {
+        // The step may be a little finer than the resolution the budget allows: then coarser.
+        let grid = Grid::stepped(field, res).map(|g| {
+            let mut g = g;
+            for _ in 0..2 {
+                if work_on(field, &g) <= budget {
+                    break;
+                }
+                match Grid::over(field, g.h * 2f32.powf(0.25), MAX_RESOLUTION) {
+                    Some(coarser) => g = coarser,
+                    None => break,
+                }
+            }
+            g
+        });
+        let Some(grid) = grid else {
             // Bounds no grid within the caps can hold (not a validated document).
             self.last = None;
             return Baked {

@@ -41,8 +41,9 @@ pub struct Revisions {
     /// The reference image.
     pub reference: u64,
     /// The clock's frame rate and range, the key frames and the shot camera (no image depends
-    /// on them: a keyed value's pose changes the part it belongs to, and the view looking
-    /// through the shot moves the camera).
+    /// on them alone: a keyed value's pose changes the part it belongs to, keys on the wind or
+    /// the torque change the render part too, and the view looking through the shot moves the
+    /// camera).
     pub clock: u64,
 }
 
@@ -83,6 +84,20 @@ fn same<T: PartialEq>(a: &[Arc<T>], b: &[Arc<T>]) -> bool {
             .all(|(x, y)| Arc::ptr_eq(x, y) || **x == **y)
 }
 
+/// The keys on the base media's wind and torque (what [`crate::field::media::Drift`]
+/// integrates), by pointer.
+fn drift_keys(scene: &Scene) -> [Option<*const super::Track>; 2] {
+    use super::{Channel, MediaProperty};
+    [MediaProperty::Wind, MediaProperty::Torque].map(|property| {
+        scene
+            .animation
+            .tracks
+            .iter()
+            .find(|t| t.channel == Channel::Media { property })
+            .map(Arc::as_ptr)
+    })
+}
+
 fn diff(a: &Scene, b: &Scene) -> Changed {
     Changed {
         geometry: a.seed != b.seed
@@ -90,10 +105,11 @@ fn diff(a: &Scene, b: &Scene) -> Changed {
             || !same(&a.planes, &b.planes)
             || a.simulation != b.simulation,
         light: a.light != b.light,
-        render: a.render != b.render || a.time != b.time,
+        // A keyed wind or torque moves the noise by its integral: new keys there redraw.
+        render: a.render != b.render || a.time != b.time || drift_keys(a) != drift_keys(b),
         camera: a.camera != b.camera,
         reference: a.reference != b.reference,
-        clock: a.clock != b.clock || a.animation != b.animation || a.shot != b.shot,
+        clock: a.clock != b.clock || !a.animation.same_as(&b.animation) || a.shot != b.shot,
     }
 }
 
@@ -223,7 +239,7 @@ impl Document {
             }
             Edit::RemovePlane(i) => changed.geometry = *i < s.planes.len(),
             Edit::SetReference(r) => changed.reference = r.as_ref() != s.reference.as_deref(),
-            Edit::SetAnimation(a, _) => changed.clock = *a != s.animation,
+            Edit::SetAnimation(a, _) => changed.clock = !a.same_as(&s.animation),
             Edit::SetShot(c) => changed.clock = *c != s.shot,
             Edit::Replace(new) => changed = diff(s, new),
         }
@@ -254,9 +270,11 @@ impl Document {
         }
         s.settle();
         if keys_edit {
-            // Keys moved or removed: the keyed values follow at the document's time.
+            // Keys moved or removed: the values they key follow at the document's time (an
+            // unkeyed edit of another value stays).
             let t = s.time;
-            s.pose(t);
+            let keyed = before.animation.changed_channels(&s.animation);
+            s.pose_channels(t, &keyed);
             changed = diff(&before, s);
         } else if self.auto_key && records {
             let mut animation = s.animation.clone();
@@ -350,10 +368,24 @@ impl Document {
         } else {
             self.redo.pop()
         }?;
-        let label = if back {
-            super::edit::describe_change(&step.scene, &self.scene, step.label)
+        // Said of the step's scene as it stands at this time (its keyed values posed here), so
+        // motion between the two times is not taken for an edit.
+        let then = if step.scene.time == self.scene.time {
+            step.scene.clone()
         } else {
-            super::edit::describe_change(&self.scene, &step.scene, step.label)
+            step.scene.posed_at(self.scene.time)
+        };
+        let say = |then: &Scene| {
+            if back {
+                super::edit::describe_change(then, &self.scene, step.label)
+            } else {
+                super::edit::describe_change(&self.scene, then, step.label)
+            }
+        };
+        // An edit whose change the time has since taken away is said as it was made.
+        let label = match say(&then) {
+            bare if bare == step.label => say(&step.scene),
+            said => said,
         };
         let done = self.restore(step);
         if back {

@@ -109,7 +109,7 @@ pub fn describe_change(from: &Scene, to: &Scene, label: &str) -> String {
     let parts: Vec<String> = ellipsoids.into_iter().chain(planes).collect();
     // A key edit says what it did to the keys (a retime that moves an ellipsoid is no move);
     // an edit that auto-key recorded says it was keyed.
-    if from.animation != to.animation {
+    if !from.animation.same_as(&to.animation) {
         if KEY_EDITS.contains(&label) || parts.is_empty() || others {
             return label.to_owned();
         }
@@ -121,7 +121,14 @@ pub fn describe_change(from: &Scene, to: &Scene, label: &str) -> String {
             to,
             label,
         );
-        return format!("{what}, keyed");
+        // Keys added with the edit: auto-key recorded it (keys gone with deleted items are
+        // no keying).
+        let keyed = to.animation.key_count() > from.animation.key_count();
+        return if keyed {
+            format!("{what}, keyed")
+        } else {
+            what
+        };
     }
     match (parts.as_slice(), others) {
         ([], _) | (_, true) => label.to_owned(),

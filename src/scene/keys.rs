@@ -8,6 +8,7 @@
 //! time moves (Blender's behaviour without auto-key), and [`Animation::key`] records a value as
 //! it stands.
 
+use std::collections::{HashMap, HashSet};
 use std::sync::Arc;
 
 use glam::{Quat, Vec3};
@@ -15,6 +16,10 @@ use serde::{Deserialize, Serialize};
 
 use super::{Scene, capped};
 use crate::limits;
+
+/// Largest magnitude a key's value may have (world units, degrees, weights): far beyond any
+/// cloud, and far enough inside f32's range that interpolating two keys stays finite.
+pub const MAX_MAGNITUDE: f32 = 1e6;
 
 /// Most tracks a document holds.
 pub const MAX_TRACKS: usize = 4096;
@@ -339,7 +344,9 @@ impl Channel {
     /// changes nothing); an item whose value is already `value` is left shared. Returns
     /// whether it changed.
     fn set(self, scene: &mut Scene, index: &Index, value: &[f32]) -> bool {
-        if value.len() != self.width() || self.get_in(scene, Some(index)).as_deref() == Some(value)
+        if value.len() != self.width()
+            || !value.iter().all(|v| v.is_finite())
+            || self.get_in(scene, Some(index)).as_deref() == Some(value)
         {
             return false;
         }
@@ -353,6 +360,10 @@ impl Channel {
                 let e = Arc::make_mut(&mut scene.ellipsoids[i]);
                 match property {
                     EllipsoidProperty::Center => e.center = v3(),
+                    // As `Scene::settle` rounds a billowed one's (a link carries them so).
+                    EllipsoidProperty::Radii if !e.billows.is_off() => {
+                        e.radii = v3().map(super::as_linked)
+                    }
                     EllipsoidProperty::Radii => e.radii = v3(),
                     EllipsoidProperty::Rotation => e.rotation = q(),
                     EllipsoidProperty::Strength => e.strength = value[0],
@@ -416,7 +427,9 @@ impl Channel {
     /// `value` brought within what the channel may hold (the sliders' ranges, radii above 0,
     /// unit rotations), or `None` where it cannot be (not finite, the wrong width).
     fn repaired(self, value: &[f32]) -> Option<Vec<f32>> {
-        if value.len() != self.width() || !value.iter().all(|v| v.is_finite()) {
+        // Finite and within [`MAX_MAGNITUDE`]: keys between which the interpolation stays
+        // finite.
+        if value.len() != self.width() || !value.iter().all(|v| v.abs() <= MAX_MAGNITUDE) {
             return None;
         }
         let param = |v: f32, p: limits::Param| vec![p.fix_f32(v)];
@@ -681,7 +694,11 @@ fn interpolate(kind: Kind, a: &[f32], b: &[f32], u: f32) -> Vec<f32> {
             let d = (b[0] - a[0] + 180.0).rem_euclid(360.0) - 180.0;
             vec![(a[0] + d * u).rem_euclid(360.0)]
         }
-        Kind::Plain => a.iter().zip(b).map(|(a, b)| a + (b - a) * u).collect(),
+        Kind::Plain => a
+            .iter()
+            .zip(b)
+            .map(|(a, b)| (*a as f64 * (1.0 - u as f64) + *b as f64 * u as f64) as f32)
+            .collect(),
     }
 }
 
@@ -718,11 +735,39 @@ impl Animation {
     /// whether a key was added or changed; a track already at [`MAX_KEYS`] takes no new one,
     /// nor a document at [`MAX_TRACKS`] a new track.
     pub fn key(&mut self, channel: Channel, t: f32, value: Vec<f32>) -> bool {
+        let mut index = None;
+        self.key_in(&mut index, channel, t, value)
+    }
+
+    /// [`Animation::key`], finding the track through `index` (built on first use, kept up to
+    /// date): keying thousands of values is not a search of every track for each.
+    fn key_in(
+        &mut self,
+        index: &mut Option<HashMap<Channel, usize>>,
+        channel: Channel,
+        t: f32,
+        value: Vec<f32>,
+    ) -> bool {
         let Some(value) = channel.repaired(&value) else {
             return false;
         };
         let t = clamp_time(t);
-        match self.tracks.iter_mut().find(|tr| tr.channel == channel) {
+        let at = match index {
+            Some(ix) => ix.get(&channel).copied(),
+            None if self.tracks.len() > 16 => {
+                let ix: HashMap<Channel, usize> = self
+                    .tracks
+                    .iter()
+                    .enumerate()
+                    .map(|(i, tr)| (tr.channel, i))
+                    .collect();
+                let at = ix.get(&channel).copied();
+                *index = Some(ix);
+                at
+            }
+            None => self.tracks.iter().position(|tr| tr.channel == channel),
+        };
+        match at.map(|i| &mut self.tracks[i]) {
             Some(track) => {
                 if track.key_at(t).is_some_and(|k| k.value == value) {
                     return false;
@@ -735,6 +780,9 @@ impl Animation {
             None => {
                 if self.tracks.len() >= MAX_TRACKS {
                     return false;
+                }
+                if let Some(ix) = index {
+                    ix.insert(channel, self.tracks.len());
                 }
                 self.tracks.push(Arc::new(Track {
                     channel,
@@ -757,10 +805,12 @@ impl Animation {
         channels: impl IntoIterator<Item = Channel>,
         t: f32,
     ) -> usize {
+        let items = Index::of(scene);
+        let mut index = None;
         channels
             .into_iter()
-            .filter_map(|c| Some((c, c.get(scene)?)))
-            .filter(|(c, v)| self.key(*c, t, v.clone()))
+            .filter_map(|c| Some((c, c.get_in(scene, Some(&items))?)))
+            .filter(|(c, v)| self.key_in(&mut index, *c, t, v.clone()))
             .count()
     }
 
@@ -789,19 +839,21 @@ impl Animation {
                 (old != new).then_some((c, new))
             })
             .collect();
+        let mut index = None;
         changed
             .into_iter()
-            .filter(|(c, v)| self.key(*c, t, v.clone()))
+            .filter(|(c, v)| self.key_in(&mut index, *c, t, v.clone()))
             .count()
     }
 
     /// The times of the keys of `channels` (or of every channel with `None`), ascending and
     /// each once.
     pub fn times(&self, channels: Option<&[Channel]>) -> Vec<f32> {
+        let channels: Option<HashSet<Channel>> = channels.map(|c| c.iter().copied().collect());
         let mut times: Vec<f32> = self
             .tracks
             .iter()
-            .filter(|t| channels.is_none_or(|c| c.contains(&t.channel)))
+            .filter(|t| channels.as_ref().is_none_or(|c| c.contains(&t.channel)))
             .flat_map(|t| t.keys.iter().map(|k| k.t))
             .collect();
         times.sort_by(f32::total_cmp);
@@ -816,6 +868,7 @@ impl Animation {
         if from == to {
             return false;
         }
+        let channels: HashSet<Channel> = channels.iter().copied().collect();
         let mut moved = false;
         for track in &mut self.tracks {
             if !channels.contains(&track.channel) || track.key_at(from).is_none() {
@@ -835,6 +888,7 @@ impl Animation {
     /// Removes the keys of `channels` at time `t` (and tracks left without keys). Returns how
     /// many keys went.
     pub fn remove_at(&mut self, channels: &[Channel], t: f32) -> usize {
+        let channels: HashSet<Channel> = channels.iter().copied().collect();
         let mut removed = 0;
         for track in &mut self.tracks {
             if channels.contains(&track.channel) && track.key_at(t).is_some() {
@@ -848,6 +902,7 @@ impl Animation {
 
     /// Sets the ease of the keys of `channels` at time `t`. Returns whether any changed.
     pub fn set_ease(&mut self, channels: &[Channel], t: f32, ease: Ease) -> bool {
+        let channels: HashSet<Channel> = channels.iter().copied().collect();
         let mut changed = false;
         for track in &mut self.tracks {
             if channels.contains(&track.channel) && track.key_at(t).is_some_and(|k| k.ease != ease)
@@ -860,6 +915,36 @@ impl Animation {
             }
         }
         changed
+    }
+
+    /// The channels whose tracks differ between `self` and `other` (added, removed or with
+    /// other keys; tracks compared by pointer first).
+    pub fn changed_channels(&self, other: &Animation) -> HashSet<Channel> {
+        let mine: HashMap<Channel, &Arc<Track>> =
+            self.tracks.iter().map(|t| (t.channel, t)).collect();
+        let theirs: HashMap<Channel, &Arc<Track>> =
+            other.tracks.iter().map(|t| (t.channel, t)).collect();
+        let mut out = HashSet::new();
+        for (c, a) in &mine {
+            match theirs.get(c) {
+                Some(b) if Arc::ptr_eq(a, b) || a == b => {}
+                _ => {
+                    out.insert(*c);
+                }
+            }
+        }
+        out.extend(theirs.keys().filter(|c| !mine.contains_key(c)));
+        out
+    }
+
+    /// Whether the tracks are the same ones (by pointer first, then by value).
+    pub fn same_as(&self, other: &Animation) -> bool {
+        self.tracks.len() == other.tracks.len()
+            && self
+                .tracks
+                .iter()
+                .zip(&other.tracks)
+                .all(|(a, b)| Arc::ptr_eq(a, b) || a == b)
     }
 
     /// Drops the tracks of ellipsoids and planes `scene` no longer has (deleting an item
@@ -943,8 +1028,8 @@ impl Animation {
             }
             if dropped > 0 {
                 said.push(format!(
-                    "{path}: {dropped} keys on {} dropped (values that are not numbers or not \
-                     {} of them, times that are not finite)",
+                    "{path}: {dropped} keys on {} dropped (values that are not {} numbers within \
+                     ±1e6, or times that are not finite)",
                     channel.describe(),
                     channel.width()
                 ));
@@ -995,6 +1080,28 @@ impl Scene {
         let index = Index::of(self);
         let mut changed = false;
         for track in &animation.tracks {
+            if let Some(value) = track.sample(t) {
+                changed |= track.channel.set(self, &index, &value);
+            }
+        }
+        self.animation = animation;
+        changed
+    }
+
+    /// [`Scene::pose`] of `channels` alone (a key edit poses what it changed and leaves an
+    /// unkeyed edit of another value as it is). Returns whether anything changed.
+    pub fn pose_channels(&mut self, t: f32, channels: &HashSet<Channel>) -> bool {
+        if channels.is_empty() {
+            return false;
+        }
+        let animation = std::mem::take(&mut self.animation);
+        let index = Index::of(self);
+        let mut changed = false;
+        for track in animation
+            .tracks
+            .iter()
+            .filter(|t| channels.contains(&t.channel))
+        {
             if let Some(value) = track.sample(t) {
                 changed |= track.channel.set(self, &index, &value);
             }
@@ -1376,5 +1483,53 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn review_cases_huge_keys_set_values_and_wind_keys_that_redraw() {
+        use crate::scene::{Document, Edit, set_by_pointer};
+        let scene = one_ellipsoid();
+        let id = scene.ellipsoids[0].id;
+        // Keys far out are dropped on reading, so no pose can overflow to NaN.
+        let json = format!(
+            r#"[{{"channel": {{"item": "ellipsoid", "id": {id}, "property": "center"}},
+                 "keys": [{{"t": 0, "v": [-3e38, 0, 0]}}, {{"t": 1, "v": [3e38, 0, 0]}},
+                          {{"t": 2, "v": [1, 2, 3]}}]}}]"#
+        );
+        let mut anim: Animation = serde_json::from_str(&json).unwrap();
+        let said = anim.repair(&scene).join("\n");
+        assert!(said.contains("2 keys"), "{said}");
+        assert_eq!(anim.key_count(), 1);
+        // `--set` of a keyed value sets it; `--set /time` poses.
+        let mut keyed = scene.clone();
+        let center = Channel::Ellipsoid {
+            id,
+            property: EllipsoidProperty::Center,
+        };
+        keyed.animation.key(center, 0.0, vec![0.0, 0.0, 0.0]);
+        keyed.animation.key(center, 2.0, vec![2.0, 0.0, 0.0]);
+        let (set, _) = set_by_pointer(&keyed, "/ellipsoids/0/center=[5,5,5]").unwrap();
+        assert_eq!(set.ellipsoids[0].center, Vec3::splat(5.0));
+        let (later, _) = set_by_pointer(&set, "/time=1").unwrap();
+        assert_eq!(later.ellipsoids[0].center, Vec3::X);
+        // New keys on the wind redraw even where they pose the same wind at this time.
+        let wind = Channel::Media {
+            property: MediaProperty::Wind,
+        };
+        let mut doc = Document::new(scene);
+        doc.set_time(5.0);
+        let mut a = Animation::default();
+        a.key(wind, 0.0, vec![0.0, 0.0]);
+        a.key(wind, 4.0, vec![1.0, 0.0]);
+        doc.apply(Edit::SetAnimation(a.clone(), "insert keys"), None);
+        let render = doc.revisions().render;
+        assert!(a.retime(&[wind], 0.0, 2.0));
+        doc.apply(Edit::SetAnimation(a, "retime keys"), None);
+        assert_eq!(doc.scene().render.wind, [1.0, 0.0], "the same wind at 5 s");
+        assert_ne!(
+            doc.revisions().render,
+            render,
+            "but it carried the noise elsewhere"
+        );
     }
 }

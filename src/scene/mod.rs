@@ -178,11 +178,23 @@ impl Scene {
         let mut scene: Scene = serde_json::from_str(text)?;
         scene.version = SCENE_VERSION;
         let repairs = scene.validate()?;
+        // A document read holds its keyed values posed at its time.
+        scene.pose(scene.time);
         Ok((scene, repairs))
     }
 
     /// Like [`Scene::from_json`] for an already parsed value.
     pub fn from_value(value: serde_json::Value) -> Result<(Self, Vec<String>), SceneError> {
+        let (mut scene, repairs) = Self::from_value_unposed(value)?;
+        scene.pose(scene.time);
+        Ok((scene, repairs))
+    }
+
+    /// [`Scene::from_value`] leaving every value as the JSON holds it, keyed or not (`--set`
+    /// of a keyed value sets it, as an edit in the app does, until the time moves).
+    pub(crate) fn from_value_unposed(
+        value: serde_json::Value,
+    ) -> Result<(Self, Vec<String>), SceneError> {
         if !value.is_object() {
             return Err(SceneError::Invalid(
                 "a scene document is a JSON object".into(),
@@ -233,7 +245,6 @@ impl Scene {
         let mut animation = std::mem::take(&mut self.animation);
         repairs.extend(animation.repair(self));
         self.animation = animation;
-        self.pose(self.time);
         const SHOWN: usize = 12;
         if repairs.len() > SHOWN {
             let more = repairs.len() - SHOWN;

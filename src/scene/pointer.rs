@@ -57,7 +57,7 @@ pub fn set_by_pointer(scene: &Scene, assignment: &str) -> Result<(Scene, Vec<Str
         });
     }
     *slot = new_value;
-    let (mut set, repairs) = Scene::from_value(doc).map_err(|e| SetError::BadValue {
+    let (mut set, repairs) = Scene::from_value_unposed(doc).map_err(|e| SetError::BadValue {
         path: path.to_string(),
         value: raw.to_string(),
         reason: match e {
@@ -67,6 +67,11 @@ pub fn set_by_pointer(scene: &Scene, assignment: &str) -> Result<(Scene, Vec<Str
     })?;
     // A stroke set point by point lands on its grid, as one drawn in the app.
     set.snap_strokes();
+    // A new time or new keys pose the keyed values; any other value set stands as set.
+    if path == "/time" || path.starts_with("/animation") {
+        let t = set.time;
+        set.pose(t);
+    }
     Ok((set, repairs))
 }
 

@@ -210,6 +210,8 @@ pub fn every_part() -> Scene {
         property: MediaProperty::Opacity,
     };
     a.key(opacity, 2.0, vec![3.0]);
+    // A key at a frame whose time has no short decimal (frame 7 at 24 fps).
+    a.key(opacity, scene.clock.seconds(7), vec![2.5]);
     a.key(opacity, 12.0, vec![2.0]);
     a.set_ease(&[opacity], 2.0, Ease::Constant);
     // A shot camera, its yaw keyed across north (the short way).

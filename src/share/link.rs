@@ -36,7 +36,7 @@ use crate::scene::{
 /// the payload's layout is the same. Version 3 is the same again on the base of scene format 2
 /// (billows and stable ids; a primitive's billows and id are written where it has them).
 /// Version 4 moved the light volume's defaults. Version 5 carries key frames (scene format 4's
-/// `animation`, written whole where a scene has keys) on version 4's base: a build that reads
+/// `animation`, written whole and unrounded where a scene has keys) on version 4's base: a build that reads
 /// up to version 4 refuses such a link instead of opening it without its keys.
 pub const LINK_VERSION: u8 = 5;
 
@@ -342,6 +342,13 @@ fn as_object(v: Value) -> Map<String, Value> {
 /// The JSON part of the payload for `scene`.
 fn settings_json(scene: &Scene) -> Value {
     let mut value = as_object(to_rounded_value(scene));
+    // Keys go unrounded: a key's time is a frame's (frame 7 at 24 fps is 0.29166666 s), and
+    // rounded it would fall between frames.
+    if !scene.animation.is_empty()
+        && let Ok(keys) = serde_json::to_value(&scene.animation)
+    {
+        value.insert("animation".into(), keys);
+    }
     let bases = bases(LINK_VERSION);
     let base = as_object(rounded(&bases.scene));
     let mut plane_base = as_object(rounded(&bases.plane));

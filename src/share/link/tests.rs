@@ -425,3 +425,17 @@ fn a_crafted_link_with_the_reference_pictures_bytes_opens_without_them() {
         "the picture's bytes came through the link"
     );
 }
+
+#[test]
+fn keys_travel_unrounded_so_a_key_stays_on_its_frame() {
+    let scene = fixture::every_part();
+    let token = encode_link(&scene).unwrap();
+    let (opened, repairs) = decode_link(&format!("#s={token}")).unwrap();
+    assert!(repairs.is_empty(), "{repairs:?}");
+    assert_eq!(opened.animation, scene.animation);
+    let seventh = scene.clock.seconds(7);
+    assert!(
+        opened.animation.times(None).contains(&seventh),
+        "frame 7's key at {seventh} s"
+    );
+}

@@ -99,7 +99,7 @@ pub fn shown_channels(scene: &Scene, selection: &Selection, shot_view: bool) -> 
         .collect()
 }
 
-fn selected_ids(scene: &Scene, selection: &Selection) -> Vec<u64> {
+fn selected_ids(scene: &Scene, selection: &Selection) -> std::collections::HashSet<u64> {
     selection
         .items()
         .iter()
@@ -184,8 +184,22 @@ impl Timeline {
         if n == 0 {
             return if channels.is_empty() {
                 "Nothing to key".into()
-            } else if animation.key_count() >= crate::scene::MAX_KEYS * crate::scene::MAX_TRACKS {
-                "No more keys fit".into()
+            } else if channels.iter().any(|c| {
+                animation.track(*c).is_some_and(|tr| {
+                    tr.keys.len() >= crate::scene::MAX_KEYS && tr.key_at(t).is_none()
+                })
+            }) {
+                format!(
+                    "No more keys fit: at most {} on one value",
+                    crate::scene::MAX_KEYS
+                )
+            } else if animation.tracks.len() >= crate::scene::MAX_TRACKS
+                && channels.iter().any(|c| animation.track(*c).is_none())
+            {
+                format!(
+                    "No more keys fit: at most {} keyed values",
+                    crate::scene::MAX_TRACKS
+                )
             } else {
                 format!("{what} already keyed as it is at frame {frame:.0}")
             };
@@ -566,6 +580,17 @@ fn retimed(
     frames: i64,
 ) -> (Animation, Vec<f32>) {
     let mut animation = from.clone();
+    // The whole selection moves by one amount, held within the clock's frames, so no key is
+    // pushed onto another at an end.
+    let frames_of: Vec<i64> = times
+        .iter()
+        .map(|t| clock.frame(*t).round() as i64)
+        .collect();
+    let (lo, hi) = (
+        frames_of.iter().copied().min().unwrap_or(0),
+        frames_of.iter().copied().max().unwrap_or(0),
+    );
+    let frames = frames.clamp(-lo, (clock.last_frame() as i64 - hi).max(-lo));
     let mut order: Vec<f32> = times.to_vec();
     order.sort_by(f32::total_cmp);
     if frames > 0 {
@@ -668,6 +693,11 @@ mod tests {
         assert_eq!(times, vec![doc.scene().clock.seconds(24)]);
         assert_eq!(a.times(Some(&channels)), times);
         assert_eq!(a.times(None).len(), 2);
+        // Dragged left past frame 0, the selection stops there together: no key lands on
+        // another.
+        let (a, times) = retimed(&a, &times, &channels, &doc.scene().clock, -100);
+        assert_eq!(times, vec![0.0]);
+        assert_eq!(a.key_count(), 7);
         timeline.selected.clear();
         let said = timeline.delete_keys(&mut doc, &selection);
         assert_eq!(said, "Deleted 4 keys");
