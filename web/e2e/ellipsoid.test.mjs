@@ -9,7 +9,7 @@ import path from 'node:path';
 import { execFileSync } from 'node:child_process';
 import { fileURLToPath } from 'node:url';
 import { PNG } from 'pngjs';
-import { serve, state, screenshot, countChanged, until, withApp, waitForFullQuality, recordTiming, SCREENSHOTS } from './harness.mjs';
+import { serve, state, screenshot, countChanged, until, withApp, waitForFullQuality, recordTiming, SCREENSHOTS, cloudColumns } from './harness.mjs';
 
 let server;
 before(async () => { server = await serve(); });
@@ -32,19 +32,7 @@ async function addEllipsoids(page, at) {
   return s;
 }
 
-/** Horizontal centroid and count of the pixels that differ from the sky (between the notice
- * and hint lines at the top and the status line at the bottom). */
-function cloud(img, [vw, vh], bg) {
-  let n = 0, sx = 0;
-  for (let y = 60; y < vh - 30; y++) {
-    for (let x = 0; x < vw; x++) {
-      const i = 4 * (y * img.width + x);
-      const d = Math.abs(img.data[i] - bg[0]) + Math.abs(img.data[i + 1] - bg[1]) + Math.abs(img.data[i + 2] - bg[2]);
-      if (d > 24) { n++; sx += x; }
-    }
-  }
-  return { n, x: n ? sx / n : NaN };
-}
+const cloud = cloudColumns;
 
 for (const backend of ['webgpu', 'webgl2']) {
   test(`add an ellipsoid with its tool, move it, undo, scale it, delete (${backend})`, { timeout: 240_000 }, async () => {

@@ -284,3 +284,18 @@ export async function withApp({ base, webgpu, query = '', viewport }, body) {
     await close();
   }
 }
+
+/** Horizontal centroid and count of the pixels that differ from the sky `bg` (RGB bytes)
+ * between the notice and hint lines at the top and the status line at the bottom of a view
+ * `vw`×`vh` points. */
+export function cloudColumns(img, [vw, vh], bg) {
+  let n = 0, sx = 0;
+  for (let y = 60; y < vh - 30; y++) {
+    for (let x = 0; x < vw; x++) {
+      const i = 4 * (y * img.width + x);
+      const d = Math.abs(img.data[i] - bg[0]) + Math.abs(img.data[i + 1] - bg[1]) + Math.abs(img.data[i + 2] - bg[2]);
+      if (d > 24) { n++; sx += x; }
+    }
+  }
+  return { n, x: n ? sx / n : NaN };
+}

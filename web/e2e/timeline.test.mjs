@@ -4,7 +4,7 @@
 // Screenshots: test-results/screenshots/timeline-*.png.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { serve, state, screenshot, countChanged, until, withApp, waitForFullQuality, openGroup, reveal } from './harness.mjs';
+import { serve, state, screenshot, countChanged, until, withApp, waitForFullQuality, openGroup, reveal, cloudColumns } from './harness.mjs';
 
 let server;
 before(async () => { server = await serve(); });
@@ -12,19 +12,7 @@ after(async () => { await server?.close(); });
 
 const toBytes = (rgb) => rgb.map((v) => Math.round(v * 255));
 
-/** Horizontal centroid and count of the pixels that differ from the sky (between the notice
- * and hint lines at the top and the status line at the bottom of the view). */
-function cloud(img, [vw, vh], bg) {
-  let n = 0, sx = 0;
-  for (let y = 60; y < vh - 30; y++) {
-    for (let x = 0; x < vw; x++) {
-      const i = 4 * (y * img.width + x);
-      const d = Math.abs(img.data[i] - bg[0]) + Math.abs(img.data[i + 1] - bg[1]) + Math.abs(img.data[i + 2] - bg[2]);
-      if (d > 24) { n++; sx += x; }
-    }
-  }
-  return { n, x: n ? sx / n : NaN };
-}
+const cloud = cloudColumns;
 
 /** The page x of `frame` on the timeline's scrub bar (the bar's ends are 8 points in). */
 function frameX(s, frame) {
