@@ -29,7 +29,9 @@ function parseGlb(bytes) {
  * `reveal` wants 10: the Export group's last row sits at the panel's foot); returns its box.
  */
 async function revealAtFoot(page, name) {
-  const [vw, vh] = (await state(page)).view.viewport;
+  // The side panel runs the window's whole height (the timeline sits under the view only).
+  const [vw] = (await state(page)).view.viewport;
+  const vh = page.viewportSize().height;
   const same = (a, b) => a && b && a.every((v, k) => v === b[k]);
   for (let i = 0; i < 30; i++) {
     const before = await state(page);

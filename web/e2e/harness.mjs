@@ -210,7 +210,9 @@ export function recordTiming(entry) {
  * page state's `view.widgets`) is in view; returns its rectangle [x, y, w, h].
  */
 export async function reveal(page, name) {
-  const [vw, vh] = (await state(page)).view.viewport;
+  // The side panel runs the window's whole height (the timeline sits under the view only).
+  const [vw] = (await state(page)).view.viewport;
+  const vh = page.viewportSize().height;
   let last = null;
   for (let i = 0; i < 60; i++) {
     const r = (await state(page)).view.widgets[name];
