@@ -319,7 +319,14 @@ impl Document {
         } else {
             0.0
         };
-        if time != self.scene.time {
+        if time != self.scene.time && self.scene.animation.is_empty() {
+            // Nothing keyed (every frame while playing): only the noise's motion changes.
+            self.scene.time = time;
+            self.bump(Changed {
+                render: true,
+                ..Default::default()
+            });
+        } else if time != self.scene.time {
             let posed = self.scene.posed_at(time);
             let changed = diff(&self.scene, &posed);
             self.scene = posed;

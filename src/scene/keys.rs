@@ -1073,35 +1073,24 @@ impl Scene {
     /// unkeyed values and every item whose keyed values are already there stay as they are
     /// (shared). Returns whether anything changed.
     pub fn pose(&mut self, t: f32) -> bool {
+        self.pose_where(t, |_| true)
+    }
+
+    /// [`Scene::pose`] of `channels` alone (a key edit poses what it changed and leaves an
+    /// unkeyed edit of another value as it is). Returns whether anything changed.
+    pub fn pose_channels(&mut self, t: f32, channels: &HashSet<Channel>) -> bool {
+        !channels.is_empty() && self.pose_where(t, |c| channels.contains(&c))
+    }
+
+    /// Poses the tracks whose channel `which` takes.
+    fn pose_where(&mut self, t: f32, which: impl Fn(Channel) -> bool) -> bool {
         if self.animation.is_empty() {
             return false;
         }
         let animation = std::mem::take(&mut self.animation);
         let index = Index::of(self);
         let mut changed = false;
-        for track in &animation.tracks {
-            if let Some(value) = track.sample(t) {
-                changed |= track.channel.set(self, &index, &value);
-            }
-        }
-        self.animation = animation;
-        changed
-    }
-
-    /// [`Scene::pose`] of `channels` alone (a key edit poses what it changed and leaves an
-    /// unkeyed edit of another value as it is). Returns whether anything changed.
-    pub fn pose_channels(&mut self, t: f32, channels: &HashSet<Channel>) -> bool {
-        if channels.is_empty() {
-            return false;
-        }
-        let animation = std::mem::take(&mut self.animation);
-        let index = Index::of(self);
-        let mut changed = false;
-        for track in animation
-            .tracks
-            .iter()
-            .filter(|t| channels.contains(&t.channel))
-        {
+        for track in animation.tracks.iter().filter(|tr| which(tr.channel)) {
             if let Some(value) = track.sample(t) {
                 changed |= track.channel.set(self, &index, &value);
             }
