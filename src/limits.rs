@@ -165,6 +165,55 @@ pub const TORQUE: Param = Param::linear(
     90.0,
     0.0,
 );
+/// Particle wind: the velocity, per horizontal axis, of the wind field that carries moving
+/// ellipsoids (Schpok et al. 2003 §5.4).
+pub const PARTICLE_WIND: Param = Param::linear(
+    "carrying wind",
+    "How fast the wind carries the moving ellipsoids (world units per second, at height 0)",
+    -5.0,
+    5.0,
+    0.0,
+);
+/// Particle wind shear: the share of the velocity gained per unit of height.
+pub const PARTICLE_SHEAR: Param = Param::linear(
+    "shear",
+    "How much faster the wind blows per unit of height: tops run ahead of bases",
+    0.0,
+    1.0,
+    0.0,
+);
+/// Particle turbulence: how far each moving ellipsoid wanders from its path.
+pub const PARTICLE_TURBULENCE: Param = Param::linear(
+    "turbulence",
+    "How far each moving ellipsoid wanders off its path (world units)",
+    0.0,
+    2.0,
+    0.0,
+);
+/// Rise: convection speed of a moving ellipsoid.
+pub const RISE: Param = Param::linear(
+    "rise",
+    "How fast the ellipsoid rises (world units per second; below 0 sinks)",
+    -2.0,
+    2.0,
+    0.0,
+);
+/// Growth of a moving ellipsoid's radii per second.
+pub const GROWTH: Param = Param::linear(
+    "growth",
+    "How fast the ellipsoid grows, as a share of its size per second (below 0 shrinks)",
+    -0.5,
+    0.5,
+    0.0,
+);
+/// Spread: growth of a moving ellipsoid's width and depth alone.
+pub const SPREAD: Param = Param::linear(
+    "spread",
+    "How fast the ellipsoid widens and deepens but does not thicken (an anvil), per second",
+    0.0,
+    0.5,
+    0.0,
+);
 /// Texels along the longest side of the light volume (transmittance toward the sun and the
 /// sky's light let through from above), up to the light pass's
 /// 128 slices (`MAX_LIGHT_SLICES` in `render::passes`).

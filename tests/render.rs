@@ -1659,3 +1659,45 @@ fn a_keyed_wind_carries_the_noise_by_its_integral_not_its_value_times_the_time()
         "value × time would carry it twice as far: {d} px differ"
     );
 }
+
+/// The topmost row of cloud pixels and the cloud's width on screen.
+fn top_and_width(image: &Image, bg: [u8; 3]) -> (u32, u32) {
+    let top = (0..image.height)
+        .find(|&y| (0..image.width).any(|x| differs(image.pixel(x, y), bg)))
+        .unwrap_or(image.height);
+    (top, cloud_box(image, bg).0)
+}
+
+#[test]
+fn the_developing_cumulus_rises_and_widens_frame_over_frame_by_its_motion() {
+    // Schpok et al. 2003, Figure 5. Without noise, so only the shape can change the outline.
+    let scene = with(
+        &Scene::preset(Preset::Developing),
+        &["/render/noise_amount=0", "/render/slices=64"],
+    );
+    let bg = background(&scene);
+    // The baseline: the same document with every motion taken off (its keys, the anvil's
+    // fade, stay).
+    let mut still = scene.clone();
+    for e in &mut still.ellipsoids {
+        std::sync::Arc::make_mut(e).motion = None;
+    }
+    let at = |s: &Scene, t: f32| top_and_width(&render(&s.posed_at(t)), bg);
+    let [a, b, c] = [0.0, 10.0, 20.0].map(|t| at(&scene, t));
+    assert!(
+        b.0 + 8 < a.0 && c.0 + 8 < b.0,
+        "the top rises frame over frame (rows from the top): {a:?} {b:?} {c:?}"
+    );
+    assert!(
+        b.1 > a.1 && c.1 > b.1 + 20,
+        "it widens frame over frame, most as the anvil spreads: {a:?} {b:?} {c:?}"
+    );
+    let (s10, s20) = (at(&still, 10.0), at(&still, 20.0));
+    assert!(
+        b.0 + 8 < s10.0 && c.0 + 8 < s20.0 && c.1 > s20.1 + 20,
+        "the motion, not the keys, does it: moving {b:?} {c:?}, still {s10:?} {s20:?}"
+    );
+    // Scrubbing back gives what playing forward gave: the frame is a function of the time.
+    let played = render(&scene.posed_at(10.0).posed_at(20.0).posed_at(10.0));
+    assert_eq!(played, render(&scene.posed_at(10.0)));
+}

@@ -308,7 +308,7 @@ impl Derived {
         }
         // The run starts from the parcels as they stand at time 0: keys that move them do not
         // restart it at every frame (the run does not follow keyed parcels yet).
-        let parcels = if scene.animation.is_empty() {
+        let parcels = if !scene.is_animated() {
             crate::simulate::parcels(scene)
         } else {
             crate::simulate::parcels(&scene.posed_at(0.0))

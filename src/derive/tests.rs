@@ -728,6 +728,23 @@ fn a_keyed_scene_derived_while_scrubbing_equals_a_fresh_derivation_at_each_time(
             .animation
             .key(radii, 3.0, (e.radii * 1.5).to_array().to_vec());
     }
+    // Two more carried by a sheared, turbulent wind, rising, growing and spreading.
+    for i in [10usize, 70] {
+        let e = Arc::make_mut(&mut scene.ellipsoids[i]);
+        e.motion = Some(crate::scene::Motion {
+            carried: true,
+            rise: 0.3,
+            growth: 0.1,
+            spread: 0.05,
+            from: e.center,
+            size: e.radii,
+        });
+    }
+    scene.wind_field = crate::scene::WindField {
+        velocity: [0.5, 0.2],
+        shear: 0.1,
+        turbulence: 0.3,
+    };
     let mut doc = Document::new(scene);
     let mut derived = Derived::default();
     derived.density(doc.scene(), doc.revisions());
@@ -757,6 +774,11 @@ fn a_keyed_scene_derived_while_scrubbing_equals_a_fresh_derivation_at_each_time(
             *doc.scene(),
             doc.scene().posed_at(t),
             "the document is its pose at {t}"
+        );
+        assert_eq!(
+            Scene::from_json(&doc.scene().to_json()).unwrap().0,
+            *doc.scene(),
+            "the document saved at {t} opens as it is"
         );
     }
     assert!(

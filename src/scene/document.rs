@@ -103,7 +103,8 @@ fn diff(a: &Scene, b: &Scene) -> Changed {
         geometry: a.seed != b.seed
             || !same(&a.ellipsoids, &b.ellipsoids)
             || !same(&a.planes, &b.planes)
-            || a.simulation != b.simulation,
+            || a.simulation != b.simulation
+            || a.wind_field != b.wind_field,
         light: a.light != b.light,
         // A keyed wind or torque moves the noise by its integral: new keys there redraw.
         render: a.render != b.render || a.time != b.time || drift_keys(a) != drift_keys(b),
@@ -203,6 +204,7 @@ impl Document {
     pub fn apply(&mut self, edit: Edit, merge_key: Option<&'static str>) -> bool {
         let label = edit.label();
         let keys_edit = matches!(edit, Edit::SetAnimation(..));
+        let moves = matches!(edit, Edit::SetEllipsoids(_) | Edit::SetWindField(_));
         // What auto-key records: the user's edits of values, not whole documents, the clock,
         // the picture or the simulation.
         let records = matches!(
@@ -241,6 +243,11 @@ impl Document {
             Edit::SetReference(r) => changed.reference = r.as_ref() != s.reference.as_deref(),
             Edit::SetAnimation(a, _) => changed.clock = !a.same_as(&s.animation),
             Edit::SetShot(c) => changed.clock = *c != s.shot,
+            Edit::SetWindField(w) => {
+                let mut w = *w;
+                w.sanitize();
+                changed.geometry = w != s.wind_field;
+            }
             Edit::Replace(new) => changed = diff(s, new),
         }
         if !changed.any() {
@@ -266,9 +273,18 @@ impl Document {
             Edit::SetReference(r) => s.reference = r.map(Arc::new),
             Edit::SetAnimation(a, _) => s.animation = a,
             Edit::SetShot(c) => s.shot = c,
+            Edit::SetWindField(mut w) => {
+                w.sanitize();
+                s.wind_field = w;
+            }
             Edit::Replace(new) => *s = *new,
         }
         s.settle();
+        // Moving ellipsoids: an edit of where one stands moves its start; a change of its
+        // motion or of the wind moves it.
+        if moves {
+            s.rebase_motion(&before);
+        }
         if keys_edit {
             // Keys moved or removed: the values they key follow at the document's time (an
             // unkeyed edit of another value stays).
@@ -319,8 +335,9 @@ impl Document {
         } else {
             0.0
         };
-        if time != self.scene.time && self.scene.animation.is_empty() {
-            // Nothing keyed (every frame while playing): only the noise's motion changes.
+        if time != self.scene.time && !self.scene.is_animated() {
+            // Nothing keyed or moving (every frame while playing): only the noise's motion
+            // changes.
             self.scene.time = time;
             self.bump(Changed {
                 render: true,

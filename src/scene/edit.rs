@@ -32,6 +32,8 @@ pub enum Edit {
     SetSimulation(Option<crate::simulate::Settings>),
     /// Set, move or remove the shot camera.
     SetShot(Option<super::OrbitCamera>),
+    /// Replace the wind field that carries the moving ellipsoids (they move with it).
+    SetWindField(super::WindField),
     /// Replace the key frames, said as the label ("insert keys", "retime keys"); the keyed
     /// values are posed again at the document's time.
     SetAnimation(Animation, &'static str),
@@ -54,6 +56,7 @@ impl Edit {
             Edit::SetReference(_) => "reference image",
             Edit::SetSimulation(_) => "simulation",
             Edit::SetShot(_) => "shot camera",
+            Edit::SetWindField(_) => "wind field",
             Edit::SetAnimation(_, label) => label,
             Edit::Replace(_) => "new scene",
         }
@@ -69,12 +72,16 @@ pub fn describe_change(from: &Scene, to: &Scene, label: &str) -> String {
         &to.ellipsoids,
         ("an ellipsoid", "ellipsoids"),
         |a, b| {
+            // Where a moving one starts follows a move (no change of its motion); where it
+            // stands follows a change of its motion (no move).
+            let motion = a.motion.map(|m| m.with_start_of(b)) != b.motion;
             [
-                ("move", a.center != b.center),
+                ("move", a.center != b.center && !motion),
                 ("rotate", a.rotation != b.rotation),
-                ("scale", a.radii != b.radii),
+                ("scale", a.radii != b.radii && !motion),
                 ("change the strength of", a.strength != b.strength),
                 ("change the billows of", a.billows != b.billows),
+                ("change the motion of", motion),
                 (if b.hidden { "hide" } else { "show" }, a.hidden != b.hidden),
             ]
         },
@@ -105,7 +112,8 @@ pub fn describe_change(from: &Scene, to: &Scene, label: &str) -> String {
         || from.reference != to.reference
         || from.simulation != to.simulation
         || from.clock != to.clock
-        || from.shot != to.shot;
+        || from.shot != to.shot
+        || from.wind_field != to.wind_field;
     let parts: Vec<String> = ellipsoids.into_iter().chain(planes).collect();
     // A key edit says what it did to the keys (a retime that moves an ellipsoid is no move);
     // an edit that auto-key recorded says it was keyed.
@@ -157,11 +165,11 @@ pub const KEY_EDITS: [&str; 4] = [
 
 /// One list's change in words: items added, deleted, or changed (each changed item by the one
 /// kind of change `kinds` finds in it, or "edit" when several).
-fn list_change<T: PartialEq>(
+fn list_change<T: PartialEq, const N: usize>(
     from: &[Arc<T>],
     to: &[Arc<T>],
     (one, many): (&str, &str),
-    kinds: impl Fn(&T, &T) -> [(&'static str, bool); 6],
+    kinds: impl Fn(&T, &T) -> [(&'static str, bool); N],
 ) -> Option<String> {
     let count = |n: usize| {
         if n == 1 {

@@ -122,6 +122,8 @@ pub enum MediaProperty {
     NoiseAmount,
     /// Lacunarity.
     Detail,
+    /// Size of the largest noise puffs.
+    NoiseScale,
     /// Alpha cut-off.
     Sharpness,
     /// Shadow magnitude.
@@ -321,6 +323,7 @@ impl Channel {
                     MediaProperty::Opacity => r.opacity,
                     MediaProperty::NoiseAmount => r.noise_amount,
                     MediaProperty::Detail => r.detail,
+                    MediaProperty::NoiseScale => r.noise_scale,
                     MediaProperty::Sharpness => r.sharpness,
                     MediaProperty::Dirtiness => r.dirtiness,
                     MediaProperty::Wind => return Some(r.wind.to_vec()),
@@ -401,6 +404,7 @@ impl Channel {
                     MediaProperty::Opacity => &mut r.opacity,
                     MediaProperty::NoiseAmount => &mut r.noise_amount,
                     MediaProperty::Detail => &mut r.detail,
+                    MediaProperty::NoiseScale => &mut r.noise_scale,
                     MediaProperty::Sharpness => &mut r.sharpness,
                     MediaProperty::Dirtiness => &mut r.dirtiness,
                     MediaProperty::Torque => &mut r.torque,
@@ -456,6 +460,7 @@ impl Channel {
                 MediaProperty::Opacity => param(value[0], limits::OPACITY),
                 MediaProperty::NoiseAmount => param(value[0], limits::NOISE_AMOUNT),
                 MediaProperty::Detail => param(value[0], limits::DETAIL),
+                MediaProperty::NoiseScale => param(value[0], limits::NOISE_SCALE),
                 MediaProperty::Sharpness => param(value[0], limits::SHARPNESS),
                 MediaProperty::Dirtiness => param(value[0], limits::DIRTINESS),
                 MediaProperty::Wind => value.iter().map(|w| limits::WIND.fix_f32(*w)).collect(),
@@ -491,8 +496,11 @@ impl Channel {
     /// light's and the media's.
     pub fn all(scene: &Scene) -> impl Iterator<Item = Channel> + '_ {
         use EllipsoidProperty as E;
+        // A moving ellipsoid's centre and radii are its motion's, not keys'.
         let ellipsoids = scene.ellipsoids.iter().flat_map(|e| {
             [E::Center, E::Radii, E::Rotation, E::Strength, E::Visible]
+                .into_iter()
+                .filter(|p| e.motion.is_none() || !matches!(p, E::Center | E::Radii))
                 .map(|property| Channel::Ellipsoid { id: e.id, property })
         });
         let planes = scene.planes.iter().flat_map(|p| {
@@ -564,10 +572,11 @@ pub const LIGHT: [LightProperty; 6] = [
 ];
 
 /// The media's keyable properties.
-pub const MEDIA: [MediaProperty; 7] = [
+pub const MEDIA: [MediaProperty; 8] = [
     MediaProperty::Opacity,
     MediaProperty::NoiseAmount,
     MediaProperty::Detail,
+    MediaProperty::NoiseScale,
     MediaProperty::Sharpness,
     MediaProperty::Dirtiness,
     MediaProperty::Wind,
@@ -1073,7 +1082,8 @@ impl Scene {
     /// unkeyed values and every item whose keyed values are already there stay as they are
     /// (shared). Returns whether anything changed.
     pub fn pose(&mut self, t: f32) -> bool {
-        self.pose_where(t, |_| true)
+        // Keys first, then the motion, which sets a moving ellipsoid's centre and radii.
+        self.pose_where(t, |_| true) | self.pose_motion(t)
     }
 
     /// [`Scene::pose`] of `channels` alone (a key edit poses what it changed and leaves an

@@ -11,6 +11,7 @@ mod document;
 mod edit;
 mod keys;
 mod looks;
+mod motion;
 mod plane;
 mod pointer;
 mod presets;
@@ -27,6 +28,7 @@ pub use keys::{
     MediaProperty, PlaneProperty, ShotProperty, Track,
 };
 pub use looks::{Look, Looks};
+pub use motion::{Motion, WindField};
 pub use plane::{
     DrawingPlane, MAX_GRID_EXPONENT, MAX_GRID_STEPS, STROKE_GRID, StrokeKind, centre_of,
     grid_exponent, grid_point, grid_points, grid_step,
@@ -62,7 +64,7 @@ pub fn as_linked(v: f32) -> f32 {
 /// document has no billows, and its primitives get ids in order when it is read). Version 3
 /// added the clock's frame rate and range (a document without them has the default clock).
 /// Version 4 added key frames (a document without them has none).
-pub const SCENE_VERSION: u32 = 4;
+pub const SCENE_VERSION: u32 = 5;
 
 /// Errors when reading a scene document.
 #[derive(Debug, thiserror::Error)]
@@ -140,6 +142,9 @@ pub struct Scene {
     /// keyed value above is its keys' pose at [`Scene::time`].
     #[serde(default, skip_serializing_if = "Animation::is_empty")]
     pub animation: Animation,
+    /// The wind that carries the moving ellipsoids (left out of a file while calm).
+    #[serde(default, skip_serializing_if = "WindField::is_calm")]
+    pub wind_field: WindField,
 }
 
 impl Default for Scene {
@@ -337,7 +342,15 @@ impl Scene {
             if billows != e.billows {
                 Arc::make_mut(e).billows = billows;
             }
+            if let Some(m) = e.motion {
+                let mut fixed = m;
+                fixed.sanitize(e.center, e.radii);
+                if fixed != m {
+                    Arc::make_mut(e).motion = Some(fixed);
+                }
+            }
         }
+        self.wind_field.sanitize();
         if self.planes.len() > MAX_PLANES {
             return Err(SceneError::Invalid(format!(
                 "{} drawing planes (at most {MAX_PLANES})",
@@ -395,6 +408,10 @@ pub struct Ellipsoid {
     /// Puffs on its surface.
     #[serde(skip_serializing_if = "Billows::is_off")]
     pub billows: Billows,
+    /// How it moves with time (Schpok et al. 2003 §3.1's particles): its centre and radii
+    /// above are this motion's pose at the scene's time.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub motion: Option<Motion>,
 }
 
 fn is_zero(v: &u64) -> bool {
@@ -418,6 +435,7 @@ impl Ellipsoid {
             hidden: false,
             id: 0,
             billows: Billows::default(),
+            motion: None,
         }
     }
 

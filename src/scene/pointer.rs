@@ -67,8 +67,13 @@ pub fn set_by_pointer(scene: &Scene, assignment: &str) -> Result<(Scene, Vec<Str
     })?;
     // A stroke set point by point lands on its grid, as one drawn in the app.
     set.snap_strokes();
-    // A new time or new keys pose the keyed values; any other value set stands as set.
-    if path == "/time" || path.starts_with("/animation") {
+    // A new time, new keys, a new motion or wind field pose the keyed and moving values; any
+    // other value set stands as set.
+    if path == "/time"
+        || path.starts_with("/animation")
+        || path.starts_with("/wind_field")
+        || path.contains("/motion")
+    {
         let t = set.time;
         set.pose(t);
     }

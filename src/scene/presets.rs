@@ -32,11 +32,14 @@ pub enum Preset {
     /// Clouds grown by the cellular automaton (Dobashi et al. 2000) in three air parcels, wind
     /// stronger aloft, a low sun: press Play.
     Simulated,
+    /// A developing cumulus (Schpok et al. 2003, Figure 5): over 20 s its puffs rise and grow,
+    /// an anvil spreads downwind at the top, and the noise slows and scales out: press Play.
+    Developing,
 }
 
 impl Preset {
     /// All presets with their names.
-    pub const ALL: [(Preset, &'static str); 7] = [
+    pub const ALL: [(Preset, &'static str); 8] = [
         (Preset::Cumulus, "cumulus"),
         (Preset::Stratus, "stratus"),
         (Preset::Cirrus, "cirrus"),
@@ -44,6 +47,7 @@ impl Preset {
         (Preset::Sunset, "sunset"),
         (Preset::Empty, "empty"),
         (Preset::Simulated, "simulated"),
+        (Preset::Developing, "developing"),
     ];
 
     /// Looks a preset up by name.
@@ -122,6 +126,88 @@ fn cumulonimbus() -> Vec<Ellipsoid> {
     v
 }
 
+/// The developing cumulus's range: 20 s at 24 frames a second.
+const DEVELOPING_END: u32 = 480;
+
+/// The developing cumulus (Schpok et al. 2003 §6, Figure 5): simple ascending implicits model
+/// the convection, puffs higher in the column rising faster and growing; a flat ellipsoid at
+/// the top, faded in by its strength's keys, spreads into the anvil while the wind, stronger
+/// aloft, carries it downwind. Its keys: the anvil's strength, and the noise slowing and
+/// scaling out as the plume spreads.
+fn developing() -> (Vec<Ellipsoid>, super::Animation, super::WindField) {
+    use super::{Channel, EllipsoidProperty, Motion};
+    let mut rng = SplitMix::new(83);
+    let mut u = move || rng.next_f64() as f32;
+    let moving = |center: Vec3, radii: Vec3, rise: f32, growth: f32, spread: f32| Ellipsoid {
+        motion: Some(Motion {
+            carried: true,
+            rise,
+            growth,
+            spread,
+            from: center,
+            size: radii,
+        }),
+        ..Ellipsoid::new(center, radii).billowed()
+    };
+    let mut v = Vec::new();
+    // The base: broad puffs that barely move.
+    for k in 0..4 {
+        let a = k as f32 * 1.6 + u();
+        let c = Vec3::new(a.cos() * 1.8, 1.6 + 0.3 * u(), a.sin() * 1.4);
+        let r = 1.9 + 0.4 * u();
+        v.push(moving(c, Vec3::new(r, r * 0.7, r), 0.02, 0.02, 0.0));
+    }
+    // The column: rings of puffs rising the faster the higher they start and growing at the
+    // same rate, so the tower stretches upward without coming apart.
+    const STRETCH: f32 = 0.05;
+    for level in 1..6 {
+        for k in 0..3 {
+            let a = k as f32 * 2.1 + level as f32 * 0.8 + u();
+            let off = 0.8 + 0.4 * u();
+            let y = 1.6 + level as f32 * 1.2 + u() * 0.3;
+            let c = Vec3::new(a.cos() * off, y, a.sin() * off);
+            let r = 1.4 + 0.3 * u() - level as f32 * 0.06;
+            let rise = STRETCH * (y - 1.6) + 0.01 * u();
+            v.push(moving(c, Vec3::splat(r), rise, STRETCH, 0.0));
+        }
+    }
+    // The anvil: flat, where the column stops, spreading as it fades in.
+    let mut anvil = moving(
+        Vec3::new(0.3, 14.0, 0.0),
+        Vec3::new(2.2, 1.0, 1.8),
+        0.08,
+        0.01,
+        0.15,
+    );
+    anvil.id = 100;
+    v.push(anvil);
+    let mut keys = super::Animation::default();
+    let strength = Channel::Ellipsoid {
+        id: 100,
+        property: EllipsoidProperty::Strength,
+    };
+    keys.key(strength, 0.0, vec![0.0]);
+    keys.key(strength, 8.0, vec![0.0]);
+    keys.key(strength, 16.0, vec![1.0]);
+    let media = |property| Channel::Media { property };
+    use super::MediaProperty as M;
+    // The rolling turbulence slows and the noise scales out as the plume spreads.
+    for (property, start, end) in [
+        (M::Wind, vec![0.5, 0.0], vec![0.1, 0.0]),
+        (M::Torque, vec![24.0], vec![4.0]),
+        (M::NoiseScale, vec![2.0], vec![4.0]),
+    ] {
+        keys.key(media(property), 0.0, start);
+        keys.key(media(property), 20.0, end);
+    }
+    let wind = super::WindField {
+        velocity: [0.12, 0.0],
+        shear: 0.06,
+        turbulence: 0.25,
+    };
+    (v, keys, wind)
+}
+
 /// Each preset's camera, light and media by name: the values an artist tunes, kept as data
 /// (what a preset leaves out keeps its default).
 /// The presets of heaped clouds carry billows, as new ellipsoids do.
@@ -166,6 +252,9 @@ impl Scene {
         } = staging(preset.name());
         let mut simulation = None;
         let mut time = 0.0;
+        let mut clock = super::Clock::default();
+        let mut animation = super::Animation::default();
+        let mut wind_field = super::WindField::default();
         let ellipsoids = match preset {
             Preset::Cumulus => billowed(cumulus()),
             Preset::Stratus => layer(28, 30.0, 10.0, 3.0, Vec3::new(3.2, 0.7, 2.6), 11),
@@ -173,6 +262,13 @@ impl Scene {
             Preset::Cumulonimbus => billowed(cumulonimbus()),
             Preset::Sunset => billowed(layer(14, 20.0, 8.0, 3.5, Vec3::new(2.6, 1.3, 2.2), 37)),
             Preset::Empty => Vec::new(),
+            Preset::Developing => {
+                clock.end = DEVELOPING_END;
+                let (ellipsoids, keys, wind) = developing();
+                animation = keys;
+                wind_field = wind;
+                ellipsoids
+            }
             Preset::Simulated => {
                 simulation = Some(Arc::new(crate::simulate::Settings::default()));
                 // Forty steps in: the parcels have clouds when the preset opens.
@@ -197,12 +293,15 @@ impl Scene {
             planes: Vec::new(),
             reference: None,
             time,
-            clock: super::Clock::default(),
+            clock,
             simulation,
             shot: None,
-            animation: Default::default(),
+            animation,
+            wind_field,
         };
         scene.settle();
+        let t = scene.time;
+        scene.pose(t);
         scene
     }
 }

@@ -158,7 +158,24 @@ pub fn every_part() -> Scene {
             hidden: true,
             ..Ellipsoid::new(Vec3::new(1.0, 2.5, 0.5), Vec3::new(1.5, 1.0, 1.0))
         }),
+        // Carried by the wind, rising, growing and spreading.
+        Arc::new(Ellipsoid {
+            motion: Some(crate::scene::Motion {
+                carried: true,
+                rise: 0.3,
+                growth: 0.05,
+                spread: 0.1,
+                from: Vec3::new(-2.0, 3.0, 1.0),
+                size: Vec3::new(1.2, 0.8, 1.0),
+            }),
+            ..Ellipsoid::new(Vec3::new(-2.0, 3.0, 1.0), Vec3::new(1.2, 0.8, 1.0))
+        }),
     ];
+    scene.wind_field = crate::scene::WindField {
+        velocity: [0.4, -0.1],
+        shear: 0.2,
+        turbulence: 0.5,
+    };
     scene.reference = Some(Arc::new(ReferenceImage {
         name: "sky.jpg".into(),
         data: Arc::new(b"not kept in links".to_vec()),
@@ -214,6 +231,11 @@ pub fn every_part() -> Scene {
     a.key(opacity, scene.clock.seconds(7), vec![2.5]);
     a.key(opacity, 12.0, vec![2.0]);
     a.set_ease(&[opacity], 2.0, Ease::Constant);
+    let noise_size = Channel::Media {
+        property: MediaProperty::NoiseScale,
+    };
+    a.key(noise_size, 0.0, vec![2.5]);
+    a.key(noise_size, 20.0, vec![4.0]);
     // A shot camera, its yaw keyed across north (the short way).
     scene.shot = Some(crate::scene::OrbitCamera {
         target: Vec3::new(0.0, 3.0, 0.0),

@@ -37,8 +37,10 @@ use crate::scene::{
 /// (billows and stable ids; a primitive's billows and id are written where it has them).
 /// Version 4 moved the light volume's defaults. Version 5 carries key frames (scene format 4's
 /// `animation`, written whole and unrounded where a scene has keys) on version 4's base: a build that reads
-/// up to version 4 refuses such a link instead of opening it without its keys.
-pub const LINK_VERSION: u8 = 5;
+/// up to version 4 refuses such a link instead of opening it without its keys. Version 6
+/// carries moving ellipsoids and the wind field that carries them (scene format 5's `motion`
+/// and `wind_field`) on version 5's base.
+pub const LINK_VERSION: u8 = 6;
 
 /// Longest token accepted or written (characters after `#s=`). Browsers take URLs of
 /// megabytes, but mail and chat tools cut them far sooner.
@@ -237,13 +239,14 @@ impl Bases {
 
 /// Each link format version's base: version 1's (the ground at 0), version 2's (at -5),
 /// version 3's (billows and ids), version 4's (the light volume at 96 texels, 4 octaves),
-/// version 5's (the same as 4's: key frames added no default).
+/// version 5's (the same as 4's: key frames added no default); version 6's the same again.
 const BASES: [&str; LINK_VERSION as usize] = [
     include_str!("link/base_v1.json"),
     include_str!("link/base_v2.json"),
     include_str!("link/base_v3.json"),
     include_str!("link/base_v4.json"),
     include_str!("link/base_v5.json"),
+    include_str!("link/base_v6.json"),
 ];
 
 /// The base of link format `version` (1 to [`LINK_VERSION`]; others take the current one).

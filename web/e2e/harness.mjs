@@ -301,3 +301,43 @@ export function cloudColumns(img, [vw, vh], bg) {
   }
   return { n, x: n ? sx / n : NaN };
 }
+
+/** The page x of `frame` on the timeline's scrub bar (the bar's ends are 8 points in). */
+export function frameX(s, frame) {
+  const [left, , width] = s.view.widgets['timeline:scrub'];
+  const { start, end } = s.scene.clock ?? { start: 0, end: 120 };
+  return left + 8 + ((frame - start) / (Math.max(end, start + 1) - start)) * (width - 16);
+}
+
+/** Drags along the scrub bar's ruler (its numbers: a press there scrubs even over a key)
+ * from where the playhead is to `frame`, with pointer moves at input rate (several a frame,
+ * none awaited per frame). */
+export async function scrubTo(page, frame) {
+  const s = await state(page);
+  const [, top] = s.view.widgets['timeline:scrub'];
+  const y = top + 5;
+  const x0 = frameX(s, s.view.timeline.frame);
+  const x1 = frameX(s, frame);
+  await page.mouse.move(x0, y);
+  await page.mouse.down();
+  for (let i = 1; i <= 12; i++) await page.mouse.move(x0 + ((x1 - x0) * i) / 12, y);
+  await page.mouse.up();
+  // Off the bar: its tooltip is no part of the image compared.
+  await page.mouse.move(x1, top - 200);
+  return until(page, (s) => Math.round(s.view.timeline.frame) === frame, `frame ${frame}`);
+}
+
+/** The topmost row and the width (points) of the pixels that differ from the sky `bg` (RGB
+ * bytes) between the notice and hint lines at the top and the status line at the bottom of a
+ * view `vw`×`vh` points, left of the orientation gizmo's column at its top right. */
+export function cloudExtent(img, [vw, vh], bg) {
+  let top = vh, x0 = vw, x1 = -1;
+  for (let y = 60; y < vh - 30; y++) {
+    for (let x = 0; x < vw - 140; x++) {
+      const i = 4 * (y * img.width + x);
+      const d = Math.abs(img.data[i] - bg[0]) + Math.abs(img.data[i + 1] - bg[1]) + Math.abs(img.data[i + 2] - bg[2]);
+      if (d > 24) { top = Math.min(top, y); x0 = Math.min(x0, x); x1 = Math.max(x1, x); }
+    }
+  }
+  return { top, width: Math.max(0, x1 - x0 + 1) };
+}

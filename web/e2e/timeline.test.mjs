@@ -4,7 +4,7 @@
 // Screenshots: test-results/screenshots/timeline-*.png.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { serve, state, screenshot, countChanged, until, withApp, waitForFullQuality, openGroup, reveal, cloudColumns } from './harness.mjs';
+import { serve, state, screenshot, countChanged, until, withApp, waitForFullQuality, openGroup, reveal, cloudColumns, frameX, scrubTo } from './harness.mjs';
 
 let server;
 before(async () => { server = await serve(); });
@@ -13,31 +13,6 @@ after(async () => { await server?.close(); });
 const toBytes = (rgb) => rgb.map((v) => Math.round(v * 255));
 
 const cloud = cloudColumns;
-
-/** The page x of `frame` on the timeline's scrub bar (the bar's ends are 8 points in). */
-function frameX(s, frame) {
-  const [left, , width] = s.view.widgets['timeline:scrub'];
-  const { start, end } = s.scene.clock ?? { start: 0, end: 120 };
-  return left + 8 + ((frame - start) / (Math.max(end, start + 1) - start)) * (width - 16);
-}
-
-/** Drags along the scrub bar's ruler (its numbers: a press there scrubs even over a key)
- * from where the playhead is to `frame`, with pointer moves at input rate (several a frame,
- * none awaited per frame). */
-async function scrubTo(page, frame) {
-  const s = await state(page);
-  const [, top] = s.view.widgets['timeline:scrub'];
-  const y = top + 5;
-  const x0 = frameX(s, s.view.timeline.frame);
-  const x1 = frameX(s, frame);
-  await page.mouse.move(x0, y);
-  await page.mouse.down();
-  for (let i = 1; i <= 12; i++) await page.mouse.move(x0 + ((x1 - x0) * i) / 12, y);
-  await page.mouse.up();
-  // Off the bar: its tooltip is no part of the image compared.
-  await page.mouse.move(x1, top - 200);
-  return until(page, (s) => Math.round(s.view.timeline.frame) === frame, `frame ${frame}`);
-}
 
 for (const backend of ['webgpu', 'webgl2']) {
   test(`I keys an ellipsoid, the scrub bar poses it between its keys, undo removes a key, a dragged key retimes (${backend})`, { timeout: 300_000 }, async () => {

@@ -4,7 +4,10 @@
 
 use egui::Ui;
 
-use crate::scene::{Document, Edit, Looks, Preset, Scene, StrokeKind};
+use std::sync::Arc;
+
+use crate::limits;
+use crate::scene::{Document, Edit, Looks, Motion, Preset, Scene, StrokeKind};
 use crate::ui::ellipsoids;
 use crate::ui::notice::Notices;
 use crate::ui::platform;
@@ -178,8 +181,87 @@ fn ellipsoid_list(ui: &mut Ui, doc: &mut Document, selection: &mut Selection) {
     super::sketch::billows_controls(ui, &mut e.billows);
     ui.checkbox(&mut e.hidden, "hidden")
         .on_hover_text("Shift+H: leave it out of the cloud, kept in the scene (Alt+H shows all)");
+    let before = e.motion;
+    motion_controls(ui, &mut e.motion);
+    if e.motion != before {
+        set_motion(doc, selection, i, e.motion);
+        return;
+    }
+    if e.motion.is_some() {
+        wind_field_controls(ui, doc);
+    }
     if e != *doc.scene().ellipsoids[i] {
         ellipsoids::set(doc, i, e, Some("ellipsoid"));
+    }
+}
+
+/// The selected ellipsoid's motion (Schpok et al. 2003 §3.1's particles): whether it moves,
+/// its rise, growth and spread, and whether the wind field carries it.
+fn motion_controls(ui: &mut Ui, motion: &mut Option<Motion>) {
+    let mut moves = motion.is_some();
+    let r = ui.checkbox(&mut moves, "moves with time").on_hover_text(
+        "Rise, grow and drift with the wind as the scene plays (for every selected ellipsoid); \
+         its centre and radii then come from its motion, not from keys",
+    );
+    mark(ui, "motion:moves", r.rect);
+    if moves != motion.is_some() {
+        *motion = moves.then(Motion::default);
+    }
+    let Some(m) = motion else { return };
+    ui.indent("motion", |ui| {
+        crate::ui::widgets::param(ui, &mut m.rise, &limits::RISE);
+        crate::ui::widgets::param(ui, &mut m.growth, &limits::GROWTH);
+        crate::ui::widgets::param(ui, &mut m.spread, &limits::SPREAD);
+        ui.checkbox(&mut m.carried, "carried by the wind field")
+            .on_hover_text("The wind field below moves it (shear: faster the higher it is)");
+    });
+}
+
+/// Sets `motion` on every selected ellipsoid (`shown` among them), each keeping where it
+/// starts: one undo step per drag.
+fn set_motion(doc: &mut Document, selection: &Selection, shown: usize, motion: Option<Motion>) {
+    let mut list = doc.scene().ellipsoids.clone();
+    let chosen = selection
+        .items()
+        .iter()
+        .filter_map(|item| match item {
+            Item::Ellipsoid(j) => Some(*j),
+            _ => None,
+        })
+        .chain([shown]);
+    for j in chosen {
+        let Some(slot) = list.get_mut(j) else {
+            continue;
+        };
+        // The document starts a newly moving ellipsoid where it stands now.
+        let new = motion.map(|m| match slot.motion {
+            Some(own) => Motion {
+                from: own.from,
+                size: own.size,
+                ..m
+            },
+            None => m,
+        });
+        if slot.motion != new {
+            Arc::make_mut(slot).motion = new;
+        }
+    }
+    doc.apply(Edit::SetEllipsoids(list), Some("motion"));
+}
+
+/// The wind field that carries every moving ellipsoid.
+fn wind_field_controls(ui: &mut Ui, doc: &mut Document) {
+    let mut w = doc.scene().wind_field;
+    ui.label("Wind field (every moving ellipsoid)");
+    ui.indent("wind field", |ui| {
+        let p = &limits::PARTICLE_WIND;
+        crate::ui::widgets::param_as(ui, &mut w.velocity[0], p, "carrying wind x");
+        crate::ui::widgets::param_as(ui, &mut w.velocity[1], p, "carrying wind z");
+        crate::ui::widgets::param(ui, &mut w.shear, &limits::PARTICLE_SHEAR);
+        crate::ui::widgets::param(ui, &mut w.turbulence, &limits::PARTICLE_TURBULENCE);
+    });
+    if w != doc.scene().wind_field {
+        doc.apply(Edit::SetWindField(w), Some("wind field"));
     }
 }
 
