@@ -50,7 +50,8 @@ struct Cli {
 enum Command {
     /// Write a new scene document.
     New {
-        /// Starting point: cumulus (default) or empty.
+        /// Starting point: cumulus (default), stratus, cirrus, cumulonimbus, sunset, empty,
+        /// simulated or developing.
         #[arg(long, default_value = "cumulus")]
         preset: String,
         /// Where to write the scene JSON.
