@@ -6,7 +6,7 @@ use std::path::Path;
 use super::{read_scene_or_link, write};
 use crate::export::{Axes, DensityGrid, write_vdb, write_vol};
 use crate::scene::{Preset, Scene};
-use crate::simulate::{Simulation, parcels};
+use crate::simulate::{Simulation, Sources};
 
 /// Most steps one run may take.
 const MAX_STEPS: u64 = 100_000;
@@ -56,7 +56,7 @@ pub fn run(
         settings.seed = seed;
     }
     let start = std::time::Instant::now();
-    let mut sim = Simulation::new(&settings, &parcels(&scene));
+    let mut sim = Simulation::steered(&settings, Sources::of(&scene));
     let mut progress = super::progress::Progress::new(format!("simulating {steps} steps"));
     let mut done = 0;
     while done < steps {

@@ -203,6 +203,33 @@ struct GeometryKey {
     resolution: u32,
 }
 
+/// What a simulated scene's outlines are baked from: its planes (held, compared by pointer)
+/// and the field grid's resolution. Not the geometry revision, which parcels moving with the
+/// time bump at every frame.
+struct OutlinesKey {
+    planes: Vec<Arc<DrawingPlane>>,
+    resolution: u32,
+}
+
+impl OutlinesKey {
+    fn of(scene: &Scene) -> Self {
+        Self {
+            planes: scene.planes.clone(),
+            resolution: scene.render.field_resolution,
+        }
+    }
+
+    fn same(&self, other: &Self) -> bool {
+        self.resolution == other.resolution
+            && self.planes.len() == other.planes.len()
+            && self
+                .planes
+                .iter()
+                .zip(&other.planes)
+                .all(|(a, b)| Arc::ptr_eq(a, b))
+    }
+}
+
 /// The derivation cache of one document (keep one per viewport or offscreen device).
 #[derive(Default)]
 pub struct Derived {
@@ -218,9 +245,9 @@ pub struct Derived {
     player: Option<crate::simulate::Player>,
     simulated: Option<((u64, u32), Versioned<DensityVolume>)>,
     /// A simulated scene's outlines, baked apart (its ellipsoids are the simulation's parcels,
-    /// not cloud), keyed on the geometry; and the simulated density united with them, keyed on
+    /// not cloud), keyed on its planes ([`OutlinesKey`]); and the simulated density united with them, keyed on
     /// both generations.
-    strokes: Option<(GeometryKey, Versioned<DensityVolume>)>,
+    strokes: Option<(OutlinesKey, Versioned<DensityVolume>)>,
     stroke_baker: Baker,
     united: Option<((u64, u64), Versioned<DensityVolume>)>,
     /// The outlines resampled onto the grid they share with the simulation: the outlines'
@@ -266,7 +293,7 @@ impl Derived {
     pub fn density(&mut self, scene: &Scene, revisions: Revisions) -> Versioned<DensityVolume> {
         if let Some(settings) = &scene.simulation {
             let simulated = self.simulated(settings, scene, revisions);
-            return self.with_outlines(scene, revisions, simulated);
+            return self.with_outlines(scene, simulated);
         }
         self.strokes = None;
         self.united = None;
@@ -306,19 +333,15 @@ impl Derived {
         {
             return v.clone();
         }
-        // The run starts from the parcels as they stand at time 0: keys that move them do not
-        // restart it at every frame (the run does not follow keyed parcels yet).
-        let parcels = if !scene.is_animated() {
-            crate::simulate::parcels(scene)
-        } else {
-            crate::simulate::parcels(&scene.posed_at(0.0))
-        };
+        // The run follows the parcels as their keys and motion move them from time 0 on (a
+        // new time is no change of the run; an edit of a parcel, its keys or its motion is).
+        let sources = crate::simulate::Sources::of(scene);
         if self
             .player
             .as_ref()
-            .is_none_or(|p| !p.runs(settings, &parcels))
+            .is_none_or(|p| !p.runs(settings, &sources))
         {
-            self.player = Some(crate::simulate::Player::new(settings, parcels));
+            self.player = Some(crate::simulate::Player::new(settings, sources));
         }
         let Some(player) = self.player.as_mut() else {
             return Versioned {
@@ -344,7 +367,6 @@ impl Derived {
     fn with_outlines(
         &mut self,
         scene: &Scene,
-        revisions: Revisions,
         simulated: Versioned<DensityVolume>,
     ) -> Versioned<DensityVolume> {
         let drawn = scene
@@ -358,12 +380,9 @@ impl Derived {
             self.left_out = 0;
             return simulated;
         }
-        let gkey = GeometryKey {
-            geometry: revisions.geometry,
-            resolution: scene.render.field_resolution,
-        };
+        let okey = OutlinesKey::of(scene);
         let strokes = match &self.strokes {
-            Some((k, v)) if *k == gkey => v.clone(),
+            Some((k, v)) if k.same(&okey) => v.clone(),
             _ => {
                 let outlines = baked_part(scene);
                 let shapes = self.planes.shapes(&outlines.planes);
@@ -374,9 +393,9 @@ impl Derived {
                 self.left_out = field.puffs_left_out;
                 let baked =
                     self.stroke_baker
-                        .update(&Arc::new(field), gkey.resolution, MAX_BAKE_WORK);
+                        .update(&Arc::new(field), okey.resolution, MAX_BAKE_WORK);
                 let v = self.counted(baked);
-                self.strokes = Some((gkey, v.clone()));
+                self.strokes = Some((okey, v.clone()));
                 v
             }
         };

@@ -126,6 +126,9 @@ fn cumulonimbus() -> Vec<Ellipsoid> {
     v
 }
 
+/// The simulated preset's range: two minutes at 24 frames a second.
+const SIMULATED_END: u32 = 2880;
+
 /// The developing cumulus's range: 20 s at 24 frames a second.
 const DEVELOPING_END: u32 = 480;
 
@@ -273,13 +276,30 @@ impl Scene {
                 simulation = Some(Arc::new(crate::simulate::Settings::default()));
                 // Forty steps in: the parcels have clouds when the preset opens.
                 time = 4.0;
+                // Two minutes in which the wind carries the humid parcels across the grid:
+                // one swells, one dries out, and their clouds form, grow and dissipate.
+                clock.end = SIMULATED_END;
+                wind_field = super::WindField {
+                    velocity: [0.05, 0.02],
+                    shear: 0.0,
+                    turbulence: 0.5,
+                };
                 [
-                    (Vec3::new(-7.0, 3.5, 0.0), Vec3::new(5.5, 2.5, 4.5)),
-                    (Vec3::new(3.0, 4.0, 2.5), Vec3::new(6.0, 3.0, 5.0)),
-                    (Vec3::new(1.0, 3.0, -7.0), Vec3::new(5.0, 2.2, 4.0)),
+                    (Vec3::new(-7.0, 3.5, 0.0), Vec3::new(5.5, 2.5, 4.5), 0.0),
+                    (Vec3::new(3.0, 4.0, 2.5), Vec3::new(6.0, 3.0, 5.0), -0.006),
+                    (Vec3::new(1.0, 3.0, -7.0), Vec3::new(5.0, 2.2, 4.0), 0.004),
                 ]
                 .into_iter()
-                .map(|(c, r)| Ellipsoid::new(c, r))
+                .map(|(c, r, growth)| Ellipsoid {
+                    motion: Some(super::Motion {
+                        carried: true,
+                        growth,
+                        from: c,
+                        size: r,
+                        ..Default::default()
+                    }),
+                    ..Ellipsoid::new(c, r)
+                })
                 .collect()
             }
         };

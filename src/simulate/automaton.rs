@@ -221,13 +221,13 @@ pub fn level_of(p: f32) -> u8 {
     if p.is_nan() || p <= LEVELS[1] * 0.5 {
         return 0;
     }
-    let mut best = 1;
-    for (k, &l) in LEVELS.iter().enumerate().skip(1) {
-        if (p.ln() - l.ln()).abs() < (p.ln() - LEVELS[best].ln()).abs() {
-            best = k;
-        }
+    // The nearest level in log space: above the geometric mean of two neighbours, the
+    // higher (no logarithm per cell: a simulation's parcels set these at every interval).
+    let mut k = 1;
+    while k + 1 < LEVELS.len() && p > (LEVELS[k] * LEVELS[k + 1]).sqrt() {
+        k += 1;
     }
-    best as u8
+    k as u8
 }
 
 /// The cells' bits, wind carry and step: what a snapshot keeps (the probability levels and

@@ -138,36 +138,123 @@ impl Settings {
 pub struct Simulation {
     settings: Settings,
     automaton: Automaton,
+    /// Where the parcels stand over time.
+    sources: Sources,
+    /// The first step of the interval whose parcels the automaton's probabilities hold.
+    steered_at: u64,
+}
+
+/// Steps between two posings of moving parcels: the automaton's probabilities follow keyed or
+/// moving parcels in intervals of this many steps (0.8 s at the default rate), each from
+/// where they stand at its first step, so a step's probabilities depend on its number alone.
+pub const SOURCE_EVERY: u64 = 8;
+
+/// The parcels of a run over time: fixed, or posed from the scene's keys and motion at the
+/// first step of each [`SOURCE_EVERY`] steps.
+#[derive(Clone, Debug)]
+pub struct Sources {
+    /// Where they stand at time 0.
+    start: Vec<Parcel>,
+    /// What poses them (the scene's ellipsoids posed at 0, their keys, the wind field and the
+    /// seed), when any of them is keyed or moves.
+    moving: Option<Box<crate::scene::Scene>>,
+}
+
+impl PartialEq for Sources {
+    fn eq(&self, other: &Self) -> bool {
+        self.start == other.start
+            && match (&self.moving, &other.moving) {
+                (None, None) => true,
+                (Some(a), Some(b)) => {
+                    a.ellipsoids == b.ellipsoids
+                        && a.animation.same_as(&b.animation)
+                        && a.wind_field == b.wind_field
+                        && a.seed == b.seed
+                }
+                _ => false,
+            }
+    }
+}
+
+impl Sources {
+    /// Parcels that never move.
+    pub fn fixed(parcels: Vec<Parcel>) -> Self {
+        Self {
+            start: parcels,
+            moving: None,
+        }
+    }
+
+    /// The parcels of `scene` (its visible ellipsoids) as its keys and motion move them from
+    /// time 0 on, whatever its time.
+    pub fn of(scene: &crate::scene::Scene) -> Self {
+        use crate::scene::Channel;
+        if !scene.is_animated() {
+            return Self::fixed(parcels(scene));
+        }
+        let start = scene.posed_at(0.0);
+        let keyed: Vec<_> = start
+            .animation
+            .tracks
+            .iter()
+            .filter(|t| matches!(t.channel, Channel::Ellipsoid { .. }))
+            .cloned()
+            .collect();
+        let moves = !keyed.is_empty() || start.ellipsoids.iter().any(|e| e.motion.is_some());
+        if !moves {
+            return Self::fixed(parcels(&start));
+        }
+        static BLANK: std::sync::OnceLock<crate::scene::Scene> = std::sync::OnceLock::new();
+        let blank = BLANK.get_or_init(|| crate::scene::Scene::preset(crate::scene::Preset::Empty));
+        let moving = crate::scene::Scene {
+            ellipsoids: start.ellipsoids.clone(),
+            animation: crate::scene::Animation { tracks: keyed },
+            wind_field: start.wind_field,
+            seed: start.seed,
+            time: 0.0,
+            ..blank.clone()
+        };
+        Self {
+            start: parcels(&start),
+            moving: Some(Box::new(moving)),
+        }
+    }
+
+    /// Whether they move.
+    pub fn moves(&self) -> bool {
+        self.moving.is_some()
+    }
+
+    /// Where they stand at `seconds`.
+    pub fn at(&self, seconds: f32) -> Vec<Parcel> {
+        match &self.moving {
+            Some(scene) => parcels(&scene.posed_at(seconds)),
+            None => self.start.clone(),
+        }
+    }
 }
 
 impl Simulation {
     /// A fresh run of `settings` steered by `parcels`: empty sky, vapour and activation then
     /// re-supplied inside the parcels each step.
     pub fn new(settings: &Settings, parcels: &[Parcel]) -> Self {
+        Self::steered(settings, Sources::fixed(parcels.to_vec()))
+    }
+
+    /// A fresh run of `settings` steered by `sources`: the parcels as they stand at each
+    /// interval of [`SOURCE_EVERY`] steps (at the settings' rate).
+    pub fn steered(settings: &Settings, sources: Sources) -> Self {
         let dims = settings.dims();
         let mut automaton = Automaton::new(dims, settings.seed);
-        let weight = |x, y, z| {
-            let p = settings.center(x, y, z);
-            parcels.iter().map(|q| q.weight(p)).fold(0.0f32, f32::max)
-        };
-        let weights: Vec<f32> = (0..dims[1])
-            .flat_map(|y| (0..dims[2]).flat_map(move |z| (0..dims[0]).map(move |x| (x, y, z))))
-            .map(|(x, y, z)| weight(x, y, z))
-            .collect();
-        let at = |x: usize, y: usize, z: usize| weights[(y * dims[2] + z) * dims[0] + x];
-        let s = settings;
-        automaton.set_levels(Kind::Hum, |x, y, z| level_of(s.p_hum * at(x, y, z)));
-        automaton.set_levels(Kind::Act, |x, y, z| level_of(s.p_act * at(x, y, z)));
-        automaton.set_levels(Kind::Ext, |x, y, z| {
-            let w = at(x, y, z);
-            level_of(s.p_ext_inside * w + s.p_ext_outside * (1.0 - w))
-        });
+        steer(&mut automaton, settings, &sources.start);
         let ny = dims[1].max(2);
-        let [bottom, top] = s.wind;
+        let [bottom, top] = settings.wind;
         automaton.set_wind(|y| bottom + (top - bottom) * y as f32 / (ny - 1) as f32);
         Self {
             settings: settings.clone(),
             automaton,
+            sources,
+            steered_at: 0,
         }
     }
 
@@ -178,6 +265,7 @@ impl Simulation {
 
     /// Goes back (or forward) to a snapshot of this run.
     pub fn restore(&mut self, state: &State) {
+        // (The next step sets the probabilities of its interval if they are another's.)
         self.automaton.restore(state);
     }
 
@@ -206,9 +294,22 @@ impl Simulation {
         self.automaton.step
     }
 
-    /// Advances `n` steps.
+    /// Advances `n` steps (moving parcels posed at each interval's first step).
     pub fn advance(&mut self, n: u64) {
         for _ in 0..n {
+            if self.sources.moves() {
+                let step = self.automaton.step;
+                let first = step - step % SOURCE_EVERY;
+                if self.steered_at != first {
+                    let seconds = first as f32 / self.settings.rate.max(1e-3);
+                    steer(
+                        &mut self.automaton,
+                        &self.settings,
+                        &self.sources.at(seconds),
+                    );
+                    self.steered_at = first;
+                }
+            }
             self.automaton.advance();
         }
     }
@@ -239,6 +340,43 @@ impl Simulation {
         };
         volume(&self.settings, self.automaton.dims, values)
     }
+}
+
+/// Sets the automaton's re-supply and extinction probabilities from `parcels` (Dobashi et al.
+/// 2000: vapour and activation re-supplied inside them, cloud dissolving outside).
+fn steer(automaton: &mut Automaton, settings: &Settings, parcels: &[Parcel]) {
+    let dims = automaton.dims;
+    // Each parcel's weight over the cells of its bounding box alone (0 elsewhere), the
+    // largest where they overlap; in (y, z, x) order.
+    let mut weights = vec![0.0f32; dims[0] * dims[1] * dims[2]];
+    let origin = Vec3::from(settings.origin);
+    let h = settings.cell_size.max(1e-3);
+    for q in parcels {
+        let reach = Vec3::splat(q.radii.max_element());
+        let cell = |v: Vec3, up: bool| {
+            let c = (v - origin) / h - 0.5;
+            let c = if up { c.ceil() } else { c.floor() };
+            [0, 1, 2].map(|i| (c[i].max(0.0) as usize).min(dims[i]))
+        };
+        let (lo, hi) = (cell(q.center - reach, false), cell(q.center + reach, true));
+        for y in lo[1]..(hi[1] + 1).min(dims[1]) {
+            for z in lo[2]..(hi[2] + 1).min(dims[2]) {
+                for x in lo[0]..(hi[0] + 1).min(dims[0]) {
+                    let w = q.weight(settings.center(x, y, z));
+                    let slot = &mut weights[(y * dims[2] + z) * dims[0] + x];
+                    *slot = slot.max(w);
+                }
+            }
+        }
+    }
+    let at = |x: usize, y: usize, z: usize| weights[(y * dims[2] + z) * dims[0] + x];
+    let s = settings;
+    automaton.set_levels(Kind::Hum, |x, y, z| level_of(s.p_hum * at(x, y, z)));
+    automaton.set_levels(Kind::Act, |x, y, z| level_of(s.p_act * at(x, y, z)));
+    automaton.set_levels(Kind::Ext, |x, y, z| {
+        let w = at(x, y, z);
+        level_of(s.p_ext_inside * w + s.p_ext_outside * (1.0 - w))
+    });
 }
 
 /// One step's cloud smoothed ([`Simulation::smoothed`]): each cell's count of cloud cells in
@@ -380,11 +518,13 @@ pub const MAX_STEP: u64 = 20_000;
 /// A run that plays to any scene time: snapshots every few steps make scrubbing back cheap
 /// (within a memory cap), the last smoothed steps are kept for the blend between steps.
 pub struct Player {
-    key: (Settings, Vec<Parcel>),
+    key: (Settings, Sources),
     run: Simulation,
     snapshots: Vec<State>,
     /// Bytes the snapshots may hold.
     snapshot_bytes: usize,
+    /// Steps computed since it began.
+    taken: u64,
     smoothed: Vec<(u64, std::sync::Arc<Smoothed>)>,
     /// The last step dropped from `smoothed`, if nothing else held it: the next one is
     /// written over it.
@@ -392,15 +532,16 @@ pub struct Player {
 }
 
 impl Player {
-    /// A run of `settings` with `parcels`, at step 0.
-    pub fn new(settings: &Settings, parcels: Vec<Parcel>) -> Self {
-        let run = Simulation::new(settings, &parcels);
+    /// A run of `settings` steered by `sources`, at step 0.
+    pub fn new(settings: &Settings, sources: Sources) -> Self {
+        let run = Simulation::steered(settings, sources.clone());
         let snapshots = vec![run.state()];
         Self {
-            key: (settings.clone(), parcels),
+            key: (settings.clone(), sources),
             run,
             snapshots,
             snapshot_bytes: SNAPSHOT_BYTES,
+            taken: 0,
             smoothed: Vec::new(),
             spare: Smoothed::default(),
         }
@@ -417,9 +558,15 @@ impl Player {
         self.snapshots.iter().map(State::bytes).sum()
     }
 
-    /// Whether it runs these settings and parcels.
-    pub fn runs(&self, settings: &Settings, parcels: &[Parcel]) -> bool {
-        self.key.0 == *settings && self.key.1 == parcels
+    /// Whether it runs these settings and sources.
+    pub fn runs(&self, settings: &Settings, sources: &Sources) -> bool {
+        self.key.0 == *settings && self.key.1 == *sources
+    }
+
+    /// Steps the run has taken since it began (every step a scrub or replay computed: a
+    /// restored snapshot's steps are not taken again), for tests and benchmarks.
+    pub fn steps_taken(&self) -> u64 {
+        self.taken
     }
 
     /// The smoothed cloud at step `n`, or at the nearest step this call could reach.
@@ -435,6 +582,7 @@ impl Player {
         let mut budget = MAX_STEPS_PER_CALL;
         while self.run.step() < n && budget > 0 {
             self.run.advance(1);
+            self.taken += 1;
             budget -= 1;
             let step = self.run.step();
             if step.is_multiple_of(SNAPSHOT_EVERY)

@@ -340,6 +340,8 @@ fn the_smoothed_density_is_the_share_of_cloud_around_each_cell() {
             ..sim.settings.clone()
         },
         automaton: sim.automaton.clone(),
+        sources: sim.sources.clone(),
+        steered_at: sim.steered_at,
     };
     assert!(near(&wide.smoothed().shares(), &brute(&wide, 3), 3));
     // A grid big enough to be smoothed on several threads (2^18 cells), its layers shared out.
@@ -368,6 +370,8 @@ fn the_smoothed_density_is_the_share_of_cloud_around_each_cell() {
                 ..s.settings.clone()
             },
             automaton: s.automaton.clone(),
+            sources: s.sources.clone(),
+            steered_at: s.steered_at,
         };
         assert!(
             near(&at_r(&sim).smoothed().shares(), &brute(&sim, r as i32), r),
@@ -394,12 +398,12 @@ fn the_smoothed_density_is_the_share_of_cloud_around_each_cell() {
 fn a_player_scrubbed_back_and_forth_shows_what_a_fresh_run_shows() {
     let (settings, parcels) = parcel_settings();
     let fresh = |time: f32| {
-        Player::new(&settings, parcels.clone())
+        Player::new(&settings, Sources::fixed(parcels.clone()))
             .density(time)
             .0
             .values
     };
-    let mut player = Player::new(&settings, parcels.clone());
+    let mut player = Player::new(&settings, Sources::fixed(parcels.clone()));
     let late = player.density(9.05).0.values; // 90 steps and a half
     let early = player.density(3.0).0.values; // back to step 30 (from a snapshot)
     assert_eq!(early, fresh(3.0));
@@ -416,7 +420,7 @@ fn a_player_scrubbed_back_and_forth_shows_what_a_fresh_run_shows() {
     assert_ne!(a, b);
     // Played frame by frame, each step's counts written over a dropped step's: every frame
     // as a fresh run shows it.
-    let mut playing = Player::new(&settings, parcels.clone());
+    let mut playing = Player::new(&settings, Sources::fixed(parcels.clone()));
     for frame in 0..40 {
         let time = frame as f32 * 0.05;
         let shown = playing.density(time).0.values;
@@ -425,7 +429,7 @@ fn a_player_scrubbed_back_and_forth_shows_what_a_fresh_run_shows() {
         }
     }
     // A far jump catches up over calls, never more than a bounded number of steps at once.
-    let mut far = Player::new(&settings, parcels);
+    let mut far = Player::new(&settings, Sources::fixed(parcels));
     let (_, behind) = far.density(100.0);
     assert!(behind, "1,000 steps take more than one call");
 }
@@ -434,14 +438,15 @@ fn a_player_scrubbed_back_and_forth_shows_what_a_fresh_run_shows() {
 fn scrubbing_snapshots_stay_within_their_byte_cap_and_still_give_the_fresh_run() {
     let (settings, parcels) = parcel_settings();
     let fresh = |time: f32| {
-        Player::new(&settings, parcels.clone())
+        Player::new(&settings, Sources::fixed(parcels.clone()))
             .density(time)
             .0
             .values
     };
     let one = Simulation::new(&settings, &parcels).state().bytes();
     let cap = 5 * one;
-    let mut player = Player::new(&settings, parcels.clone()).with_snapshot_bytes(cap);
+    let mut player =
+        Player::new(&settings, Sources::fixed(parcels.clone())).with_snapshot_bytes(cap);
     // 40 s at 10 steps a second: 400 steps, a snapshot every 32 (12 of them uncapped).
     let mut t = 0.0;
     while t < 40.0 {
@@ -457,7 +462,7 @@ fn scrubbing_snapshots_stay_within_their_byte_cap_and_still_give_the_fresh_run()
     // Scrubbing back still lands on what a fresh run shows.
     assert_eq!(player.density(13.0).0.values, fresh(13.0));
     // An uncapped player keeps more.
-    let mut uncapped = Player::new(&settings, parcels.clone());
+    let mut uncapped = Player::new(&settings, Sources::fixed(parcels.clone()));
     while uncapped.density(40.0).1 {}
     assert!(uncapped.snapshot_bytes() > cap);
 }
@@ -543,4 +548,53 @@ fn smoothed_counts_equal_a_brute_force_count_on_ragged_grids() {
             "big, radius {r}"
         );
     }
+}
+
+#[test]
+fn moving_parcels_steer_the_run_and_a_scrubbed_frame_equals_it_played_from_step_0() {
+    use crate::scene::{Preset, Scene};
+    // The simulated preset's parcels, carried by its wind, one swelling and one drying out,
+    // over a coarser grid of the same extent.
+    let scene = Scene::preset(Preset::Simulated);
+    let settings = Settings {
+        cells: [64, 16, 64],
+        cell_size: 0.5,
+        origin: [-16.0, -1.0, -16.0],
+        ..Settings::default()
+    };
+    let sources = Sources::of(&scene);
+    assert!(sources.moves());
+    assert_ne!(sources.at(10.0), sources.at(0.0), "they move");
+    // Its time does not change the sources (a new time is no new run).
+    assert_eq!(Sources::of(&scene.posed_at(30.0)), sources);
+    // Played one step at a time from step 0 to 101.
+    let mut played = Simulation::steered(&settings, sources.clone());
+    for _ in 0..101 {
+        played.advance(1);
+    }
+    // A player taken to step 200, then scrubbed back to step 100 (it blends 100 and 101).
+    let mut player = Player::new(&settings, sources.clone());
+    let time = |n: u64| n as f32 / settings.rate;
+    while player.density(time(200)).1 {}
+    let taken = player.steps_taken();
+    assert!(!player.density(time(100)).1);
+    assert_eq!(player.run.step(), 101);
+    assert_eq!(
+        player.run.smoothed(),
+        played.smoothed(),
+        "scrubbed = played"
+    );
+    assert!(
+        player.steps_taken() - taken <= SNAPSHOT_EVERY + 1,
+        "the scrub back took {} steps",
+        player.steps_taken() - taken
+    );
+    // The baseline: parcels held where they start give another cloud.
+    let mut still = Simulation::new(&settings, &sources.at(0.0));
+    still.advance(101);
+    assert_ne!(
+        still.smoothed(),
+        played.smoothed(),
+        "the moving parcels steered it"
+    );
 }
