@@ -505,7 +505,50 @@ fn time_moves() -> Vec<BenchResult> {
         "time_full_derive_2000_ellipsoids",
         full * 1e3,
     ));
+    out.push(simulated_scrub());
     out
+}
+
+/// The `simulated` preset (its parcels moving with the wind) at step 2,000: scrubbed back 100
+/// steps (a snapshot and at most 32 steps) against replayed from step 0 by a fresh
+/// derivation, each to the frame's density.
+fn simulated_scrub() -> BenchResult {
+    let rate = crate::simulate::Settings::default().rate;
+    let (at, back) = (2_000.0 / rate, 1_900.0 / rate);
+    let mut doc = Document::new(Scene::preset(crate::scene::Preset::Simulated));
+    let settle = |derived: &mut Derived, doc: &Document| {
+        while {
+            std::hint::black_box(derived.density(doc.scene(), doc.revisions()));
+            derived.catching_up
+        } {}
+    };
+    let mut derived = Derived::default();
+    doc.set_time(at);
+    settle(&mut derived, &doc);
+    let scrub = median(
+        (0..7)
+            .map(|_| {
+                let t = Instant::now();
+                doc.set_time(back);
+                settle(&mut derived, &doc);
+                let took = t.elapsed().as_secs_f64();
+                // Forward again, untimed.
+                doc.set_time(at);
+                settle(&mut derived, &doc);
+                took
+            })
+            .collect(),
+    );
+    let replay = time_median(3, &mut || {
+        settle(&mut Derived::default(), &doc);
+    });
+    result(
+        "time_simulated_scrub_back_100_steps_at_2000",
+        scrub * 1e3,
+        "ms",
+        "time_simulated_replay_2000_steps",
+        replay * 1e3,
+    )
 }
 
 /// The other way to build the field (ARCHITECTURE.md, "The field at scale"): every texel
