@@ -5,7 +5,8 @@
 //!
 //! - [`scene`]: the document, the only state a user makes, with undo and revisions (pure);
 //! - [`sketch`]: stroke → skeleton → spheres (pure);
-//! - [`field`]: the blended implicit field and the density volume it is sampled into (pure);
+//! - [`density`]: the density volume every source lands in (pure);
+//! - [`field`]: the blended implicit field, baked into a density volume (pure);
 //! - [`derive`]: document → per-plane spheres → field → density and light volumes, cached
 //!   per part (pure);
 //! - [`share`]: share links and scene files, read as untrusted input (pure);
@@ -15,6 +16,7 @@
 //! - `files` (native): the one safe writer and the one bounded reader;
 //! - `cli`, `bench` (native) and `web` (wasm32): the entry points of each target.
 
+pub mod density;
 pub mod derive;
 pub mod export;
 pub mod field;

@@ -24,8 +24,7 @@ use glam::{Mat3, Vec2, Vec3, Vec4};
 
 use crate::scene::Ellipsoid;
 
-/// Iso-level of the visible surface.
-pub const ISO: f32 = 0.5;
+pub use crate::density::ISO;
 /// Influence radius over visible radius.
 pub const SUPPORT: f32 = 2.0;
 /// How far (in visible radii) the field can reach the surface level once blended; grid bounds

@@ -39,7 +39,7 @@ where
 }
 
 /// The members a scene document may have at its top level.
-pub const MEMBERS: [&str; 10] = [
+pub const MEMBERS: [&str; 14] = [
     "version",
     "seed",
     "camera",
@@ -49,7 +49,11 @@ pub const MEMBERS: [&str; 10] = [
     "planes",
     "reference",
     "time",
+    "clock",
     "simulation",
+    "shot",
+    "animation",
+    "wind_field",
 ];
 
 /// What a first pass over a document finds without building any of it: the version it says
@@ -153,8 +157,10 @@ mod tests {
 
     #[test]
     fn every_member_a_scene_writes_is_known() {
-        let mut scene = crate::scene::Scene::preset(crate::scene::Preset::Simulated);
-        scene.reference = Some(Default::default());
+        // Every member set: the fixture that sets every field, simulated too.
+        let mut scene = crate::share::fixture::every_part();
+        scene.simulation = crate::scene::Scene::preset(crate::scene::Preset::Simulated).simulation;
+        assert!(scene.reference.is_some() && scene.shot.is_some() && !scene.wind_field.is_calm());
         let value = serde_json::to_value(&scene).unwrap();
         for key in value.as_object().unwrap().keys() {
             assert!(MEMBERS.contains(&key.as_str()), "{key} is not in MEMBERS");

@@ -29,7 +29,7 @@ pub enum Edit {
     /// Set, change or remove the reference image.
     SetReference(Option<ReferenceImage>),
     /// Turn the simulation on (with these settings), change it, or turn it off.
-    SetSimulation(Option<crate::simulate::Settings>),
+    SetSimulation(Option<super::SimulationSettings>),
     /// Set, move or remove the shot camera.
     SetShot(Option<super::OrbitCamera>),
     /// Replace the wind field that carries the moving ellipsoids (they move with it).

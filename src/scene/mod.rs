@@ -16,6 +16,7 @@ mod plane;
 mod pointer;
 mod presets;
 mod reference;
+mod simulation;
 
 pub use crate::limits::{MAX_ELLIPSOIDS, MAX_PLANE_POINTS, MAX_PLANES};
 pub use billows::Billows;
@@ -36,6 +37,7 @@ pub use plane::{
 pub use pointer::{SetError, set_by_pointer};
 pub use presets::Preset;
 pub use reference::ReferenceImage;
+pub use simulation::{MAX_CELLS, Settings as SimulationSettings};
 
 use std::sync::Arc;
 
@@ -132,7 +134,7 @@ pub struct Scene {
     /// A cloud simulation (Dobashi et al. 2000): when present, the cloud is the automaton's
     /// smoothed cloud at the scene's time, and the ellipsoids are its parcels.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub simulation: Option<Arc<crate::simulate::Settings>>,
+    pub simulation: Option<Arc<SimulationSettings>>,
     /// The shot camera: the view a shot is rendered from (`render --shot`), keyable, apart
     /// from the free view the artist orbits with (`camera`); the view looks through it on
     /// demand (numpad 0). Left out of a file while there is none.

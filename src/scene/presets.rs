@@ -273,7 +273,7 @@ impl Scene {
                 ellipsoids
             }
             Preset::Simulated => {
-                simulation = Some(Arc::new(crate::simulate::Settings::default()));
+                simulation = Some(Arc::new(super::SimulationSettings::default()));
                 // Forty steps in: the parcels have clouds when the preset opens.
                 time = 4.0;
                 // Two minutes in which the wind carries the humid parcels across the grid:
