@@ -291,6 +291,7 @@ impl Document {
             let t = s.time;
             let keyed = before.animation.changed_channels(&s.animation);
             s.pose_channels(t, &keyed);
+            s.pose_motion(t);
             changed = diff(&before, s);
         } else if self.auto_key && records {
             let mut animation = s.animation.clone();

@@ -35,10 +35,17 @@ pub struct Motion {
     pub growth: f32,
     /// Further growth of its width and depth alone per second (an anvil spreading).
     pub spread: f32,
-    /// Its centre at time 0.
+    /// Its centre at time 0 (missing in a file: the ellipsoid's own centre).
+    #[serde(default = "unset")]
     pub from: Vec3,
-    /// Its radii at time 0.
+    /// Its radii at time 0 (missing in a file: the ellipsoid's own radii).
+    #[serde(default = "unset")]
     pub size: Vec3,
+}
+
+/// A start a file left out: [`Motion::sanitize`] gives it the ellipsoid's own.
+fn unset() -> Vec3 {
+    Vec3::NAN
 }
 
 impl Default for Motion {
@@ -64,7 +71,8 @@ pub struct WindField {
     pub velocity: [f32; 2],
     /// Share of the velocity gained per unit of height (wind shear).
     pub shear: f32,
-    /// Largest wander of an ellipsoid from its path, in world units.
+    /// How far each ellipsoid wanders from its path, in world units (at most twice this
+    /// horizontally, once vertically).
     pub turbulence: f32,
 }
 
@@ -83,21 +91,32 @@ impl WindField {
 }
 
 impl Motion {
-    /// Clamps every value into its range; a start that is not finite or a size ≤ 0 becomes
-    /// the ellipsoid's own (`center`, `radii`).
+    /// Clamps every value into its range; a start or size that is missing or not finite (or a
+    /// size ≤ 0) becomes the ellipsoid's own (`center`, `radii`), and each coordinate is kept
+    /// within ±10⁶.
     pub fn sanitize(&mut self, center: Vec3, radii: Vec3) {
         self.rise = limits::RISE.fix_f32(self.rise);
         self.growth = limits::GROWTH.fix_f32(self.growth);
         self.spread = limits::SPREAD.fix_f32(self.spread);
-        if !self.from.is_finite() || self.from.abs().max_element() > MAX_START {
-            self.from = center;
-        }
-        if !self.size.is_finite()
-            || self.size.min_element() <= 0.0
-            || self.size.max_element() > MAX_START
-        {
-            self.size = radii;
-        }
+        // Each coordinate on its own, into ±MAX_START (sizes above 0): a repair that holds on
+        // the next reading, whatever the ellipsoid's own values are.
+        let fix = |v: f32, own: f32, lo: f32| {
+            let v = if v.is_finite() { v } else { own };
+            if v.is_finite() {
+                v.clamp(lo, MAX_START)
+            } else {
+                lo.max(0.0)
+            }
+        };
+        self.from = Vec3::from_array([0, 1, 2].map(|i| fix(self.from[i], center[i], -MAX_START)));
+        self.size = Vec3::from_array([0, 1, 2].map(|i| {
+            let v = if self.size[i] > 0.0 {
+                self.size[i]
+            } else {
+                f32::NAN
+            };
+            fix(v, radii[i], 1e-4)
+        }));
     }
 
     /// How far it has gone from its start at time `t` (seconds), in `wind`; `seed` (the
@@ -162,8 +181,9 @@ impl Motion {
     }
 }
 
-/// A smooth, seeded wander of at most about 1 in each axis, 0 at time 0: two sines of
-/// different periods (a few seconds to half a minute) per axis.
+/// A smooth, seeded wander, 0 at time 0: two sines of different periods (a few seconds to
+/// half a minute) per axis, each at most 1 away from its start, so at most 2 horizontally and
+/// 1 vertically.
 fn turbulence(seed: u64, t: f64) -> glam::DVec3 {
     let mut rng = crate::seeded::SplitMix::new(seed ^ 0x7475_7262_756c_656e);
     let mut axis = || {
@@ -238,6 +258,22 @@ impl Scene {
         let was: std::collections::HashMap<u64, &Ellipsoid> =
             before.ellipsoids.iter().map(|e| (e.id, &**e)).collect();
         let (wind, seed, t) = (self.wind_field, self.seed, self.time);
+        // Keys on where a moving ellipsoid stands and its size are its motion's now.
+        let moving: std::collections::HashSet<u64> = self
+            .ellipsoids
+            .iter()
+            .filter(|e| e.motion.is_some())
+            .map(|e| e.id)
+            .collect();
+        self.animation.tracks.retain(|tr| {
+            !matches!(
+                tr.channel,
+                super::Channel::Ellipsoid {
+                    id,
+                    property: super::EllipsoidProperty::Center | super::EllipsoidProperty::Radii,
+                } if moving.contains(&id)
+            )
+        });
         for e in &mut self.ellipsoids {
             let Some(m) = e.motion else { continue };
             let old = was.get(&e.id).copied();
@@ -425,5 +461,101 @@ mod tests {
         assert_eq!(doc.scene().ellipsoids[0].center, Vec3::new(1.0, 3.0, 0.0));
         assert_eq!(doc.undo().as_deref(), Some("move an ellipsoid"));
         assert_eq!(doc.scene().ellipsoids[0].center, Vec3::new(0.0, 3.0, 0.0));
+    }
+
+    #[test]
+    fn a_file_motion_missing_or_out_of_range_is_repaired_once_and_for_all() {
+        // Only a rise: it starts where the ellipsoid stands, its own size.
+        let mut scene = moving(Motion::default());
+        scene.time = 2.0;
+        let mut json: serde_json::Value = serde_json::from_str(&scene.to_json()).unwrap();
+        json["ellipsoids"][0]["center"] = serde_json::json!([1.0, 2.0, 3.0]);
+        json["ellipsoids"][0]["radii"] = serde_json::json!([2.0, 1.0, 2.0]);
+        json["ellipsoids"][0]["motion"] = serde_json::json!({"rise": 1.0});
+        let (read, _) = Scene::from_json(&json.to_string()).unwrap();
+        let m = read.ellipsoids[0].motion.unwrap();
+        assert_eq!(
+            (m.from, m.size),
+            (Vec3::new(1.0, 2.0, 3.0), Vec3::new(2.0, 1.0, 2.0))
+        );
+        assert_eq!(
+            read.ellipsoids[0].center,
+            Vec3::new(1.0, 4.0, 3.0),
+            "posed at 2 s"
+        );
+        // Far out of range: clamped, and the second reading keeps what the first made.
+        json["ellipsoids"][0]["radii"] = serde_json::json!([2e6, 1.0, 2.0]);
+        json["ellipsoids"][0]["motion"] =
+            serde_json::json!({"growth": 0.5, "from": [3e7, 0, 0], "size": [5e6, -1, 1]});
+        let (once, _) = Scene::from_json(&json.to_string()).unwrap();
+        let (twice, _) = Scene::from_json(&once.to_json()).unwrap();
+        assert_eq!(once, twice);
+        let m = once.ellipsoids[0].motion.unwrap();
+        assert_eq!(m.from.x, MAX_START);
+        assert_eq!(m.size, Vec3::new(MAX_START, 1.0, 1.0));
+    }
+
+    #[test]
+    fn set_by_pointer_moves_a_moving_ellipsoids_start_and_reaches_a_calm_wind() {
+        use super::super::set_by_pointer;
+        let mut scene = moving(Motion {
+            rise: 1.0,
+            from: Vec3::new(0.0, 1.0, 0.0),
+            ..Default::default()
+        });
+        scene = scene.posed_at(2.0);
+        let (set, _) = set_by_pointer(&scene, "/ellipsoids/0/center/0=5").unwrap();
+        assert_eq!(set.ellipsoids[0].center, Vec3::new(5.0, 3.0, 0.0));
+        assert_eq!(
+            set.ellipsoids[0].motion.unwrap().from,
+            Vec3::new(5.0, 1.0, 0.0)
+        );
+        // What the command line sets, the file holds: read again, it stands there.
+        let (read, _) = Scene::from_json(&set.to_json()).unwrap();
+        assert_eq!(read.ellipsoids[0].center, Vec3::new(5.0, 3.0, 0.0));
+        let (windy, _) = set_by_pointer(&set, "/wind_field/velocity/0=1").unwrap();
+        assert_eq!(
+            windy.ellipsoids[0].center,
+            Vec3::new(7.0, 3.0, 0.0),
+            "carried 2 s"
+        );
+    }
+
+    #[test]
+    fn giving_a_keyed_ellipsoid_a_motion_drops_its_centre_keys_and_keeps_its_others() {
+        use super::super::{Channel, Document, Edit, EllipsoidProperty};
+        let mut scene = moving(Motion::default());
+        Arc::make_mut(&mut scene.ellipsoids[0]).motion = None;
+        let key = |property| Channel::Ellipsoid { id: 1, property };
+        scene
+            .animation
+            .key(key(EllipsoidProperty::Center), 0.0, vec![0.0, 1.0, 0.0]);
+        scene
+            .animation
+            .key(key(EllipsoidProperty::Center), 2.0, vec![4.0, 1.0, 0.0]);
+        scene
+            .animation
+            .key(key(EllipsoidProperty::Strength), 0.0, vec![0.5]);
+        let mut doc = Document::new(scene);
+        doc.set_time(1.0);
+        assert_eq!(doc.scene().ellipsoids[0].center.x, 2.0);
+        let mut list = doc.scene().ellipsoids.clone();
+        Arc::make_mut(&mut list[0]).motion = Some(Motion {
+            rise: 1.0,
+            ..Default::default()
+        });
+        assert!(doc.apply(Edit::SetEllipsoids(list), None));
+        let tracks: Vec<Channel> = doc
+            .scene()
+            .animation
+            .tracks
+            .iter()
+            .map(|t| t.channel)
+            .collect();
+        assert_eq!(tracks, [key(EllipsoidProperty::Strength)]);
+        // It starts where it stood and rises from there.
+        assert_eq!(doc.scene().ellipsoids[0].center, Vec3::new(2.0, 1.0, 0.0));
+        doc.set_time(2.0);
+        assert_eq!(doc.scene().ellipsoids[0].center, Vec3::new(2.0, 2.0, 0.0));
     }
 }

@@ -45,6 +45,10 @@ pub fn set_by_pointer(scene: &Scene, assignment: &str) -> Result<(Scene, Vec<Str
     if let (Some(map), Ok(clock)) = (doc.as_object_mut(), serde_json::to_value(scene.clock)) {
         map.entry("clock").or_insert(clock);
     }
+    // So is a calm wind field's.
+    if let (Some(map), Ok(wind)) = (doc.as_object_mut(), serde_json::to_value(scene.wind_field)) {
+        map.entry("wind_field").or_insert(wind);
+    }
     let slot = doc
         .pointer_mut(path)
         .ok_or_else(|| SetError::UnknownPath(path.to_string()))?;
@@ -67,15 +71,14 @@ pub fn set_by_pointer(scene: &Scene, assignment: &str) -> Result<(Scene, Vec<Str
     })?;
     // A stroke set point by point lands on its grid, as one drawn in the app.
     set.snap_strokes();
-    // A new time, new keys, a new motion or wind field pose the keyed and moving values; any
-    // other value set stands as set.
-    if path == "/time"
-        || path.starts_with("/animation")
-        || path.starts_with("/wind_field")
-        || path.contains("/motion")
-    {
+    // A new time or new keys pose the keyed and moving values; any other value set stands as
+    // set, as an edit in the app does: a moving ellipsoid set elsewhere starts where it must to
+    // stand there, one given a new motion or wind moves by it.
+    if path == "/time" || path.starts_with("/animation") {
         let t = set.time;
         set.pose(t);
+    } else {
+        set.rebase_motion(scene);
     }
     Ok((set, repairs))
 }

@@ -101,7 +101,7 @@ impl Sources {
     /// The parcels of `scene` (its visible ellipsoids) as its keys and motion move them from
     /// time 0 on, whatever its time.
     pub fn of(scene: &crate::scene::Scene) -> Self {
-        use crate::scene::Channel;
+        use crate::scene::{Channel, EllipsoidProperty};
         if !scene.is_animated() {
             return Self::fixed(parcels(scene));
         }
@@ -110,7 +110,19 @@ impl Sources {
             .animation
             .tracks
             .iter()
-            .filter(|t| matches!(t.channel, Channel::Ellipsoid { .. }))
+            // What places a parcel: where it stands, its size, turn and visibility.
+            .filter(|t| {
+                matches!(
+                    t.channel,
+                    Channel::Ellipsoid {
+                        property: EllipsoidProperty::Center
+                            | EllipsoidProperty::Radii
+                            | EllipsoidProperty::Rotation
+                            | EllipsoidProperty::Visible,
+                        ..
+                    }
+                )
+            })
             .cloned()
             .collect();
         let moves = !keyed.is_empty() || start.ellipsoids.iter().any(|e| e.motion.is_some());

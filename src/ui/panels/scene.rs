@@ -173,9 +173,13 @@ fn ellipsoid_list(ui: &mut Ui, doc: &mut Document, selection: &mut Selection) {
     let mut e = (*doc.scene().ellipsoids[i]).clone();
     ui.label(egui::RichText::new(format!("Ellipsoid {}", i + 1)).strong());
     vec3_fields(ui, "centre", &mut e.center, 0.05);
+    let radii = e.radii;
     vec3_fields(ui, "radii", &mut e.radii, 0.02);
     rotation_fields(ui, &mut e.rotation);
-    e.radii = e.radii.max(glam::Vec3::splat(0.01));
+    if e.radii != radii {
+        // (Only a typed size: a shrinking moving one may be smaller than a field allows.)
+        e.radii = e.radii.max(glam::Vec3::splat(0.01));
+    }
     ui.add(egui::Slider::new(&mut e.strength, -2.0..=2.0).text("strength"))
         .on_hover_text("How much it adds to the cloud; below zero it carves the cloud away");
     super::sketch::billows_controls(ui, &mut e.billows);
@@ -187,8 +191,9 @@ fn ellipsoid_list(ui: &mut Ui, doc: &mut Document, selection: &mut Selection) {
         set_motion(doc, selection, i, e.motion);
         return;
     }
-    if e.motion.is_some() {
-        wind_field_controls(ui, doc);
+    if e.motion.is_some() && wind_field_controls(ui, doc) {
+        // The wind moved the ellipsoids: `e` is where this one stood before.
+        return;
     }
     if e != *doc.scene().ellipsoids[i] {
         ellipsoids::set(doc, i, e, Some("ellipsoid"));
@@ -249,8 +254,8 @@ fn set_motion(doc: &mut Document, selection: &Selection, shown: usize, motion: O
     doc.apply(Edit::SetEllipsoids(list), Some("motion"));
 }
 
-/// The wind field that carries every moving ellipsoid.
-fn wind_field_controls(ui: &mut Ui, doc: &mut Document) {
+/// The wind field that carries every moving ellipsoid; returns whether it changed.
+fn wind_field_controls(ui: &mut Ui, doc: &mut Document) -> bool {
     let mut w = doc.scene().wind_field;
     ui.label("Wind field (every moving ellipsoid)");
     ui.indent("wind field", |ui| {
@@ -260,9 +265,7 @@ fn wind_field_controls(ui: &mut Ui, doc: &mut Document) {
         crate::ui::widgets::param(ui, &mut w.shear, &limits::PARTICLE_SHEAR);
         crate::ui::widgets::param(ui, &mut w.turbulence, &limits::PARTICLE_TURBULENCE);
     });
-    if w != doc.scene().wind_field {
-        doc.apply(Edit::SetWindField(w), Some("wind field"));
-    }
+    w != doc.scene().wind_field && doc.apply(Edit::SetWindField(w), Some("wind field"))
 }
 
 /// What a scene holds, in words: "2 outlines, 1 cut, 6 ellipsoids".
