@@ -125,6 +125,13 @@ pub struct CloudApp {
     autosave: Option<Autosave>,
     /// Open, Save, Copy link and the unsaved marker.
     files: SceneFiles,
+    /// Cached playback of the frame range.
+    flipbook: super::flipbook::Flipbook,
+    /// When the last frame played (the app's clock), while playing.
+    last_tick: Option<f64>,
+    /// The cache's next capture, asked for once the view has drawn the frame's time (and a
+    /// simulation has caught up with it): its size, and frames waited.
+    flipbook_capture: Option<([u32; 2], u32)>,
 }
 
 impl CloudApp {
@@ -178,6 +185,9 @@ impl CloudApp {
             last_status: None,
             cpu_seconds: None,
             published: None,
+            flipbook: Default::default(),
+            last_tick: None,
+            flipbook_capture: None,
         }
     }
 
@@ -274,6 +284,7 @@ impl CloudApp {
                     &self.files.name,
                 );
                 if ask.capture.is_some() {
+                    self.stop_caching(now, "Caching stopped for the PNG export");
                     self.viewport.capture_request = ask.capture;
                 }
             }
@@ -354,12 +365,88 @@ impl CloudApp {
             &self.files.name,
         );
         if ask.capture.is_some() {
+            let now = ui.input(|i| i.time);
+            self.stop_caching(now, "Caching stopped for the PNG export");
             self.viewport.capture_request = ask.capture;
         }
         if ask.cancel_capture {
             self.viewport.cancel_capture();
         }
         self.selection.retain_valid(self.doc.scene());
+    }
+
+    /// Cached playback: starts or cancels caching as the timeline asked, advances it a frame
+    /// at a time through the viewport's capture, and while playing hands the viewport the
+    /// kept frame of the time, if it is still what the view shows.
+    fn cache_frames(&mut self, ctx: &egui::Context, now: f64) {
+        let timeline = &mut self.panels.timeline;
+        if std::mem::take(&mut timeline.cache_asked) && !self.flipbook.building() {
+            timeline.playing = false;
+            self.viewport.cancel_capture();
+            if let Some(said) = self
+                .flipbook
+                .start(self.doc.scene(), self.viewport.stats.viewport_px)
+            {
+                self.notices.note(now, said);
+            }
+        }
+        if std::mem::take(&mut self.panels.timeline.cache_cancel) {
+            self.stop_caching(now, "Caching cancelled: the frames cached so far are kept");
+        }
+        if self.flipbook.building() {
+            self.panels.timeline.playing = false;
+            // The capture's pixels, once the asked frame's came back.
+            let captured =
+                if self.flipbook_capture.is_none() && self.viewport.capture_progress().is_none() {
+                    self.viewport.captured.take().map(|(_, pixels)| pixels)
+                } else {
+                    None
+                };
+            let ask = self.flipbook.step(ctx, self.doc.scene(), captured);
+            if let Some(t) = ask.time {
+                self.doc.set_time(t);
+            }
+            if let Some(size) = ask.capture {
+                self.flipbook_capture = Some((size, 0));
+            }
+            if let Some(said) = ask.say {
+                self.notices.note(now, said);
+            }
+            // Asked once the view has derived the frame's time (a simulation caught up).
+            if let Some((size, waited)) = self.flipbook_capture {
+                if waited >= 1 && !self.viewport.stats.catching_up {
+                    self.viewport.capture_request = Some((size, false));
+                    self.flipbook_capture = None;
+                } else {
+                    self.flipbook_capture = Some((size, waited + 1));
+                }
+            }
+            ctx.request_repaint();
+        }
+        self.viewport.caching = self.flipbook.building();
+        if self.flipbook.building() {
+            self.viewport.flipbook = self.flipbook.latest().cloned();
+            self.flipbook.showing = false;
+            return;
+        }
+        let shown = (self.panels.timeline.playing && !self.viewport.capturing())
+            .then(|| self.flipbook.frame(self.doc.scene()).cloned())
+            .flatten();
+        self.flipbook.showing = shown.is_some();
+        if shown.is_some() {
+            self.flipbook.shown += 1;
+        }
+        self.viewport.flipbook = shown;
+    }
+
+    /// Stops caching, if it runs, back at the time it began from.
+    fn stop_caching(&mut self, now: f64, why: &str) {
+        if let Some(t) = self.flipbook.cancel() {
+            self.flipbook_capture = None;
+            self.viewport.cancel_capture();
+            self.doc.set_time(t);
+            self.notices.note(now, why);
+        }
     }
 
     /// The timeline under the view, or the button that shows it again.
@@ -386,6 +473,8 @@ impl CloudApp {
             .exact_size(height)
             .show(ui, |ui| {
                 ui.add_space(2.0);
+                self.panels.timeline.cache_progress = self.flipbook.progress();
+                self.panels.timeline.cache_kept = self.flipbook.kept().0;
                 if let Some(said) = self.panels.timeline.ui(ui, &mut self.doc, &self.selection) {
                     self.notices.note(now, said);
                 }
@@ -565,6 +654,7 @@ impl CloudApp {
         view["catching_up"] = stats.catching_up.into();
         view["light_preview"] = serde_json::json!(stats.light_preview);
         view["timeline"] = super::panels::timeline_state(&self.panels.timeline, &self.doc);
+        view["timeline"]["cache"] = self.flipbook.state();
         view["through_shot"] = self.panels.view.through_shot.into();
         let state = format!("{{\"scene\":{scene_json},\"view\":{view}}}");
         let status = PageStatus {
@@ -626,11 +716,11 @@ impl eframe::App for CloudApp {
         let ctx = ui.ctx().clone();
         let pressed = super::shortcuts::take(&ctx, self.tool.modal_active());
         self.shortcuts(&ctx, &pressed.before_pointer);
-        if self
-            .panels
-            .timeline
-            .tick(&mut self.doc, ctx.input(|i| i.stable_dt))
-        {
+        // Playing follows the wall clock (egui's stable dt is a prediction after each wait).
+        let wall = ctx.input(|i| i.time);
+        let dt = self.last_tick.map_or(0.0, |t| (wall - t) as f32);
+        self.last_tick = self.panels.timeline.playing.then_some(wall);
+        if self.panels.timeline.tick(&mut self.doc, dt) {
             ctx.request_repaint();
         }
         self.arrivals(&ctx);
@@ -641,6 +731,7 @@ impl eframe::App for CloudApp {
         if self.panels.export.step(&mut self.notices, now) {
             ctx.request_repaint();
         }
+        self.cache_frames(&ctx, now);
         self.panels.export.capture_progress = self.viewport.capture_progress().unwrap_or(0.0);
         if let Some((size, pixels)) = self.viewport.captured.take() {
             self.panels

@@ -27,6 +27,7 @@ mod app;
 mod autosave;
 mod camera_input;
 mod ellipsoids;
+mod flipbook;
 mod gizmo;
 mod guide;
 mod notice;

@@ -17,6 +17,9 @@ use crate::render::crop::{OUTSIDE_SHAFTS_DIVISOR, PixelCrop};
 /// Seconds of a frame an export's capture may take (the rest is the view's: a drag during an
 /// export keeps its frames).
 const CAPTURE_BUDGET: f64 = 0.04;
+/// The same while cached playback caches (the view renders nothing else): within the
+/// interactive frame's 0.3 s.
+const CACHE_BUDGET: f64 = 0.2;
 use crate::derive::PUFFS_OVER_CAP;
 use crate::render::progressive::{Budget, Progressive};
 use crate::render::viewport::{BackdropPaint, ShaftsApart, ViewportPaint, paint_callback};
@@ -57,12 +60,22 @@ pub struct Viewport {
     capture_geometry: u64,
     /// A finished capture: its size and pixels (straight-alpha RGBA), or why it failed.
     pub captured: Option<([u32; 2], Result<Vec<u8>, String>)>,
+    /// A kept frame of cached playback to show instead of rendering (this frame only).
+    pub flipbook: Option<egui::TextureHandle>,
+    /// Cached playback is caching: the view renders nothing of its own (its capture renders
+    /// each frame), so the capture may take most of a frame.
+    pub caching: bool,
 }
 
 impl Viewport {
     /// The share of the capture under way that is done, if one is.
     pub fn capture_progress(&self) -> Option<f32> {
         self.capture.as_ref().map(Capture::progress)
+    }
+
+    /// Whether a capture is asked for or under way.
+    pub fn capturing(&self) -> bool {
+        self.capture.is_some() || self.capture_request.is_some()
     }
 
     /// Drops the capture under way (the export was cancelled): nothing more is drawn for it.
@@ -115,6 +128,8 @@ impl Viewport {
             capture: None,
             capture_geometry: 0,
             captured: None,
+            flipbook: None,
+            caching: false,
         }
     }
 
@@ -201,6 +216,40 @@ impl Viewport {
             || view.render.light_octaves != scene.render.light_octaves)
             .then_some([view.render.light_resolution, view.render.light_octaves]);
         guide.paint(&painter, rect, cx.doc, false);
+        let frame = self.flipbook.take();
+        if frame.is_some() || self.caching {
+            // Cached playback: the kept frame (while caching, the last one cached), nothing
+            // rendered but the cache's capture.
+            if let Some(frame) = frame {
+                let uv = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
+                painter.image(frame.id(), rect, uv, Color32::WHITE);
+            }
+            if self.capturing() {
+                let volumes = cx.derived.update(scene, cx.doc.revisions());
+                self.stats.catching_up = cx.derived.catching_up;
+                // At the view's own quality (its light previewed on a CPU adapter): the
+                // frames play where the view shows them.
+                let capture = self.drive_capture(ui, &mut cx, &view, CACHE_BUDGET);
+                if let Some(capture) = capture.filter(|_| self.stats.backend.is_some()) {
+                    painter.add(paint_callback(
+                        rect,
+                        ViewportPaint {
+                            volumes,
+                            job: None,
+                            display: None,
+                            capture: Some(capture),
+                            fence: None,
+                            job_id: 0,
+                            own_submission: false,
+                            crop: crate::render::FULL_VIEW,
+                        },
+                    ));
+                }
+            }
+            let now = ui.input(|i| i.time);
+            self.overlays(ui, rect, &mut cx, tool, guide, now);
+            return;
+        }
 
         let ppp = ui.ctx().pixels_per_point();
         let px = [
@@ -336,40 +385,7 @@ impl Viewport {
         if plan.shown.is_some_and(|q| q.full) {
             self.ready = true;
         }
-        if let Some((size, transparent)) = self.capture_request.take() {
-            // Its slices spread over frames within a frame's budget, as refinement's are.
-            let pixels = size[0] as u64 * size[1] as u64;
-            let chunks = capture_chunks(
-                pixels,
-                view.render.slices,
-                self.progressive.cost(),
-                CAPTURE_BUDGET,
-            );
-            self.capture = Some(Capture::new(&exported, size, transparent, chunks));
-            self.capture_geometry = cx.doc.revisions().geometry;
-        }
-        // The clouds changed while the capture was drawn (a move, a stroke, the simulation):
-        // its chunks would show two different clouds, so it starts over with the change (with
-        // the camera and the light it was asked with).
-        let geometry = cx.doc.revisions().geometry;
-        if let Some(capture) = self.capture.as_ref().filter(|c| c.drawing())
-            && geometry != self.capture_geometry
-        {
-            self.capture = Some(capture.restart());
-            self.capture_geometry = geometry;
-            cx.notices.note(
-                now,
-                "The clouds changed during the PNG export: it starts over with the change",
-            );
-        }
-        if let Some(capture) = &self.capture {
-            if let Some(result) = capture.take() {
-                self.captured = Some((capture.size, result));
-                self.capture = None;
-            } else {
-                ui.ctx().request_repaint();
-            }
-        }
+        self.drive_capture(ui, &mut cx, &exported, CAPTURE_BUDGET);
         let capture = self.capture.clone();
         if crop.is_none() && capture.is_some() && self.stats.backend.is_some() {
             // Nothing of the cloud in view: the capture still needs the callback to run.
@@ -424,6 +440,68 @@ impl Viewport {
             // The GPU's report wakes the UI; this is in case it never comes.
             ui.ctx().request_repaint_after(FENCE_POLL);
         }
+        self.overlays(ui, rect, &mut cx, tool, guide, now);
+    }
+
+    /// Starts the capture asked for (its slices spread over frames within `budget` seconds
+    /// of each), starts it over when the clouds changed under it, and hands a finished one to
+    /// `captured`; returns the capture still under way.
+    fn drive_capture(
+        &mut self,
+        ui: &egui::Ui,
+        cx: &mut ToolContext<'_>,
+        exported: &View,
+        budget: f64,
+    ) -> Option<Capture> {
+        let now = ui.input(|i| i.time);
+        if let Some((size, transparent)) = self.capture_request.take() {
+            // Its slices spread over frames within a frame's budget, as refinement's are.
+            let pixels = size[0] as u64 * size[1] as u64;
+            let chunks = capture_chunks(
+                pixels,
+                exported.render.slices,
+                self.progressive.cost(),
+                budget,
+            );
+            self.capture = Some(Capture::new(exported, size, transparent, chunks));
+            self.capture_geometry = cx.doc.revisions().geometry;
+        }
+        // The clouds changed while the capture was drawn (a move, a stroke, the simulation):
+        // its chunks would show two different clouds, so it starts over with the change (with
+        // the camera and the light it was asked with).
+        let geometry = cx.doc.revisions().geometry;
+        if let Some(capture) = self.capture.as_ref().filter(|c| c.drawing())
+            && geometry != self.capture_geometry
+        {
+            self.capture = Some(capture.restart());
+            self.capture_geometry = geometry;
+            cx.notices.note(
+                now,
+                "The clouds changed during the PNG export: it starts over with the change",
+            );
+        }
+        if let Some(capture) = &self.capture {
+            if let Some(result) = capture.take() {
+                self.captured = Some((capture.size, result));
+                self.capture = None;
+            } else {
+                ui.ctx().request_repaint();
+            }
+        }
+        self.capture.clone()
+    }
+
+    /// What is drawn over the cloud: guides in front, the status line, the tool's overlay and
+    /// the sun handle.
+    fn overlays(
+        &self,
+        ui: &mut egui::Ui,
+        rect: egui::Rect,
+        cx: &mut ToolContext<'_>,
+        tool: &mut Toolbox,
+        guide: &mut Guide,
+        now: f64,
+    ) {
         guide.paint(&ui.painter_at(rect), rect, cx.doc, true);
         self.status_line(ui, rect, cx.doc, cx.notices, now);
         tool.overlay(ui, rect, cx.doc, cx.derived, cx.selection);

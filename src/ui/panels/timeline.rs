@@ -58,6 +58,14 @@ pub struct Timeline {
     pub drawn: Vec<(f32, f32)>,
     /// The height the keys were drawn at.
     pub keys_y: f32,
+    /// Cached playback's progress (frames done of the range's) while it caches.
+    pub cache_progress: Option<(usize, usize)>,
+    /// Frames cached.
+    pub cache_kept: usize,
+    /// Cache was pressed: cache the range.
+    pub cache_asked: bool,
+    /// Cancel was pressed while caching.
+    pub cache_cancel: bool,
 }
 
 impl Default for Timeline {
@@ -74,6 +82,10 @@ impl Default for Timeline {
             drag: None,
             drawn: Vec::new(),
             keys_y: 0.0,
+            cache_progress: None,
+            cache_kept: 0,
+            cache_asked: false,
+            cache_cancel: false,
         }
     }
 }
@@ -259,8 +271,8 @@ impl Timeline {
     /// the panel is laid out at its height from the first frame (egui sizes a panel from the
     /// frame before: the view's first frame was 38 points too tall under two rows).
     pub fn fit(&mut self, width: f32) -> f32 {
-        // The controls left of the bar take about 380 points, the range and rate 230.
-        self.narrow = width < 380.0 + 240.0 + 230.0;
+        // The controls left of the bar take about 470 points, the range and rate 230.
+        self.narrow = width < 470.0 + 240.0 + 230.0;
         if self.narrow { 63.0 } else { 36.0 }
     }
 
@@ -324,6 +336,27 @@ impl Timeline {
             mark(ui, "timeline:auto", auto_r.rect);
             if auto_r.changed() {
                 doc.set_auto_key(auto);
+            }
+            // Cached playback: the range rendered once at full quality, then played from it.
+            let cache = match self.cache_progress {
+                Some((done, of)) => ui
+                    .add_sized([84.0, 20.0], egui::Button::new(format!("Stop {done}/{of}")))
+                    .on_hover_text("Caching the range at full quality: click to cancel (the frames cached so far are kept)"),
+                None => ui
+                    .add_sized([84.0, 20.0], egui::Button::new(if self.cache_kept > 0 {
+                        format!("Cache ({})", self.cache_kept)
+                    } else {
+                        "Cache".to_owned()
+                    }))
+                    .on_hover_text("Render every frame of the range at full quality once, then Play shows them at the frame rate (an edit re-renders only the frames it changes)"),
+            };
+            mark(ui, "timeline:cache", cache.rect);
+            if cache.clicked() {
+                if self.cache_progress.is_some() {
+                    self.cache_cancel = true;
+                } else {
+                    self.cache_asked = true;
+                }
             }
             // The range and the rate at the right (or under it), the bar between.
             let right = if narrow { 0.0 } else { 230.0 };

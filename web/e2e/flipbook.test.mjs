@@ -1,0 +1,80 @@
+// Cached playback (a flipbook) in the browser, driven as a user drives it at 1280×800: Cache
+// renders every frame of the range once (progress on the timeline, the page answering
+// meanwhile), Play then shows the kept frames at the document's frame rate; caching again
+// with nothing changed renders nothing, and an edit that changes every frame renders them all
+// again. The quality is lowered to 16 slices first (setup) so the run fits the suite's time.
+// Screenshots: test-results/screenshots/flipbook-*.png.
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import { serve, state, screenshot, until, withApp } from './harness.mjs';
+
+let server;
+before(async () => { server = await serve(); });
+after(async () => { await server?.close(); });
+
+const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+
+async function click(page, name) {
+  const [x, y, w, h] = (await state(page)).view.widgets[name];
+  await page.mouse.click(x + w / 2, y + h / 2);
+}
+
+for (const backend of ['webgpu', 'webgl2']) {
+  test(`Cache renders the range once, Play shows the cached frames at the frame rate, an edit re-renders what it changes (${backend})`, { timeout: 600_000 }, async () => {
+    await withApp({ base: server.url, webgpu: backend === 'webgpu', query: '?preset=developing', viewport: { width: 1280, height: 800 } }, async (page) => {
+      await page.evaluate(() => { window.cloudsketch.set('/clock/end=23'); window.cloudsketch.set('/render/slices=16'); });
+      let s = await until(page, (s) => s.scene.clock.end === 23 && s.scene.render.slices === 16, 'a 24-frame range');
+      assert.equal(s.view.timeline.cache.frames, 0);
+
+      await click(page, 'timeline:cache');
+      s = await until(page, (s) => s.view.timeline.cache.building, 'caching');
+      // The page answers while it caches: the progress moves on, frame by frame.
+      const seen = new Set();
+      s = await until(page, (s) => {
+        const p = s.view.timeline.cache.progress;
+        if (p) seen.add(p[0]);
+        return !s.view.timeline.cache.building;
+      }, 'cached', 420_000);
+      assert.equal(s.view.timeline.cache.frames, 24, JSON.stringify(s.view.timeline.cache));
+      assert.ok(seen.size >= 4, `progress seen at ${[...seen]}`);
+      assert.match(s.view.notice.text, /Cached 24 frames/);
+      assert.equal(Math.round(s.view.timeline.frame), 0, 'back where it began');
+
+      // Loop and Play: the time runs at 24 frames a second and the kept frames are shown.
+      await click(page, 'timeline:loop');
+      await click(page, 'timeline:play');
+      await sleep(500);
+      // Frames played (the range loops every 24), summed over page-state reads a few frames
+      // apart.
+      const a = await state(page);
+      let prev = a.view.timeline.frame, played = 0, b = a;
+      const t0 = Date.now();
+      while (Date.now() - t0 < 3000) {
+        await sleep(100);
+        b = await state(page);
+        played += (b.view.timeline.frame - prev + 24) % 24;
+        prev = b.view.timeline.frame;
+      }
+      const seconds = (Date.now() - t0) / 1000;
+      await screenshot(page, `flipbook-1-playing-${backend}`);
+      assert.ok(Math.abs(played / seconds - 24) < 4, `${played.toFixed(1)} frames in ${seconds} s`);
+      assert.ok(b.view.timeline.cache.showing, 'a cached frame shown');
+      const shown = b.view.timeline.cache.shown - a.view.timeline.cache.shown;
+      assert.ok(shown >= 5, `cached frames drawn: ${shown}`);
+      await click(page, 'timeline:play');
+      s = await until(page, (s) => !s.view.timeline.playing, 'paused');
+
+      // Nothing changed: caching again renders nothing.
+      await click(page, 'timeline:cache');
+      s = await until(page, (s) => !s.view.timeline.cache.building && /Cached 24 frames/.test(s.view.notice.text) && s.view.timeline.cache.frames === 24, 'nothing to cache', 30_000);
+      // The sun lower: every frame changes, and every frame is rendered again.
+      await page.evaluate(() => window.cloudsketch.set('/light/sun_elevation_deg=15'));
+      await until(page, (s) => s.scene.light.sun_elevation_deg === 15, 'sun lower');
+      await click(page, 'timeline:cache');
+      s = await until(page, (s) => s.view.timeline.cache.progress?.[0] === 0 && s.view.timeline.cache.progress?.[1] === 24, 'every frame again');
+      await click(page, 'timeline:cache');
+      s = await until(page, (s) => !s.view.timeline.cache.building, 'cancelled');
+      assert.match(s.view.notice.text, /Caching cancelled/);
+    });
+  });
+}
