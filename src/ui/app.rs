@@ -381,13 +381,21 @@ impl CloudApp {
     fn cache_frames(&mut self, ctx: &egui::Context, now: f64) {
         let timeline = &mut self.panels.timeline;
         if std::mem::take(&mut timeline.cache_asked) && !self.flipbook.building() {
-            timeline.playing = false;
-            self.viewport.cancel_capture();
-            if let Some(said) = self
-                .flipbook
-                .start(self.doc.scene(), self.viewport.stats.viewport_px)
-            {
-                self.notices.note(now, said);
+            if self.viewport.stats.backend.is_none() {
+                self.notices
+                    .error(now, "No GPU renderer: there is nothing to cache");
+            } else if self.viewport.capturing() {
+                // The PNG export's capture: it finishes first.
+                self.notices
+                    .note(now, "A PNG export is under way: cache when it is done");
+            } else {
+                timeline.playing = false;
+                if let Some(said) = self
+                    .flipbook
+                    .start(self.doc.scene(), self.viewport.stats.viewport_px)
+                {
+                    self.notices.note(now, said);
+                }
             }
         }
         if std::mem::take(&mut self.panels.timeline.cache_cancel) {
@@ -395,7 +403,19 @@ impl CloudApp {
         }
         if self.flipbook.building() {
             self.panels.timeline.playing = false;
-            // The capture's pixels, once the asked frame's came back.
+            // The time stays on the frame being cached (a scrub meanwhile is taken back, and
+            // its capture started again).
+            if let Some(t) = self.flipbook.waiting_time(self.doc.scene())
+                && t != self.doc.scene().time
+            {
+                self.doc.set_time(t);
+                if self.flipbook_capture.is_none() {
+                    self.viewport.cancel_capture();
+                    self.flipbook_capture = Some((self.flipbook.size(), 0));
+                }
+            }
+            // The capture's pixels, once the asked frame's came back (only the cache asks
+            // for captures while it caches: a PNG export stops it first).
             let captured =
                 if self.flipbook_capture.is_none() && self.viewport.capture_progress().is_none() {
                     self.viewport.captured.take().map(|(_, pixels)| pixels)
@@ -430,7 +450,11 @@ impl CloudApp {
             return;
         }
         let shown = (self.panels.timeline.playing && !self.viewport.capturing())
-            .then(|| self.flipbook.frame(self.doc.scene()).cloned())
+            .then(|| {
+                self.flipbook
+                    .frame(self.doc.scene(), self.viewport.stats.viewport_px)
+                    .cloned()
+            })
             .flatten();
         self.flipbook.showing = shown.is_some();
         if shown.is_some() {
@@ -443,6 +467,8 @@ impl CloudApp {
     fn stop_caching(&mut self, now: f64, why: &str) {
         if let Some(t) = self.flipbook.cancel() {
             self.flipbook_capture = None;
+            // A frame's capture finished or under way is the cache's: nobody else takes it.
+            self.viewport.captured = None;
             self.viewport.cancel_capture();
             self.doc.set_time(t);
             self.notices.note(now, why);

@@ -21,6 +21,9 @@ pub const MEMORY_CAP: usize = 512 << 20;
 /// Smallest share of the view's side a frame is cached at.
 const MIN_SCALE: f32 = 0.25;
 
+/// Most frames cached (a range of a day at 120 frames a second has ten million).
+const MAX_FRAMES: usize = 10_000;
+
 /// One kept frame.
 struct Frame {
     key: u64,
@@ -32,8 +35,8 @@ struct Frame {
 struct Build {
     /// Frames still to render, in order.
     todo: Vec<u32>,
-    /// The frame whose capture is under way.
-    waiting: Option<u32>,
+    /// The frame whose capture is under way, with the key of what it was asked to show.
+    waiting: Option<(u32, u64)>,
     /// The time to go back to when done.
     time: f32,
     /// Frames in the range.
@@ -47,6 +50,8 @@ pub struct Flipbook {
     build: Option<Build>,
     /// The pixel size frames are cached at.
     size: [u32; 2],
+    /// The view's size they were cached for.
+    view_px: [u32; 2],
     /// Cached frames shown while playing (the page test counts them).
     pub shown: u64,
     /// Whether the last frame drawn was a cached one.
@@ -87,8 +92,20 @@ pub fn frame_key(scene: &Scene, t: f32, size: [u32; 2]) -> u64 {
     } else {
         scene.posed_at(t)
     };
+    // Looking through a keyed shot camera, the view is the shot's at that time.
+    if scene.shot.as_ref() == Some(&scene.camera)
+        && let Some(shot) = &at.shot
+    {
+        at.camera = shot.clone();
+    }
     let drift = crate::field::media::Drift::of(&at);
-    at.animation = Default::default();
+    // A simulation's run is steered by its parcels' keys from time 0 on: there the keys are
+    // part of the frame.
+    if at.simulation.is_none() {
+        at.animation = Default::default();
+    }
+    // The picture traced is no part of the frame (and may be megabytes).
+    at.reference = None;
     let mut h = Hashing(Default::default());
     // (A scene always serialises; a failure only makes the key differ from every frame's.)
     let _ = serde_json::to_writer(&mut h, &at);
@@ -128,25 +145,34 @@ impl Flipbook {
     /// whose kept image no longer matches are rendered again, the rest kept.
     pub fn start(&mut self, scene: &Scene, view_px: [u32; 2]) -> Option<String> {
         let clock = scene.clock;
-        let all: Vec<u32> = (clock.start..=clock.end).collect();
-        // Within the memory cap: smaller frames, then fewer.
-        let full = view_px[0] as usize * view_px[1] as usize * 4;
-        let fit = (MEMORY_CAP as f32 / (full * all.len()).max(1) as f32).sqrt();
+        let count = (clock.end.saturating_sub(clock.start) as usize).saturating_add(1);
+        // Within the memory cap: smaller frames, then fewer (in f64: usize is 32 bits on
+        // the web).
+        let full = f64::from(view_px[0]) * f64::from(view_px[1]) * 4.0;
+        let fit = (MEMORY_CAP as f64 / (full * count as f64).max(1.0)).sqrt() as f32;
         let scale = fit.clamp(MIN_SCALE, 1.0);
         let size = view_px.map(|v| ((v as f32 * scale).round() as u32).max(1));
-        let each = size[0] as usize * size[1] as usize * 4;
-        let room = (MEMORY_CAP / each.max(1)).max(1);
+        let each = f64::from(size[0]) * f64::from(size[1]) * 4.0;
+        let room = ((MEMORY_CAP as f64 / each.max(1.0)) as usize).clamp(1, MAX_FRAMES);
         let mut said = None;
-        if size != self.size {
+        if size != self.size || view_px != self.view_px {
             self.frames.clear();
             self.size = size;
+            self.view_px = view_px;
         }
-        let frames: Vec<u32> = all.iter().copied().take(room).collect();
-        if frames.len() < all.len() {
+        let last = clock
+            .start
+            .saturating_add(room.min(count) as u32)
+            .saturating_sub(1)
+            .min(clock.end);
+        let frames: Vec<u32> = (clock.start..=last).collect();
+        if frames.len() < count {
             said = Some(format!(
-                "Caching the first {} of {} frames at a quarter size: the cache holds at most {} MB",
+                "Caching the first {} of {} frames at {}×{}: the cache holds at most {} MB",
                 frames.len(),
-                all.len(),
+                count,
+                size[0],
+                size[1],
                 MEMORY_CAP >> 20
             ));
         } else if scale < 1.0 {
@@ -158,7 +184,7 @@ impl Flipbook {
                 MEMORY_CAP >> 20
             ));
         }
-        self.frames.retain(|f, _| frames.contains(f));
+        self.frames.retain(|f, _| (clock.start..=last).contains(f));
         let todo: Vec<u32> = frames
             .iter()
             .copied()
@@ -178,6 +204,17 @@ impl Flipbook {
         said
     }
 
+    /// The pixel size frames are cached at.
+    pub fn size(&self) -> [u32; 2] {
+        self.size
+    }
+
+    /// The time of the frame being cached, if one is.
+    pub fn waiting_time(&self, scene: &Scene) -> Option<f32> {
+        let (frame, _) = self.build.as_ref()?.waiting?;
+        Some(scene.clock.seconds(frame))
+    }
+
     /// Stops caching (the frames kept so far stay); returns the time to go back to.
     pub fn cancel(&mut self) -> Option<f32> {
         self.build.take().map(|b| b.time)
@@ -195,11 +232,13 @@ impl Flipbook {
             return Ask::default();
         };
         let mut ask = Ask::default();
-        if let (Some(frame), Some(result)) = (build.waiting, captured) {
+        if let (Some((frame, asked)), Some(result)) = (build.waiting, captured) {
             build.waiting = None;
+            let t = scene.clock.seconds(frame);
             match result {
+                // The scene changed while it was drawn (an orbit, an edit): drawn again.
+                Ok(_) if frame_key(scene, t, self.size) != asked => build.todo.push(frame),
                 Ok(pixels) => {
-                    let t = scene.clock.seconds(frame);
                     let image = egui::ColorImage::from_rgba_unmultiplied(
                         self.size.map(|v| v as usize),
                         &pixels,
@@ -213,7 +252,7 @@ impl Flipbook {
                     self.frames.insert(
                         frame,
                         Frame {
-                            key: frame_key(scene, t, self.size),
+                            key: asked,
                             texture,
                             bytes: pixels.len(),
                         },
@@ -232,8 +271,9 @@ impl Flipbook {
         if build.waiting.is_none() {
             match build.todo.pop() {
                 Some(frame) => {
-                    build.waiting = Some(frame);
-                    ask.time = Some(scene.clock.seconds(frame));
+                    let t = scene.clock.seconds(frame);
+                    build.waiting = Some((frame, frame_key(scene, t, self.size)));
+                    ask.time = Some(t);
                     ask.capture = Some(self.size);
                 }
                 None => {
@@ -252,7 +292,10 @@ impl Flipbook {
 
     /// The kept image of the frame `scene`'s time falls in (held until the next frame's
     /// time, as a flipbook holds it), if it is still what the view shows at that frame.
-    pub fn frame(&self, scene: &Scene) -> Option<&egui::TextureHandle> {
+    pub fn frame(&self, scene: &Scene, view_px: [u32; 2]) -> Option<&egui::TextureHandle> {
+        if view_px != self.view_px {
+            return None;
+        }
         let clock = scene.clock;
         let f = (clock.frame(scene.time) + 1e-3).floor();
         if !(0.0..=f64::from(u32::MAX)).contains(&f64::from(f)) {
@@ -336,20 +379,20 @@ mod tests {
         // Each frame's time shows its kept frame, and so does a time between two frames.
         for f in [0, 7, 24] {
             assert!(
-                book.frame(&scene.posed_at(scene.clock.seconds(f)))
+                book.frame(&scene.posed_at(scene.clock.seconds(f)), [8, 6])
                     .is_some(),
                 "{f}"
             );
         }
-        assert!(book.frame(&scene.posed_at(0.51)).is_some());
+        assert!(book.frame(&scene.posed_at(0.51), [8, 6]).is_some());
         // Past the range, nothing.
-        assert!(book.frame(&scene.posed_at(1.2)).is_none());
+        assert!(book.frame(&scene.posed_at(1.2), [8, 6]).is_none());
         // The key at frame 12 moved further: frames 1 to 23 change, 0 and 24 keep theirs.
         let center = scene.animation.tracks[0].channel;
         let t12 = scene.clock.seconds(12);
         scene.animation.key(center, t12, vec![9.0, 1.6, 0.0]);
-        assert!(book.frame(&scene.posed_at(t12)).is_none());
-        assert!(book.frame(&scene.posed_at(0.0)).is_some());
+        assert!(book.frame(&scene.posed_at(t12), [8, 6]).is_none());
+        assert!(book.frame(&scene.posed_at(0.0), [8, 6]).is_some());
         assert_eq!(
             cache_all(&mut book, &ctx, &mut scene),
             23,
@@ -376,6 +419,29 @@ mod tests {
         book.cancel();
         scene.clock.end = 9_999;
         let said = book.start(&scene, [1920, 1080]).unwrap();
-        assert!(said.contains("first 1035 of 10000"), "{said}");
+        assert!(
+            said.contains("first 1035 of 10000 frames at 480×270"),
+            "{said}"
+        );
+        // Another view size: nothing kept shows.
+        assert!(book.frame(&scene, [1920, 1080]).is_none());
+    }
+
+    #[test]
+    fn a_frame_whose_scene_changed_while_it_was_drawn_is_drawn_again() {
+        let ctx = egui::Context::default();
+        let mut scene = keyed();
+        scene.clock.end = 1;
+        let mut book = Flipbook::default();
+        book.start(&scene, [8, 6]);
+        let ask = book.step(&ctx, &scene, None);
+        assert_eq!((ask.time, ask.capture), (Some(0.0), Some([8, 6])));
+        // Orbited while frame 0 was captured: its pixels show the old view.
+        scene.camera.yaw_deg += 20.0;
+        let pixels = Ok(vec![0; 8 * 6 * 4]);
+        let ask = book.step(&ctx, &scene, Some(pixels));
+        assert_eq!(book.kept().0, 0, "not kept");
+        assert_eq!(ask.time, Some(0.0), "asked again");
+        assert_eq!(book.progress(), Some((0, 2)));
     }
 }

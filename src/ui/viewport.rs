@@ -58,6 +58,8 @@ pub struct Viewport {
     /// revision it draws.
     capture: Option<Capture>,
     capture_geometry: u64,
+    /// The density's generation a cache's capture was last drawn with.
+    capture_density: u64,
     /// A finished capture: its size and pixels (straight-alpha RGBA), or why it failed.
     pub captured: Option<([u32; 2], Result<Vec<u8>, String>)>,
     /// A kept frame of cached playback to show instead of rendering (this frame only).
@@ -127,6 +129,7 @@ impl Viewport {
             capture_request: None,
             capture: None,
             capture_geometry: 0,
+            capture_density: 0,
             captured: None,
             flipbook: None,
             caching: false,
@@ -216,6 +219,12 @@ impl Viewport {
             || view.render.light_octaves != scene.render.light_octaves)
             .then_some([view.render.light_resolution, view.render.light_octaves]);
         guide.paint(&painter, rect, cx.doc, false);
+        let ppp = ui.ctx().pixels_per_point();
+        let px = [
+            (rect.width() * ppp).round().max(1.0) as u32,
+            (rect.height() * ppp).round().max(1.0) as u32,
+        ];
+        self.stats.viewport_px = px;
         let frame = self.flipbook.take();
         if frame.is_some() || self.caching {
             // Cached playback: the kept frame (while caching, the last one cached), nothing
@@ -224,11 +233,23 @@ impl Viewport {
                 let uv = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
                 painter.image(frame.id(), rect, uv, Color32::WHITE);
             }
-            if self.capturing() {
+            if self.caching {
+                // The frame's time derived (a simulation steps toward it over several frames:
+                // the cache asks its capture once it has caught up).
                 let volumes = cx.derived.update(scene, cx.doc.revisions());
                 self.stats.catching_up = cx.derived.catching_up;
+                if cx.derived.catching_up {
+                    ui.ctx().request_repaint();
+                }
                 // At the view's own quality (its light previewed on a CPU adapter): the
-                // frames play where the view shows them.
+                // frames play where the view shows them. The density changing under it (a
+                // simulation) starts it over.
+                if self.capture_density != volumes.density.generation {
+                    self.capture_density = volumes.density.generation;
+                    if let Some(capture) = self.capture.as_ref().filter(|c| c.drawing()) {
+                        self.capture = Some(capture.restart());
+                    }
+                }
                 let capture = self.drive_capture(ui, &mut cx, &view, CACHE_BUDGET);
                 if let Some(capture) = capture.filter(|_| self.stats.backend.is_some()) {
                     painter.add(paint_callback(
@@ -251,12 +272,6 @@ impl Viewport {
             return;
         }
 
-        let ppp = ui.ctx().pixels_per_point();
-        let px = [
-            (rect.width() * ppp).round().max(1.0) as u32,
-            (rect.height() * ppp).round().max(1.0) as u32,
-        ];
-        self.stats.viewport_px = px;
         // The geometry, timed.
         let (before, t0) = (cx.derived.work(), super::platform::now());
         let density = cx.derived.density(scene, cx.doc.revisions());
@@ -477,7 +492,7 @@ impl Viewport {
             self.capture_geometry = geometry;
             cx.notices.note(
                 now,
-                "The clouds changed during the PNG export: it starts over with the change",
+                "The clouds changed during the capture: it starts over with the change",
             );
         }
         if let Some(capture) = &self.capture {

@@ -340,8 +340,11 @@ impl Timeline {
             // Cached playback: the range rendered once at full quality, then played from it.
             let cache = match self.cache_progress {
                 Some((done, of)) => ui
-                    .add_sized([84.0, 20.0], egui::Button::new(format!("Stop {done}/{of}")))
-                    .on_hover_text("Caching the range at full quality: click to cancel (the frames cached so far are kept)"),
+                    .add_sized(
+                        [84.0, 20.0],
+                        egui::Button::new(format!("Stop {}%", 100 * done / of.max(1))),
+                    )
+                    .on_hover_text(format!("Caching the range: {done} of {of} frames; click to stop (the frames cached so far are kept)")),
                 None => ui
                     .add_sized([84.0, 20.0], egui::Button::new(if self.cache_kept > 0 {
                         format!("Cache ({})", self.cache_kept)
