@@ -171,21 +171,29 @@ fn every_file_is_written_through_the_one_safe_writer() {
     );
 }
 
-/// The modules of `src/ui/` each file names (`super::x`, `crate::ui::x`, `super::{x, …}`),
-/// outside its unit tests; a folder (`panels/`, `tools/`) counts as one module.
-fn ui_imports() -> std::collections::BTreeMap<String, std::collections::BTreeSet<String>> {
-    let mut graph = std::collections::BTreeMap::new();
-    let modules: Vec<(String, String)> = sources()
+/// The files under `prefix` (`src/` or `src/ui/`) as (module, code before its unit tests,
+/// whether at a file's end or in a `tests.rs` of their own): a folder under it is one module,
+/// a file another.
+fn modules_under(prefix: &str) -> Vec<(String, String)> {
+    sources()
         .into_iter()
+        .filter(|(path, _)| !path.ends_with("/tests.rs"))
         .filter_map(|(path, code)| {
-            let rest = path.strip_prefix("src/ui/")?;
+            let rest = path.strip_prefix(prefix)?;
             let name = match rest.split_once('/') {
                 Some((dir, _)) => dir.to_owned(),
                 None => rest.trim_end_matches(".rs").to_owned(),
             };
             Some((name, before_tests(&code).to_owned()))
         })
-        .collect();
+        .collect()
+}
+
+/// The modules of `src/ui/` each file names (`super::x`, `crate::ui::x`, `super::{x, …}`),
+/// outside its unit tests; a folder (`panels/`, `tools/`) counts as one module.
+fn ui_imports() -> std::collections::BTreeMap<String, std::collections::BTreeSet<String>> {
+    let mut graph = std::collections::BTreeMap::new();
+    let modules = modules_under("src/ui/");
     let names: std::collections::BTreeSet<String> =
         modules.iter().map(|(n, _)| n.clone()).collect();
     // Folders: inside one, `super::` is the folder's own module.
@@ -338,18 +346,7 @@ fn the_checks_catch_what_they_look_for() {
 /// module.
 fn crate_imports() -> std::collections::BTreeMap<String, std::collections::BTreeSet<String>> {
     let mut graph = std::collections::BTreeMap::<String, std::collections::BTreeSet<String>>::new();
-    let sources: Vec<(String, String)> = sources()
-        .into_iter()
-        .filter(|(path, _)| !path.ends_with("/tests.rs"))
-        .filter_map(|(path, code)| {
-            let rest = path.strip_prefix("src/")?;
-            let name = match rest.split_once('/') {
-                Some((dir, _)) => dir.to_owned(),
-                None => rest.trim_end_matches(".rs").to_owned(),
-            };
-            Some((name, before_tests(&code).to_owned()))
-        })
-        .collect();
+    let sources = modules_under("src/");
     let names: std::collections::BTreeSet<String> =
         sources.iter().map(|(n, _)| n.clone()).collect();
     for (name, code) in &sources {

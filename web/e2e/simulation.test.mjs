@@ -158,7 +158,7 @@ test('after a far jump in time the image shows the cloud the simulation caught u
 
     // The clock's frame rate is the document's (an undo step that redraws nothing).
     const undo = (await state(page)).view.undo;
-    assert.equal((await state(page)).scene.clock, undefined, 'a default clock is left out of the document');
+    assert.equal((await state(page)).scene.clock?.end, 2880, "the preset's two-minute range");
     await page.evaluate(() => window.cloudsketch.set('/clock/fps=30'));
     s = await until(page, (s) => s.scene.clock?.fps === 30, 'a frame rate of 30');
     assert.equal(s.view.undo, undo + 1);

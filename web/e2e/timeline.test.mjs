@@ -101,6 +101,22 @@ for (const backend of ['webgpu', 'webgl2']) {
       assert.ok(Math.abs(s.scene.ellipsoids[0].center[0] - (x0 + x48) / 2) < 1e-3, 'half way at frame 48 after the retime');
       await page.keyboard.press('Control+z');
       s = await until(page, (s) => s.view.timeline.keys.some((k) => Math.abs(k.t - 2) < 1e-4), 'the retime undone in one step');
+
+      // A box drawn along the keys' row, from past frame 48 back past frame 0, takes both;
+      // Delete over the strip deletes them in one undo step.
+      s = await state(page);
+      const [left] = s.view.widgets['timeline:scrub'];
+      const from = frameX(s, 80);
+      await page.mouse.move(from, y);
+      await page.mouse.down();
+      for (let i = 1; i <= 12; i++) await page.mouse.move(from + ((left + 1 - from) * i) / 12, y);
+      await page.mouse.up();
+      s = await until(page, (s) => s.view.timeline.selected_keys.length === 2, 'both keys boxed');
+      assert.deepEqual([...s.view.timeline.selected_keys].sort(), [0, 2]);
+      await page.keyboard.press('Delete');
+      s = await until(page, (s) => s.view.timeline.key_count === 0, 'the boxed keys deleted');
+      await page.keyboard.press('Control+z');
+      s = await until(page, (s) => s.view.timeline.key_count === 8, 'the deletion undone');
     });
   });
 }

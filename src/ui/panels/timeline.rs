@@ -54,6 +54,9 @@ pub struct Timeline {
     /// made are the shot's.
     pub shot_view: bool,
     drag: Option<KeyDrag>,
+    /// A box drawn along the keys' row from this x (points), over the selection it began
+    /// with (Shift adds to it; otherwise it starts empty).
+    boxing: Option<(f32, Vec<f32>)>,
     /// Where the shown keys were drawn this frame (time, x), for the page state.
     pub drawn: Vec<(f32, f32)>,
     /// The height the keys were drawn at.
@@ -80,6 +83,7 @@ impl Default for Timeline {
             narrow: false,
             shot_view: false,
             drag: None,
+            boxing: None,
             drawn: Vec::new(),
             keys_y: 0.0,
             cache_progress: None,
@@ -504,6 +508,10 @@ impl Timeline {
                         if !shift {
                             self.selected.clear();
                         }
+                        // A drag from an empty place of the keys' row draws a box.
+                        if on_keys && response.drag_started() {
+                            self.boxing = Some((p.x, self.selected.clone()));
+                        }
                     }
                 }
             }
@@ -530,6 +538,29 @@ impl Timeline {
             if response.drag_stopped() {
                 self.drag = None;
                 doc.end_merge();
+            }
+        } else if let Some((x0, base)) = &self.boxing {
+            // The keys whose diamonds lie between the press and the pointer are selected.
+            if let Some(p) = response.interact_pointer_pos() {
+                let (lo, hi) = (x0.min(p.x), x0.max(p.x));
+                let mut selected = base.clone();
+                for (t, x) in &self.drawn {
+                    if (lo - DIAMOND_REACH..=hi + DIAMOND_REACH).contains(x)
+                        && !selected.contains(t)
+                    {
+                        selected.push(*t);
+                    }
+                }
+                let top = rect.top() + RULER;
+                painter.rect_filled(
+                    egui::Rect::from_x_y_ranges(lo..=hi, top..=rect.bottom()),
+                    0.0,
+                    Color32::from_rgba_unmultiplied(120, 160, 255, 40),
+                );
+                self.selected = selected;
+            }
+            if response.drag_stopped() || !moving {
+                self.boxing = None;
             }
         } else if (moving || response.clicked())
             && let Some(p) = response.interact_pointer_pos()
