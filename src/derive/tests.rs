@@ -797,3 +797,73 @@ fn a_keyed_scene_derived_while_scrubbing_equals_a_fresh_derivation_at_each_time(
         "the keyed ellipsoids moved the density"
     );
 }
+
+#[test]
+fn a_planes_keyed_inflation_blend_and_billows_pose_its_outline_as_a_fresh_one_would() {
+    use crate::scene::{Channel, PlaneProperty};
+    let mut scene = Scene::preset(Preset::Empty);
+    scene
+        .planes
+        .push(Arc::new(plane(StrokeKind::Outline, cloud_outline())));
+    scene.settle();
+    let id = scene.planes[0].id;
+    let channel = |property| Channel::Plane { id, property };
+    let (start, end) = (0.0f32, 2.0f32);
+    let keys = [
+        (PlaneProperty::Inflation, vec![0.0], vec![0.8]),
+        (PlaneProperty::Blend, vec![0.0], vec![0.5]),
+        (PlaneProperty::Billows, vec![0.35, 0.0], vec![0.35, 0.9]),
+    ];
+    {
+        let p = Arc::make_mut(&mut scene.planes[0]);
+        p.billows.levels = 2;
+    }
+    for (property, a, b) in &keys {
+        scene.animation.key(channel(*property), start, a.clone());
+        scene.animation.key(channel(*property), end, b.clone());
+    }
+    let scene = scene.posed_at(start);
+    // The baseline: the same plane with the end's values set, nothing keyed.
+    let mut at_end = scene.clone();
+    at_end.animation = Default::default();
+    {
+        let p = Arc::make_mut(&mut at_end.planes[0]);
+        p.sketch.inflate = 0.8f32 as f64;
+        p.sketch.blend = 0.5f32 as f64;
+        p.billows.coverage = 0.9;
+    }
+    let static_end = density_of(&at_end);
+
+    let mut doc = Document::new(scene);
+    let mut derived = Derived::default();
+    let first = derived.density(doc.scene(), doc.revisions()).data.clone();
+    let mut seen = vec![];
+    for t in [1.0, 2.0, 0.5, 0.0, 2.0] {
+        doc.set_time(t);
+        let incremental = derived.density(doc.scene(), doc.revisions()).data;
+        assert!(
+            *incremental == *density_of(&doc.scene().clone()),
+            "at {t} s the scrubbed density differs from a fresh one"
+        );
+        seen.push((t, incremental));
+    }
+    assert!(*seen[0].1 != *first, "halfway the keys changed nothing");
+    assert!(*seen[1].1 != *seen[0].1, "the end is its halfway");
+    assert!(
+        *seen[1].1 == *static_end,
+        "at its last key the plane is not the plane with those values set"
+    );
+    assert!(
+        *seen[3].1 == *first,
+        "back at 0 the plane is not where it began"
+    );
+    let p = &doc.scene().planes[0];
+    assert_eq!(
+        (
+            p.sketch.inflate as f32,
+            p.sketch.blend as f32,
+            p.billows.coverage
+        ),
+        (0.8, 0.5, 0.9)
+    );
+}

@@ -83,8 +83,8 @@ pub enum EllipsoidProperty {
     Visible,
 }
 
-/// A keyed property of a drawing plane: where it stands (the stroke and the shape drawn on it
-/// are not keyed, so a moving plane re-interprets nothing).
+/// A keyed property of a drawing plane: where it stands (a moving plane re-interprets
+/// nothing), and the controls of what its outline makes (the stroke itself is not keyed).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum PlaneProperty {
@@ -92,7 +92,23 @@ pub enum PlaneProperty {
     Origin,
     /// The plane's orientation (a quaternion).
     Rotation,
+    /// The outline's inflation slider (Wither et al.'s t; each new value re-interprets the
+    /// stroke, which the plane cache keeps per value).
+    Inflation,
+    /// The soft blend between the outline's spheres.
+    Blend,
+    /// The billows' size ratio and coverage (their levels are a count, not keyed).
+    Billows,
 }
+
+/// A drawing plane's keyable properties.
+pub const PLANE: [PlaneProperty; 5] = [
+    PlaneProperty::Origin,
+    PlaneProperty::Rotation,
+    PlaneProperty::Inflation,
+    PlaneProperty::Blend,
+    PlaneProperty::Billows,
+];
 
 /// A keyed property of the light.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -219,6 +235,8 @@ impl Channel {
             Channel::Plane { property, .. } => match property {
                 PlaneProperty::Origin => 3,
                 PlaneProperty::Rotation => 4,
+                PlaneProperty::Inflation | PlaneProperty::Blend => 1,
+                PlaneProperty::Billows => 2,
             },
             Channel::Light { property } => match property {
                 LightProperty::SunColor => 3,
@@ -301,9 +319,19 @@ impl Channel {
             }
             Channel::Plane { id, property } => {
                 let p = &scene.planes[Index::plane(index, scene, id)?];
+                let outline = p.kind == super::StrokeKind::Outline;
                 match property {
+                    // A cut's line has no inflation, blend or billows.
+                    PlaneProperty::Inflation | PlaneProperty::Blend | PlaneProperty::Billows
+                        if !outline =>
+                    {
+                        return None;
+                    }
                     PlaneProperty::Origin => v3(p.origin),
                     PlaneProperty::Rotation => q(p.rotation),
+                    PlaneProperty::Inflation => vec![p.sketch.inflate as f32],
+                    PlaneProperty::Blend => vec![p.sketch.blend as f32],
+                    PlaneProperty::Billows => vec![p.billows.ratio, p.billows.coverage],
                 }
             }
             Channel::Light { property } => {
@@ -381,6 +409,12 @@ impl Channel {
                 match property {
                     PlaneProperty::Origin => p.origin = v3(),
                     PlaneProperty::Rotation => p.rotation = q(),
+                    PlaneProperty::Inflation => p.sketch.inflate = f64::from(value[0]),
+                    PlaneProperty::Blend => p.sketch.blend = f64::from(value[0]),
+                    PlaneProperty::Billows => {
+                        p.billows.ratio = value[0];
+                        p.billows.coverage = value[1];
+                    }
                 }
             }
             Channel::Light { property } => {
@@ -447,6 +481,12 @@ impl Channel {
             Channel::Plane { property, .. } => match property {
                 PlaneProperty::Origin => value.to_vec(),
                 PlaneProperty::Rotation => unit_quaternion(value)?,
+                PlaneProperty::Inflation => param(value[0], limits::INFLATE),
+                PlaneProperty::Blend => param(value[0], limits::BLEND),
+                PlaneProperty::Billows => vec![
+                    limits::BILLOW_RATIO.fix_f32(value[0]),
+                    limits::BILLOW_COVERAGE.fix_f32(value[1]),
+                ],
             },
             Channel::Light { property } => match property {
                 LightProperty::SunAzimuth => param(value[0], limits::SUN_AZIMUTH),
@@ -503,8 +543,14 @@ impl Channel {
                 .filter(|p| e.motion.is_none() || !matches!(p, E::Center | E::Radii))
                 .map(|property| Channel::Ellipsoid { id: e.id, property })
         });
+        // A cut's line has no inflation, blend or billows.
         let planes = scene.planes.iter().flat_map(|p| {
-            [PlaneProperty::Origin, PlaneProperty::Rotation]
+            let outline = p.kind == super::StrokeKind::Outline;
+            PLANE
+                .into_iter()
+                .filter(move |property| {
+                    outline || matches!(property, PlaneProperty::Origin | PlaneProperty::Rotation)
+                })
                 .map(|property| Channel::Plane { id: p.id, property })
         });
         let shot = scene
@@ -1332,6 +1378,54 @@ mod tests {
             anim.tracks[1].keys[0].value[0] as f64,
             limits::SUN_ELEVATION.max
         );
+    }
+
+    #[test]
+    fn a_planes_outline_controls_key_within_their_ranges_and_a_cut_has_none() {
+        let mut scene = Scene::preset(crate::scene::Preset::Empty);
+        for kind in [
+            super::super::StrokeKind::Outline,
+            super::super::StrokeKind::Cut,
+        ] {
+            scene.planes.push(Arc::new(super::super::DrawingPlane {
+                kind,
+                ..Default::default()
+            }));
+        }
+        scene.settle();
+        let (outline, cut) = (scene.planes[0].id, scene.planes[1].id);
+        let of = |id| Channel::all(&scene).filter(|c| c.id() == Some(id)).count();
+        assert_eq!((of(outline), of(cut)), (5, 2));
+        let json = format!(
+            r#"[
+              {{"channel": {{"item": "plane", "id": {outline}, "property": "inflation"}},
+                "keys": [{{"t": 0, "v": [7]}}, {{"t": 1, "v": [0.5]}}]}},
+              {{"channel": {{"item": "plane", "id": {outline}, "property": "billows"}},
+                "keys": [{{"t": 0, "v": [-1, 3]}}]}},
+              {{"channel": {{"item": "plane", "id": {cut}, "property": "blend"}},
+                "keys": [{{"t": 0, "v": [0.2]}}]}}
+            ]"#
+        );
+        let mut anim: Animation = serde_json::from_str(&json).unwrap();
+        let said = anim.repair(&scene).join("\n");
+        assert!(said.contains("animation[2]"), "{said}");
+        assert_eq!(anim.tracks.len(), 2);
+        assert_eq!(
+            anim.tracks[0].keys[0].value,
+            vec![limits::INFLATE.max as f32]
+        );
+        assert_eq!(
+            anim.tracks[1].keys[0].value,
+            vec![
+                limits::BILLOW_RATIO.min as f32,
+                limits::BILLOW_COVERAGE.max as f32
+            ]
+        );
+        // Posed halfway, the plane's inflation is between its keys.
+        scene.animation = anim;
+        let posed = scene.posed_at(0.5);
+        let t = posed.planes[0].sketch.inflate;
+        assert!(t > 0.5 && t < limits::INFLATE.max, "{t}");
     }
 
     #[test]

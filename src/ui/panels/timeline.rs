@@ -8,8 +8,7 @@
 use egui::{Color32, Pos2, Sense, Stroke, Ui, vec2};
 
 use crate::scene::{
-    Animation, Channel, Clock, Document, Ease, Edit, EllipsoidProperty, LightProperty,
-    PlaneProperty, Scene,
+    Animation, Channel, Clock, Document, Ease, Edit, EllipsoidProperty, LightProperty, Scene,
 };
 use crate::ui::selection::{Item, Selection};
 use crate::ui::widgets::mark;
@@ -126,9 +125,9 @@ fn selected_ids(scene: &Scene, selection: &Selection) -> std::collections::HashS
         .collect()
 }
 
-/// What I keys: the selected ellipsoids' centre, radii, rotation and strength and the
-/// selected planes' origin and rotation (and any other of their values already keyed); with
-/// nothing selected, the shot camera's orbit while the view looks through it, else the sun's
+/// What I keys: the selected ellipsoids' centre, radii, rotation and strength (and any other
+/// of their values already keyed) and every keyable value of the selected planes (placement,
+/// inflation, soft blend, billows); with nothing selected, the shot camera's orbit while the view looks through it, else the sun's
 /// azimuth, elevation and intensity (and any light or media value already keyed).
 pub fn keyed_by_i(scene: &Scene, selection: &Selection, shot_view: bool) -> Vec<Channel> {
     let animation = &scene.animation;
@@ -145,14 +144,12 @@ pub fn keyed_by_i(scene: &Scene, selection: &Selection, shot_view: bool) -> Vec<
                             | EllipsoidProperty::Rotation
                             | EllipsoidProperty::Strength,
                         ..
-                    } | Channel::Plane {
-                        property: PlaneProperty::Origin | PlaneProperty::Rotation,
-                        ..
-                    } | Channel::Light {
-                        property: LightProperty::SunAzimuth
-                            | LightProperty::SunElevation
-                            | LightProperty::SunIntensity
-                    }
+                    } | Channel::Plane { .. }
+                        | Channel::Light {
+                            property: LightProperty::SunAzimuth
+                                | LightProperty::SunElevation
+                                | LightProperty::SunIntensity
+                        }
                 )
         })
         .collect()
