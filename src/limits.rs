@@ -18,6 +18,9 @@ pub const MAX_SPHERES: usize = 3000;
 pub const MAX_PRIMITIVES: usize = 20_000;
 /// Latest scene time (seconds): a day of playing.
 pub const MAX_TIME: f32 = 86_400.0;
+/// Most frames one `render`/`export --frames` run writes (a longer range is split into
+/// chunks, which any number of processes can run).
+pub const MAX_SEQUENCE_FRAMES: u32 = 10_000;
 /// Most texels along one side of the density volume.
 pub const MAX_GRID_RESOLUTION: u32 = 128;
 /// Most texels along one side of an exported grid (VDB, Mitsuba, meshes).

@@ -957,3 +957,190 @@ fn render_poses_the_keys_at_the_frame_and_shot_renders_through_the_shot_camera()
     assert!(stderr(&out).contains("no shot camera"), "{}", stderr(&out));
     assert!(!png.exists());
 }
+
+/// The JSON lines a `--progress json` run printed.
+fn json_lines(o: &Output) -> Vec<serde_json::Value> {
+    String::from_utf8_lossy(&o.stdout)
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap_or_else(|e| panic!("{l:?}: {e}")))
+        .collect()
+}
+
+#[test]
+fn a_sequence_writes_each_frame_once_and_any_split_of_it_gives_the_same_bytes() {
+    let dir = folder("sequence");
+    let path = |name: &str| dir.join(name).to_str().unwrap().to_owned();
+    let scene = path("developing.json");
+    let o = cloudsketch(&["new", "--preset", "developing", "-o", &scene]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let render = |frames: &str, pattern: &str, extra: &[&str]| {
+        let mut args = vec![
+            "render",
+            &scene,
+            "--size",
+            "96x54",
+            "--set",
+            "/render/slices=24",
+            "--fps",
+            "1",
+            "--progress",
+            "json",
+            "-o",
+            pattern,
+        ];
+        if !frames.is_empty() {
+            args.extend(["--frames", frames]);
+        }
+        args.extend(extra);
+        cloudsketch(&args)
+    };
+    // One run of frames 0..3 (inclusive), the name's #### the zero-padded frame.
+    let whole = path("whole/f_####.png");
+    let o = render("0..3", &whole, &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let lines = json_lines(&o);
+    assert_eq!(
+        lines
+            .iter()
+            .map(|l| l["frame"].as_u64().unwrap())
+            .collect::<Vec<_>>(),
+        [0, 1, 2, 3]
+    );
+    assert!(
+        lines
+            .iter()
+            .all(|l| l["skipped"] == false && l["total"] == 4)
+    );
+    let frame = |folder: &str, n: u32| {
+        std::fs::read(dir.join(folder).join(format!("f_{n:04}.png"))).unwrap()
+    };
+    assert_ne!(
+        frame("whole", 0),
+        frame("whole", 3),
+        "the developing cloud did not move"
+    );
+    // The same frames from another process, split differently, are the same bytes.
+    let o = render("2..3", &path("split/f_####.png"), &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = render("1", &path("split/f_####.png"), &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    for n in 1..=3 {
+        assert!(
+            frame("whole", n) == frame("split", n),
+            "frame {n} differs between runs"
+        );
+    }
+    // Run again: every frame is already there, with the same scene and options.
+    let before = std::fs::metadata(dir.join("whole/f_0002.png"))
+        .unwrap()
+        .modified()
+        .unwrap();
+    let o = render("0..3", &whole, &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        json_lines(&o).iter().all(|l| l["skipped"] == true),
+        "{}",
+        String::from_utf8_lossy(&o.stdout)
+    );
+    assert_eq!(
+        std::fs::metadata(dir.join("whole/f_0002.png"))
+            .unwrap()
+            .modified()
+            .unwrap(),
+        before
+    );
+    // Other options redo them; so does --overwrite.
+    let o = render("0..1", &whole, &["--set", "/render/slices=25"]);
+    assert!(json_lines(&o).iter().all(|l| l["skipped"] == false));
+    let o = render("0..1", &whole, &["--overwrite"]);
+    assert!(json_lines(&o).iter().all(|l| l["skipped"] == false));
+    // Without --frames, a name with # is the document's range (the developing preset's 0..480
+    // at its rate): here --frame N alone.
+    let o = render("", &path("one/f_##.png"), &["--frame", "7"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(
+        listing(&dir.join("one")),
+        ["f_07.png", "f_07.png.cloudsketch.json"]
+    );
+
+    // Bad requests: a clear error and nothing written.
+    let blocker = path("a-file");
+    std::fs::write(&blocker, b"x").unwrap();
+    for (frames, pattern, says) in [
+        ("5..2", path("bad/f_##.png"), "reversed"),
+        ("0..x", path("bad/f_##.png"), "whole frame numbers"),
+        ("0..20000", path("bad/f_##.png"), "at most 10000"),
+        ("0..3", path("plain.png"), "no run of #"),
+        ("0..3", format!("{blocker}/f_##.png"), "cannot"),
+    ] {
+        let o = render(frames, &pattern, &[]);
+        assert!(!o.status.success(), "{frames} {pattern}");
+        assert!(
+            stderr(&o).contains(says),
+            "{frames} {pattern}: {}",
+            stderr(&o)
+        );
+    }
+    assert!(!dir.join("bad").exists() && !dir.join("plain.png").exists());
+    let o = cloudsketch(&[
+        "render",
+        &scene,
+        "--fps",
+        "0",
+        "--frames",
+        "0..1",
+        "-o",
+        &path("t/f_#.png"),
+    ]);
+    assert!(stderr(&o).contains("--fps 0"), "{}", stderr(&o));
+}
+
+#[test]
+fn a_simulated_vdb_sequence_steps_on_and_equals_each_frame_exported_alone() {
+    let dir = folder("vdb-sequence");
+    let path = |name: &str| dir.join(name).to_str().unwrap().to_owned();
+    let scene = path("simulated.json");
+    let o = cloudsketch(&["new", "--preset", "simulated", "-o", &scene]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let export = |extra: &[&str]| {
+        let mut args = vec![
+            "export",
+            &scene,
+            "--format",
+            "vdb",
+            "--resolution",
+            "32",
+            "--fps",
+            "2",
+        ];
+        args.extend(extra);
+        cloudsketch(&args)
+    };
+    // Its first frames hold no cloud yet: they are written clear, so the sequence is whole.
+    let o = export(&["--frames", "0..4", "-o", &path("seq/cloud.####.vdb")]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let names: Vec<String> = listing(&dir.join("seq"))
+        .into_iter()
+        .filter(|n| n.ends_with(".vdb"))
+        .collect();
+    assert_eq!(
+        names,
+        [
+            "cloud.0000.vdb",
+            "cloud.0001.vdb",
+            "cloud.0002.vdb",
+            "cloud.0003.vdb",
+            "cloud.0004.vdb"
+        ]
+    );
+    let seq = |n: u32| std::fs::read(dir.join(format!("seq/cloud.{n:04}.vdb"))).unwrap();
+    assert_ne!(seq(0), seq(4), "the simulation did not move");
+    // Frame 4 exported alone plays the run from step 0: the same file.
+    let alone = path("alone.vdb");
+    let o = export(&["--frame", "4", "-o", &alone]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        std::fs::read(&alone).unwrap() == seq(4),
+        "frame 4 differs from its sequence's"
+    );
+}

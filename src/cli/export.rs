@@ -4,6 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use super::render::parse_size;
+use super::sequence::{FrameFiles, Pattern, Sequence, SequenceArgs, stable_hash};
 use super::{check_outputs, read_scene_or_link, write};
 use crate::export::{Format, Options, Up, export};
 use crate::render::offscreen::{Backdrop, Offscreen};
@@ -33,6 +34,8 @@ pub struct Request<'a> {
     pub samples: u32,
     /// The moment to export (else the scene's time).
     pub at: Option<crate::scene::Moment>,
+    /// `--frames`, `--fps`, `--progress`, `--overwrite`.
+    pub sequence: &'a SequenceArgs,
 }
 
 /// Runs an export.
@@ -56,50 +59,44 @@ pub fn run(r: &Request) -> Result<(), String> {
         return Err(format!("--resolution {}: 8 to {max}", r.resolution));
     }
     let (width, height) = parse_size(r.size)?;
-    let stem = r
-        .output
-        .file_stem()
-        .and_then(|s| s.to_str())
-        .filter(|s| !s.is_empty())
-        .unwrap_or("cloud");
-    let dir = r.output.parent().unwrap_or(Path::new(""));
-    // The main file where asked, the others (Mitsuba's volume) beside it under their own names.
-    let mut paths = vec![r.output.to_path_buf()];
-    paths.extend(format.companions(stem).iter().map(|name| dir.join(name)));
+    let backdrop = if r.transparent {
+        Backdrop::Transparent
+    } else {
+        Backdrop::Sky
+    };
+    let options = Options {
+        resolution: r.resolution,
+        axes_up: up,
+        scale: r.scale,
+        noise: !r.no_noise,
+        image: [width, height],
+        samples: r.samples.clamp(1, 65_536),
+    };
+    if Pattern::of(r.output).is_some() {
+        return sequence(r, format, &options, backdrop);
+    }
+    let paths = files_of(format, r.output);
     check_outputs(
         &r.scene.into_iter().collect::<Vec<_>>(),
         &paths.iter().map(PathBuf::as_path).collect::<Vec<_>>(),
     )?;
-    let mut scene = match r.scene {
-        Some(arg) => read_scene_or_link(arg)?,
-        None => Scene::default(),
-    };
+    let mut scene = read(r)?;
+    // --fps applied; --frames with a name without # refused (no sequence without #).
+    r.sequence.plan(r.output, &mut scene, r.at)?;
     if let Some(at) = r.at {
         scene = scene.posed_at(at.seconds(&scene.clock)?);
     }
     let start = std::time::Instant::now();
     if format == Format::Png {
         let mut offscreen = Offscreen::new().map_err(|e| e.to_string())?;
-        let backdrop = if r.transparent {
-            Backdrop::Transparent
-        } else {
-            Backdrop::Sky
-        };
         let image = super::render_shown(&mut offscreen, &scene, [width, height], backdrop)?;
         let png = image
             .to_png()
             .map_err(|e| format!("PNG encoding failed: {e}"))?;
         write(r.output, &png)?;
     } else {
-        let options = Options {
-            resolution: r.resolution,
-            axes_up: up,
-            scale: r.scale,
-            noise: !r.no_noise,
-            image: [width, height],
-            samples: r.samples.clamp(1, 65_536),
-        };
-        let files = export(&scene, format, &options, stem).map_err(|e| e.to_string())?;
+        let files =
+            export(&scene, format, &options, &stem_of(r.output)).map_err(|e| e.to_string())?;
         // The companions first and the main file last, so a main file never refers to a
         // volume that is not there; on a failure, what this run wrote is removed.
         let mut written: Vec<&Path> = Vec::new();
@@ -123,4 +120,98 @@ pub fn run(r: &Request) -> Result<(), String> {
         r.output.display()
     );
     Ok(())
+}
+
+/// The scene asked for.
+fn read(r: &Request) -> Result<Scene, String> {
+    match r.scene {
+        Some(arg) => read_scene_or_link(arg),
+        None => Ok(Scene::default()),
+    }
+}
+
+/// The name a file's companions are named after (`cloud` of `out/cloud.vdb`).
+fn stem_of(output: &Path) -> String {
+    output
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .filter(|s| !s.is_empty())
+        .unwrap_or("cloud")
+        .to_string()
+}
+
+/// The files an export to `output` writes: the main file where asked, the others (Mitsuba's
+/// volume) beside it under their own names.
+fn files_of(format: Format, output: &Path) -> Vec<PathBuf> {
+    let dir = output.parent().unwrap_or(Path::new(""));
+    let mut paths = vec![output.to_path_buf()];
+    paths.extend(
+        format
+            .companions(&stem_of(output))
+            .iter()
+            .map(|name| dir.join(name)),
+    );
+    paths
+}
+
+/// `export --frames A..B -o out/cloud.####.vdb`: one export per frame. A simulated scene's
+/// run steps on from frame to frame (one derivation cache for the whole sequence).
+fn sequence(
+    r: &Request,
+    format: Format,
+    options: &Options,
+    backdrop: Backdrop,
+) -> Result<(), String> {
+    let mut scene = read(r)?;
+    let Some(plan) = r.sequence.plan(r.output, &mut scene, r.at)? else {
+        return Err(format!("{}: no # for the frame number", r.output.display()));
+    };
+    let key = stable_hash(
+        format!(
+            "{}\nexport {} {:?} {}",
+            scene.to_json(),
+            format.name(),
+            options,
+            env!("CARGO_PKG_VERSION")
+        )
+        .as_bytes(),
+    );
+    let mut offscreen = None;
+    let mut derived = crate::derive::Derived::default();
+    Sequence {
+        frames: plan.frames,
+        pattern: &plan.pattern,
+        key,
+        overwrite: r.sequence.overwrite,
+        report: plan.report,
+        verb: "exported",
+    }
+    .run(|frame, main| -> Result<FrameFiles, String> {
+        let posed = scene.posed_at(scene.clock.seconds(frame));
+        if format == Format::Png {
+            if offscreen.is_none() {
+                offscreen = Some(Offscreen::new().map_err(|e| e.to_string())?);
+            }
+            let Some(offscreen) = offscreen.as_mut() else {
+                return Err("no renderer".into());
+            };
+            let image = offscreen
+                .render(&posed, options.image[0], options.image[1], backdrop)
+                .map_err(|e| e.to_string())?;
+            let png = image
+                .to_png()
+                .map_err(|e| format!("PNG encoding failed: {e}"))?;
+            return Ok(vec![(main.to_path_buf(), png)]);
+        }
+        let files =
+            crate::export::export_frame(&mut derived, &posed, format, options, &stem_of(main))
+                .map_err(|e| e.to_string())?;
+        // The companions first, the main file last.
+        Ok(files
+            .into_iter()
+            .zip(files_of(format, main))
+            .rev()
+            .map(|(f, path)| (path, f.bytes))
+            .collect())
+    })
 }

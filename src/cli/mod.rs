@@ -9,6 +9,7 @@ mod link;
 mod new;
 mod progress;
 mod render;
+mod sequence;
 mod simulate;
 mod sketch;
 
@@ -80,6 +81,8 @@ enum Command {
         /// Render through the scene's shot camera (posed at the time) instead of its view.
         #[arg(long)]
         shot: bool,
+        #[command(flatten)]
+        sequence: sequence::SequenceArgs,
     },
     /// Run a scene's cloud simulation (the `simulated` preset without SCENE) and write the
     /// smoothed density after N steps as a Mitsuba .vol or an OpenVDB .vdb.
@@ -183,6 +186,8 @@ enum Command {
         /// Export the scene at this frame of its clock.
         #[arg(long)]
         frame: Option<u32>,
+        #[command(flatten)]
+        sequence: sequence::SequenceArgs,
     },
     /// Run the benchmark suite.
     Bench {
@@ -223,8 +228,18 @@ pub fn main() -> ExitCode {
             time,
             frame,
             shot,
-        }) => Moment::from_args(time, frame)
-            .and_then(|at| render::run(scene.as_deref(), &output, &size, &set, at, shot)),
+            sequence,
+        }) => Moment::from_args(time, frame).and_then(|at| {
+            render::run(&render::Request {
+                scene: scene.as_deref(),
+                output: &output,
+                size: &size,
+                sets: &set,
+                at,
+                shot,
+                sequence: &sequence,
+            })
+        }),
         Some(Command::Simulate {
             scene,
             steps,
@@ -274,6 +289,7 @@ pub fn main() -> ExitCode {
             samples,
             time,
             frame,
+            sequence,
         }) => Moment::from_args(time, frame).and_then(|at| {
             export::run(&export::Request {
                 scene: scene.as_deref(),
@@ -287,6 +303,7 @@ pub fn main() -> ExitCode {
                 transparent,
                 samples,
                 at,
+                sequence: &sequence,
             })
         }),
         Some(Command::Bench { json, only }) => crate::bench::run(json, only.as_deref()),

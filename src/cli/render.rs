@@ -2,6 +2,7 @@
 
 use std::path::Path;
 
+use super::sequence::{Pattern, Sequence, SequenceArgs, stable_hash};
 use super::{read_scene_or_link, write};
 use crate::render::offscreen::{Backdrop, MAX_SIDE, Offscreen};
 use crate::scene::{Scene, set_by_pointer};
@@ -21,51 +22,105 @@ pub fn parse_size(text: &str) -> Result<(u32, u32), String> {
     Ok((w, h))
 }
 
-/// `cloudsketch render [SCENE|URL] -o OUT.png --size WxH --set PATH=VALUE… [--time T | --frame N]
-/// [--shot]`.
-pub fn run(
-    scene: Option<&str>,
-    output: &Path,
-    size: &str,
-    sets: &[String],
-    at: Option<crate::scene::Moment>,
-    shot: bool,
-) -> Result<(), String> {
-    let (width, height) = parse_size(size)?;
-    super::check_outputs(&scene.into_iter().collect::<Vec<_>>(), &[output])?;
-    let mut scene = match scene {
+/// What `cloudsketch render` was asked for.
+pub struct Request<'a> {
+    /// Scene file or link; the default scene when `None`.
+    pub scene: Option<&'a str>,
+    /// Output PNG, or a sequence's name pattern.
+    pub output: &'a Path,
+    /// `WIDTHxHEIGHT`.
+    pub size: &'a str,
+    /// `--set PATH=VALUE` overrides.
+    pub sets: &'a [String],
+    /// The moment to render (else the scene's time).
+    pub at: Option<crate::scene::Moment>,
+    /// Through the shot camera.
+    pub shot: bool,
+    /// `--frames`, `--fps`, `--progress`, `--overwrite`.
+    pub sequence: &'a SequenceArgs,
+}
+
+/// `cloudsketch render [SCENE|URL] -o OUT.png --size WxH --set PATH=VALUE… [--time T | --frame N
+/// | --frames A..B -o out/frame_####.png] [--shot]`.
+pub fn run(r: &Request) -> Result<(), String> {
+    let (width, height) = parse_size(r.size)?;
+    let inputs = r.scene.into_iter().collect::<Vec<_>>();
+    if Pattern::of(r.output).is_none() {
+        super::check_outputs(&inputs, &[r.output])?;
+    }
+    let mut scene = match r.scene {
         Some(arg) => read_scene_or_link(arg)?,
         None => Scene::default(),
     };
-    for assignment in sets {
+    for assignment in r.sets {
         let (set, repairs) = set_by_pointer(&scene, assignment).map_err(|e| e.to_string())?;
         for r in repairs {
             eprintln!("warning: --set {assignment}: repaired {r}");
         }
         scene = set;
     }
-    if let Some(at) = at {
-        scene = scene.posed_at(at.seconds(&scene.clock)?);
+    let plan = r.sequence.plan(r.output, &mut scene, r.at)?;
+    if r.shot && scene.shot.is_none() {
+        return Err(
+            "--shot: the scene has no shot camera (View › Set shot from view makes one)".into(),
+        );
     }
-    if shot {
-        scene.camera = scene
-            .shot
-            .clone()
-            .ok_or("--shot: the scene has no shot camera (View › Set shot from view makes one)")?;
-    }
+    // Through the shot camera where asked.
+    let framed = |mut posed: Scene| {
+        if r.shot
+            && let Some(shot) = posed.shot.clone()
+        {
+            posed.camera = shot;
+        }
+        posed
+    };
     let mut offscreen = Offscreen::new().map_err(|e| e.to_string())?;
+    if let Some(plan) = plan {
+        let key = stable_hash(
+            format!(
+                "{}\nrender {width}x{height} shot={} {}",
+                scene.to_json(),
+                r.shot,
+                env!("CARGO_PKG_VERSION")
+            )
+            .as_bytes(),
+        );
+        return Sequence {
+            frames: plan.frames,
+            pattern: &plan.pattern,
+            key,
+            overwrite: r.sequence.overwrite,
+            report: plan.report,
+            verb: "rendered",
+        }
+        .run(|frame, main| {
+            let posed = framed(scene.posed_at(scene.clock.seconds(frame)));
+            let image = offscreen
+                .render(&posed, width, height, Backdrop::Sky)
+                .map_err(|e| e.to_string())?;
+            let png = image
+                .to_png()
+                .map_err(|e| format!("PNG encoding failed: {e}"))?;
+            Ok(vec![(main.to_path_buf(), png)])
+        });
+    }
+    // Without a moment, the scene as read (a --set of a keyed value shows, as an edit does).
+    let scene = framed(match r.at {
+        Some(moment) => scene.posed_at(moment.seconds(&scene.clock)?),
+        None => scene,
+    });
     let start = std::time::Instant::now();
     let image = super::render_shown(&mut offscreen, &scene, [width, height], Backdrop::Sky)?;
     let png = image
         .to_png()
         .map_err(|e| format!("PNG encoding failed: {e}"))?;
-    write(output, &png)?;
+    write(r.output, &png)?;
     eprintln!(
         "rendered {width}x{height}, {} slices on {} in {:.2} s → {}",
         scene.render.slices,
         offscreen.adapter_name(),
         start.elapsed().as_secs_f64(),
-        output.display()
+        r.output.display()
     );
     Ok(())
 }

@@ -183,13 +183,7 @@ pub fn check_cost(scene: &mut Scene) -> Result<Option<String>, String> {
 /// played all the way to the time (the app spreads that over frames), with the outlines
 /// sketched in it.
 pub fn density_of(scene: &Scene) -> Arc<DensityVolume> {
-    let doc = crate::scene::Document::new(scene.clone());
-    let mut derived = Derived::default();
-    let mut volume = derived.density(doc.scene(), doc.revisions());
-    while derived.catching_up {
-        volume = derived.density(doc.scene(), doc.revisions());
-    }
-    volume.data
+    Derived::default().density_afresh(scene)
 }
 
 /// The field a document describes, derived from scratch (no cache).
@@ -480,6 +474,20 @@ impl Derived {
         self.strokes = None;
         self.united = None;
         self.outlines_on_grid = None;
+    }
+
+    /// The density volume `scene` describes at its time, as [`density_of`] derives it from
+    /// scratch (on the grid a fresh load would choose), reusing this cache's plane shapes and
+    /// simulation run: frame after frame of a sequence steps a simulation on from the last
+    /// instead of replaying it (a frame reached so equals the frame played from step 0).
+    pub fn density_afresh(&mut self, scene: &Scene) -> Arc<DensityVolume> {
+        let doc = crate::scene::Document::new(scene.clone());
+        self.forget_grid();
+        let mut volume = self.density(doc.scene(), doc.revisions());
+        while self.catching_up {
+            volume = self.density(doc.scene(), doc.revisions());
+        }
+        volume.data
     }
 
     /// The work done so far.

@@ -59,12 +59,32 @@ impl Sampling {
     /// longest side (at most [`MAX_EXPORT_RESOLUTION`]); the density follows with
     /// [`Sampling::step`] (none for a mesh of the plain field, which reads only its surface).
     pub fn start(scene: &Scene, format: Format, options: &Options) -> Result<Self, ExportError> {
+        Self::start_in(
+            &mut crate::derive::Derived::default(),
+            scene,
+            format,
+            options,
+            false,
+        )
+    }
+
+    /// [`Sampling::start`] through `derived`, whose simulation run a simulated scene steps on
+    /// from (a sequence's frames cost the steps between them, not a replay each). With
+    /// `clear_ok`, a grid holding no cloud yet (a simulation's first frames) is sampled as it
+    /// is for a volume format (a sequence's frame); a mesh of it is still refused.
+    pub fn start_in(
+        derived: &mut crate::derive::Derived,
+        scene: &Scene,
+        format: Format,
+        options: &Options,
+        clear_ok: bool,
+    ) -> Result<Self, ExportError> {
         let (resolution, noise) = (options.resolution, options.noise);
         let surface_only = format.is_mesh() && !noise && scene.simulation.is_none();
         let volume = match &scene.simulation {
             // A simulated cloud: the run's smoothed cloud at the scene's time, on its own grid
             // (with the outlines sketched in it, on one grid over both), as the app shows it.
-            Some(_) => Arc::unwrap_or_clone(crate::derive::density_of(scene)),
+            Some(_) => Arc::unwrap_or_clone(derived.density_afresh(scene)),
             None => {
                 let resolution = resolution.clamp(8, MAX_EXPORT_RESOLUTION);
                 let field = crate::derive::field_of(scene);
@@ -84,7 +104,8 @@ impl Sampling {
                 }
             }
         };
-        if volume.is_empty() || volume.values.iter().all(|&v| v <= 0.0) {
+        let clear = volume.values.iter().all(|&v| v <= 0.0);
+        if volume.is_empty() || (clear && !(clear_ok && !format.is_mesh())) {
             return Err(ExportError::Empty);
         }
         let grid = DensityGrid {

@@ -177,6 +177,23 @@ pub fn export(
     Ok(write(scene, &grid, format, options, stem))
 }
 
+/// A sequence's frame of [`export`], through `derived` (see [`Sampling::start_in`]): a
+/// simulated scene's run steps on from frame to frame, and a volume of a frame with no cloud
+/// yet is written clear rather than refused.
+pub fn export_frame(
+    derived: &mut crate::derive::Derived,
+    scene: &Scene,
+    format: Format,
+    options: &Options,
+    stem: &str,
+) -> Result<Vec<File>, ExportError> {
+    if format == Format::Png {
+        return Err(ExportError::NeedsRenderer);
+    }
+    let grid = Sampling::start_in(derived, scene, format, options, true)?.finish();
+    Ok(write(scene, &grid, format, options, stem))
+}
+
 /// The surface of a sampled grid: the field's iso-surface, or with the media the surface
 /// where their density reaches a half.
 pub fn surface(grid: &DensityGrid, noise: bool) -> Mesh {

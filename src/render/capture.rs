@@ -1,14 +1,16 @@
-//! A capture of the viewport's view at a chosen size, for the app's PNG export: rendered at
-//! full quality into its own accumulation target ([`CAPTURE_TARGET`], so the viewport's
-//! preview and refinement stay as they are), its slices drawn a chunk a frame (far to near,
-//! as refinement draws them: the same image as one draw) so the app answers input meanwhile,
-//! then composited over the background (or transparent), copied into a buffer and read back
-//! once the GPU is done — a frame or more later, which the browser requires (its buffers map
-//! asynchronously).
+//! A capture of the viewport's view at a chosen size, for the app's PNG export and cached
+//! playback: rendered at full quality into its own accumulation target ([`CAPTURE_TARGET`],
+//! so the viewport's preview and refinement stay as they are), its slices drawn a chunk a
+//! frame (far to near, as refinement draws them: the same image as one draw) so the app
+//! answers input meanwhile, over the cloud's box on screen alone (as the viewport draws it:
+//! the shafts of light beyond it drawn apart), then composited over the background (or
+//! transparent), copied into a buffer and read back once the GPU is done — a frame or more
+//! later, which the browser requires (its buffers map asynchronously).
 
 use std::sync::atomic::{AtomicU8, AtomicU32, Ordering};
 use std::sync::{Arc, Mutex};
 
+use super::crop::{OUTSIDE_SHAFTS_DIVISOR, PixelCrop};
 use super::progressive::JobPlan;
 use super::renderer::{SliceJob, VolumeRenderer};
 use super::resources::{CAPTURE_TARGET, copy_for_readback, read_rows, unpremultiply};
@@ -21,8 +23,10 @@ const MAP_FAILED: u8 = 2;
 
 /// Where a capture stands; shared by the UI (which polls it) and the paint callback.
 enum State {
-    /// Slices being drawn: chunk `done` of the capture's chunks is the next, one a frame.
-    Drawing { done: u32 },
+    /// Slices being drawn: chunk `done` of the capture's chunks is the next, one a frame,
+    /// over `crop` (the cloud's box on screen, found at the first chunk; `None`: the whole
+    /// view).
+    Drawing { done: u32, crop: Option<PixelCrop> },
     /// Rendered and copied; the buffer maps when the GPU is done.
     Reading {
         buffer: wgpu::Buffer,
@@ -73,7 +77,10 @@ impl Capture {
                 crop: FULL_VIEW,
                 ..view.clone()
             },
-            state: Arc::new(Mutex::new(State::Drawing { done: 0 })),
+            state: Arc::new(Mutex::new(State::Drawing {
+                done: 0,
+                crop: None,
+            })),
         }
     }
 
@@ -118,13 +125,23 @@ impl Capture {
     ) {
         let mut state = self.state.lock().unwrap_or_else(|e| e.into_inner());
         match &*state {
-            State::Drawing { done } => {
+            State::Drawing { done, crop } => {
                 let done = *done;
-                *state = if done + 1 < self.chunks {
-                    self.draw_chunk(renderer, device, queue, done);
-                    State::Drawing { done: done + 1 }
+                // The box of the density the renderer holds now: a change of the clouds
+                // later starts the capture over (`restart`), so every chunk has the same.
+                let crop = if done == 0 {
+                    self.crop_of(renderer)
                 } else {
-                    self.encode(renderer, device, queue, done)
+                    *crop
+                };
+                *state = if done + 1 < self.chunks {
+                    self.draw_chunk(renderer, device, queue, done, crop.as_ref());
+                    State::Drawing {
+                        done: done + 1,
+                        crop,
+                    }
+                } else {
+                    self.encode(renderer, device, queue, done, crop.as_ref())
                 };
                 self.drawn.store(done + 1, Ordering::Relaxed);
             }
@@ -149,7 +166,16 @@ impl Capture {
         }
     }
 
-    /// The job of chunk `k`: its slices, far to near; the first clears the target.
+    /// The pixels of the capture the cloud's box covers, or `None` without a cloud or
+    /// where the box reaches behind the camera (the whole view).
+    fn crop_of(&self, renderer: &VolumeRenderer) -> Option<PixelCrop> {
+        let (lo, hi) = renderer.density_box()?;
+        let ndc = self.view.camera.ndc_bounds(lo, hi, self.view.aspect)?;
+        Some(PixelCrop::snap(ndc, self.size))
+    }
+
+    /// The job of chunk `k` over the whole view: its slices, far to near; the first clears
+    /// the target.
     fn chunk_job(&self, k: u32) -> SliceJob {
         let total = self.view.render.slices;
         let bound = |k: u32| (total as u64 * k as u64 / self.chunks as u64) as u32;
@@ -178,8 +204,13 @@ impl Capture {
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         k: u32,
+        crop: Option<&PixelCrop>,
     ) {
         let job = self.chunk_job(k);
+        let job = match crop {
+            Some(crop) => VolumeRenderer::cropped_job(&job, crop),
+            None => job,
+        };
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("capture chunk"),
         });
@@ -195,6 +226,7 @@ impl Capture {
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         k: u32,
+        crop: Option<&PixelCrop>,
     ) -> State {
         let bgra = matches!(
             renderer.output_format(),
@@ -205,7 +237,18 @@ impl Capture {
             label: Some("capture"),
         });
         let background = (!self.transparent).then_some(self.view.light.background);
-        let output = renderer.render_image(device, queue, &mut encoder, &job, background, None);
+        let output = match crop {
+            Some(crop) => renderer.render_image_cropped(
+                device,
+                queue,
+                &mut encoder,
+                &job,
+                background,
+                crop,
+                OUTSIDE_SHAFTS_DIVISOR,
+            ),
+            None => renderer.render_image(device, queue, &mut encoder, &job, background, None),
+        };
         let (buffer, row) = copy_for_readback(device, &mut encoder, &output, self.size);
         queue.submit([encoder.finish()]);
         let mapped = Arc::new(AtomicU8::new(MAPPING));

@@ -807,11 +807,15 @@ impl VolumeRenderer {
         crop: &super::crop::PixelCrop,
         divisor: u32,
     ) -> wgpu::Texture {
-        let [width, height] = job.plan.size;
-        let output = self.output_texture(device, job.plan.size);
-        let view = output.create_view(&wgpu::TextureViewDescriptor::default());
         self.update_light(device, queue, encoder, &job.view);
-        let cropped = SliceJob {
+        self.draw_slices(device, queue, encoder, &Self::cropped_job(job, crop), None);
+        self.composite_image_cropped(device, queue, encoder, job, background, crop, divisor)
+    }
+
+    /// `job` (of the whole view) drawn over `crop` alone, with the shafts of light's shells
+    /// among its slices: what [`VolumeRenderer::composite_image_cropped`] lays in the view.
+    pub fn cropped_job(job: &SliceJob, crop: &super::crop::PixelCrop) -> SliceJob {
+        SliceJob {
             plan: super::progressive::JobPlan {
                 size: crop.size(),
                 ..job.plan.clone()
@@ -821,8 +825,26 @@ impl VolumeRenderer {
                 ..job.view.clone()
             },
             shells_apart: true,
-        };
-        self.draw_slices(device, queue, encoder, &cropped, None);
+        }
+    }
+
+    /// The image of `job`'s whole view from its target, drawn over `crop` by
+    /// [`VolumeRenderer::cropped_job`]s: the shafts beyond the box drawn at 1/`divisor` of
+    /// the size and laid around it, over `background` and its sky.
+    #[allow(clippy::too_many_arguments)]
+    pub fn composite_image_cropped(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        job: &SliceJob,
+        background: Option<[f32; 3]>,
+        crop: &super::crop::PixelCrop,
+        divisor: u32,
+    ) -> wgpu::Texture {
+        let [width, height] = job.plan.size;
+        let output = self.output_texture(device, job.plan.size);
+        let view = output.create_view(&wgpu::TextureViewDescriptor::default());
         let outside = self.draw_outside_shafts(
             device,
             queue,
@@ -831,7 +853,7 @@ impl VolumeRenderer {
             job.plan.total,
             job.plan.size.map(|v| v.div_ceil(divisor.max(1))),
         );
-        self.prepare_cropped_composite(device, queue, job.plan.target, cropped.view.crop);
+        self.prepare_cropped_composite(device, queue, job.plan.target, crop.ndc(job.plan.size));
         let mut pass = self.backdrop_pass(
             queue,
             encoder,

@@ -250,7 +250,8 @@ impl Viewport {
                         self.capture = Some(capture.restart());
                     }
                 }
-                let capture = self.drive_capture(ui, &mut cx, &view, CACHE_BUDGET);
+                let capture =
+                    self.drive_capture(ui, &mut cx, &view, &volumes.density.data, CACHE_BUDGET);
                 if let Some(capture) = capture.filter(|_| self.stats.backend.is_some()) {
                     painter.add(paint_callback(
                         rect,
@@ -400,7 +401,13 @@ impl Viewport {
         if plan.shown.is_some_and(|q| q.full) {
             self.ready = true;
         }
-        self.drive_capture(ui, &mut cx, &exported, CAPTURE_BUDGET);
+        self.drive_capture(
+            ui,
+            &mut cx,
+            &exported,
+            &volumes.density.data,
+            CAPTURE_BUDGET,
+        );
         let capture = self.capture.clone();
         if crop.is_none() && capture.is_some() && self.stats.backend.is_some() {
             // Nothing of the cloud in view: the capture still needs the callback to run.
@@ -458,20 +465,31 @@ impl Viewport {
         self.overlays(ui, rect, &mut cx, tool, guide, now);
     }
 
-    /// Starts the capture asked for (its slices spread over frames within `budget` seconds
-    /// of each), starts it over when the clouds changed under it, and hands a finished one to
+    /// Starts the capture asked for (its slices over the cloud's box, `density`'s, spread
+    /// over frames within `budget` seconds of each), starts it over when the clouds changed under it, and hands a finished one to
     /// `captured`; returns the capture still under way.
     fn drive_capture(
         &mut self,
         ui: &egui::Ui,
         cx: &mut ToolContext<'_>,
         exported: &View,
+        density: &crate::density::DensityVolume,
         budget: f64,
     ) -> Option<Capture> {
         let now = ui.input(|i| i.time);
         if let Some((size, transparent)) = self.capture_request.take() {
-            // Its slices spread over frames within a frame's budget, as refinement's are.
-            let pixels = size[0] as u64 * size[1] as u64;
+            // Its slices spread over frames within a frame's budget, as refinement's are,
+            // counting the pixels of the cloud's box the capture draws them over.
+            let aspect = size[0] as f32 / size[1].max(1) as f32;
+            let pixels = (!density.is_empty())
+                .then(|| {
+                    exported
+                        .camera
+                        .ndc_bounds(density.min, density.min + density.size, aspect)
+                })
+                .flatten()
+                .map_or(size, |ndc| PixelCrop::snap(ndc, size).size());
+            let pixels = pixels[0] as u64 * pixels[1] as u64;
             let chunks = capture_chunks(
                 pixels,
                 exported.render.slices,
