@@ -4,7 +4,8 @@
 # the desktop window under Xvfb, link fixtures), a 30-second fuzz run of the link decoders (nightly + cargo-fuzz, installed
 # here when missing), the release web build, and the browser end-to-end tests in headless
 # Chromium (WebGPU on SwiftShader, then the WebGL2 fallback), and the exports read back by
-# independent readers (OpenVDB's Python module, Mitsuba 3, the Khronos glTF validator).
+# independent readers (OpenVDB's Python module, Mitsuba 3, the Khronos glTF validator), and a
+# frame range rendered by a Slurm job array on a one-node cluster (scripts/check_slurm.sh).
 # Screenshots: web/test-results/screenshots/.
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -38,6 +39,11 @@ fi
 log "exports read by OpenVDB, Mitsuba and the glTF validator (files: target/export-check/)"
 "$VENV/bin/python" scripts/check_exports.py target/export-check
 (cd web && node check-glb.mjs ../target/export-check/cloud.glb)
+
+# A frame range as a job array on a real scheduler (Debian's slurm-wlm, installed there when
+# missing; a one-node cluster started and stopped inside the check), against one local run.
+log "a frame range on a one-node Slurm cluster (scripts/check_slurm.sh, docs/farm.md)"
+bash scripts/check_slurm.sh target/debug/cloudsketch
 
 # The fuzz target needs nightly Rust and cargo-fuzz (test-only tools: not in setup.sh).
 CARGO_FUZZ_VERSION=0.13.2

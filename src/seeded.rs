@@ -11,6 +11,14 @@ pub fn hash64(mut x: u64) -> u64 {
     x ^ (x >> 31)
 }
 
+/// FNV-1a over bytes: a 64-bit hash that is the same in every process and build (std's hasher
+/// is not promised to be), for keys written to files (a sequence's sidecars, checkpoints).
+pub fn stable_hash(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+    })
+}
+
 /// SplitMix64: a deterministic stream of numbers from a seed.
 #[derive(Clone, Debug)]
 pub struct SplitMix(u64);

@@ -1144,3 +1144,71 @@ fn a_simulated_vdb_sequence_steps_on_and_equals_each_frame_exported_alone() {
         "frame 4 differs from its sequence's"
     );
 }
+
+#[test]
+fn a_chunk_starts_from_the_furthest_checkpoint_and_refuses_another_runs() {
+    let dir = folder("checkpoints");
+    let path = |name: &str| dir.join(name).to_str().unwrap().to_owned();
+    let scene = path("simulated.json");
+    let o = cloudsketch(&["new", "--preset", "simulated", "-o", &scene]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let checkpoints = path("ck");
+    let export = |frames: &str, out: &str| {
+        cloudsketch(&[
+            "export",
+            &scene,
+            "--format",
+            "vdb",
+            "--resolution",
+            "24",
+            "--fps",
+            "1",
+            "--progress",
+            "json",
+            "--checkpoints",
+            &checkpoints,
+            "--frames",
+            frames,
+            "-o",
+            out,
+        ])
+    };
+    // The whole range, 10 steps a frame: it passes steps 32, 64 and 96 and writes them.
+    let o = export("0..10", &path("whole/cloud.####.vdb"));
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(json_lines(&o)[0]["simulation"], "step 0");
+    let mut written: Vec<String> = listing(&dir.join("ck"));
+    written.retain(|n| n.ends_with(".ckpt"));
+    assert_eq!(written.len(), 3, "{written:?}");
+    // A chunk in a fresh process starts from the furthest checkpoint at or before its first
+    // frame (step 64 for frame 8), and its frames equal the whole run's.
+    let o = export("8..9", &path("chunk/cloud.####.vdb"));
+    assert!(o.status.success(), "{}", stderr(&o));
+    let said = json_lines(&o)[0]["simulation"].as_str().unwrap().to_owned();
+    assert!(said.starts_with("the checkpoint at step 64"), "{said}");
+    let file = |folder: &str, n: u32| {
+        std::fs::read(dir.join(format!("{folder}/cloud.{n:04}.vdb"))).unwrap()
+    };
+    for n in [8, 9] {
+        assert!(
+            file("chunk", n) == file("whole", n),
+            "frame {n} from the checkpoint differs"
+        );
+    }
+    // A checkpoint whose hash is another run's is refused, whatever its name: the chunk falls
+    // back to the one before it, and its frames are still the same.
+    let furthest = dir
+        .join("ck")
+        .join(written.iter().find(|n| n.ends_with("00064.ckpt")).unwrap());
+    let mut bytes = std::fs::read(&furthest).unwrap();
+    bytes[8] ^= 0xff;
+    std::fs::write(&furthest, &bytes).unwrap();
+    let o = export("8..9", &path("again/cloud.####.vdb"));
+    assert!(o.status.success(), "{}", stderr(&o));
+    let said = json_lines(&o)[0]["simulation"].as_str().unwrap().to_owned();
+    assert!(
+        said.contains("refused: a checkpoint of another scene") && said.contains("step 32"),
+        "{said}"
+    );
+    assert!(file("again", 9) == file("whole", 9));
+}

@@ -3,8 +3,9 @@
 
 use std::path::{Path, PathBuf};
 
+use super::checkpoints::Checkpoints;
 use super::render::parse_size;
-use super::sequence::{FrameFiles, Pattern, Sequence, SequenceArgs, stable_hash};
+use super::sequence::{FrameFiles, Made, Pattern, Sequence, SequenceArgs, stable_hash};
 use super::{check_outputs, read_scene_or_link, write};
 use crate::export::{Format, Options, Up, export};
 use crate::render::offscreen::{Backdrop, Offscreen};
@@ -176,8 +177,15 @@ fn sequence(
         )
         .as_bytes(),
     );
-    let mut offscreen = None;
-    let mut derived = crate::derive::Derived::default();
+    let mut offscreen: Option<Offscreen> = None;
+    let mut own = crate::derive::Derived::default();
+    let mut checkpoints = r
+        .sequence
+        .checkpoints
+        .as_deref()
+        .map(Checkpoints::open)
+        .transpose()?;
+    let mut first = true;
     Sequence {
         frames: plan.frames,
         pattern: &plan.pattern,
@@ -186,32 +194,49 @@ fn sequence(
         report: plan.report,
         verb: "exported",
     }
-    .run(|frame, main| -> Result<FrameFiles, String> {
+    .run(|frame, main: &Path| -> Result<Made, String> {
         let posed = scene.posed_at(scene.clock.seconds(frame));
-        if format == Format::Png {
-            if offscreen.is_none() {
-                offscreen = Some(Offscreen::new().map_err(|e| e.to_string())?);
-            }
-            let Some(offscreen) = offscreen.as_mut() else {
-                return Err("no renderer".into());
-            };
-            let image = offscreen
-                .render(&posed, options.image[0], options.image[1], backdrop)
-                .map_err(|e| e.to_string())?;
-            let png = image
-                .to_png()
-                .map_err(|e| format!("PNG encoding failed: {e}"))?;
-            return Ok(vec![(main.to_path_buf(), png)]);
+        if format == Format::Png && offscreen.is_none() {
+            offscreen = Some(Offscreen::new().map_err(|e| e.to_string())?);
         }
-        let files =
-            crate::export::export_frame(&mut derived, &posed, format, options, &stem_of(main))
-                .map_err(|e| e.to_string())?;
-        // The companions first, the main file last.
-        Ok(files
-            .into_iter()
-            .zip(files_of(format, main))
-            .rev()
-            .map(|(f, path)| (path, f.bytes))
-            .collect())
+        // The renderer's derivation cache for a PNG, this sequence's own for the others: the
+        // one whose simulation run steps on from frame to frame.
+        let note = match checkpoints.as_mut() {
+            Some(c) if std::mem::take(&mut first) => {
+                let derived = match offscreen.as_mut() {
+                    Some(o) => o.derived(),
+                    None => &mut own,
+                };
+                c.resume(derived, &posed, posed.time)
+            }
+            _ => None,
+        };
+        let files: FrameFiles = match offscreen.as_mut() {
+            Some(offscreen) => {
+                let image = offscreen
+                    .render(&posed, options.image[0], options.image[1], backdrop)
+                    .map_err(|e| e.to_string())?;
+                let png = image
+                    .to_png()
+                    .map_err(|e| format!("PNG encoding failed: {e}"))?;
+                vec![(main.to_path_buf(), png)]
+            }
+            None => crate::export::export_frame(&mut own, &posed, format, options, &stem_of(main))
+                .map_err(|e| e.to_string())?
+                .into_iter()
+                .zip(files_of(format, main))
+                // The companions first, the main file last.
+                .rev()
+                .map(|(f, path)| (path, f.bytes))
+                .collect(),
+        };
+        if let Some(c) = checkpoints.as_mut() {
+            let derived = match offscreen.as_mut() {
+                Some(o) => o.derived(),
+                None => &mut own,
+            };
+            c.save(derived, &posed)?;
+        }
+        Ok(Made { files, note })
     })
 }

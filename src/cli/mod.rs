@@ -3,6 +3,7 @@
 //! `crate::bench`);
 //! `desktop` opens the window.
 
+mod checkpoints;
 mod desktop;
 mod export;
 mod link;

@@ -2,7 +2,8 @@
 
 use std::path::Path;
 
-use super::sequence::{Pattern, Sequence, SequenceArgs, stable_hash};
+use super::checkpoints::Checkpoints;
+use super::sequence::{Made, Pattern, Sequence, SequenceArgs, stable_hash};
 use super::{read_scene_or_link, write};
 use crate::render::offscreen::{Backdrop, MAX_SIDE, Offscreen};
 use crate::scene::{Scene, set_by_pointer};
@@ -85,6 +86,13 @@ pub fn run(r: &Request) -> Result<(), String> {
             )
             .as_bytes(),
         );
+        let mut checkpoints = r
+            .sequence
+            .checkpoints
+            .as_deref()
+            .map(Checkpoints::open)
+            .transpose()?;
+        let mut first = true;
         return Sequence {
             frames: plan.frames,
             pattern: &plan.pattern,
@@ -95,13 +103,25 @@ pub fn run(r: &Request) -> Result<(), String> {
         }
         .run(|frame, main| {
             let posed = framed(scene.posed_at(scene.clock.seconds(frame)));
+            let note = match checkpoints.as_mut() {
+                Some(c) if std::mem::take(&mut first) => {
+                    c.resume(offscreen.derived(), &posed, posed.time)
+                }
+                _ => None,
+            };
             let image = offscreen
                 .render(&posed, width, height, Backdrop::Sky)
                 .map_err(|e| e.to_string())?;
+            if let Some(c) = checkpoints.as_mut() {
+                c.save(offscreen.derived(), &posed)?;
+            }
             let png = image
                 .to_png()
                 .map_err(|e| format!("PNG encoding failed: {e}"))?;
-            Ok(vec![(main.to_path_buf(), png)])
+            Ok(Made {
+                files: vec![(main.to_path_buf(), png)],
+                note,
+            })
         });
     }
     // Without a moment, the scene as read (a --set of a keyed value shows, as an edit does).

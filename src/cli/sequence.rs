@@ -42,6 +42,11 @@ pub struct SequenceArgs {
     /// options (else they are skipped).
     #[arg(long)]
     pub overwrite: bool,
+    /// A folder of a simulated scene's checkpoints: a sequence starts its run from the
+    /// furthest one at or before its first frame (else from step 0) and writes the run's
+    /// snapshots there as it passes them, for the chunks after it.
+    #[arg(long, value_name = "DIR")]
+    pub checkpoints: Option<PathBuf>,
 }
 
 /// A sequence asked for on the command line.
@@ -262,13 +267,7 @@ fn sidecar_path(main: &Path) -> PathBuf {
     main.with_file_name(name)
 }
 
-/// FNV-1a, 64 bits: a hash that is the same in every process and build (std's hasher is not
-/// promised to be).
-pub fn stable_hash(bytes: &[u8]) -> u64 {
-    bytes.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| {
-        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
-    })
-}
+pub use crate::seeded::stable_hash;
 
 /// Whether a previous run finished frame `frame` at `main` with `key`: its sidecar says so
 /// and every file it lists is there with its size.
@@ -293,6 +292,20 @@ fn finished(main: &Path, frame: u32, key: &str) -> bool {
 /// not there yet).
 pub type FrameFiles = Vec<(PathBuf, Vec<u8>)>;
 
+/// A frame made: its files, and what its making has to say (where a simulation started).
+pub struct Made {
+    /// The files.
+    pub files: FrameFiles,
+    /// Said with the frame's report.
+    pub note: Option<String>,
+}
+
+impl From<FrameFiles> for Made {
+    fn from(files: FrameFiles) -> Self {
+        Self { files, note: None }
+    }
+}
+
 /// A sequence to write.
 pub struct Sequence<'a> {
     /// The frames.
@@ -316,7 +329,7 @@ impl Sequence<'_> {
     /// before it stay.
     pub fn run(
         &self,
-        mut make: impl FnMut(u32, &Path) -> Result<FrameFiles, String>,
+        mut make: impl FnMut(u32, &Path) -> Result<Made, String>,
     ) -> Result<(), String> {
         let folder = self.pattern.folder();
         if !folder.as_os_str().is_empty() {
@@ -342,17 +355,19 @@ impl Sequence<'_> {
             let main = self.pattern.path(frame);
             let began = Instant::now();
             let skip = !self.overwrite && finished(&main, frame, &key);
+            let mut note = None;
             if skip {
                 skipped += 1;
             } else {
-                let files = make(frame, &main).map_err(|e| format!("frame {frame}: {e}"))?;
-                self.write(frame, &main, &files, &key)?;
+                let frame_made = make(frame, &main).map_err(|e| format!("frame {frame}: {e}"))?;
+                self.write(frame, &main, &frame_made.files, &key)?;
+                note = frame_made.note;
                 made += 1;
             }
             let done = i as u32 + 1;
             match self.report {
                 Report::Json => {
-                    let record = serde_json::json!({
+                    let mut record = serde_json::json!({
                         "frame": frame,
                         "file": main.display().to_string(),
                         "skipped": skip,
@@ -360,11 +375,19 @@ impl Sequence<'_> {
                         "done": done,
                         "total": total,
                     });
+                    if let Some(note) = note {
+                        record["simulation"] = note.into();
+                    }
                     let mut out = std::io::stdout().lock();
                     let _ = writeln!(out, "{record}");
                     let _ = out.flush();
                 }
-                Report::Line => line.set(done as f32 / total as f32),
+                Report::Line => {
+                    if let Some(note) = note {
+                        eprintln!("frame {frame}: the simulation runs from {note}");
+                    }
+                    line.set(done as f32 / total as f32)
+                }
             }
         }
         drop(line);
@@ -515,7 +538,7 @@ mod tests {
             if frame == 2 {
                 return Err("no room".into());
             }
-            Ok(vec![(main.to_path_buf(), vec![1, 2, 3])])
+            Ok(vec![(main.to_path_buf(), vec![1, 2, 3])].into())
         })
         .unwrap_err();
         assert!(err.contains("frame 2") && err.contains("no room"), "{err}");

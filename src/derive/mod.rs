@@ -313,6 +313,27 @@ impl Derived {
         }
     }
 
+    /// The simulation run of `scene`, which `settings` simulates (made afresh where this
+    /// cache holds another run or none); the CLI writes checkpoints from it and reads them
+    /// into it.
+    pub fn player_for(
+        &mut self,
+        settings: &crate::simulate::Settings,
+        scene: &Scene,
+    ) -> Option<&mut crate::simulate::Player> {
+        // The run follows the parcels as their keys and motion move them from time 0 on (a
+        // new time is no change of the run; an edit of a parcel, its keys or its motion is).
+        let sources = crate::simulate::Sources::of(scene);
+        if self
+            .player
+            .as_ref()
+            .is_none_or(|p| !p.runs(settings, &sources))
+        {
+            self.player = Some(crate::simulate::Player::new(settings, sources));
+        }
+        self.player.as_mut()
+    }
+
     /// The density of a simulated scene: the run's smoothed cloud at the scene's time.
     fn simulated(
         &mut self,
@@ -327,17 +348,7 @@ impl Derived {
         {
             return v.clone();
         }
-        // The run follows the parcels as their keys and motion move them from time 0 on (a
-        // new time is no change of the run; an edit of a parcel, its keys or its motion is).
-        let sources = crate::simulate::Sources::of(scene);
-        if self
-            .player
-            .as_ref()
-            .is_none_or(|p| !p.runs(settings, &sources))
-        {
-            self.player = Some(crate::simulate::Player::new(settings, sources));
-        }
-        let Some(player) = self.player.as_mut() else {
+        let Some(player) = self.player_for(settings, scene) else {
             return Versioned {
                 generation: 0,
                 data: Arc::new(DensityVolume::default()),

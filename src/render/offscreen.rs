@@ -262,6 +262,12 @@ impl Offscreen {
         self.info.device_type == wgpu::DeviceType::Cpu
     }
 
+    /// Its derivation cache, whose simulation run carries from render to render (a
+    /// sequence's checkpoints are written from it and read into it).
+    pub fn derived(&mut self) -> &mut Derived {
+        &mut self.derived
+    }
+
     /// Renders `scene` from its camera at full quality, over its sky or over nothing.
     pub fn render(
         &mut self,

@@ -247,6 +247,55 @@ impl State {
     pub fn bytes(&self) -> usize {
         (self.hum.len() + self.act.len() + self.cld.len()) * 8 + self.carry.len() * 4
     }
+
+    /// Its step, then its cells and carry, little-endian (a checkpoint file's body).
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut out = Vec::with_capacity(8 + self.bytes());
+        out.extend_from_slice(&self.step.to_le_bytes());
+        for words in [&self.hum, &self.act, &self.cld] {
+            out.extend(words.iter().flat_map(|w| w.to_le_bytes()));
+        }
+        out.extend(self.carry.iter().flat_map(|c| c.to_le_bytes()));
+        out
+    }
+
+    /// A state of the same automaton as `like` read back from [`State::to_bytes`], or why
+    /// not (another size: another automaton).
+    pub fn from_bytes(bytes: &[u8], like: &State) -> Result<State, String> {
+        if bytes.len() != 8 + like.bytes() {
+            return Err(format!(
+                "{} bytes where this run's state has {}",
+                bytes.len(),
+                8 + like.bytes()
+            ));
+        }
+        let (step, mut rest) = bytes.split_at(8);
+        let mut words = |n: usize| {
+            let (these, after) = rest.split_at(n * 8);
+            rest = after;
+            these
+                .chunks_exact(8)
+                .map(|c| u64::from_le_bytes(c.try_into().unwrap_or_default()))
+                .collect::<Vec<u64>>()
+        };
+        let hum = words(like.hum.len());
+        let act = words(like.act.len());
+        let cld = words(like.cld.len());
+        let carry = rest
+            .chunks_exact(4)
+            .map(|c| f32::from_le_bytes(c.try_into().unwrap_or_default()))
+            .collect::<Vec<f32>>();
+        if carry.iter().any(|c| !c.is_finite()) {
+            return Err("a wind carry that is not a number".into());
+        }
+        Ok(State {
+            hum,
+            act,
+            cld,
+            carry,
+            step: u64::from_le_bytes(step.try_into().unwrap_or_default()),
+        })
+    }
 }
 
 /// The three random terms.

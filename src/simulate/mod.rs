@@ -431,6 +431,8 @@ pub fn parcels(scene: &crate::scene::Scene) -> Vec<Parcel> {
 
 /// Steps a run keeps snapshots at (every this many steps), and how many at most.
 const SNAPSHOT_EVERY: u64 = 32;
+/// What a checkpoint file begins with (then the run's hash and its state).
+const CHECKPOINT_MAGIC: &[u8; 8] = b"CSSIMCK1";
 const MAX_SNAPSHOTS: usize = 64;
 /// Bytes the snapshots of one run may hold (a 256×64×256 run's state is 1.5 MiB: 32 of them).
 pub const SNAPSHOT_BYTES: usize = 48 << 20;
@@ -483,6 +485,69 @@ impl Player {
         self.snapshots.iter().map(State::bytes).sum()
     }
 
+    /// A hash of what it runs (its settings and where its parcels stand over time), the same
+    /// in every process: a checkpoint of another run is refused by it.
+    pub fn run_key(&self) -> u64 {
+        let (settings, sources) = &self.key;
+        let moving = sources.moving.as_ref().map(|s| {
+            serde_json::json!({
+                "ellipsoids": s.ellipsoids,
+                "animation": s.animation,
+                "wind_field": s.wind_field,
+                "seed": s.seed,
+            })
+        });
+        let text = serde_json::json!({
+            "settings": settings,
+            "start": format!("{:?}", sources.start),
+            "moving": moving,
+        })
+        .to_string();
+        crate::seeded::stable_hash(text.as_bytes())
+    }
+
+    /// The furthest snapshot of the run (a step that is a multiple of 32) and its state as a
+    /// checkpoint file holds it ([`Player::resume`] reads it back).
+    pub fn checkpoint(&self) -> (u64, Vec<u8>) {
+        let last = self.snapshots.iter().max_by_key(|s| s.step);
+        let state = last.cloned().unwrap_or_else(|| self.run.state());
+        let mut bytes = CHECKPOINT_MAGIC.to_vec();
+        bytes.extend_from_slice(&self.run_key().to_le_bytes());
+        bytes.extend_from_slice(&state.to_bytes());
+        (state.step, bytes)
+    }
+
+    /// Takes a checkpoint of this run (written by any process that played it), so steps up
+    /// to its own need not be played again; returns its step, or why it is refused (another
+    /// run's, damaged, past the last step).
+    pub fn resume(&mut self, bytes: &[u8]) -> Result<u64, String> {
+        let head = CHECKPOINT_MAGIC.len() + 8;
+        if bytes.len() < head || !bytes.starts_with(CHECKPOINT_MAGIC) {
+            return Err("not a cloudsketch simulation checkpoint".into());
+        }
+        let key = u64::from_le_bytes(
+            bytes[CHECKPOINT_MAGIC.len()..head]
+                .try_into()
+                .unwrap_or_default(),
+        );
+        if key != self.run_key() {
+            return Err("a checkpoint of another scene or simulation (its hash differs)".into());
+        }
+        let state = State::from_bytes(&bytes[head..], &self.snapshots[0])?;
+        if state.step > MAX_STEP || !state.step.is_multiple_of(SNAPSHOT_EVERY) {
+            return Err(format!(
+                "a checkpoint at step {}, not one this run makes",
+                state.step
+            ));
+        }
+        let step = state.step;
+        if !self.snapshots.iter().any(|s| s.step == step) {
+            let at = self.snapshots.partition_point(|s| s.step < step);
+            self.snapshots.insert(at, state);
+        }
+        Ok(step)
+    }
+
     /// Whether it runs these settings and sources.
     pub fn runs(&self, settings: &Settings, sources: &Sources) -> bool {
         self.key.0 == *settings && self.key.1 == *sources
@@ -499,8 +564,10 @@ impl Player {
         if let Some((s, v)) = self.smoothed.iter().find(|(s, _)| *s == n) {
             return (*s, v.clone());
         }
-        if self.run.step() > n
-            && let Some(snap) = self.snapshots.iter().rev().find(|s| s.step <= n)
+        // The nearest snapshot at or before `n`: back to it from past `n`, or on to it (one a
+        // checkpoint gave) from before it.
+        if let Some(snap) = self.snapshots.iter().rev().find(|s| s.step <= n)
+            && (self.run.step() > n || snap.step > self.run.step())
         {
             self.run.restore(&snap.clone());
         }
