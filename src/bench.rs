@@ -551,6 +551,100 @@ fn simulated_scrub() -> BenchResult {
     )
 }
 
+/// Sequences of the `simulated` preset at one frame a second (10 steps a frame), as
+/// `export --frames` writes them: 48 frames as VDB through one derivation cache, against the
+/// parts it cannot do without (the 470 steps played once, plus 48 exports of a frame whose run
+/// is already there) and against 48 single-frame exports, each replaying its run from step 0;
+/// and a chunk of 4 frames from step 5,000 started from a checkpoint file's state, against the
+/// same chunk played from step 0.
+fn sequences() -> Vec<BenchResult> {
+    use crate::export::{Format, Options, export, export_frame};
+    let mut scene = Scene::preset(Preset::Simulated);
+    scene.clock.fps = 1.0;
+    let options = Options {
+        resolution: 64,
+        ..Options::default()
+    };
+    let at = |frame: u32| scene.posed_at(scene.clock.seconds(frame));
+    let write = |derived: &mut Derived, frame: u32| {
+        std::hint::black_box(export_frame(
+            derived,
+            &at(frame),
+            Format::Vdb,
+            &options,
+            "cloud",
+        ))
+        .map(|_| ())
+        .map_err(|e| e.to_string())
+    };
+    let frames = 0..48u32;
+    let t = Instant::now();
+    let mut derived = Derived::default();
+    for f in frames.clone() {
+        if write(&mut derived, f).is_err() {
+            return Vec::new();
+        }
+    }
+    let sequence = t.elapsed().as_secs_f64();
+    // The parts: the steps alone, then one frame's export with its run already there.
+    let t = Instant::now();
+    let mut steps = Derived::default();
+    std::hint::black_box(steps.density_afresh(&at(47)));
+    let stepping = t.elapsed().as_secs_f64();
+    let one = time_median(3, &mut || {
+        let _ = write(&mut steps, 47);
+    });
+    let t = Instant::now();
+    for f in frames {
+        let _ = std::hint::black_box(export(&at(f), Format::Vdb, &options, "cloud"));
+    }
+    let replays = t.elapsed().as_secs_f64();
+
+    // A checkpoint at step 4,992 (frame 499 and a bit), made untimed; then frames 500–503.
+    let mut made = Derived::default();
+    let _ = write(&mut made, 500);
+    let settings = scene.simulation.clone().unwrap_or_default();
+    let checkpoint = made
+        .player_for(&settings, &at(500))
+        .map(|p| p.checkpoint().1)
+        .unwrap_or_default();
+    let chunk = |from_checkpoint: bool| {
+        let t = Instant::now();
+        let mut d = Derived::default();
+        if from_checkpoint && let Some(p) = d.player_for(&settings, &at(500)) {
+            let _ = p.resume(&checkpoint);
+        }
+        for f in 500..504 {
+            let _ = write(&mut d, f);
+        }
+        t.elapsed().as_secs_f64()
+    };
+    let (resumed, replayed) = (chunk(true), chunk(false));
+    vec![
+        result(
+            "sequence_simulated_48_vdb_frames",
+            sequence * 1e3,
+            "ms",
+            "sequence_steps_once_plus_48_warm_frame_exports",
+            (stepping + 48.0 * one) * 1e3,
+        ),
+        result(
+            "sequence_simulated_48_vdb_frames_vs_replays",
+            sequence * 1e3,
+            "ms",
+            "sequence_48_single_frame_exports_each_replaying",
+            replays * 1e3,
+        ),
+        result(
+            "sequence_chunk_4_frames_at_step_5000_from_checkpoint",
+            resumed * 1e3,
+            "ms",
+            "sequence_chunk_4_frames_at_step_5000_from_step_0",
+            replayed * 1e3,
+        ),
+    ]
+}
+
 /// The other way to build the field (ARCHITECTURE.md, "The field at scale"): every texel
 /// evaluated on the GPU, one render pass per slice, against the CPU's full bake on the same
 /// grid and the CPU's partial update after one primitive moved (which the app uses).
@@ -817,9 +911,9 @@ fn links() -> Vec<BenchResult> {
 }
 
 /// The groups `--only` may name.
-pub const GROUPS: [&str; 16] = [
-    "sketch", "light", "stroke", "worst", "field", "time", "link", "mesh", "simulate", "ca",
-    "shafts", "render", "march", "quality", "gpu", "all",
+pub const GROUPS: [&str; 17] = [
+    "sketch", "light", "stroke", "worst", "field", "time", "sequence", "link", "mesh", "simulate",
+    "ca", "shafts", "render", "march", "quality", "gpu", "all",
 ];
 
 /// Runs the suite (or only the groups named in `only`, comma-separated) and prints it. A group
@@ -869,6 +963,9 @@ pub fn run(json: bool, only: Option<&str>) -> Result<(), String> {
     }
     if wanted("time") {
         results.extend(time_moves());
+    }
+    if wanted("sequence") {
+        results.extend(sequences());
     }
     if wanted("link") {
         results.extend(links());

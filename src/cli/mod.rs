@@ -195,7 +195,8 @@ enum Command {
         /// Print one JSON object instead of a table.
         #[arg(long)]
         json: bool,
-        /// Run only these groups, comma-separated: sketch, light, stroke, worst, field, link,
+        /// Run only these groups, comma-separated: sketch, light, stroke, worst, field, time,
+        /// sequence (frame sequences and checkpoints), link,
         /// mesh, simulate, shafts (the ground's shadow and the shafts of light), ca (simulate
         /// and shafts), render, march (the slices marched against rasterised), quality, gpu.
         #[arg(long)]

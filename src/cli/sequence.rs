@@ -501,10 +501,7 @@ mod tests {
             }
             .run(|frame, main| {
                 made.push(frame);
-                Ok(vec![(
-                    main.to_path_buf(),
-                    format!("frame {frame}").into_bytes(),
-                )])
+                Ok(vec![(main.to_path_buf(), format!("frame {frame}").into_bytes())].into())
             })
         };
         let mut made = vec![];

@@ -598,3 +598,33 @@ fn moving_parcels_steer_the_run_and_a_scrubbed_frame_equals_it_played_from_step_
         "the moving parcels steered it"
     );
 }
+
+#[test]
+fn a_checkpoint_resumes_the_run_in_a_fresh_player_and_refuses_another_runs() {
+    let (settings, parcels) = parcel_settings();
+    let mut played = Player::new(&settings, Sources::fixed(parcels.clone()));
+    while played.density(13.0).1 {} // 130 steps: snapshots to step 128
+    let (step, bytes) = played.checkpoint();
+    assert_eq!(step, 128);
+    let mut fresh = Player::new(&settings, Sources::fixed(parcels.clone()));
+    assert_eq!(fresh.resume(&bytes), Ok(128));
+    let mut shown = fresh.density(13.0);
+    while shown.1 {
+        shown = fresh.density(13.0);
+    }
+    assert_eq!(shown.0.values, played.density(13.0).0.values);
+    assert!(
+        fresh.steps_taken() <= 3,
+        "took {} steps",
+        fresh.steps_taken()
+    );
+    // Another run (a parcel moved), a damaged file: refused, nothing taken.
+    let mut moved = parcels.clone();
+    moved[0].center.x += 1.0;
+    let mut other = Player::new(&settings, Sources::fixed(moved));
+    let err = other.resume(&bytes).unwrap_err();
+    assert!(err.contains("another scene"), "{err}");
+    let err = fresh.resume(&bytes[..bytes.len() - 1]).unwrap_err();
+    assert!(err.contains("bytes"), "{err}");
+    assert!(fresh.resume(b"not a checkpoint").is_err());
+}
