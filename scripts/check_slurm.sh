@@ -7,10 +7,12 @@
 #
 #   bash scripts/check_slurm.sh [path/to/cloudsketch]   (default: target/debug/cloudsketch)
 set -euo pipefail
+# The daemons run as root (SlurmUser=root), as on the CI machine; elsewhere through sudo.
+if [ "$(id -u)" != 0 ]; then exec sudo -E bash "$0" "$@"; fi
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BIN="$(realpath "${1:-$ROOT/target/debug/cloudsketch}")"
 log() { printf '\033[1;34m[slurm]\033[0m %s\n' "$*" >&2; }
-SUDO=$( [ "$(id -u)" = 0 ] || echo sudo )
+SUDO=""
 
 if ! command -v slurmctld >/dev/null || ! command -v munged >/dev/null; then
   log "apt-get install slurm-wlm (brings munge)"
@@ -22,11 +24,20 @@ work="$(mktemp -d /tmp/cloudsketch-slurm.XXXXXX)"
 chmod 755 "$work"
 munge_pid=""
 stop() {
+  # Jobs first (an interrupted run leaves none running), then the daemons, waited for.
+  if [ -n "${SLURM_CONF:-}" ]; then scancel --quiet --full --partition=main 2>/dev/null || true; fi
+  local pids=()
   for pidfile in "$work/slurmd.pid" "$work/slurmctld.pid"; do
-    [ -f "$pidfile" ] && kill "$(cat "$pidfile")" 2>/dev/null || true
+    [ -f "$pidfile" ] && pids+=("$(cat "$pidfile")")
   done
-  [ -n "$munge_pid" ] && kill "$munge_pid" 2>/dev/null || true
-  sleep 1
+  [ -n "$munge_pid" ] && pids+=("$munge_pid")
+  for pid in "${pids[@]}"; do kill "$pid" 2>/dev/null || true; done
+  for _ in $(seq 50); do
+    alive=0
+    for pid in "${pids[@]}"; do kill -0 "$pid" 2>/dev/null && alive=1; done
+    [ "$alive" = 0 ] && break
+    sleep 0.2
+  done
   rm -rf "$work"
 }
 trap stop EXIT
@@ -47,6 +58,8 @@ fi
 
 host="$(hostname -s)"
 cpus="$(nproc)"
+# Ports of their own per run (two runs side by side do not meet).
+port=$(( 20000 + ($$ % 5000) * 2 ))
 mkdir -p "$work/state" "$work/spool" "$work/farm" "$work/local"
 cat >"$work/slurm.conf" <<EOF
 ClusterName=cloudsketch
@@ -61,8 +74,8 @@ SelectType=select/cons_tres
 SelectTypeParameters=CR_Core
 ReturnToService=2
 MpiDefault=none
-SlurmctldPort=16817
-SlurmdPort=16818
+SlurmctldPort=$port
+SlurmdPort=$((port + 1))
 StateSaveLocation=$work/state
 SlurmdSpoolDir=$work/spool
 SlurmctldPidFile=$work/slurmctld.pid
@@ -99,7 +112,7 @@ EOF
 chmod +x "$work/chunk.sh"
 log "sbatch --array=0-6:2 (frames 0..7 in chunks of 2)"
 start=$(date +%s)
-if ! sbatch --wait --array=0-6:2 --output="$work/task-%a.log" "$work/chunk.sh" >/dev/null; then
+if ! timeout 900 sbatch --wait --array=0-6:2 --output="$work/task-%a.log" "$work/chunk.sh" >/dev/null; then
   cat "$work"/task-*.log >&2 || true
   log "the array job failed"
   exit 1

@@ -612,7 +612,7 @@ fn sequences() -> Vec<BenchResult> {
         let t = Instant::now();
         let mut d = Derived::default();
         if from_checkpoint && let Some(p) = d.player_for(&settings, &at(500)) {
-            let _ = p.resume(&checkpoint);
+            let _ = p.resume(&checkpoint, u64::MAX);
         }
         for f in 500..504 {
             let _ = write(&mut d, f);

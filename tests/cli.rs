@@ -1082,6 +1082,22 @@ fn a_sequence_writes_each_frame_once_and_any_split_of_it_gives_the_same_bytes() 
         );
     }
     assert!(!dir.join("bad").exists() && !dir.join("plain.png").exists());
+    // A frame that would overwrite the input scene.
+    std::fs::copy(&scene, dir.join("s_1.json")).unwrap();
+    let o = cloudsketch(&[
+        "render",
+        &path("s_1.json"),
+        "--frames",
+        "0..2",
+        "-o",
+        &path("s_#.json"),
+    ]);
+    assert!(
+        stderr(&o).contains("would overwrite the input"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!dir.join("s_0.json").exists());
     let o = cloudsketch(&[
         "render",
         &scene,

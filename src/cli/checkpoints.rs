@@ -62,7 +62,7 @@ impl Checkpoints {
         while let Some((_, path)) = found.pop() {
             let read = crate::files::read_bounded(&path, MAX_CHECKPOINT_BYTES)
                 .map_err(|e| e.at(&path))
-                .and_then(|bytes| player.resume(&bytes));
+                .and_then(|bytes| player.resume(&bytes, target));
             match read {
                 Ok(step) => {
                     self.furthest = Some(step);
@@ -80,21 +80,22 @@ impl Checkpoints {
     }
 
     /// Writes `scene`'s run's furthest snapshot in `derived` when it is past what was written
-    /// or read.
-    pub fn save(&mut self, derived: &mut Derived, scene: &Scene) -> Result<(), String> {
+    /// or read. A checkpoint that cannot be written is a warning: the frame is made.
+    pub fn save(&mut self, derived: &mut Derived, scene: &Scene) {
         let Some(settings) = scene.simulation.as_ref() else {
-            return Ok(());
+            return;
         };
         let Some(player) = derived.player_for(settings, scene) else {
-            return Ok(());
+            return;
         };
         let (step, bytes) = player.checkpoint();
         if step == 0 || self.furthest.is_some_and(|f| f >= step) {
-            return Ok(());
+            return;
         }
         let path = self.dir.join(Self::name(player.run_key(), step));
-        super::write(&path, &bytes)?;
-        self.furthest = Some(step);
-        Ok(())
+        match super::write(&path, &bytes) {
+            Ok(()) => self.furthest = Some(step),
+            Err(e) => eprintln!("warning: checkpoint not written: {e}"),
+        }
     }
 }

@@ -169,10 +169,11 @@ fn sequence(
     };
     let key = stable_hash(
         format!(
-            "{}\nexport {} {:?} {}",
+            "{}\nexport {} {:?} transparent={} {}",
             scene.to_json(),
             format.name(),
             options,
+            r.transparent,
             env!("CARGO_PKG_VERSION")
         )
         .as_bytes(),
@@ -193,6 +194,7 @@ fn sequence(
         overwrite: r.sequence.overwrite,
         report: plan.report,
         verb: "exported",
+        inputs: &r.scene.into_iter().collect::<Vec<_>>(),
     }
     .run(|frame, main: &Path| -> Result<Made, String> {
         let posed = scene.posed_at(scene.clock.seconds(frame));
@@ -235,7 +237,7 @@ fn sequence(
                 Some(o) => o.derived(),
                 None => &mut own,
             };
-            c.save(derived, &posed)?;
+            c.save(derived, &posed);
         }
         Ok(Made { files, note })
     })

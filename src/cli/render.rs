@@ -100,6 +100,7 @@ pub fn run(r: &Request) -> Result<(), String> {
             overwrite: r.sequence.overwrite,
             report: plan.report,
             verb: "rendered",
+            inputs: &inputs,
         }
         .run(|frame, main| {
             let posed = framed(scene.posed_at(scene.clock.seconds(frame)));
@@ -113,7 +114,7 @@ pub fn run(r: &Request) -> Result<(), String> {
                 .render(&posed, width, height, Backdrop::Sky)
                 .map_err(|e| e.to_string())?;
             if let Some(c) = checkpoints.as_mut() {
-                c.save(offscreen.derived(), &posed)?;
+                c.save(offscreen.derived(), &posed);
             }
             let png = image
                 .to_png()

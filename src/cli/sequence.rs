@@ -320,6 +320,8 @@ pub struct Sequence<'a> {
     pub report: Report,
     /// What is made, for messages ("rendered", "exported").
     pub verb: &'a str,
+    /// The command's inputs (a scene file or a link): no frame may overwrite one.
+    pub inputs: &'a [&'a str],
 }
 
 impl Sequence<'_> {
@@ -336,6 +338,7 @@ impl Sequence<'_> {
             std::fs::create_dir_all(folder)
                 .map_err(|e| format!("cannot make the folder {}: {e}", folder.display()))?;
         }
+        self.check_inputs()?;
         let first = self.pattern.path(self.frames.first);
         crate::files::check_writable(&first).map_err(|e| {
             format!(
@@ -397,6 +400,35 @@ impl Sequence<'_> {
             start.elapsed().as_secs_f64(),
             self.pattern.path(self.frames.first).display()
         );
+        Ok(())
+    }
+
+    /// Refuses, before any frame, a range one of whose files is an input (compared as real
+    /// paths: `./s_1.json` and `s_1.json` are one file).
+    fn check_inputs(&self) -> Result<(), String> {
+        let inputs: Vec<PathBuf> = self
+            .inputs
+            .iter()
+            .filter(|arg| !super::is_link(arg))
+            .filter_map(|arg| Path::new(arg).canonicalize().ok())
+            .collect();
+        let folder = match self.pattern.folder() {
+            f if f.as_os_str().is_empty() => Path::new("."),
+            f => f,
+        };
+        let (Ok(folder), false) = (folder.canonicalize(), inputs.is_empty()) else {
+            return Ok(());
+        };
+        for frame in self.frames.iter() {
+            let path = self.pattern.path(frame);
+            let name = path.file_name().unwrap_or_default();
+            if inputs.contains(&folder.join(name)) {
+                return Err(format!(
+                    "{}: frame {frame} would overwrite the input (no frame was written)",
+                    path.display()
+                ));
+            }
+        }
         Ok(())
     }
 
@@ -498,6 +530,7 @@ mod tests {
                 overwrite,
                 report: Report::Line,
                 verb: "made",
+                inputs: &[],
             }
             .run(|frame, main| {
                 made.push(frame);
@@ -530,6 +563,7 @@ mod tests {
             overwrite: false,
             report: Report::Line,
             verb: "made",
+            inputs: &[],
         }
         .run(|frame, main| {
             if frame == 2 {

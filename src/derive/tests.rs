@@ -845,6 +845,12 @@ fn a_planes_keyed_inflation_blend_and_billows_pose_its_outline_as_a_fresh_one_wo
             *incremental == *density_of(&doc.scene().clone()),
             "at {t} s the scrubbed density differs from a fresh one"
         );
+        // Saved here (billows keyed to no coverage at 0 s), it opens as it is.
+        assert_eq!(
+            Scene::from_json(&doc.scene().to_json()).unwrap().0,
+            *doc.scene(),
+            "the document saved at {t} s opens otherwise"
+        );
         seen.push((t, incremental));
     }
     assert!(*seen[0].1 != *first, "halfway the keys changed nothing");

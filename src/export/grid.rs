@@ -104,6 +104,18 @@ impl Sampling {
                 }
             }
         };
+        // A sequence's frame with nothing to bake (every primitive hidden, say): one clear
+        // texel at the origin, so the sequence stays whole.
+        let volume = if volume.is_empty() && clear_ok && !format.is_mesh() {
+            DensityVolume {
+                dims: UVec3::ONE,
+                min: Vec3::ZERO,
+                size: Vec3::ONE,
+                values: vec![0.0],
+            }
+        } else {
+            volume
+        };
         let clear = volume.values.iter().all(|&v| v <= 0.0);
         if volume.is_empty() || (clear && !(clear_ok && !format.is_mesh())) {
             return Err(ExportError::Empty);

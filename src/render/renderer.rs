@@ -853,6 +853,10 @@ impl VolumeRenderer {
             job.plan.total,
             job.plan.size.map(|v| v.div_ceil(divisor.max(1))),
         );
+        // The shafts beyond the box are the viewport's too: it draws its own again.
+        if let Some(backdrop) = &mut self.backdrop {
+            backdrop.key = None;
+        }
         self.prepare_cropped_composite(device, queue, job.plan.target, crop.ndc(job.plan.size));
         let mut pass = self.backdrop_pass(
             queue,

@@ -42,6 +42,13 @@ impl Billows {
         self.levels == 0 || self.coverage <= 0.0
     }
 
+    /// Whether a file leaves it out: no levels (a missing one reads as none). Billows with
+    /// levels are kept whatever their coverage, so a coverage keyed to 0 at the time a
+    /// document is saved does not lose them.
+    pub fn is_unset(&self) -> bool {
+        self.levels == 0
+    }
+
     /// Clamps every value into its range (documents and links may carry anything).
     pub fn sanitize(&mut self) {
         self.levels = limits::BILLOW_LEVELS.fix_u32(self.levels);

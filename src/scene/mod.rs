@@ -408,7 +408,7 @@ pub struct Ellipsoid {
     #[serde(skip_serializing_if = "is_zero")]
     pub id: u64,
     /// Puffs on its surface.
-    #[serde(skip_serializing_if = "Billows::is_off")]
+    #[serde(skip_serializing_if = "Billows::is_unset")]
     pub billows: Billows,
     /// How it moves with time (Schpok et al. 2003 §3.1's particles): its centre and radii
     /// above are this motion's pose at the scene's time.

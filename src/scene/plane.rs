@@ -56,7 +56,7 @@ pub struct DrawingPlane {
     #[serde(skip_serializing_if = "is_zero")]
     pub id: u64,
     /// Puffs on the outline's spheres.
-    #[serde(skip_serializing_if = "Billows::is_off")]
+    #[serde(skip_serializing_if = "Billows::is_unset")]
     pub billows: Billows,
 }
 

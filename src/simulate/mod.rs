@@ -498,6 +498,8 @@ impl Player {
             })
         });
         let text = serde_json::json!({
+            // Another build may step differently: its checkpoints are another run's.
+            "build": env!("CARGO_PKG_VERSION"),
             "settings": settings,
             "start": format!("{:?}", sources.start),
             "moving": moving,
@@ -519,8 +521,8 @@ impl Player {
 
     /// Takes a checkpoint of this run (written by any process that played it), so steps up
     /// to its own need not be played again; returns its step, or why it is refused (another
-    /// run's, damaged, past the last step).
-    pub fn resume(&mut self, bytes: &[u8]) -> Result<u64, String> {
+    /// run's, damaged, past step `at_most`).
+    pub fn resume(&mut self, bytes: &[u8], at_most: u64) -> Result<u64, String> {
         let head = CHECKPOINT_MAGIC.len() + 8;
         if bytes.len() < head || !bytes.starts_with(CHECKPOINT_MAGIC) {
             return Err("not a cloudsketch simulation checkpoint".into());
@@ -534,7 +536,7 @@ impl Player {
             return Err("a checkpoint of another scene or simulation (its hash differs)".into());
         }
         let state = State::from_bytes(&bytes[head..], &self.snapshots[0])?;
-        if state.step > MAX_STEP || !state.step.is_multiple_of(SNAPSHOT_EVERY) {
+        if state.step > at_most.min(MAX_STEP) || !state.step.is_multiple_of(SNAPSHOT_EVERY) {
             return Err(format!(
                 "a checkpoint at step {}, not one this run makes",
                 state.step

@@ -607,7 +607,11 @@ fn a_checkpoint_resumes_the_run_in_a_fresh_player_and_refuses_another_runs() {
     let (step, bytes) = played.checkpoint();
     assert_eq!(step, 128);
     let mut fresh = Player::new(&settings, Sources::fixed(parcels.clone()));
-    assert_eq!(fresh.resume(&bytes), Ok(128));
+    assert!(
+        fresh.resume(&bytes, 100).is_err(),
+        "a checkpoint past the step asked for"
+    );
+    assert_eq!(fresh.resume(&bytes, 130), Ok(128));
     let mut shown = fresh.density(13.0);
     while shown.1 {
         shown = fresh.density(13.0);
@@ -622,9 +626,9 @@ fn a_checkpoint_resumes_the_run_in_a_fresh_player_and_refuses_another_runs() {
     let mut moved = parcels.clone();
     moved[0].center.x += 1.0;
     let mut other = Player::new(&settings, Sources::fixed(moved));
-    let err = other.resume(&bytes).unwrap_err();
+    let err = other.resume(&bytes, 130).unwrap_err();
     assert!(err.contains("another scene"), "{err}");
-    let err = fresh.resume(&bytes[..bytes.len() - 1]).unwrap_err();
+    let err = fresh.resume(&bytes[..bytes.len() - 1], 130).unwrap_err();
     assert!(err.contains("bytes"), "{err}");
-    assert!(fresh.resume(b"not a checkpoint").is_err());
+    assert!(fresh.resume(b"not a checkpoint", 130).is_err());
 }

@@ -242,16 +242,9 @@ impl Viewport {
                     ui.ctx().request_repaint();
                 }
                 // At the view's own quality (its light previewed on a CPU adapter): the
-                // frames play where the view shows them. The density changing under it (a
-                // simulation) starts it over.
-                if self.capture_density != volumes.density.generation {
-                    self.capture_density = volumes.density.generation;
-                    if let Some(capture) = self.capture.as_ref().filter(|c| c.drawing()) {
-                        self.capture = Some(capture.restart());
-                    }
-                }
+                // frames play where the view shows them.
                 let capture =
-                    self.drive_capture(ui, &mut cx, &view, &volumes.density.data, CACHE_BUDGET);
+                    self.drive_capture(ui, &mut cx, &view, &volumes.density, CACHE_BUDGET);
                 if let Some(capture) = capture.filter(|_| self.stats.backend.is_some()) {
                     painter.add(paint_callback(
                         rect,
@@ -401,13 +394,7 @@ impl Viewport {
         if plan.shown.is_some_and(|q| q.full) {
             self.ready = true;
         }
-        self.drive_capture(
-            ui,
-            &mut cx,
-            &exported,
-            &volumes.density.data,
-            CAPTURE_BUDGET,
-        );
+        self.drive_capture(ui, &mut cx, &exported, &volumes.density, CAPTURE_BUDGET);
         let capture = self.capture.clone();
         if crop.is_none() && capture.is_some() && self.stats.backend.is_some() {
             // Nothing of the cloud in view: the capture still needs the callback to run.
@@ -473,9 +460,18 @@ impl Viewport {
         ui: &egui::Ui,
         cx: &mut ToolContext<'_>,
         exported: &View,
-        density: &crate::density::DensityVolume,
+        density: &crate::derive::Versioned<crate::density::DensityVolume>,
         budget: f64,
     ) -> Option<Capture> {
+        // The density changing under a capture (a simulation stepping on, a far jump caught
+        // up) starts it over: its chunks, and the box they are drawn over, show one cloud.
+        if self.capture_density != density.generation {
+            self.capture_density = density.generation;
+            if let Some(capture) = self.capture.as_ref().filter(|c| c.drawing()) {
+                self.capture = Some(capture.restart());
+            }
+        }
+        let density = &density.data;
         let now = ui.input(|i| i.time);
         if let Some((size, transparent)) = self.capture_request.take() {
             // Its slices spread over frames within a frame's budget, as refinement's are,
