@@ -156,19 +156,22 @@ pub fn keyed_by_i(scene: &Scene, selection: &Selection, shot_view: bool) -> Vec<
 }
 
 impl Timeline {
-    /// Advances the scene time by `dt` seconds of wall time while playing (back to the range's
-    /// start past its end when looping); returns whether it did (the caller asks for the next
-    /// frame).
+    /// Advances the scene time by `dt` seconds of wall time while playing (at most half a
+    /// second: a stalled frame does not jump the clock); looping, the range's last frame lasts
+    /// a frame like the others and the time past it carries on from the first, so a loop of
+    /// 24 frames takes one second at 24 a second however the frames fall. Returns whether it
+    /// moved (the caller asks for the next frame).
     pub fn tick(&mut self, doc: &mut Document, dt: f32) -> bool {
         if !self.playing {
             return false;
         }
         let clock = doc.scene().clock;
-        let mut t = doc.scene().time + dt.clamp(0.0, 0.25) * self.speed;
+        let mut t = doc.scene().time + dt.clamp(0.0, 0.5) * self.speed;
         if self.looping {
-            let (start, end) = (clock.seconds(clock.start), clock.seconds(clock.end));
-            if t > end || t < start {
-                t = start;
+            let start = clock.seconds(clock.start);
+            let period = clock.seconds(clock.end.saturating_add(1)) - start;
+            if t < start || t >= start + period {
+                t = start + (t - start).rem_euclid(period.max(1e-6));
             }
         }
         doc.set_time(t);
@@ -711,15 +714,21 @@ mod tests {
         assert!(doc.revisions().render > render, "the image knows to change");
         // A stalled frame does not jump the clock.
         timeline.tick(&mut doc, 30.0);
-        assert!(doc.scene().time < 2.6);
-        // Looping: past the range's last frame, back to its first.
+        assert!(doc.scene().time < 3.1);
+        // Looping: the last frame lasts a frame, and the time past it carries on from the
+        // first (none is lost at the wrap: a loop takes its frames' time exactly).
         timeline.looping = true;
-        let end = doc.scene().clock.seconds(doc.scene().clock.end);
-        doc.set_time(end - 0.01);
+        let clock = doc.scene().clock;
+        let end = clock.seconds(clock.end);
+        doc.set_time(end + 0.01);
+        timeline.tick(&mut doc, 0.01);
+        assert!((doc.scene().time - (end + 0.03)).abs() < 1e-5, "still the last frame");
         timeline.tick(&mut doc, 0.1);
-        assert_eq!(
-            doc.scene().time,
-            doc.scene().clock.seconds(doc.scene().clock.start)
+        let past = end + 0.23 - clock.seconds(clock.end + 1);
+        assert!(
+            (doc.scene().time - (clock.seconds(clock.start) + past)).abs() < 1e-4,
+            "{} s, not {past}",
+            doc.scene().time
         );
     }
 
