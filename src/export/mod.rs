@@ -170,11 +170,14 @@ pub fn export(
     options: &Options,
     stem: &str,
 ) -> Result<Vec<File>, ExportError> {
-    if format == Format::Png {
-        return Err(ExportError::NeedsRenderer);
-    }
-    let grid = sample(scene, format, options)?;
-    Ok(write(scene, &grid, format, options, stem))
+    exported(
+        &mut crate::derive::Derived::default(),
+        scene,
+        format,
+        options,
+        stem,
+        false,
+    )
 }
 
 /// A sequence's frame of [`export`], through `derived` (see [`Sampling::start_in`]): a
@@ -187,10 +190,22 @@ pub fn export_frame(
     options: &Options,
     stem: &str,
 ) -> Result<Vec<File>, ExportError> {
+    exported(derived, scene, format, options, stem, true)
+}
+
+/// [`export`] and [`export_frame`]: sampled through `derived`, a clear volume allowed or not.
+fn exported(
+    derived: &mut crate::derive::Derived,
+    scene: &Scene,
+    format: Format,
+    options: &Options,
+    stem: &str,
+    clear_ok: bool,
+) -> Result<Vec<File>, ExportError> {
     if format == Format::Png {
         return Err(ExportError::NeedsRenderer);
     }
-    let grid = Sampling::start_in(derived, scene, format, options, true)?.finish();
+    let grid = Sampling::start_in(derived, scene, format, options, clear_ok)?.finish();
     Ok(write(scene, &grid, format, options, stem))
 }
 

@@ -722,7 +722,10 @@ mod tests {
         let end = clock.seconds(clock.end);
         doc.set_time(end + 0.01);
         timeline.tick(&mut doc, 0.01);
-        assert!((doc.scene().time - (end + 0.03)).abs() < 1e-5, "still the last frame");
+        assert!(
+            (doc.scene().time - (end + 0.03)).abs() < 1e-5,
+            "still the last frame"
+        );
         timeline.tick(&mut doc, 0.1);
         let past = end + 0.23 - clock.seconds(clock.end + 1);
         assert!(
