@@ -10,7 +10,9 @@
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$ROOT"
-log() { printf '\033[1;34m[test]\033[0m %s\n' "$*" >&2; }
+# Each stage's line says how long the suite has run (CI stops it at 90 minutes).
+START=$SECONDS
+log() { printf '\033[1;34m[test %3d:%02d]\033[0m %s\n' $(((SECONDS - START) / 60)) $(((SECONDS - START) % 60)) "$*" >&2; }
 
 bash scripts/setup.sh
 

@@ -644,6 +644,7 @@ impl CloudApp {
             "export": {
                 "format": self.panels.export.format.name(),
                 "transparent": self.panels.export.transparent,
+                "png_width": self.panels.export.png_width,
                 "progress": self.panels.export.progress(),
                 "last": self.panels.export.last.as_ref().map(|r| match r {
                     Ok(names) => serde_json::json!({ "files": names }),

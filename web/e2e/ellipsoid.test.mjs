@@ -9,7 +9,7 @@ import path from 'node:path';
 import { execFileSync } from 'node:child_process';
 import { fileURLToPath } from 'node:url';
 import { PNG } from 'pngjs';
-import { serve, state, screenshot, countChanged, until, withApp, waitForFullQuality, recordTiming, SCREENSHOTS, cloudColumns } from './harness.mjs';
+import { serve, state, screenshot, countChanged, until, withApp, waitForFullQuality, recordTiming, SCREENSHOTS, cloudColumns, EDITING_BUILDS } from './harness.mjs';
 
 let server;
 before(async () => { server = await serve(); });
@@ -34,7 +34,7 @@ async function addEllipsoids(page, at) {
 
 const cloud = cloudColumns;
 
-for (const backend of ['webgpu', 'webgl2']) {
+for (const backend of EDITING_BUILDS) {
   test(`add an ellipsoid with its tool, move it, undo, scale it, delete (${backend})`, { timeout: 240_000 }, async () => {
     await withApp({ base: server.url, webgpu: backend === 'webgpu', query: '?preset=empty', viewport: { width: 1280, height: 800 } }, async (page) => {
       let s = await state(page);
@@ -103,7 +103,7 @@ for (const backend of ['webgpu', 'webgl2']) {
 // wanders; G then X does the same from anywhere; Esc in the middle of a drag takes it back;
 // Shift+H hides the ellipsoid (the cloud goes), Alt+H shows it; F frames it; Ctrl+D is kept
 // from the browser (its bookmark dialog).
-for (const backend of ['webgpu', 'webgl2']) {
+for (const backend of EDITING_BUILDS) {
   test(`gizmo arrows, axis lock, Esc, hide and frame (${backend})`, { timeout: 240_000 }, async () => {
     await withApp({ base: server.url, webgpu: backend === 'webgpu', query: '?preset=empty', viewport: { width: 1280, height: 800 } }, async (page) => {
       let s = await state(page);
@@ -190,7 +190,7 @@ for (const backend of ['webgpu', 'webgl2']) {
 // Several at once: a box dragged with Move and nothing selected selects both ellipsoids; a drag
 // on the X arrow moves both by the same distance; Shift+click takes one out; Ctrl+D duplicates
 // the selection; one Ctrl+Z undoes the whole move.
-for (const backend of ['webgpu', 'webgl2']) {
+for (const backend of EDITING_BUILDS) {
   test(`box select, move several, Shift+click (${backend})`, { timeout: 240_000 }, async () => {
     await withApp({ base: server.url, webgpu: backend === 'webgpu', query: '?preset=empty', viewport: { width: 1280, height: 800 } }, async (page) => {
       let s = await state(page);

@@ -11,6 +11,18 @@ import { chromium } from 'playwright-core';
 import { PNG } from 'pngjs';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
+/**
+ * The builds a test runs in. What draws runs in both: the WebGL2 fallback draws through wgpu's GL
+ * backend (the WGSL translated to GLSL), the WebGPU build through the browser's WebGPU. Tools,
+ * input handling, undo and the document are the same Rust in both builds, so a test of those
+ * alone runs in the WebGPU build, which most visitors get; the WebGL2 build's drawing of what
+ * they make is covered by the tests that run in both. (Every test in both took the suite past
+ * CI's 90 minutes on a busy machine.)
+ */
+export const BOTH_BUILDS = ['webgpu', 'webgl2'];
+/** See [`BOTH_BUILDS`]. */
+export const EDITING_BUILDS = ['webgpu'];
+
 export const DIST = process.env.CLOUDSKETCH_DIST ?? path.resolve(here, '../../dist');
 /** Screenshots of every run land here, for a person to look at. */
 export const SCREENSHOTS = path.resolve(here, '../test-results/screenshots');

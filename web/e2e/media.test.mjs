@@ -4,7 +4,7 @@
 // test-results/screenshots/media-*.png.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { serve, launch, openApp, waitForBody, state, screenshot, countChanged, countDiffering, until, withApp, waitForFullQuality, reveal as revealWidget, openGroup } from './harness.mjs';
+import { serve, launch, openApp, waitForBody, state, screenshot, countChanged, countDiffering, until, withApp, waitForFullQuality, reveal as revealWidget, openGroup, EDITING_BUILDS } from './harness.mjs';
 
 let server;
 before(async () => { server = await serve(); });
@@ -49,7 +49,7 @@ for (const backend of ['webgpu', 'webgl2']) {
 
 // Every preset opens from its link (?preset=NAME) with its own framing and media, and each looks
 // unlike every other (pairwise pixel differences; the shapes are measured offscreen).
-for (const backend of ['webgpu', 'webgl2']) {
+for (const backend of EDITING_BUILDS) {
   test(`each preset opens from a link and looks its own (${backend})`, { timeout: 300_000 }, async () => {
     const { browser, close } = await launch({ webgpu: backend === 'webgpu' });
     try {

@@ -5,7 +5,7 @@
 // Screenshots: test-results/screenshots/motion-*.png.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { serve, state, screenshot, until, withApp, waitForFullQuality, openGroup, reveal, scrubTo, cloudExtent } from './harness.mjs';
+import { serve, state, screenshot, until, withApp, waitForFullQuality, openGroup, reveal, scrubTo, cloudExtent, EDITING_BUILDS } from './harness.mjs';
 
 let server;
 before(async () => { server = await serve(); });
@@ -13,7 +13,7 @@ after(async () => { await server?.close(); });
 
 const toBytes = (rgb) => rgb.map((v) => Math.round(v * 255));
 
-for (const backend of ['webgpu', 'webgl2']) {
+for (const backend of EDITING_BUILDS) {
   test(`the developing cumulus rises and widens along the timeline; a motion taken off stays put and undo restores it (${backend})`, { timeout: 300_000 }, async () => {
     await withApp({ base: server.url, webgpu: backend === 'webgpu', query: '?preset=developing', viewport: { width: 1280, height: 800 } }, async (page) => {
       let s = await state(page);

@@ -130,7 +130,8 @@ impl ExportPanel {
             let o = &mut self.options;
             if self.format == Format::Png {
                 ui.horizontal(|ui| {
-                    ui.add(egui::DragValue::new(&mut self.png_width).range(16..=8192));
+                    let r = ui.add(egui::DragValue::new(&mut self.png_width).range(16..=8192));
+                    mark(ui, "export:width", r.rect);
                     let h = png_height(self.png_width, view_px);
                     ui.label(format!("× {h} px (the view's shape)"));
                 });
