@@ -1228,3 +1228,151 @@ fn a_chunk_starts_from_the_furthest_checkpoint_and_refuses_another_runs() {
     );
     assert!(file("again", 9) == file("whole", 9));
 }
+
+/// A frame that cannot be written whole: its sidecar's name is taken by a folder, so its image is
+/// written and then its sidecar fails. The run fails naming that frame; the frames before it stay
+/// with their sidecars; the frame's image is removed (a rerun would redo it anyway) and no
+/// temporary file is left.
+#[test]
+fn a_frame_whose_sidecar_fails_is_removed_and_the_earlier_frames_stay() {
+    let dir = folder("sidecar-fails");
+    let scene = dir.join("developing.json");
+    let scene = scene.to_str().unwrap();
+    let o = cloudsketch(&["new", "--preset", "developing", "-o", scene]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = dir.join("out");
+    std::fs::create_dir_all(out.join("f_0003.png.cloudsketch.json")).unwrap();
+    let pattern = out.join("f_####.png");
+    let o = cloudsketch(&[
+        "render",
+        scene,
+        "--size",
+        "64x36",
+        "--set",
+        "/render/slices=16",
+        "--fps",
+        "1",
+        "--frames",
+        "0..5",
+        "--progress",
+        "json",
+        "-o",
+        pattern.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success(), "frame 3 could not be written whole");
+    let err = stderr(&o);
+    assert!(err.contains("frame 3:"), "the error names the frame: {err}");
+    assert_eq!(json_lines(&o).len(), 3, "frames 0, 1 and 2 reported");
+    assert_eq!(
+        listing(&out),
+        [
+            "f_0000.png",
+            "f_0000.png.cloudsketch.json",
+            "f_0001.png",
+            "f_0001.png.cloudsketch.json",
+            "f_0002.png",
+            "f_0002.png.cloudsketch.json",
+            "f_0003.png.cloudsketch.json",
+        ],
+        "{err}"
+    );
+    assert!(out.join("f_0003.png.cloudsketch.json").is_dir());
+}
+
+/// A disk that fills in the middle of a sequence: a 64 KiB tmpfs, mounted in a mount namespace
+/// of the run's own (nothing outside sees it, and it goes when the run ends), takes the first
+/// frames and not the rest. The run fails naming the frame it could not write; the frames before
+/// it stay whole with their sidecars; nothing of that frame, and no temporary file, is left.
+#[test]
+fn a_disk_that_fills_mid_sequence_keeps_the_earlier_frames_and_names_the_lost_one() {
+    let dir = folder("full-disk");
+    let scene = dir.join("developing.json");
+    let scene = scene.to_str().unwrap();
+    let o = cloudsketch(&["new", "--preset", "developing", "-o", scene]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let disk = dir.join("disk");
+    std::fs::create_dir_all(&disk).unwrap();
+    let root = Command::new("id")
+        .arg("-u")
+        .output()
+        .is_ok_and(|o| o.stdout.trim_ascii() == b"0");
+    // As root a mount namespace alone; otherwise a user namespace too (where the system allows
+    // one: the suite runs as root).
+    let mut unshare = Command::new("unshare");
+    unshare.arg("--mount");
+    if !root {
+        unshare.arg("--map-root-user");
+    }
+    let script = r#"
+        mount -t tmpfs -o size=64k tmpfs "$1" || exit 90
+        "$2" render "$3" --size 96x54 --set /render/slices=24 --fps 1 --frames 0..11 \
+            --progress json -o "$1/f_####.png"
+        echo "exit $?" >&2
+        find "$1" -mindepth 1 -printf '%f %s\n' >&2
+    "#;
+    let o = unshare
+        .args(["sh", "-c", script, "sh"])
+        .arg(&disk)
+        .arg(env!("CARGO_BIN_EXE_cloudsketch"))
+        .arg(scene)
+        .output();
+    // Where no mount namespace can be had (no `unshare`, or a container that forbids it), there
+    // is no small disk to fill: said, and skipped. The suite's machine has one.
+    let o = match o {
+        Ok(o) if stderr(&o).contains("exit ") => o,
+        Ok(o) => {
+            eprintln!(
+                "skipped: no mount namespace for a small disk ({})",
+                stderr(&o)
+            );
+            return;
+        }
+        Err(e) => {
+            eprintln!("skipped: no `unshare` ({e})");
+            return;
+        }
+    };
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    let exit = err
+        .lines()
+        .find_map(|l| l.strip_prefix("exit "))
+        .expect("the run's exit code");
+    assert_ne!(exit, "0", "the run filled the disk and said nothing: {err}");
+    let made: Vec<u64> = json_lines(&o)
+        .iter()
+        .map(|l| l["frame"].as_u64().unwrap())
+        .collect();
+    let lost = made.len() as u64;
+    assert!(
+        (1..12).contains(&lost),
+        "the disk should hold some frames and not all: {made:?}\n{err}"
+    );
+    assert_eq!(made, (0..lost).collect::<Vec<_>>());
+    assert!(
+        err.contains(&format!("frame {lost}:")) && err.contains("No space left on device"),
+        "the error names the frame and the cause: {err}"
+    );
+    // What is left on the disk: each reported frame and its sidecar, whole, and nothing else.
+    let mut left: Vec<(String, u64)> = err
+        .lines()
+        .skip_while(|l| !l.starts_with("exit "))
+        .skip(1)
+        .filter_map(|l| l.rsplit_once(' '))
+        .map(|(name, size)| (name.to_owned(), size.parse().unwrap()))
+        .collect();
+    left.sort();
+    let mut expected: Vec<String> = (0..lost)
+        .flat_map(|n| {
+            let png = format!("f_{n:04}.png");
+            [format!("{png}.cloudsketch.json"), png]
+        })
+        .collect();
+    expected.sort();
+    assert_eq!(
+        left.iter().map(|(n, _)| n.clone()).collect::<Vec<_>>(),
+        expected,
+        "{err}"
+    );
+    assert!(left.iter().all(|(_, size)| *size > 0), "{left:?}");
+}

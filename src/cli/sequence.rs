@@ -460,8 +460,14 @@ impl Sequence<'_> {
                 .collect(),
         };
         let text = serde_json::to_string(&record).map_err(|e| e.to_string())?;
-        super::write(&sidecar, text.as_bytes())
-            .map_err(|e| format!("frame {frame}: {e} (earlier frames are kept)"))
+        super::write(&sidecar, text.as_bytes()).map_err(|e| {
+            // Files without their sidecar would be redone by a rerun anyway; a full disk
+            // gets its room back now, and the folder holds whole frames only.
+            for done in written {
+                let _ = std::fs::remove_file(done);
+            }
+            format!("frame {frame}: {e} (earlier frames are kept)")
+        })
     }
 }
 

@@ -8,7 +8,7 @@
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import {
-  serve, launch, openApp, fetchedBuilds, waitForBody, waitForFullQuality, state, screenshot, countDiffering, countChanged, recordTiming, sunHandleBox,
+  serve, launch, openApp, fetchedBuilds, waitForBody, waitForFullQuality, state, screenshot, countDiffering, countChanged, recordTiming, sunHandleBox, BOTH_BUILDS,
 } from './harness.mjs';
 
 let server;
@@ -30,7 +30,7 @@ async function drag(page, rect, dx, dy) {
   await page.mouse.up();
 }
 
-for (const backend of ['webgpu', 'webgl2']) {
+for (const backend of BOTH_BUILDS) {
   test(`default cloud drawn and orbited (${backend})`, { timeout: 300_000 }, async () => {
     const { browser, close } = await launch({ webgpu: backend === 'webgpu' });
     try {

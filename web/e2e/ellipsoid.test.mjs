@@ -9,7 +9,7 @@ import path from 'node:path';
 import { execFileSync } from 'node:child_process';
 import { fileURLToPath } from 'node:url';
 import { PNG } from 'pngjs';
-import { serve, state, screenshot, countChanged, until, withApp, waitForFullQuality, recordTiming, SCREENSHOTS, cloudColumns, EDITING_BUILDS } from './harness.mjs';
+import { serve, state, screenshot, countChanged, until, withApp, waitForFullQuality, recordTiming, SCREENSHOTS, cloudColumns, EDITING_BUILDS, BOTH_BUILDS } from './harness.mjs';
 
 let server;
 before(async () => { server = await serve(); });
@@ -252,7 +252,7 @@ function mask(img, w, h, bg) {
   return m;
 }
 
-for (const backend of ['webgpu', 'webgl2']) {
+for (const backend of BOTH_BUILDS) {
   test(`a scene with ellipsoids looks the same natively and in the page (${backend})`, { timeout: 240_000 }, async () => {
     assert.ok(fs.existsSync(NATIVE), `${NATIVE} missing: run cargo test (it builds the CLI) first`);
     await withApp({ base: server.url, webgpu: backend === 'webgpu', viewport: { width: 1280, height: 800 } }, async (page) => {

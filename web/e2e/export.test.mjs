@@ -5,7 +5,7 @@ import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import fs from 'node:fs';
 import { PNG } from 'pngjs';
-import { serve, state, screenshot, until, withApp, waitForFullQuality, recordTiming } from './harness.mjs';
+import { serve, state, screenshot, until, withApp, waitForFullQuality, recordTiming, BOTH_BUILDS } from './harness.mjs';
 
 let server;
 before(async () => { server = await serve(); });
@@ -57,7 +57,7 @@ async function revealAtFoot(page, name) {
 // limits only catch a download that never comes.
 const DOWNLOAD_WAIT = 240_000;
 
-for (const backend of ['webgpu', 'webgl2']) {
+for (const backend of BOTH_BUILDS) {
   test(`a glb and PNGs of the view download from the Export group (${backend})`, { timeout: 600_000 }, async () => {
     await withApp({ base: server.url, webgpu: backend === 'webgpu', viewport: { width: 1280, height: 800 } }, async (page) => {
       let s = await state(page);
@@ -86,7 +86,9 @@ for (const backend of ['webgpu', 'webgl2']) {
       // The PNG of the view at 1920 px wide, the view's shape: sky in the corner, cloud in the
       // middle; then over a transparent background.
       await click('export:png');
+      const t1920 = Date.now();
       const [png] = await Promise.all([page.waitForEvent('download', { timeout: DOWNLOAD_WAIT }), click('export:run')]);
+      const seconds1920 = (Date.now() - t1920) / 1000;
       assert.equal(png.suggestedFilename(), 'untitled.png');
       const img = PNG.sync.read(fs.readFileSync(await png.path()));
       assert.equal(img.width, 1920);
@@ -108,7 +110,9 @@ for (const backend of ['webgpu', 'webgl2']) {
       await page.keyboard.type('480');
       await page.keyboard.press('Enter');
       await until(page, (s) => s.view.export.png_width === 480, 'a width of 480 px');
+      const t480 = Date.now();
       const [fine] = await Promise.all([page.waitForEvent('download', { timeout: DOWNLOAD_WAIT }), click('export:run')]);
+      console.log(`# ${backend}: a PNG 1920 px wide in ${seconds1920} s, 480 px wide in ${(Date.now() - t480) / 1000} s`);
       const f = PNG.sync.read(fs.readFileSync(await fine.path()));
       assert.deepEqual([f.width, f.height], [480, Math.round(480 * vh / vw)], 'the typed width, the view\'s shape');
       await until(page, (s) => s.view.export.progress == null, 'the 480-px PNG is done');
@@ -149,7 +153,7 @@ for (const backend of ['webgpu', 'webgl2']) {
 // page for 35 s at 1920×1566 on a CPU adapter, its progress stuck at a half). While it runs the
 // progress moves, a drag orbits the camera, an edit of the clouds starts it over, and Cancel
 // stops it with no download.
-for (const backend of ['webgpu', 'webgl2']) {
+for (const backend of BOTH_BUILDS) {
   test(`a PNG export draws over frames: a drag orbits meanwhile, Cancel leaves no download (${backend})`, { timeout: 300_000 }, async () => {
     await withApp({ base: server.url, webgpu: backend === 'webgpu', viewport: { width: 1280, height: 800 } }, async (page) => {
       let s = await state(page);

@@ -8,7 +8,7 @@ import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
 import { PNG } from 'pngjs';
-import { serve, launch, openApp, waitForBody, state, screenshot, until, withApp } from './harness.mjs';
+import { serve, launch, openApp, waitForBody, state, screenshot, until, withApp, BOTH_BUILDS } from './harness.mjs';
 
 let server;
 before(async () => { server = await serve(); });
@@ -88,7 +88,7 @@ function reddish(img, [vw, vh]) {
   return n;
 }
 
-for (const backend of ['webgpu', 'webgl2']) {
+for (const backend of BOTH_BUILDS) {
   test(`the reference image stays in the scene when orbiting, under or over the cloud (${backend})`, { timeout: 240_000 }, async () => {
     await withApp({ base: server.url, webgpu: backend === 'webgpu', viewport: { width: 1280, height: 800 } }, async (page) => {
       const view = (await state(page)).view.viewport;

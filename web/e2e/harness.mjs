@@ -12,12 +12,14 @@ import { PNG } from 'pngjs';
 
 const here = path.dirname(fileURLToPath(import.meta.url));
 /**
- * The builds a test runs in. What draws runs in both: the WebGL2 fallback draws through wgpu's GL
- * backend (the WGSL translated to GLSL), the WebGPU build through the browser's WebGPU. Tools,
- * input handling, undo and the document are the same Rust in both builds, so a test of those
- * alone runs in the WebGPU build, which most visitors get; the WebGL2 build's drawing of what
- * they make is covered by the tests that run in both. (Every test in both took the suite past
- * CI's 90 minutes on a busy machine.)
+ * The builds a test runs in. The WebGL2 fallback draws through wgpu's GL backend (the WGSL
+ * translated to GLSL), the WebGPU build through the browser's WebGPU; tools, input handling,
+ * undo, animation and the document are the same Rust in both. Tests of drawing, of the page's
+ * speed, and of loading run in both builds. Tests of tools, input, keys and the timeline run in the
+ * WebGPU build alone, which most visitors get: their screenshots show that build drawing what
+ * they made, and the WebGL2 build draws the same kinds of scene in the tests that run in both
+ * (ellipsoids: the parity test; every preset: the preset buttons test; the developing preset:
+ * the flipbook test). Every test in both builds took the suite past CI's 90 minutes.
  */
 export const BOTH_BUILDS = ['webgpu', 'webgl2'];
 /** See [`BOTH_BUILDS`]. */

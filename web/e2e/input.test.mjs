@@ -4,10 +4,10 @@
 // that was drawn. One sample per frame — what egui's per-frame pointer position gives — keeps
 // about a tenth of them and fails here. Then Tab, Space and Enter over the view press nothing
 // and the view's shortcuts still work; the side panel keeps its width while values change and
-// N hides and shows it. Both backends.
+// N hides and shows it. The pointer rates in the WebGPU build (EDITING_BUILDS); the views in both.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { serve, withApp, waitForFullQuality, state, until, recordTiming, screenshot, countDiffering } from './harness.mjs';
+import { serve, withApp, waitForFullQuality, state, until, recordTiming, screenshot, countDiffering, BOTH_BUILDS, EDITING_BUILDS } from './harness.mjs';
 
 let server;
 before(async () => { server = await serve(); });
@@ -53,7 +53,7 @@ function meanNearest(a, b) {
   return a.reduce((s, [x, y]) => s + Math.min(...b.map(([u, v]) => Math.hypot(x - u, y - v))), 0) / a.length;
 }
 
-for (const backend of ['webgpu', 'webgl2']) {
+for (const backend of EDITING_BUILDS) {
   test(`every pointer sample is kept at 60 and 240 Hz (${backend})`, { timeout: 300_000 }, async () => {
     const app = { base: server.url, webgpu: backend === 'webgpu', query: '?preset=empty', viewport: { width: 1280, height: 800 } };
     await withApp(app, async (page) => {
@@ -129,7 +129,7 @@ for (const backend of ['webgpu', 'webgl2']) {
   });
 }
 
-for (const backend of ['webgpu', 'webgl2']) {
+for (const backend of BOTH_BUILDS) {
   test(`standard views, and an outline drawn in the orthographic front view (${backend})`, { timeout: 300_000 }, async () => {
     const app = { base: server.url, webgpu: backend === 'webgpu', query: '?preset=empty', viewport: { width: 1280, height: 800 } };
     await withApp(app, async (page) => {

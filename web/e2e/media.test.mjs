@@ -4,13 +4,13 @@
 // test-results/screenshots/media-*.png.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { serve, launch, openApp, waitForBody, state, screenshot, countChanged, countDiffering, until, withApp, waitForFullQuality, reveal as revealWidget, openGroup, EDITING_BUILDS } from './harness.mjs';
+import { serve, launch, openApp, waitForBody, state, screenshot, countChanged, countDiffering, until, withApp, waitForFullQuality, reveal as revealWidget, openGroup, EDITING_BUILDS, BOTH_BUILDS } from './harness.mjs';
 
 let server;
 before(async () => { server = await serve(); });
 after(async () => { await server?.close(); });
 
-for (const backend of ['webgpu', 'webgl2']) {
+for (const backend of BOTH_BUILDS) {
   test(`a filter changes the media and playing moves it with the wind (${backend})`, { timeout: 240_000 }, async () => {
     await withApp({ base: server.url, webgpu: backend === 'webgpu', viewport: { width: 1280, height: 800 } }, async (page) => {
       let s = await state(page);
@@ -80,7 +80,7 @@ for (const backend of EDITING_BUILDS) {
   });
 }
 
-for (const backend of ['webgpu', 'webgl2']) {
+for (const backend of BOTH_BUILDS) {
   test(`the sky gradient draws a horizon behind the cloud (${backend})`, { timeout: 180_000 }, async () => {
     await withApp({ base: server.url, webgpu: backend === 'webgpu', query: '?preset=empty', viewport: { width: 1280, height: 800 } }, async (page) => {
       const [vw, vh] = (await state(page)).view.viewport;
@@ -101,7 +101,7 @@ for (const backend of ['webgpu', 'webgl2']) {
   });
 }
 
-for (const backend of ['webgpu', 'webgl2']) {
+for (const backend of BOTH_BUILDS) {
   test(`an upper tier changes the cloud above its floor only (${backend})`, { timeout: 240_000 }, async () => {
     // Both images at the view's whole resolution (`refine=whole`): on a busy machine the
     // planner fitted them to different resolutions, which changed the lower half too
@@ -132,7 +132,7 @@ for (const backend of ['webgpu', 'webgl2']) {
 
 // The real widgets: each preset button of the Scene group, the Opacity slider and the sun
 // handle in the view's corner, pressed where the page state says the app drew them.
-for (const backend of ['webgpu', 'webgl2']) {
+for (const backend of BOTH_BUILDS) {
   test(`preset buttons, the opacity slider and the sun handle change the image (${backend})`, { timeout: 300_000 }, async () => {
     await withApp({ base: server.url, webgpu: backend === 'webgpu', viewport: { width: 1280, height: 800 } }, async (page) => {
       let s = await state(page);
@@ -222,7 +222,7 @@ for (const backend of ['webgpu', 'webgl2']) {
 // Shafts of light from their checkbox in the Light group: looking toward a low sun over the
 // ground, the air lights up across the whole view (not only the cloud's box), darker in the
 // cloud's shadow than beside it; undo puts the image back.
-for (const backend of ['webgpu', 'webgl2']) {
+for (const backend of BOTH_BUILDS) {
   test(`the shafts of light checkbox lights the air around the cloud's shadow (${backend})`, { timeout: 300_000 }, async () => {
     await withApp({ base: server.url, webgpu: backend === 'webgpu', viewport: { width: 1280, height: 800 } }, async (page) => {
       for (const set of ['/light/ground=true', '/light/ground_height=-3', '/light/sun_azimuth_deg=270', '/light/sun_elevation_deg=25']) {

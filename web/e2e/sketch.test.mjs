@@ -4,7 +4,7 @@
 // Screenshots: web/test-results/screenshots/sketch-*.png.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { serve, launch, openApp, waitForBody, waitForFullQuality, state, screenshot, countDiffering, countChanged, until, withApp, recordTiming, reveal } from './harness.mjs';
+import { serve, launch, openApp, waitForBody, waitForFullQuality, state, screenshot, countDiffering, countChanged, until, withApp, recordTiming, reveal, BOTH_BUILDS } from './harness.mjs';
 
 let server;
 before(async () => { server = await serve(); });
@@ -305,7 +305,7 @@ test('a pen stroke stores its pressure per point; a mouse stroke stores none', {
   });
 });
 
-for (const backend of ['webgpu', 'webgl2']) {
+for (const backend of BOTH_BUILDS) {
   test(`sketching, and the deflate slider changing the image (${backend})`, { timeout: 240_000 }, async () => {
     await withApp({ base: server.url, webgpu: backend === 'webgpu', query: '?preset=empty', viewport: { width: 1280, height: 800 } }, async (page) => {
       const [vw, vh] = await startSketching(page);
