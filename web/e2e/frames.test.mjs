@@ -6,7 +6,7 @@
 // goal; a test fails on a frame over 1 s, which means the app blocked), never a timing goal.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { serve, launch, openApp, waitForBody, waitForFullQuality, state, until, recordTiming, BOTH_BUILDS } from './harness.mjs';
+import { serve, launch, openApp, waitForBody, waitForFullQuality, state, until, recordTiming, BOTH_BUILDS, COSTLY_BUILDS } from './harness.mjs';
 
 let server;
 before(async () => { server = await serve(); });
@@ -66,7 +66,7 @@ async function outline(page, cx, cy, r) {
   await page.mouse.up();
 }
 
-for (const backend of BOTH_BUILDS) {
+for (const backend of COSTLY_BUILDS) {
   test(`frame time while dragging (${backend})`, { timeout: 420_000 }, async () => {
     const { browser, close } = await launch({ webgpu: backend === 'webgpu' });
     try {
@@ -131,7 +131,7 @@ for (const backend of BOTH_BUILDS) {
 
 // Full quality after an orbit and after a stroke, at the window sizes people have. Figures to
 // timings.json; the assertion is only that refinement finishes (no fixed time limit here).
-for (const backend of BOTH_BUILDS) {
+for (const backend of COSTLY_BUILDS) {
   test(`refinement at 1280×800 and 1920×1080 (${backend})`, { timeout: 420_000 }, async () => {
     const record = { test: 'refine', backend };
     // A fresh browser per size, as a user opens the page: on SwiftShader's WebGPU a second

@@ -4,7 +4,7 @@
 // test-results/screenshots/media-*.png.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { serve, launch, openApp, waitForBody, state, screenshot, countChanged, countDiffering, until, withApp, waitForFullQuality, reveal as revealWidget, openGroup, EDITING_BUILDS, BOTH_BUILDS } from './harness.mjs';
+import { serve, launch, openApp, waitForBody, state, screenshot, countChanged, countDiffering, until, withApp, waitForFullQuality, reveal as revealWidget, openGroup, EDITING_BUILDS, BOTH_BUILDS, COSTLY_BUILDS } from './harness.mjs';
 
 let server;
 before(async () => { server = await serve(); });
@@ -101,7 +101,7 @@ for (const backend of BOTH_BUILDS) {
   });
 }
 
-for (const backend of BOTH_BUILDS) {
+for (const backend of COSTLY_BUILDS) {
   test(`an upper tier changes the cloud above its floor only (${backend})`, { timeout: 240_000 }, async () => {
     // Both images at the view's whole resolution (`refine=whole`): on a busy machine the
     // planner fitted them to different resolutions, which changed the lower half too
