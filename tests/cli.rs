@@ -1229,6 +1229,14 @@ fn a_chunk_starts_from_the_furthest_checkpoint_and_refuses_another_runs() {
     assert!(file("again", 9) == file("whole", 9));
 }
 
+/// The `developing` preset saved as `developing.json` in `dir`; its path.
+fn developing_scene(dir: &std::path::Path) -> String {
+    let scene = dir.join("developing.json").to_str().unwrap().to_owned();
+    let o = cloudsketch(&["new", "--preset", "developing", "-o", &scene]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    scene
+}
+
 /// A frame that cannot be written whole: its sidecar's name is taken by a folder, so its image is
 /// written and then its sidecar fails. The run fails naming that frame; the frames before it stay
 /// with their sidecars; the frame's image is removed (a rerun would redo it anyway) and no
@@ -1236,10 +1244,8 @@ fn a_chunk_starts_from_the_furthest_checkpoint_and_refuses_another_runs() {
 #[test]
 fn a_frame_whose_sidecar_fails_is_removed_and_the_earlier_frames_stay() {
     let dir = folder("sidecar-fails");
-    let scene = dir.join("developing.json");
-    let scene = scene.to_str().unwrap();
-    let o = cloudsketch(&["new", "--preset", "developing", "-o", scene]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let scene = developing_scene(&dir);
+    let scene = scene.as_str();
     let out = dir.join("out");
     std::fs::create_dir_all(out.join("f_0003.png.cloudsketch.json")).unwrap();
     let pattern = out.join("f_####.png");
@@ -1286,10 +1292,8 @@ fn a_frame_whose_sidecar_fails_is_removed_and_the_earlier_frames_stay() {
 #[test]
 fn a_disk_that_fills_mid_sequence_keeps_the_earlier_frames_and_names_the_lost_one() {
     let dir = folder("full-disk");
-    let scene = dir.join("developing.json");
-    let scene = scene.to_str().unwrap();
-    let o = cloudsketch(&["new", "--preset", "developing", "-o", scene]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let scene = developing_scene(&dir);
+    let scene = scene.as_str();
     let disk = dir.join("disk");
     std::fs::create_dir_all(&disk).unwrap();
     let root = Command::new("id")
