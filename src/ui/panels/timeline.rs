@@ -68,6 +68,12 @@ pub struct Timeline {
     pub cache_asked: bool,
     /// Cancel was pressed while caching.
     pub cache_cancel: bool,
+    /// Wall seconds ticked while playing, in all.
+    pub ticked_s: f64,
+    /// Of those, the seconds not played: a stalled frame's time past the half second it may
+    /// advance the clock (the page state reports both, so a test on a busy machine can tell a
+    /// stall from time lost in the clock).
+    pub stalled_s: f64,
 }
 
 impl Default for Timeline {
@@ -89,6 +95,8 @@ impl Default for Timeline {
             cache_kept: 0,
             cache_asked: false,
             cache_cancel: false,
+            ticked_s: 0.0,
+            stalled_s: 0.0,
         }
     }
 }
@@ -166,7 +174,10 @@ impl Timeline {
             return false;
         }
         let clock = doc.scene().clock;
-        let mut t = doc.scene().time + dt.clamp(0.0, 0.5) * self.speed;
+        let dt = dt.max(0.0);
+        self.ticked_s += f64::from(dt);
+        self.stalled_s += f64::from((dt - 0.5).max(0.0));
+        let mut t = doc.scene().time + dt.min(0.5) * self.speed;
         if self.looping {
             let start = clock.seconds(clock.start);
             let period = clock.seconds(clock.end.saturating_add(1)) - start;
@@ -681,6 +692,8 @@ pub fn state(timeline: &Timeline, doc: &Document) -> serde_json::Value {
         "looping": timeline.looping,
         "auto_key": doc.auto_key(),
         "frame": doc.scene().clock.frame(doc.scene().time),
+        "ticked_s": timeline.ticked_s,
+        "stalled_s": timeline.stalled_s,
         "keys": timeline.drawn.iter().map(|(t, x)| serde_json::json!({"t": t, "x": x, "y": timeline.keys_y})).collect::<Vec<_>>(),
         "selected_keys": timeline.selected,
         "key_count": doc.scene().animation.key_count(),
@@ -715,6 +728,8 @@ mod tests {
         // A stalled frame does not jump the clock.
         timeline.tick(&mut doc, 30.0);
         assert!(doc.scene().time < 3.1);
+        assert!((timeline.ticked_s - 31.0).abs() < 1e-4, "{}", timeline.ticked_s);
+        assert!((timeline.stalled_s - 29.5).abs() < 1e-4, "the stall is counted");
         // Looping: the last frame lasts a frame, and the time past it carries on from the
         // first (none is lost at the wrap: a loop takes its frames' time exactly).
         timeline.looping = true;
