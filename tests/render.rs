@@ -1660,6 +1660,47 @@ fn a_keyed_wind_carries_the_noise_by_its_integral_not_its_value_times_the_time()
     );
 }
 
+#[test]
+fn a_tiers_keyed_wind_carries_its_noise_by_its_integral_on_the_gpu() {
+    // The same for an atmospheric tier covering the whole cloud, the base media calm: the
+    // slices' tier transforms take the tier's integrated wind, as the CPU media do.
+    use cloudsketch::scene::{Channel, TierProperty};
+    let base = with(
+        &smooth_cumulus(),
+        &[
+            "/render/slices=64",
+            "/render/noise_amount=0.6",
+            "/render/wind=[0,0]",
+            "/render/tiers=[{\"floor\": -50}]",
+        ],
+    );
+    let mut keyed = base.clone();
+    let wind = Channel::Tier {
+        tier: 0,
+        property: TierProperty::Wind,
+    };
+    keyed.animation.key(wind, 0.0, vec![0.0, 0.0]);
+    keyed.animation.key(wind, 2.0, vec![2.0, 0.0]);
+    let keyed = keyed.posed_at(2.0);
+    assert_eq!(keyed.render.tiers[0].wind, [2.0, 0.0]);
+    let steady = |w: f32| {
+        let mut s = with(&base, &[&format!("/render/tiers/0/wind=[{w},0]")]);
+        s.time = 2.0;
+        render(&s)
+    };
+    let image = render(&keyed);
+    assert_eq!(
+        image,
+        steady(1.0),
+        "the integral: as far as a steady wind of 1"
+    );
+    let d = changed(&image, &steady(2.0));
+    assert!(
+        d > 300,
+        "value × time would carry it twice as far: {d} px differ"
+    );
+}
+
 /// The topmost row of cloud pixels and the cloud's width on screen.
 fn top_and_width(image: &Image, bg: [u8; 3]) -> (u32, u32) {
     let top = (0..image.height)

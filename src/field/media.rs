@@ -40,12 +40,63 @@ impl Drift {
         Self { travelled, turned }
     }
 
+    /// The drift of `scene`'s tier `tier` (0-based) at its own time: its keys on wind and
+    /// torque integrated, or its settings times the time; none where the tier is not there.
+    pub fn of_tier(scene: &Scene, tier: usize) -> Self {
+        let Some(settings) = scene.render.tiers.get(tier) else {
+            return Self::default();
+        };
+        let t = scene.time;
+        let keyed = |property| {
+            scene
+                .animation
+                .track(crate::scene::Channel::Tier {
+                    tier: tier as u32,
+                    property,
+                })
+                .and_then(|track| track.integral(t))
+        };
+        let steady = Self::steady(settings.wind, settings.torque, t);
+        Self {
+            travelled: keyed(crate::scene::TierProperty::Wind)
+                .map_or(steady.travelled, |v| [v[0], v[1]]),
+            turned: keyed(crate::scene::TierProperty::Torque).map_or(steady.turned, |v| v[0]),
+        }
+    }
+
     /// A steady `wind` and `torque` for `time` seconds.
     pub fn steady(wind: [f32; 2], torque: f32, time: f32) -> Self {
         Self {
             travelled: [wind[0] * time, wind[1] * time],
             turned: torque * time,
         }
+    }
+}
+
+/// How far the wind and torque of the base media and of each tier have carried the noise by a
+/// scene time ([`Drift::of`], [`Drift::of_tier`]): what the noise's motion needs of the time.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Drifts {
+    /// The base media's.
+    pub base: Drift,
+    /// Each tier's, from the lowest (none past the scene's tiers).
+    pub tiers: [Drift; MAX_TIERS],
+}
+
+impl Drifts {
+    /// The drifts of `scene` at its own time.
+    pub fn of(scene: &Scene) -> Self {
+        Self {
+            base: Drift::of(scene),
+            tiers: std::array::from_fn(|k| Drift::of_tier(scene, k)),
+        }
+    }
+
+    /// Every number they hold, for hashing.
+    pub fn values(&self) -> impl Iterator<Item = f32> + '_ {
+        std::iter::once(&self.base)
+            .chain(&self.tiers)
+            .flat_map(|d| [d.travelled[0], d.travelled[1], d.turned])
     }
 }
 
@@ -58,19 +109,19 @@ pub fn octave_transform(render: &RenderSettings, i: usize, drift: Drift) -> Mat4
     moving_octave(render, drift, i)
 }
 
-/// [`octave_transform`] in atmospheric tier `tier` (1-based; 0 is the base media) at scene
-/// time `time`: its own steady wind and torque, except octave 0, which moves with the base
+/// [`octave_transform`] in atmospheric tier `tier` (1-based; 0 is the base media), carried
+/// by `drifts`: its own wind and torque, except octave 0, which moves with the base
 /// everywhere (the paper's Base tier, which keeps the tiers one cloud).
 pub fn tier_octave_transform(
     render: &RenderSettings,
     tier: usize,
     i: usize,
-    drift: Drift,
-    time: f32,
+    drifts: &Drifts,
 ) -> Mat4 {
-    match render.tiers.get(tier.wrapping_sub(1)) {
-        Some(t) if i > 0 => moving_octave(render, Drift::steady(t.wind, t.torque, time), i),
-        _ => octave_transform(render, i, drift),
+    let k = tier.wrapping_sub(1);
+    match drifts.tiers.get(k) {
+        Some(drift) if i > 0 && k < render.tiers.len() => moving_octave(render, *drift, i),
+        _ => octave_transform(render, i, drifts.base),
     }
 }
 
@@ -133,15 +184,14 @@ impl Media {
             .step_by(2)
             .map(|&b| b as f32 / 255.0)
             .collect();
-        let time = scene.time;
-        let drift = Drift::of(scene);
+        let drifts = Drifts::of(scene);
         let tiers = r
             .tiers
             .iter()
             .take(MAX_TIERS)
             .enumerate()
             .map(|(k, t)| {
-                let m = std::array::from_fn(|i| tier_octave_transform(r, k + 1, i, drift, time));
+                let m = std::array::from_fn(|i| tier_octave_transform(r, k + 1, i, &drifts));
                 (t.floor, t.filter, m)
             })
             .collect();
@@ -153,7 +203,7 @@ impl Media {
             softness: r.softness,
             filter: r.noise_filter,
             tiers,
-            base: std::array::from_fn(|i| octave_transform(r, i, drift)),
+            base: std::array::from_fn(|i| octave_transform(r, i, drifts.base)),
             blend: r.tier_blend,
         }
     }
@@ -233,6 +283,63 @@ impl Media {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_tiers_keyed_wind_and_torque_carry_its_noise_by_their_integrals() {
+        use crate::scene::{Channel, Tier, TierProperty};
+        let mut scene = Scene::default();
+        scene.render.noise_amount = 0.6;
+        scene.render.wind = [0.0, 0.0];
+        scene.render.tiers = vec![Tier {
+            floor: -50.0,
+            ..Default::default()
+        }];
+        let key = |s: &mut Scene, property, a: Vec<f32>, b: Vec<f32>| {
+            let c = Channel::Tier { tier: 0, property };
+            s.animation.key(c, 0.0, a);
+            s.animation.key(c, 2.0, b);
+        };
+        // Wind from calm to 2 units/s and torque from 0 to 40°/s over 2 s: by then they have
+        // carried the tier's noise as far as a steady 1 and 20 would; value × time twice as far.
+        let mut keyed = scene.clone();
+        key(
+            &mut keyed,
+            TierProperty::Wind,
+            vec![0.0, 0.0],
+            vec![2.0, 0.0],
+        );
+        key(&mut keyed, TierProperty::Torque, vec![0.0], vec![40.0]);
+        let keyed = keyed.posed_at(2.0);
+        assert_eq!(keyed.render.tiers[0].wind, [2.0, 0.0]);
+        let steady = |w: f32, torque: f32| {
+            let mut s = scene.clone();
+            s.render.tiers[0].wind = [w, 0.0];
+            s.render.tiers[0].torque = torque;
+            s.time = 2.0;
+            Media::new(&s)
+        };
+        let drift = Drifts::of(&keyed).tiers[0];
+        assert!((drift.travelled[0] - 2.0).abs() < 1e-4 && (drift.turned - 40.0).abs() < 1e-3);
+        let points: Vec<Vec3> = (0..400)
+            .map(|i| Vec3::new((i % 20) as f32 * 0.2 - 2.0, (i / 20) as f32 * 0.15, 0.3))
+            .collect();
+        let sample = |m: &Media| {
+            points
+                .iter()
+                .map(|&p| m.density(ISO, p))
+                .collect::<Vec<_>>()
+        };
+        let got = sample(&Media::new(&keyed));
+        let same = sample(&steady(1.0, 20.0));
+        let far = sample(&steady(2.0, 40.0));
+        let gap = |a: &[f32], b: &[f32]| a.iter().zip(b).map(|(x, y)| (x - y).abs()).sum::<f32>();
+        assert!(
+            gap(&got, &same) < 1e-3,
+            "as a steady wind: {}",
+            gap(&got, &same)
+        );
+        assert!(gap(&got, &far) > 1.0, "value × time: {}", gap(&got, &far));
+    }
 
     #[test]
     fn the_media_move_the_surface_and_off_they_leave_the_plain_density() {

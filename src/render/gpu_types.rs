@@ -7,7 +7,7 @@ use std::mem::offset_of;
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
 
-pub use crate::field::media::Drift;
+pub use crate::field::media::{Drift, Drifts};
 use crate::field::media::{octave_transform, tier_octave_transform};
 use crate::field::{DensityVolume, ISO};
 use crate::scene::{Lighting, NoiseBasis, NoiseFilter, OrbitCamera, RenderSettings};
@@ -311,11 +311,9 @@ pub struct View {
     pub light: Lighting,
     /// Media and quality.
     pub render: RenderSettings,
-    /// The scene clock (seconds): how far the tiers' wind and torque have carried the noise.
-    pub time: f32,
-    /// How far the base media's wind and torque (keyed ones integrated) have carried the
-    /// noise by then ([`Drift::of`]).
-    pub drift: Drift,
+    /// How far the wind and torque of the base media and of each tier (keyed ones
+    /// integrated) have carried the noise by the scene's time ([`Drifts::of`]).
+    pub drift: Drifts,
     /// Width / height of the whole view.
     pub aspect: f32,
     /// The part of the view this image covers, in normalised device coordinates
@@ -473,18 +471,14 @@ impl VolumeUniforms {
                 if octaves == 0 { 0.0 } else { r.noise_amount },
             ],
             noise: [0.5, octaves as f32, filter, basis],
-            octaves: std::array::from_fn(|i| octave_transform(r, i, view.drift).to_cols_array_2d()),
+            octaves: std::array::from_fn(|i| {
+                octave_transform(r, i, view.drift.base).to_cols_array_2d()
+            }),
             tiers: [floor(0), floor(1), r.tier_blend, tiers.len() as f32],
             tier_filters: [tier_filter(0), tier_filter(1), 0.0, 0.0],
             tier_octaves: std::array::from_fn(|j| {
-                tier_octave_transform(
-                    r,
-                    1 + j / MAX_OCTAVES,
-                    j % MAX_OCTAVES,
-                    view.drift,
-                    view.time,
-                )
-                .to_cols_array_2d()
+                tier_octave_transform(r, 1 + j / MAX_OCTAVES, j % MAX_OCTAVES, &view.drift)
+                    .to_cols_array_2d()
             }),
             inv_view_proj: view_proj.inverse().to_cols_array_2d(),
             shells: [
@@ -529,8 +523,7 @@ mod tests {
             camera: scene.camera.clone(),
             light: scene.light.clone(),
             render: scene.render.clone(),
-            time: 0.0,
-            drift: Drift::default(),
+            drift: Drifts::default(),
             aspect: 1.5,
             crop: FULL_VIEW,
         };

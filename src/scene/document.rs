@@ -84,18 +84,37 @@ fn same<T: PartialEq>(a: &[Arc<T>], b: &[Arc<T>]) -> bool {
             .all(|(x, y)| Arc::ptr_eq(x, y) || **x == **y)
 }
 
-/// The keys on the base media's wind and torque (what [`crate::field::media::Drift`]
-/// integrates), by pointer.
-fn drift_keys(scene: &Scene) -> [Option<*const super::Track>; 2] {
-    use super::{Channel, MediaProperty};
-    [MediaProperty::Wind, MediaProperty::Torque].map(|property| {
-        scene
-            .animation
-            .tracks
-            .iter()
-            .find(|t| t.channel == Channel::Media { property })
-            .map(Arc::as_ptr)
-    })
+/// The keys on the wind and torque of the base media and the tiers (what
+/// [`crate::field::media::Drifts`] integrates), by pointer.
+fn drift_keys(scene: &Scene) -> Vec<*const super::Track> {
+    use super::{Channel, MediaProperty, TierProperty};
+    scene
+        .animation
+        .tracks
+        .iter()
+        .filter(|t| {
+            matches!(
+                t.channel,
+                Channel::Media {
+                    property: MediaProperty::Wind | MediaProperty::Torque
+                } | Channel::Tier {
+                    property: TierProperty::Wind | TierProperty::Torque,
+                    ..
+                }
+            )
+        })
+        .map(Arc::as_ptr)
+        .collect()
+}
+
+/// Which tier went between `before` and `after`, where one did (the others unchanged, in
+/// order).
+fn removed_tier(before: &[super::Tier], after: &[super::Tier]) -> Option<usize> {
+    (after.len() + 1 == before.len())
+        .then(|| {
+            (0..before.len()).find(|&k| before[..k] == after[..k] && before[k + 1..] == after[k..])
+        })
+        .flatten()
 }
 
 fn diff(a: &Scene, b: &Scene) -> Changed {
@@ -258,7 +277,17 @@ impl Document {
         match edit {
             Edit::SetLight(l) => s.light = l,
             Edit::SetSimulation(sim) => s.simulation = sim.map(Arc::new),
-            Edit::SetRender(r) => s.render = r,
+            Edit::SetRender(r) => {
+                // A tier removed takes its keys, and those above it move down with their tiers.
+                if let Some(k) = removed_tier(&s.render.tiers, &r.tiers) {
+                    let mut animation = s.animation.clone();
+                    if animation.tier_removed(k) {
+                        s.animation = animation;
+                        changed.clock = true;
+                    }
+                }
+                s.render = r;
+            }
             Edit::SetClock(mut c) => {
                 c.sanitize();
                 s.clock = c;

@@ -150,6 +150,27 @@ pub enum MediaProperty {
     Torque,
 }
 
+/// A keyed property of an atmospheric tier (Schpok et al. §5.4): where it begins and how its
+/// noise moves. Its filter is a choice, not a value, and is not keyed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TierProperty {
+    /// The altitude where the tier begins (keyed floors are held in order, each at or above
+    /// the one below).
+    Floor,
+    /// The tier's wind (x, z): what carries its noise is the wind's integral over time.
+    Wind,
+    /// The tier's torque: what turns its noise is the torque's integral over time.
+    Torque,
+}
+
+/// A tier's keyable properties.
+pub const TIER: [TierProperty; 3] = [
+    TierProperty::Floor,
+    TierProperty::Wind,
+    TierProperty::Torque,
+];
+
 /// A keyed property of the shot camera (its orbit).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -208,6 +229,15 @@ pub enum Channel {
         /// Which property.
         property: ShotProperty,
     },
+    /// A property of atmospheric tier `tier` (0 is the lowest tier above the base media).
+    /// Tiers have no ids: removing one moves the keys of those above it down with them
+    /// ([`Animation::tier_removed`]).
+    Tier {
+        /// The tier's place, from the lowest.
+        tier: u32,
+        /// Which property.
+        property: TierProperty,
+    },
 }
 
 /// How a channel's values interpolate.
@@ -249,6 +279,10 @@ impl Channel {
             Channel::Shot { property } => match property {
                 ShotProperty::Target => 3,
                 _ => 1,
+            },
+            Channel::Tier { property, .. } => match property {
+                TierProperty::Wind => 2,
+                TierProperty::Floor | TierProperty::Torque => 1,
             },
         }
     }
@@ -293,6 +327,7 @@ impl Channel {
             Channel::Light { property } => format!("the light's {property:?}"),
             Channel::Media { property } => format!("the media's {property:?}"),
             Channel::Shot { property } => format!("the shot camera's {property:?}"),
+            Channel::Tier { tier, property } => format!("tier {}'s {property:?}", tier + 1),
         }
         .to_lowercase()
     }
@@ -366,6 +401,14 @@ impl Channel {
                     ShotProperty::Pitch => vec![c.pitch_deg],
                     ShotProperty::Distance => vec![c.distance],
                     ShotProperty::Fov => vec![c.fov_y_deg],
+                }
+            }
+            Channel::Tier { tier, property } => {
+                let t = scene.render.tiers.get(tier as usize)?;
+                match property {
+                    TierProperty::Floor => vec![t.floor],
+                    TierProperty::Wind => t.wind.to_vec(),
+                    TierProperty::Torque => vec![t.torque],
                 }
             }
         })
@@ -458,6 +501,16 @@ impl Channel {
                     ShotProperty::Fov => c.fov_y_deg = value[0],
                 }
             }
+            Channel::Tier { tier, property } => {
+                let Some(t) = scene.render.tiers.get_mut(tier as usize) else {
+                    return false;
+                };
+                match property {
+                    TierProperty::Floor => t.floor = value[0],
+                    TierProperty::Wind => t.wind = [value[0], value[1]],
+                    TierProperty::Torque => t.torque = value[0],
+                }
+            }
         }
         true
     }
@@ -529,11 +582,16 @@ impl Channel {
                     }
                 }
             }
+            Channel::Tier { property, .. } => match property {
+                TierProperty::Floor => param(value[0], limits::TIER_FLOOR),
+                TierProperty::Wind => value.iter().map(|w| limits::WIND.fix_f32(*w)).collect(),
+                TierProperty::Torque => param(value[0], limits::TORQUE),
+            },
         })
     }
 
     /// The keyable channels of `scene`: every property of every ellipsoid and plane, the
-    /// light's and the media's.
+    /// light's, the media's, its tiers' and its shot camera's.
     pub fn all(scene: &Scene) -> impl Iterator<Item = Channel> + '_ {
         use EllipsoidProperty as E;
         // A moving ellipsoid's centre and radii are its motion's, not keys'.
@@ -559,10 +617,13 @@ impl Channel {
             .then_some(SHOT.map(|property| Channel::Shot { property }))
             .into_iter()
             .flatten();
+        let tiers = (0..scene.render.tiers.len().min(limits::MAX_TIERS) as u32)
+            .flat_map(|tier| TIER.map(|property| Channel::Tier { tier, property }));
         ellipsoids
             .chain(planes)
             .chain(LIGHT.map(|property| Channel::Light { property }))
             .chain(MEDIA.map(|property| Channel::Media { property }))
+            .chain(tiers)
             .chain(shot)
     }
 }
@@ -1015,6 +1076,28 @@ impl Animation {
         before - self.tracks.len()
     }
 
+    /// Tier `removed` went: its keys go with it and the keys of the tiers above it move down
+    /// one place, as the tiers did. Returns whether any track changed.
+    pub fn tier_removed(&mut self, removed: usize) -> bool {
+        let before = self.tracks.len();
+        self.tracks.retain(
+            |t| !matches!(t.channel, Channel::Tier { tier, .. } if tier as usize == removed),
+        );
+        let mut changed = self.tracks.len() != before;
+        for track in &mut self.tracks {
+            if let Channel::Tier { tier, property } = track.channel
+                && tier as usize > removed
+            {
+                Arc::make_mut(track).channel = Channel::Tier {
+                    tier: tier - 1,
+                    property,
+                };
+                changed = true;
+            }
+        }
+        changed
+    }
+
     /// Repairs what a file or a link may hold, saying what it changed: keys whose value cannot
     /// be held are dropped, values brought within range, times that are not finite dropped
     /// and others brought within [0, [`limits::MAX_TIME`]], keys sorted, one key a time (the
@@ -1146,9 +1229,27 @@ impl Scene {
         let animation = std::mem::take(&mut self.animation);
         let index = Index::of(self);
         let mut changed = false;
+        let mut floors = false;
         for track in animation.tracks.iter().filter(|tr| which(tr.channel)) {
-            if let Some(value) = track.sample(t) {
-                changed |= track.channel.set(self, &index, &value);
+            if let Some(value) = track.sample(t)
+                && track.channel.set(self, &index, &value)
+            {
+                changed = true;
+                floors |= matches!(
+                    track.channel,
+                    Channel::Tier {
+                        property: TierProperty::Floor,
+                        ..
+                    }
+                );
+            }
+        }
+        // Keyed floors stay in order, each at or above the one below, as the panel keeps
+        // them (the tiers are never re-sorted under their keys).
+        if floors {
+            let tiers = &mut self.render.tiers;
+            for k in 1..tiers.len() {
+                tiers[k].floor = tiers[k].floor.max(tiers[k - 1].floor);
             }
         }
         self.animation = animation;
@@ -1545,6 +1646,98 @@ mod tests {
         scene.shot = None;
         let mut animation = scene.animation.clone();
         assert_eq!(animation.forget_missing(&scene), 1);
+    }
+
+    #[test]
+    fn a_tiers_floor_wind_and_torque_key_pose_and_go_with_their_tier() {
+        use crate::scene::{Document, Edit, Tier};
+        let tier = |floor: f32| Tier {
+            floor,
+            ..Default::default()
+        };
+        let floor = |tier| Channel::Tier {
+            tier,
+            property: TierProperty::Floor,
+        };
+        let torque = |tier| Channel::Tier {
+            tier,
+            property: TierProperty::Torque,
+        };
+        let mut scene = one_ellipsoid();
+        scene.render.tiers = vec![tier(2.0), tier(6.0)];
+        assert_eq!(
+            Channel::all(&scene)
+                .filter(|c| matches!(c, Channel::Tier { .. }))
+                .count(),
+            6
+        );
+        // Auto-key records an edit of tier 2's torque at the document's time.
+        let mut doc = Document::new(scene);
+        doc.set_auto_key(true);
+        doc.set_time(1.0);
+        let mut r = doc.scene().render.clone();
+        r.tiers[1].torque = 30.0;
+        assert!(doc.apply(Edit::SetRender(r), None));
+        let track = doc.scene().animation.track(torque(1)).expect("keyed");
+        assert_eq!(track.keys[0].value, vec![30.0]);
+        doc.set_auto_key(false);
+        // Floors keyed across each other pose in order: tier 1's keys take it from 0 to 10,
+        // past tier 2's floor of 6, which holds it up to itself.
+        let mut a = doc.scene().animation.clone();
+        a.key(floor(0), 0.0, vec![0.0]);
+        a.key(floor(0), 2.0, vec![10.0]);
+        a.key(floor(1), 0.0, vec![6.0]);
+        doc.apply(Edit::SetAnimation(a, "insert keys"), None);
+        doc.set_time(1.0);
+        assert_eq!(doc.scene().render.tiers[0].floor, 5.0, "halfway");
+        doc.set_time(2.0);
+        let tiers = &doc.scene().render.tiers;
+        assert_eq!(
+            (tiers[0].floor, tiers[1].floor),
+            (10.0, 10.0),
+            "never above the next"
+        );
+        assert_eq!(
+            tiers[1].torque, 30.0,
+            "the tiers kept their places, not re-sorted"
+        );
+        // Removing tier 1 takes its keys; tier 2's move down with it and still pose it.
+        let mut r = doc.scene().render.clone();
+        r.tiers.remove(0);
+        assert!(doc.apply(Edit::SetRender(r), None));
+        let a = &doc.scene().animation;
+        assert!(a.track(floor(1)).is_none() && a.track(torque(1)).is_none());
+        assert_eq!(a.track(torque(0)).unwrap().keys[0].value, vec![30.0]);
+        assert_eq!(
+            a.track(floor(0)).unwrap().keys[0].value,
+            vec![6.0],
+            "tier 2's floor key"
+        );
+        doc.set_time(0.0);
+        assert_eq!(doc.scene().render.tiers[0].floor, 6.0);
+        assert_eq!(doc.scene().render.tiers[0].torque, 30.0);
+        // Undo brings the tier and its keys back.
+        doc.undo();
+        assert_eq!(doc.scene().render.tiers.len(), 2);
+        assert!(doc.scene().animation.track(floor(1)).is_some());
+        // Keys on a tier the scene does not have are dropped on reading, naming it.
+        let mut scene = one_ellipsoid();
+        scene.render.tiers = vec![tier(2.0)];
+        let json = r#"[{"channel": {"item": "tier", "tier": 1, "property": "wind"},
+                        "keys": [{"t": 0, "v": [1, 0]}]},
+                       {"channel": {"item": "tier", "tier": 0, "property": "floor"},
+                        "keys": [{"t": 0, "v": [1e5]}]}]"#;
+        let mut anim: Animation = serde_json::from_str(json).unwrap();
+        let said = anim.repair(&scene).join("\n");
+        assert!(
+            said.contains("animation[0]: keys on tier 2's wind dropped"),
+            "{said}"
+        );
+        assert_eq!(
+            anim.track(floor(0)).unwrap().keys[0].value,
+            vec![200.0],
+            "{said}"
+        );
     }
 
     #[test]

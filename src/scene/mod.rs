@@ -26,7 +26,7 @@ pub use document::{Document, Revisions};
 pub use edit::Edit;
 pub use keys::{
     Animation, Channel, Ease, EllipsoidProperty, Key, LightProperty, MAX_KEYS, MAX_TRACKS,
-    MediaProperty, PlaneProperty, ShotProperty, Track,
+    MediaProperty, PlaneProperty, ShotProperty, TierProperty, Track,
 };
 pub use looks::{Look, Looks};
 pub use motion::{Motion, WindField};

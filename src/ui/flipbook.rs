@@ -98,7 +98,7 @@ pub fn frame_key(scene: &Scene, t: f32, size: [u32; 2]) -> u64 {
     {
         at.camera = shot.clone();
     }
-    let drift = crate::field::media::Drift::of(&at);
+    let drift = crate::field::media::Drifts::of(&at);
     // A simulation's run is steered by its parcels' keys from time 0 on: there the keys are
     // part of the frame.
     if at.simulation.is_none() {
@@ -109,7 +109,7 @@ pub fn frame_key(scene: &Scene, t: f32, size: [u32; 2]) -> u64 {
     let mut h = Hashing(Default::default());
     // (A scene always serialises; a failure only makes the key differ from every frame's.)
     let _ = serde_json::to_writer(&mut h, &at);
-    for v in [drift.travelled[0], drift.travelled[1], drift.turned] {
+    for v in drift.values() {
         h.0.write_u32(v.to_bits());
     }
     h.0.write_u32(size[0]);

@@ -199,8 +199,7 @@ impl Viewport {
             camera: scene.camera.clone(),
             light: scene.light.clone(),
             render: scene.render.clone(),
-            time: scene.time,
-            drift: crate::render::gpu_types::Drift::of(scene),
+            drift: crate::render::gpu_types::Drifts::of(scene),
             aspect: rect.aspect_ratio(),
             crop: crate::render::FULL_VIEW,
         };

@@ -103,7 +103,7 @@ impl Default for Timeline {
 
 /// The channels the timeline shows and deletes keys of: every keyable value of the selected
 /// ellipsoids and planes; with nothing selected, the shot camera's while the view looks
-/// through it, else the light's and the media's.
+/// through it, else the light's, the media's and the tiers'.
 pub fn shown_channels(scene: &Scene, selection: &Selection, shot_view: bool) -> Vec<Channel> {
     if selection.is_empty() {
         return Channel::all(scene)
@@ -111,7 +111,10 @@ pub fn shown_channels(scene: &Scene, selection: &Selection, shot_view: bool) -> 
                 if shot_view {
                     matches!(c, Channel::Shot { .. })
                 } else {
-                    matches!(c, Channel::Light { .. } | Channel::Media { .. })
+                    matches!(
+                        c,
+                        Channel::Light { .. } | Channel::Media { .. } | Channel::Tier { .. }
+                    )
                 }
             })
             .collect();
@@ -728,8 +731,15 @@ mod tests {
         // A stalled frame does not jump the clock.
         timeline.tick(&mut doc, 30.0);
         assert!(doc.scene().time < 3.1);
-        assert!((timeline.ticked_s - 31.0).abs() < 1e-4, "{}", timeline.ticked_s);
-        assert!((timeline.stalled_s - 29.5).abs() < 1e-4, "the stall is counted");
+        assert!(
+            (timeline.ticked_s - 31.0).abs() < 1e-4,
+            "{}",
+            timeline.ticked_s
+        );
+        assert!(
+            (timeline.stalled_s - 29.5).abs() < 1e-4,
+            "the stall is counted"
+        );
         // Looping: the last frame lasts a frame, and the time past it carries on from the
         // first (none is lost at the wrap: a loop takes its frames' time exactly).
         timeline.looping = true;
