@@ -185,14 +185,16 @@ impl Media {
             .map(|&b| b as f32 / 255.0)
             .collect();
         let drifts = Drifts::of(scene);
+        let floors = r.tier_floors();
         let tiers = r
             .tiers
             .iter()
             .take(MAX_TIERS)
+            .zip(floors)
             .enumerate()
-            .map(|(k, t)| {
+            .map(|(k, (t, floor))| {
                 let m = std::array::from_fn(|i| tier_octave_transform(r, k + 1, i, &drifts));
-                (t.floor, t.filter, m)
+                (floor, t.filter, m)
             })
             .collect();
         let octaves = (r.noise_octaves as usize).min(MAX_OCTAVES);

@@ -439,7 +439,8 @@ impl VolumeUniforms {
             -1.0e30
         };
         let tiers = &r.tiers[..r.tiers.len().min(MAX_TIERS)];
-        let floor = |k: usize| tiers.get(k).map_or(f32::MAX, |t| t.floor);
+        let floors = r.tier_floors();
+        let floor = |k: usize| floors.get(k).copied().unwrap_or(f32::MAX);
         let tier_filter = |k: usize| tiers.get(k).map_or(filter, |t| filter_code(t.filter));
         let basis = match r.noise_basis {
             NoiseBasis::Perlin => 0.0,

@@ -107,16 +107,6 @@ fn drift_keys(scene: &Scene) -> Vec<*const super::Track> {
         .collect()
 }
 
-/// Which tier went between `before` and `after`, where one did (the others unchanged, in
-/// order).
-fn removed_tier(before: &[super::Tier], after: &[super::Tier]) -> Option<usize> {
-    (after.len() + 1 == before.len())
-        .then(|| {
-            (0..before.len()).find(|&k| before[..k] == after[..k] && before[k + 1..] == after[k..])
-        })
-        .flatten()
-}
-
 fn diff(a: &Scene, b: &Scene) -> Changed {
     Changed {
         geometry: a.seed != b.seed
@@ -259,6 +249,7 @@ impl Document {
                 changed.geometry = *i <= s.planes.len() && s.planes.len() < MAX_PLANES;
             }
             Edit::RemovePlane(i) => changed.geometry = *i < s.planes.len(),
+            Edit::RemoveTier(i) => changed.render = *i < s.render.tiers.len(),
             Edit::SetReference(r) => changed.reference = r.as_ref() != s.reference.as_deref(),
             Edit::SetAnimation(a, _) => changed.clock = !a.same_as(&s.animation),
             Edit::SetShot(c) => changed.clock = *c != s.shot,
@@ -277,16 +268,14 @@ impl Document {
         match edit {
             Edit::SetLight(l) => s.light = l,
             Edit::SetSimulation(sim) => s.simulation = sim.map(Arc::new),
-            Edit::SetRender(r) => {
-                // A tier removed takes its keys, and those above it move down with their tiers.
-                if let Some(k) = removed_tier(&s.render.tiers, &r.tiers) {
-                    let mut animation = s.animation.clone();
-                    if animation.tier_removed(k) {
-                        s.animation = animation;
-                        changed.clock = true;
-                    }
+            Edit::SetRender(r) => s.render = r,
+            Edit::RemoveTier(i) => {
+                s.render.tiers.remove(i);
+                let mut animation = s.animation.clone();
+                if animation.tier_removed(i) {
+                    s.animation = animation;
+                    changed.clock = true;
                 }
-                s.render = r;
             }
             Edit::SetClock(mut c) => {
                 c.sanitize();

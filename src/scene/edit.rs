@@ -26,6 +26,9 @@ pub enum Edit {
     InsertPlane(usize, DrawingPlane),
     /// Remove drawing plane `index`.
     RemovePlane(usize),
+    /// Remove atmospheric tier `index` with its keys (the keys of the tiers above it move
+    /// down with them).
+    RemoveTier(usize),
     /// Set, change or remove the reference image.
     SetReference(Option<ReferenceImage>),
     /// Turn the simulation on (with these settings), change it, or turn it off.
@@ -53,6 +56,7 @@ impl Edit {
             Edit::SetPlane(..) => "drawing plane",
             Edit::InsertPlane(..) => "new drawing plane",
             Edit::RemovePlane(_) => "deleted drawing plane",
+            Edit::RemoveTier(_) => "removed tier",
             Edit::SetReference(_) => "reference image",
             Edit::SetSimulation(_) => "simulation",
             Edit::SetShot(_) => "shot camera",

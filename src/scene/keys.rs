@@ -155,8 +155,8 @@ pub enum MediaProperty {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum TierProperty {
-    /// The altitude where the tier begins (keyed floors are held in order, each at or above
-    /// the one below).
+    /// The altitude where the tier begins (a keyed floor posed past the next tier's takes that
+    /// tier up with it: [`crate::scene::RenderSettings::tier_floors`]).
     Floor,
     /// The tier's wind (x, z): what carries its noise is the wind's integral over time.
     Wind,
@@ -1229,27 +1229,9 @@ impl Scene {
         let animation = std::mem::take(&mut self.animation);
         let index = Index::of(self);
         let mut changed = false;
-        let mut floors = false;
         for track in animation.tracks.iter().filter(|tr| which(tr.channel)) {
-            if let Some(value) = track.sample(t)
-                && track.channel.set(self, &index, &value)
-            {
-                changed = true;
-                floors |= matches!(
-                    track.channel,
-                    Channel::Tier {
-                        property: TierProperty::Floor,
-                        ..
-                    }
-                );
-            }
-        }
-        // Keyed floors stay in order, each at or above the one below, as the panel keeps
-        // them (the tiers are never re-sorted under their keys).
-        if floors {
-            let tiers = &mut self.render.tiers;
-            for k in 1..tiers.len() {
-                tiers[k].floor = tiers[k].floor.max(tiers[k - 1].floor);
+            if let Some(value) = track.sample(t) {
+                changed |= track.channel.set(self, &index, &value);
             }
         }
         self.animation = animation;
@@ -1680,9 +1662,9 @@ mod tests {
         assert!(doc.apply(Edit::SetRender(r), None));
         let track = doc.scene().animation.track(torque(1)).expect("keyed");
         assert_eq!(track.keys[0].value, vec![30.0]);
-        doc.set_auto_key(false);
-        // Floors keyed across each other pose in order: tier 1's keys take it from 0 to 10,
-        // past tier 2's floor of 6, which holds it up to itself.
+        // Floors keyed across each other: tier 1's keys take it from 0 to 10, past tier 2's
+        // floor of 6, which then begins with it; back at 0 s it is at 6 again (the pose is
+        // the time's alone, not where the scrub has been).
         let mut a = doc.scene().animation.clone();
         a.key(floor(0), 0.0, vec![0.0]);
         a.key(floor(0), 2.0, vec![10.0]);
@@ -1691,20 +1673,21 @@ mod tests {
         doc.set_time(1.0);
         assert_eq!(doc.scene().render.tiers[0].floor, 5.0, "halfway");
         doc.set_time(2.0);
-        let tiers = &doc.scene().render.tiers;
+        assert_eq!(doc.scene().render.tier_floors(), vec![10.0, 10.0]);
         assert_eq!(
-            (tiers[0].floor, tiers[1].floor),
-            (10.0, 10.0),
-            "never above the next"
+            doc.scene().render.tiers[1].torque,
+            30.0,
+            "the tiers kept their places"
         );
-        assert_eq!(
-            tiers[1].torque, 30.0,
-            "the tiers kept their places, not re-sorted"
-        );
-        // Removing tier 1 takes its keys; tier 2's move down with it and still pose it.
-        let mut r = doc.scene().render.clone();
-        r.tiers.remove(0);
-        assert!(doc.apply(Edit::SetRender(r), None));
+        doc.set_time(0.0);
+        assert_eq!(doc.scene().render.tier_floors(), vec![0.0, 6.0]);
+        doc.set_time(2.0);
+        // Removing tier 1 (auto-key on) takes its keys; tier 2's move down with it and still
+        // pose it, and nothing new is keyed.
+        let keys = doc.scene().animation.key_count();
+        assert!(doc.apply(Edit::RemoveTier(0), None));
+        assert_eq!(doc.scene().animation.key_count(), keys - 2);
+        doc.set_auto_key(false);
         let a = &doc.scene().animation;
         assert!(a.track(floor(1)).is_none() && a.track(torque(1)).is_none());
         assert_eq!(a.track(torque(0)).unwrap().keys[0].value, vec![30.0]);

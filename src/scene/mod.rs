@@ -722,6 +722,21 @@ impl RenderSettings {
         }
     }
 
+    /// The floors the tiers take effect at, from the lowest: each at or above the one below
+    /// (keys may pose a floor past the next tier's, which then begins with it).
+    pub fn tier_floors(&self) -> Vec<f32> {
+        let mut floors: Vec<f32> = self
+            .tiers
+            .iter()
+            .take(limits::MAX_TIERS)
+            .map(|t| t.floor)
+            .collect();
+        for k in 1..floors.len() {
+            floors[k] = floors[k].max(floors[k - 1]);
+        }
+        floors
+    }
+
     fn sanitize(&mut self) {
         self.slices = limits::SLICES.fix_u32(self.slices);
         self.field_resolution = limits::FIELD_RESOLUTION.fix_u32(self.field_resolution);
@@ -741,7 +756,8 @@ impl RenderSettings {
             t.wind = t.wind.map(|w| limits::WIND.fix_f32(w));
             t.torque = limits::TORQUE.fix_f32(t.torque);
         }
-        self.tiers.sort_by(|a, b| a.floor.total_cmp(&b.floor));
+        // Not sorted: keys address tiers by place ([`RenderSettings::tier_floors`] orders the
+        // floors where they are used).
         self.tier_blend = limits::TIER_BLEND.fix_f32(self.tier_blend);
         self.light_resolution = limits::LIGHT_RESOLUTION.fix_u32(self.light_resolution);
         self.light_octaves = limits::LIGHT_OCTAVES.fix_u32(self.light_octaves);

@@ -352,6 +352,9 @@ impl CloudApp {
         );
         self.guide.ui(ui, &mut self.doc, &mut self.notices);
         RENDER.ui(ui, &mut self.doc);
+        if let Some(k) = super::panels::take_removed_tier(ui.ctx()) {
+            self.doc.apply(crate::scene::Edit::RemoveTier(k), None);
+        }
         LIGHT.ui(ui, &mut self.doc);
         p.scene
             .ui(ui, &mut self.doc, &mut self.selection, &mut self.notices);

@@ -12,7 +12,7 @@ mod view;
 
 pub use export::ExportPanel;
 pub use light::LIGHT;
-pub use render::RENDER;
+pub use render::{RENDER, take_removed_tier};
 pub use scene::ScenePanel;
 pub use simulation::SimulationPanel;
 pub use sketch::SketchPanel;

@@ -60,6 +60,14 @@ fn filter_combo(ui: &mut Ui, id: &str, filter: &mut NoiseFilter) {
         .on_hover_text("Schpok et al.'s Table 2: how each octave's noise is shaped");
 }
 
+const REMOVE_TIER: &str = "remove tier";
+
+/// The tier whose "remove" was pressed this frame, once: the caller removes it with
+/// [`crate::scene::Edit::RemoveTier`], which takes its keys too.
+pub fn take_removed_tier(ctx: &egui::Context) -> Option<usize> {
+    ctx.data_mut(|d| d.remove_temp(egui::Id::unique(REMOVE_TIER)))
+}
+
 /// Atmospheric tiers: from each floor up, the noise has its own filter and motion; the media
 /// above are the base, below the first floor (and their first octave moves everywhere).
 fn tiers(ui: &mut Ui, r: &mut RenderSettings) {
@@ -69,7 +77,7 @@ fn tiers(ui: &mut Ui, r: &mut RenderSettings) {
         .id_salt("tiers")
         .default_open(false)
         .show(ui, |ui| {
-            let mut remove = None;
+            let floors: Vec<f32> = r.tiers.iter().map(|t| t.floor).collect();
             for (k, t) in r.tiers.iter_mut().enumerate() {
                 ui.horizontal(|ui| {
                     ui.label(egui::RichText::new(format!("Tier {}", k + 1)).strong());
@@ -78,15 +86,13 @@ fn tiers(ui: &mut Ui, r: &mut RenderSettings) {
                         .on_hover_text("Back to the media below")
                         .clicked()
                     {
-                        remove = Some(k);
+                        // Its own edit, which takes the tier's keys with it.
+                        ui.ctx().data_mut(|d| d.insert_temp(egui::Id::unique(REMOVE_TIER), k));
                     }
                 });
                 param(ui, &mut t.floor, &limits::TIER_FLOOR);
                 filter_combo(ui, &format!("tier {k} filter"), &mut t.filter);
                 wind_and_torque(ui, &mut t.wind, &mut t.torque);
-            }
-            if let Some(k) = remove {
-                r.tiers.remove(k);
             }
             let add = (r.tiers.len() < limits::MAX_TIERS).then(|| {
                 ui.button("Add a tier").on_hover_text(
@@ -104,9 +110,14 @@ fn tiers(ui: &mut Ui, r: &mut RenderSettings) {
                 });
             }
             param(ui, &mut r.tier_blend, &limits::TIER_BLEND);
-            // Floors stay in order: a tier's floor is never below the one under it.
-            for k in 1..r.tiers.len() {
-                r.tiers[k].floor = r.tiers[k].floor.max(r.tiers[k - 1].floor);
+            // A floor the user moves stays between its neighbours' (keys may pose them out of
+            // order, which this leaves as it is).
+            for k in 0..r.tiers.len().min(floors.len()) {
+                if r.tiers[k].floor != floors[k] {
+                    let lo = if k > 0 { r.tiers[k - 1].floor } else { f32::MIN };
+                    let hi = r.tiers.get(k + 1).map_or(f32::MAX, |t| t.floor);
+                    r.tiers[k].floor = r.tiers[k].floor.max(lo).min(hi.max(lo));
+                }
             }
         });
     crate::ui::widgets::mark(ui, "group:Tiers", shown.header_response.rect);
