@@ -181,7 +181,9 @@ impl Viewport {
         };
         let drawing = tool.input(&input, &mut cx);
         let mut camera = cx.doc.scene().camera.clone();
-        if super::camera_input::handle(ui, &response, &mut camera, !drawing) {
+        let primary_at_rest = matches!(tool.tool, super::Tool::Navigate | super::Tool::Ellipsoid)
+            && !tool.modal_active();
+        if super::camera_input::handle(ui, &response, &mut camera, !drawing, primary_at_rest) {
             cx.doc.set_camera(camera);
         }
 
