@@ -1625,25 +1625,21 @@ fn a_keyed_ellipsoid_moves_the_rendered_cloud_the_way_its_keys_say() {
     assert_eq!(render(&scene.posed_at(2.0)), render(&scene.posed_at(5.0)));
 }
 
-#[test]
-fn a_keyed_wind_carries_the_noise_by_its_integral_not_its_value_times_the_time() {
-    use cloudsketch::scene::{Channel, MediaProperty};
-    let base = with(
-        &smooth_cumulus(),
-        &["/render/slices=64", "/render/noise_amount=0.6"],
-    );
-    // Wind keyed from calm at 0 s to 2 units/s at 2 s: by 2 s it has carried the noise 2
-    // units, as a steady wind of 1 does; its value times the time would be 4.
+/// Keys `channel` (a wind) from calm at 0 s to 2 units/s at 2 s in `base` and renders it at
+/// 2 s: by then it has carried the noise 2 units, as a steady wind of 1 does (set by `steady`,
+/// a `--set` pointer with `{w}` for the wind's x), where its value times the time would be 4.
+fn assert_a_keyed_wind_carries_by_its_integral(
+    base: &Scene,
+    channel: cloudsketch::scene::Channel,
+    steady: &str,
+) {
     let mut keyed = base.clone();
-    let wind = Channel::Media {
-        property: MediaProperty::Wind,
-    };
-    keyed.animation.key(wind, 0.0, vec![0.0, 0.0]);
-    keyed.animation.key(wind, 2.0, vec![2.0, 0.0]);
+    keyed.animation.key(channel, 0.0, vec![0.0, 0.0]);
+    keyed.animation.key(channel, 2.0, vec![2.0, 0.0]);
     let keyed = keyed.posed_at(2.0);
-    assert_eq!(keyed.render.wind, [2.0, 0.0]);
+    assert_eq!(channel.get(&keyed), Some(vec![2.0, 0.0]));
     let steady = |w: f32| {
-        let mut s = with(&base, &[&format!("/render/wind=[{w},0]")]);
+        let mut s = with(base, &[&steady.replace("{w}", &w.to_string())]);
         s.time = 2.0;
         render(&s)
     };
@@ -1661,6 +1657,19 @@ fn a_keyed_wind_carries_the_noise_by_its_integral_not_its_value_times_the_time()
 }
 
 #[test]
+fn a_keyed_wind_carries_the_noise_by_its_integral_not_its_value_times_the_time() {
+    use cloudsketch::scene::{Channel, MediaProperty};
+    let base = with(
+        &smooth_cumulus(),
+        &["/render/slices=64", "/render/noise_amount=0.6"],
+    );
+    let wind = Channel::Media {
+        property: MediaProperty::Wind,
+    };
+    assert_a_keyed_wind_carries_by_its_integral(&base, wind, "/render/wind=[{w},0]");
+}
+
+#[test]
 fn a_tiers_keyed_wind_carries_its_noise_by_its_integral_on_the_gpu() {
     // The same for an atmospheric tier covering the whole cloud, the base media calm: the
     // slices' tier transforms take the tier's integrated wind, as the CPU media do.
@@ -1674,31 +1683,11 @@ fn a_tiers_keyed_wind_carries_its_noise_by_its_integral_on_the_gpu() {
             "/render/tiers=[{\"floor\": -50}]",
         ],
     );
-    let mut keyed = base.clone();
     let wind = Channel::Tier {
         tier: 0,
         property: TierProperty::Wind,
     };
-    keyed.animation.key(wind, 0.0, vec![0.0, 0.0]);
-    keyed.animation.key(wind, 2.0, vec![2.0, 0.0]);
-    let keyed = keyed.posed_at(2.0);
-    assert_eq!(keyed.render.tiers[0].wind, [2.0, 0.0]);
-    let steady = |w: f32| {
-        let mut s = with(&base, &[&format!("/render/tiers/0/wind=[{w},0]")]);
-        s.time = 2.0;
-        render(&s)
-    };
-    let image = render(&keyed);
-    assert_eq!(
-        image,
-        steady(1.0),
-        "the integral: as far as a steady wind of 1"
-    );
-    let d = changed(&image, &steady(2.0));
-    assert!(
-        d > 300,
-        "value × time would carry it twice as far: {d} px differ"
-    );
+    assert_a_keyed_wind_carries_by_its_integral(&base, wind, "/render/tiers/0/wind=[{w},0]");
 }
 
 /// The topmost row of cloud pixels and the cloud's width on screen.

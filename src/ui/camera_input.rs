@@ -7,10 +7,11 @@ use glam::Vec2;
 use crate::scene::OrbitCamera;
 
 /// Applies this frame's camera input. `orbit_with_primary` is false while a drawing tool owns
-/// the primary button (then Alt+drag or two fingers still orbit); `primary_at_rest` says whether
-/// the tool that is out leaves the primary button's drags to the camera (Navigate, Ellipsoid),
-/// for a drag that egui never saw: one pressed and released within one long frame. Returns
-/// whether the camera moved.
+/// the primary button (then Alt+drag or two fingers still orbit); `quick` says whose a drag is
+/// that egui never saw, one pressed and released within one long frame (or with the press's
+/// frame moving too little for a drag): `None`, not the camera's; `Some(primary)`, the
+/// camera's, the primary button's too where `primary` ([`crate::ui::tools::Toolbox::quick_drags`]).
+/// Returns whether the camera moved.
 ///
 /// A drag moves the camera by the pointer's whole path, however few frames it spans: egui
 /// recognises a drag a few pixels after its press and reports no motion in the frame of its
@@ -22,7 +23,7 @@ pub fn handle(
     response: &Response,
     camera: &mut OrbitCamera,
     orbit_with_primary: bool,
-    primary_at_rest: bool,
+    quick: Option<bool>,
 ) -> bool {
     let before = camera.clone();
     let rect = response.rect;
@@ -47,33 +48,40 @@ pub fn handle(
     let over_view = |at: egui::Pos2| {
         rect.contains(at)
             && ui.ctx().layer_id_at(at) == Some(response.layer_id)
-            && !super::sun_handle::orb(rect).is_some_and(|(c, r)| c.distance(at) <= r + 4.0)
+            && !super::sun_handle::orb_area(rect).is_some_and(|area| area.contains(at))
     };
     let rules = Rules {
         modifiers,
         orbit_with_primary,
     };
+    // (Of two buttons held, a pan wins, as it always did.)
     let dragged = [
-        PointerButton::Primary,
         PointerButton::Secondary,
         PointerButton::Middle,
+        PointerButton::Primary,
     ]
     .into_iter()
     .find(|&b| response.dragged_by(b) && rules.mode(b).is_some());
     let stopped = [
-        PointerButton::Primary,
         PointerButton::Secondary,
         PointerButton::Middle,
+        PointerButton::Primary,
     ]
     .into_iter()
     .find(|&b| response.drag_stopped_by(b));
     let mut next = None;
     let gesture: Option<(Mode, Vec2)> = if let Some(button) = dragged {
-        // From where the last frame left it, or from the press (the pixels before egui knew
-        // it for a drag).
-        let from = last.or(pending.map(|p| p.1)).or(origin);
+        // From where the last frame left it; in the frame egui takes it for a drag, from the
+        // press (the pixels before egui knew it for one); else (a drag that becomes the
+        // camera's midway, as Alt is pressed) this frame's motion alone.
+        let from = if response.drag_started_by(button) {
+            pending.map(|p| p.1).or(origin)
+        } else {
+            last.or_else(|| latest.map(|l| l - ui.input(|i| i.pointer.delta())))
+        };
         let to = latest;
-        next = to;
+        // (The pointer gone from the page mid-drag keeps where it was last seen.)
+        next = to.or(last);
         match (from, to) {
             (Some(a), Some(b)) => rules
                 .mode(button)
@@ -102,10 +110,17 @@ pub fn handle(
             .find(|p| over_view(p.pressed))
             .and_then(|p| {
                 let to = p.released?;
+                let primary = quick?;
                 let rules = Rules {
-                    orbit_with_primary: orbit_with_primary && primary_at_rest,
+                    modifiers: p.modifiers,
                     ..rules
                 };
+                if p.button == PointerButton::Primary
+                    && !(primary && orbit_with_primary)
+                    && !p.modifiers.alt
+                {
+                    return None;
+                }
                 let mode = rules.mode(p.button)?;
                 let d = Vec2::new(to.x - p.pressed.x, to.y - p.pressed.y);
                 (d.length() > 6.0).then_some((mode, d))
@@ -186,6 +201,7 @@ impl Rules {
 #[derive(Clone, Copy)]
 struct Press {
     button: PointerButton,
+    modifiers: egui::Modifiers,
     pressed: egui::Pos2,
     released: Option<egui::Pos2>,
     earlier: bool,
@@ -200,12 +216,13 @@ fn presses(events: &[egui::Event]) -> Vec<Press> {
             pos,
             button,
             pressed,
-            ..
+            modifiers,
         } = *e
         {
             if pressed {
                 out.push(Press {
                     button,
+                    modifiers,
                     pressed: pos,
                     released: None,
                     earlier: false,
@@ -219,6 +236,7 @@ fn presses(events: &[egui::Event]) -> Vec<Press> {
             } else {
                 out.push(Press {
                     button,
+                    modifiers,
                     pressed: pos,
                     released: Some(pos),
                     earlier: true,
@@ -243,6 +261,18 @@ mod tests {
         sizes: &[usize],
         primary_at_rest: bool,
     ) -> OrbitCamera {
+        dragged_in_with(button, from, sizes, primary_at_rest, None)
+    }
+
+    /// [`dragged_in`], the pointer leaving the page at the end of frame `gone` (of the drag's)
+    /// and coming back where it left.
+    fn dragged_in_with(
+        button: PointerButton,
+        from: egui::Pos2,
+        sizes: &[usize],
+        primary_at_rest: bool,
+        gone: Option<usize>,
+    ) -> OrbitCamera {
         let rect = crate::ui::test_view();
         let at = |i: usize| from + egui::vec2(4.0 * i as f32, 1.5 * i as f32);
         let press = |pressed, i| Event::PointerButton {
@@ -256,9 +286,13 @@ mod tests {
         events.push(press(false, 40));
         let mut chunks = vec![vec![Event::PointerMoved(at(0))]];
         let mut rest = &events[..];
-        for &n in sizes {
+        for (k, &n) in sizes.iter().enumerate() {
             let (chunk, after) = rest.split_at(n.min(rest.len()));
-            chunks.push(chunk.to_vec());
+            let mut chunk = chunk.to_vec();
+            if gone == Some(k) {
+                chunk.push(Event::PointerGone);
+            }
+            chunks.push(chunk);
             rest = after;
         }
         assert!(rest.is_empty());
@@ -274,7 +308,7 @@ mod tests {
             };
             let mut output = ctx.run_ui(raw, |ui| {
                 let response = ui.allocate_rect(rect, Sense::click_and_drag());
-                handle(ui, &response, &mut camera, true, primary_at_rest);
+                handle(ui, &response, &mut camera, true, Some(primary_at_rest));
             });
             output.textures_delta.clear();
         }
@@ -326,6 +360,21 @@ mod tests {
             wrong.push(format!(
                 "press, then the rest: yaw {} pitch {}",
                 late.yaw_deg, late.pitch_deg
+            ));
+        }
+        // The pointer gone from the page midway (dragged off the canvas and back): the camera
+        // goes on from where it was, no jump by the path so far.
+        let gone = dragged_in_with(
+            PointerButton::Primary,
+            centre,
+            &[10, 10, 10, 12],
+            true,
+            Some(2),
+        );
+        if !orbited_as_whole(&gone) {
+            wrong.push(format!(
+                "pointer gone: yaw {} pitch {}",
+                gone.yaw_deg, gone.pitch_deg
             ));
         }
         assert!(wrong.is_empty(), "{}", wrong.join("\n"));

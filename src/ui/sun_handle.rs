@@ -46,6 +46,11 @@ pub fn orb(rect: egui::Rect) -> Option<(Pos2, f32)> {
     rect.contains_rect(area(center)).then_some((center, RADIUS))
 }
 
+/// Where the orb takes the pointer in `rect`, if it fits there.
+pub fn orb_area(rect: egui::Rect) -> Option<egui::Rect> {
+    orb(rect).map(|(center, _)| area(center))
+}
+
 fn area(center: Pos2) -> egui::Rect {
     egui::Rect::from_center_size(center, Vec2::splat(2.0 * RADIUS + 8.0))
 }

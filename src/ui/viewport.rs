@@ -181,9 +181,8 @@ impl Viewport {
         };
         let drawing = tool.input(&input, &mut cx);
         let mut camera = cx.doc.scene().camera.clone();
-        let primary_at_rest = matches!(tool.tool, super::Tool::Navigate | super::Tool::Ellipsoid)
-            && !tool.modal_active();
-        if super::camera_input::handle(ui, &response, &mut camera, !drawing, primary_at_rest) {
+        let quick = tool.quick_drags();
+        if super::camera_input::handle(ui, &response, &mut camera, !drawing, quick) {
             cx.doc.set_camera(camera);
         }
 

@@ -151,6 +151,17 @@ impl Toolbox {
         self.modal.is_some()
     }
 
+    /// Whose a drag is that egui never saw (pressed and released within a frame or two): none
+    /// of the camera's while a modal transform has the pointer or its confirming click's
+    /// button is held (`None`); else the camera's, with the primary button's too where the
+    /// tool that is out leaves its drags to the camera (Navigate, Ellipsoid) and no box
+    /// selection is armed.
+    pub fn quick_drags(&self) -> Option<bool> {
+        (self.modal.is_none() && !self.swallow).then(|| {
+            matches!(self.tool, Tool::Navigate | Tool::Ellipsoid) && !self.boxes.is_active()
+        })
+    }
+
     /// The modal transform under way, for the page state: its kind, its locked axis and what
     /// was typed.
     pub fn modal_state(&self) -> Option<(ModalKind, Option<Axis>, String)> {
