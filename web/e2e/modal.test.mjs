@@ -196,6 +196,20 @@ for (const backend of EDITING_BUILDS) {
       await page.waitForTimeout(300);
       s = await state(page);
       assert.ok(s.view.widgets['button:Add a tier'], 'still open after adding a tier');
+      // A second tier, then "remove" on the first: the second moves down (its own edit, which
+      // takes the first's keys with it: the unit tests key them), and undo brings both back.
+      const again = await reveal(page, 'button:Add a tier');
+      await page.mouse.click(again[0] + again[2] / 2, again[1] + again[3] / 2);
+      s = await until(page, (s) => s.scene.render.tiers.length === 2, 'a second tier');
+      const floors = s.scene.render.tiers.map((t) => t.floor);
+      assert.ok(floors[1] > floors[0], `floors ${floors}`);
+      const remove = await reveal(page, 'button:remove tier 1');
+      await page.mouse.click(remove[0] + remove[2] / 2, remove[1] + remove[3] / 2);
+      s = await until(page, (s) => s.scene.render.tiers.length === 1, 'tier 1 removed');
+      assert.equal(s.scene.render.tiers[0].floor, floors[1], 'tier 2 moved down');
+      await page.keyboard.press('Control+z');
+      s = await until(page, (s) => s.scene.render.tiers.length === 2, 'undone');
+      assert.deepEqual(s.scene.render.tiers.map((t) => t.floor), floors);
     });
   });
 }

@@ -81,11 +81,11 @@ fn tiers(ui: &mut Ui, r: &mut RenderSettings) {
             for (k, t) in r.tiers.iter_mut().enumerate() {
                 ui.horizontal(|ui| {
                     ui.label(egui::RichText::new(format!("Tier {}", k + 1)).strong());
-                    if ui
+                    let remove = ui
                         .small_button("remove")
-                        .on_hover_text("Back to the media below")
-                        .clicked()
-                    {
+                        .on_hover_text("Back to the media below");
+                    crate::ui::widgets::mark(ui, &format!("button:remove tier {}", k + 1), remove.rect);
+                    if remove.clicked() {
                         // Its own edit, which takes the tier's keys with it.
                         ui.ctx().data_mut(|d| d.insert_temp(egui::Id::unique(REMOVE_TIER), k));
                     }
@@ -112,8 +112,8 @@ fn tiers(ui: &mut Ui, r: &mut RenderSettings) {
             param(ui, &mut r.tier_blend, &limits::TIER_BLEND);
             // A floor the user moves stays between its neighbours' (keys may pose them out of
             // order, which this leaves as it is).
-            for k in 0..r.tiers.len().min(floors.len()) {
-                if r.tiers[k].floor != floors[k] {
+            for (k, &was) in floors.iter().enumerate().take(r.tiers.len()) {
+                if r.tiers[k].floor != was {
                     let lo = if k > 0 { r.tiers[k - 1].floor } else { f32::MIN };
                     let hi = r.tiers.get(k + 1).map_or(f32::MAX, |t| t.floor);
                     r.tiers[k].floor = r.tiers[k].floor.max(lo).min(hi.max(lo));
