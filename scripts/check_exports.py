@@ -11,6 +11,10 @@ independent readers:
   background), and the export with the noise matches the app's image better than the one
   without.
 
+- OpenEXR (through Mitsuba's Bitmap) opens the app's EXR of the same view: RGBA half floats
+  of the PNG's size, opaque, the sky the PNG's sky decoded from sRGB, light above 1 inside the
+  cloud (no tone map), and inside the cloud the same order of brightness as the PNG.
+
 Usage: check_exports.py DIR. Exits non-zero with a message on the first failure.
 """
 import json
@@ -98,6 +102,44 @@ def check_mitsuba(d):
              f"{corrs['mitsuba_plain']:.3f} without)")
 
 
+def check_exr(d):
+    import mitsuba as mi
+    import numpy as np
+    mi.set_variant("scalar_rgb")
+    bitmap = mi.Bitmap(os.path.join(d, "app_view.exr"))
+    if bitmap.pixel_format() != mi.Bitmap.PixelFormat.RGBA or bitmap.component_format() != mi.Struct.Type.Float16:
+        fail(f"app_view.exr is {bitmap.pixel_format()} {bitmap.component_format()}, not RGBA half floats")
+    exr = np.array(bitmap, dtype=np.float64)
+    png = np.array(mi.Bitmap(os.path.join(d, "app_view.png")), dtype=np.float64)[:, :, :3]
+    if exr.shape[:2] != png.shape[:2]:
+        fail(f"app_view.exr is {exr.shape[:2]}, the PNG {png.shape[:2]}")
+    if np.abs(exr[:, :, 3] - 1).max() > 1e-3:
+        fail("app_view.exr over the sky is not opaque")
+    background = np.array(json.load(open(os.path.join(d, "app_view.json")))["background"], dtype=np.float64)
+    cloud = (np.abs(png - background) > 6).any(axis=2)
+    linear = np.clip(exr[:, :, :3], 0, None)
+    srgb = np.where(linear <= 0.0031308, linear * 12.92, 1.055 * np.power(linear, 1 / 2.4) - 0.055) * 255
+    # The sky away from the cloud's faint fringe (which the display composites in sRGB and
+    # the linear image in linear light, so they differ there by design).
+    near = cloud.copy()
+    for dy in range(-4, 5):
+        for dx in range(-4, 5):
+            near |= np.roll(np.roll(cloud, dy, axis=0), dx, axis=1)
+    sky_error = np.abs(srgb[~near] - png[~near]).max()
+    if sky_error > 1.5:
+        fail(f"app_view.exr's sky is not the PNG's decoded (off by {sky_error:.2f} levels)")
+    lum = lambda rgb: rgb @ np.array([0.2126, 0.7152, 0.0722])
+    rank = lambda v: np.argsort(np.argsort(v))
+    e, p = lum(exr[:, :, :3])[cloud], lum(png)[cloud]
+    corr = np.corrcoef(rank(e), rank(p))[0, 1]
+    print(f"check_exports: app_view.exr: {cloud.sum()} cloud px, brightest {e.max():.2f}, "
+          f"sky within {sky_error:.2f} levels, rank correlation with the PNG {corr:.3f}")
+    if e.max() <= 1.0:
+        fail("app_view.exr holds no light above 1 in the cloud: tone-mapped already?")
+    if corr < 0.95:
+        fail(f"app_view.exr's cloud is not the PNG's (rank correlation {corr:.3f} < 0.95)")
+
+
 def main():
     d = sys.argv[1] if len(sys.argv) > 1 else "target/export-check"
     what = sys.argv[2] if len(sys.argv) > 2 else "all"
@@ -105,6 +147,8 @@ def main():
         check_vdb(d)
     if what in ("all", "mitsuba"):
         check_mitsuba(d)
+    if what in ("all", "exr"):
+        check_exr(d)
     print("check_exports: ok")
 
 

@@ -1,6 +1,7 @@
 // Composites the linear, premultiplied volume image into the output (egui's frame or the
 // offscreen image): tone map, encode sRGB, premultiplied "over" blending; with shafts of
-// light (fs_shafts) their light is added on top.
+// light (fs_shafts) their light is added on top. Into a float target (the offscreen linear
+// image an EXR holds) the `_linear` entry points lay the same light before any tone map.
 
 @group(0) @binding(0) var src: texture_2d<f32>;
 @group(0) @binding(1) var src_smp: sampler;
@@ -92,4 +93,39 @@ fn glow(c: vec4<f32>) -> vec4<f32> {
 @fragment
 fn fs_shafts_transparent(in: Fullscreen) -> @location(0) vec4<f32> {
     return glow(with_shafts(in.uv));
+}
+
+// Into a float target: the cloud's premultiplied light as the slices accumulated it (exposure
+// applied there), no tone map and no encoding, with `shafts` light added as is. Premultiplied
+// light over nothing stays light with no alpha (it adds to whatever lies under it), so over a
+// transparent background it needs no glow.
+fn linear_with_light(uv: vec2<f32>, shafts: vec3<f32>) -> vec4<f32> {
+    let p = textureSampleLevel(src, src_smp, uv, 0.0);
+    var out = vec4<f32>(0.0);
+    if p.a > 1e-4 {
+        out = p;
+    }
+    return vec4<f32>(out.rgb + shafts, out.a);
+}
+
+@fragment
+fn fs_linear(in: Fullscreen) -> @location(0) vec4<f32> {
+    let p = textureSampleLevel(src, src_smp, in.uv, 0.0);
+    if p.a <= 1e-4 {
+        discard;
+    }
+    return p;
+}
+
+@fragment
+fn fs_shafts_linear(in: Fullscreen) -> @location(0) vec4<f32> {
+    return linear_with_light(in.uv, textureSampleLevel(shafts_tex, src_smp, in.uv, 0.0).rgb);
+}
+
+@fragment
+fn fs_shafts_beyond_linear(in: Fullscreen) -> @location(0) vec4<f32> {
+    let alpha = textureSampleLevel(src, src_smp, in.uv, 0.0).a;
+    let beyond = textureSampleLevel(beyond_tex, src_smp, beyond_uv.xy + in.uv * beyond_uv.zw, 0.0).rgb;
+    let own = textureSampleLevel(shafts_tex, src_smp, in.uv, 0.0).rgb;
+    return linear_with_light(in.uv, own + (1.0 - alpha) * beyond);
 }

@@ -53,6 +53,24 @@ fn vs_main(@builtin(vertex_index) vi: u32) -> Fullscreen {
 
 @fragment
 fn fs_main(in: Fullscreen) -> @location(0) vec4<f32> {
+    return vec4<f32>(sky_colour(in), 1.0);
+}
+
+// Into a float target (the offscreen linear image an EXR holds): the same colour as linear
+// light.
+@fragment
+fn fs_linear(in: Fullscreen) -> @location(0) vec4<f32> {
+    return vec4<f32>(srgb_to_linear(sky_colour(in)), 1.0);
+}
+
+fn srgb_to_linear(c: vec3<f32>) -> vec3<f32> {
+    let lo = c / 12.92;
+    let hi = pow((max(c, vec3<f32>(0.0)) + 0.055) / 1.055, vec3<f32>(2.4));
+    return select(hi, lo, c <= vec3<f32>(0.04045));
+}
+
+// This pixel's sRGB-encoded colour: the gradient or the flat background, the ground over it.
+fn sky_colour(in: Fullscreen) -> vec3<f32> {
     let d = normalize(sky.forward.xyz + in.ndc.x * sky.right.xyz + in.ndc.y * sky.up.xyz);
     let e = d.y;
     var colour: vec3<f32>;
@@ -81,5 +99,5 @@ fn fs_main(in: Fullscreen) -> @location(0) vec4<f32> {
             colour = mix(colour, lit, haze);
         }
     }
-    return vec4<f32>(colour, 1.0);
+    return colour;
 }

@@ -1380,3 +1380,91 @@ fn a_disk_that_fills_mid_sequence_keeps_the_earlier_frames_and_names_the_lost_on
     );
     assert!(left.iter().all(|(_, size)| *size > 0), "{left:?}");
 }
+
+/// Reads an EXR's first RGBA layer: its size and pixels.
+fn read_exr(path: &std::path::Path) -> ((usize, usize), Vec<[f32; 4]>) {
+    let image = exr::prelude::read_first_rgba_layer_from_file(
+        path,
+        |size, _| (size.width(), size.height(), vec![[0.0f32; 4]; size.area()]),
+        |(w, _, pixels), at, (r, g, b, a): (f32, f32, f32, f32)| {
+            pixels[at.y() * *w + at.x()] = [r, g, b, a]
+        },
+    )
+    .unwrap_or_else(|e| panic!("{} is not an EXR: {e}", path.display()));
+    let (w, h, pixels) = image.layer_data.channel_data.pixels;
+    ((w, h), pixels)
+}
+
+#[test]
+fn render_writes_linear_exr_images_and_sequences_the_same_wherever_made() {
+    let dir = folder("exr");
+    let path = |name: &str| dir.join(name).to_str().unwrap().to_owned();
+    let small = ["--size", "64x36", "--set", "/render/slices=16"];
+    let render = |extra: &[&str]| {
+        let mut args = vec!["render"];
+        args.extend(small);
+        args.extend(extra);
+        cloudsketch(&args)
+    };
+    // An .exr name is enough; --transparent keeps the cloud alone, premultiplied.
+    let o = render(&["-o", &path("shot.exr")]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("rendered 64x36 exr"), "{}", stderr(&o));
+    let (size, sky) = read_exr(&dir.join("shot.exr"));
+    assert_eq!(size, (64, 36));
+    assert!(
+        sky.iter().all(|p| (p[3] - 1.0).abs() < 1e-3),
+        "over the sky every pixel is opaque"
+    );
+    let o = render(&["--format", "exr", "--transparent", "-o", &path("alone.exr")]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (_, alone) = read_exr(&dir.join("alone.exr"));
+    let clear = alone.iter().filter(|p| p[3] == 0.0).count();
+    let cloud = alone.iter().filter(|p| p[3] > 0.5).count();
+    assert!(
+        clear > 100 && cloud > 20,
+        "{clear} clear, {cloud} cloud pixels"
+    );
+    assert!(
+        alone
+            .iter()
+            .all(|p| p[3] > 0.0 || p[..3].iter().all(|&c| c == 0.0)),
+        "light where nothing is (shafts are off)"
+    );
+    // Where the cloud is opaque, the transparent image is the image over the sky.
+    for (a, s) in alone.iter().zip(&sky) {
+        if a[3] > 0.999 {
+            assert!((a[1] - s[1]).abs() < 0.01, "{a:?} over the sky {s:?}");
+        }
+    }
+    // Names and formats that disagree, or formats it does not know, are refused.
+    let o = render(&["--format", "exr", "-o", &path("wrong.png")]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("names a png file"), "{}", stderr(&o));
+    let o = render(&["--format", "tiff", "-o", &path("x.tif")]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("png or exr"), "{}", stderr(&o));
+    assert!(!dir.join("wrong.png").exists() && !dir.join("x.tif").exists());
+    // A sequence of EXRs: the frames of one run equal those of another split, byte for byte.
+    let scene = developing_scene(&dir);
+    let frames = |frames: &str, pattern: &str| {
+        render(&[&scene, "--fps", "1", "--frames", frames, "-o", pattern])
+    };
+    let o = frames("0..2", &path("whole/f_####.exr"));
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = frames("2", &path("split/f_####.exr"));
+    assert!(o.status.success(), "{}", stderr(&o));
+    let read = |folder: &str, n: u32| {
+        std::fs::read(dir.join(folder).join(format!("f_{n:04}.exr"))).unwrap()
+    };
+    assert!(
+        read("whole", 2) == read("split", 2),
+        "frame 2 differs between runs"
+    );
+    assert!(
+        read("whole", 0) != read("whole", 2),
+        "the developing cloud did not move"
+    );
+    let (size, _) = read_exr(&dir.join("whole/f_0001.exr"));
+    assert_eq!(size, (64, 36));
+}

@@ -14,7 +14,7 @@ use std::path::PathBuf;
 use cloudsketch::export::{Axes, Format, Options, Up, export};
 use cloudsketch::field::media::Media;
 use cloudsketch::field::{ISO, bake_fine, density};
-use cloudsketch::render::offscreen::{Backdrop, Offscreen};
+use cloudsketch::render::offscreen::{Backdrop, Offscreen, Output};
 use cloudsketch::scene::Scene;
 use glam::Vec3;
 
@@ -362,6 +362,12 @@ fn mitsuba_scenes_and_the_apps_render_of_their_view() {
         .render(&scene, size[0], size[1], Backdrop::Sky)
         .unwrap();
     std::fs::write(out_dir().join("app_view.png"), image.to_png().unwrap()).unwrap();
+    // The same view as linear light, for the check's own EXR reader (OpenEXR, in Mitsuba).
+    let linear = Offscreen::with_output(Output::Linear)
+        .expect("an offscreen adapter")
+        .render_linear(&scene, size, Backdrop::Sky, 1, None)
+        .unwrap();
+    std::fs::write(out_dir().join("app_view.exr"), linear.to_exr().unwrap()).unwrap();
     // The same cloud seen through an orthographic camera (Mitsuba's orthographic sensor).
     let mut ortho = scene.clone();
     ortho.camera.orthographic = true;

@@ -4,7 +4,7 @@
 
 use std::sync::{Mutex, OnceLock};
 
-use cloudsketch::render::offscreen::{Backdrop, Image, Offscreen};
+use cloudsketch::render::offscreen::{Backdrop, Image, LinearImage, Offscreen, Output};
 use cloudsketch::scene::{Preset, Scene, set_by_pointer};
 
 const W: u32 = 200;
@@ -1730,4 +1730,105 @@ fn the_developing_cumulus_rises_and_widens_frame_over_frame_by_its_motion() {
     // Scrubbing back gives what playing forward gave: the frame is a function of the time.
     let played = render(&scene.posed_at(10.0).posed_at(20.0).posed_at(10.0));
     assert_eq!(played, render(&scene.posed_at(10.0)));
+}
+
+/// The tests' one offscreen device making linear images (what an EXR holds).
+fn linear_offscreen() -> std::sync::MutexGuard<'static, Offscreen> {
+    static DEVICE: OnceLock<Mutex<Offscreen>> = OnceLock::new();
+    DEVICE
+        .get_or_init(|| {
+            Mutex::new(Offscreen::with_output(Output::Linear).expect("an offscreen wgpu adapter"))
+        })
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+}
+
+fn render_linear(scene: &Scene, backdrop: Backdrop) -> LinearImage {
+    linear_offscreen()
+        .render_linear(scene, [W, H], backdrop, 1, None)
+        .expect("linear render")
+}
+
+fn encode_srgb(v: f64) -> f64 {
+    if v <= 0.003_130_8 {
+        v * 12.92
+    } else {
+        1.055 * v.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+/// The linear image (an EXR's) is the display image before its tone map: the display's
+/// colour is `1 − exp(−light)` of the linear image's light, sRGB-encoded, with the same
+/// alpha. Writing display values, or tone-mapping twice, fails it. Exposure scales the linear
+/// light by its stops, and the flat background is its sRGB colour decoded.
+#[test]
+fn the_linear_image_is_the_display_image_before_its_tone_map() {
+    let mut scene = smooth_cumulus();
+    scene.light.sky_gradient = false;
+    scene.light.ground = false;
+    scene.light.shafts = false;
+    let display = offscreen()
+        .render(&scene, W, H, Backdrop::Transparent)
+        .expect("render");
+    let linear = render_linear(&scene, Backdrop::Transparent);
+    assert_eq!((linear.width, linear.height), (W, H));
+    let (mut compared, mut worst, mut sum, mut bright) = (0usize, 0.0f64, 0.0f64, 0usize);
+    for y in 0..H {
+        for x in 0..W {
+            let d = display.pixel(x, y);
+            let l = linear.pixel(x, y);
+            assert!(
+                (l[3] as f64 * 255.0 - d[3] as f64).abs() <= 1.5,
+                "alpha at ({x}, {y}): linear {} display {}",
+                l[3],
+                d[3]
+            );
+            if d[3] < 96 {
+                continue;
+            }
+            for c in 0..3 {
+                let light = l[c] as f64 / l[3] as f64;
+                bright += usize::from(light > 1.0);
+                let expected = 255.0 * encode_srgb(1.0 - (-light).exp());
+                let error = (expected - d[c] as f64).abs();
+                worst = worst.max(error);
+                sum += error;
+                compared += 1;
+            }
+        }
+    }
+    assert!(compared > 1500, "only {compared} cloud channels compared");
+    assert!(
+        worst <= 4.0 && sum / compared as f64 <= 1.0,
+        "display vs the tone-mapped linear light: worst {worst:.2}, mean {:.2} levels",
+        sum / compared as f64
+    );
+    assert!(
+        bright > 0,
+        "no light above 1: the linear image looks tone-mapped already"
+    );
+    // Exposure: +1 stop doubles the cloud's light.
+    let brighter = render_linear(&with(&scene, &["/light/exposure=1"]), Backdrop::Transparent);
+    let mut ratios: Vec<f64> = (0..W * H)
+        .map(|i| (linear.pixel(i % W, i / W), brighter.pixel(i % W, i / W)))
+        .filter(|(a, b)| a[3] > 0.5 && (a[3] - b[3]).abs() < 1e-3 && a[1] > 0.01)
+        .map(|(a, b)| b[1] as f64 / a[1] as f64)
+        .collect();
+    ratios.sort_by(f64::total_cmp);
+    let median = ratios[ratios.len() / 2];
+    assert!(
+        (median - 2.0).abs() < 0.03,
+        "+1 EV scaled the light by {median:.3}"
+    );
+    // Over the sky: every pixel opaque, the corner the background decoded.
+    let over = render_linear(&scene, Backdrop::Sky);
+    let corner = over.pixel(1, 1);
+    let bg = cloudsketch::scene::srgb_to_linear(scene.light.background);
+    for (c, want) in bg.to_array().into_iter().enumerate() {
+        assert!(
+            (corner[c] - want).abs() < 2e-3,
+            "corner {corner:?}, background {bg:?}"
+        );
+    }
+    assert!(over.rgba.chunks_exact(4).all(|p| (p[3] - 1.0).abs() < 1e-3));
 }

@@ -90,10 +90,13 @@ pub fn run(r: &Request) -> Result<(), String> {
     let start = std::time::Instant::now();
     if format == Format::Png {
         let mut offscreen = Offscreen::new().map_err(|e| e.to_string())?;
-        let image = super::render_shown(&mut offscreen, &scene, [width, height], backdrop)?;
-        let png = image
-            .to_png()
-            .map_err(|e| format!("PNG encoding failed: {e}"))?;
+        let png = super::render_shown(
+            &mut offscreen,
+            &scene,
+            [width, height],
+            backdrop,
+            super::ImageFile::Png,
+        )?;
         write(r.output, &png)?;
     } else {
         let files =

@@ -60,13 +60,21 @@ enum Command {
         #[arg(short, long)]
         output: PathBuf,
     },
-    /// Render a scene offscreen to PNG with the app's renderer (full quality).
+    /// Render a scene offscreen to PNG or EXR with the app's renderer (full quality).
     Render {
         /// Scene JSON or share link (`…#s=…`); the default scene when left out.
         scene: Option<String>,
-        /// Output PNG.
+        /// Output image: .png, or .exr for linear light (or a sequence's name pattern).
         #[arg(short, long)]
         output: PathBuf,
+        /// png (display colour, 8 bits) or exr (linear half floats before the tone map,
+        /// exposure applied); else the output's extension says, else png.
+        #[arg(long)]
+        format: Option<String>,
+        /// The cloud alone over a transparent background (EXR: premultiplied alpha; PNG:
+        /// straight).
+        #[arg(long)]
+        transparent: bool,
         /// Image size as WIDTHxHEIGHT.
         #[arg(long, default_value = "1280x720")]
         size: String,
@@ -225,6 +233,8 @@ pub fn main() -> ExitCode {
         Some(Command::Render {
             scene,
             output,
+            format,
+            transparent,
             size,
             set,
             time,
@@ -235,6 +245,8 @@ pub fn main() -> ExitCode {
             render::run(&render::Request {
                 scene: scene.as_deref(),
                 output: &output,
+                format: format.as_deref(),
+                transparent,
                 size: &size,
                 sets: &set,
                 at,
@@ -421,23 +433,117 @@ fn canonical_output(path: &Path) -> Result<PathBuf, String> {
     Ok(dir.join(name))
 }
 
-/// Renders `scene` at full quality; on a terminal, in chunks with a progress line (the same
-/// image: chunks draw the same slices).
+/// An image file `render` writes (and `export --format png`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ImageFile {
+    /// 8-bit display colour, tone-mapped and sRGB-encoded (straight alpha when transparent).
+    Png,
+    /// Linear half floats before any tone map, exposure applied (premultiplied alpha).
+    Exr,
+}
+
+impl ImageFile {
+    /// The kind `--format` names, else the one `output`'s extension names (`.exr`), else PNG;
+    /// an error for an unknown name or one the extension contradicts.
+    pub fn choose(format: Option<&str>, output: &Path) -> Result<Self, String> {
+        let by_name = match output
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase)
+            .as_deref()
+        {
+            Some("exr") => Some(Self::Exr),
+            Some("png") => Some(Self::Png),
+            _ => None,
+        };
+        let Some(format) = format else {
+            return Ok(by_name.unwrap_or(Self::Png));
+        };
+        let asked = match format.to_ascii_lowercase().as_str() {
+            "png" => Self::Png,
+            "exr" => Self::Exr,
+            other => return Err(format!("--format {other:?}: png or exr")),
+        };
+        match by_name {
+            Some(named) if named != asked => Err(format!(
+                "--format {format} but the output {} names a {} file",
+                output.display(),
+                named.name()
+            )),
+            _ => Ok(asked),
+        }
+    }
+
+    /// Its name, as `--format` takes it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Png => "png",
+            Self::Exr => "exr",
+        }
+    }
+
+    /// What the offscreen renderer makes for it.
+    pub fn output(self) -> crate::render::offscreen::Output {
+        match self {
+            Self::Png => crate::render::offscreen::Output::Display,
+            Self::Exr => crate::render::offscreen::Output::Linear,
+        }
+    }
+}
+
+/// Renders `scene` at full quality and encodes it as `file`, with a progress line where the
+/// terminal shows one (the renderer must make `file.output()`'s images).
 pub fn render_shown(
+    offscreen: &mut crate::render::offscreen::Offscreen,
+    scene: &Scene,
+    size: [u32; 2],
+    backdrop: crate::render::offscreen::Backdrop,
+    file: ImageFile,
+) -> Result<Vec<u8>, String> {
+    let mut progress = progress::Progress::new(format!("rendering {}x{}", size[0], size[1]));
+    if progress.shown() {
+        render_file(
+            offscreen,
+            scene,
+            size,
+            backdrop,
+            file,
+            Some(&mut |done| progress.set(done)),
+        )
+    } else {
+        render_file(offscreen, scene, size, backdrop, file, None)
+    }
+}
+
+/// Renders `scene` at full quality and encodes it as `file`; with `progress`, the slices in
+/// chunks, each reported (the same image).
+pub fn render_file(
     offscreen: &mut crate::render::offscreen::Offscreen,
     scene: &Scene,
     [width, height]: [u32; 2],
     backdrop: crate::render::offscreen::Backdrop,
-) -> Result<crate::render::offscreen::Image, String> {
-    let mut progress = progress::Progress::new(format!("rendering {width}x{height}"));
-    let image = if progress.shown() {
-        offscreen.render_with_progress(scene, [width, height], backdrop, 32, &mut |done| {
-            progress.set(done)
-        })
-    } else {
-        offscreen.render(scene, width, height, backdrop)
-    };
-    image.map_err(|e| e.to_string())
+    file: ImageFile,
+    progress: Option<&mut dyn FnMut(f32)>,
+) -> Result<Vec<u8>, String> {
+    let chunks = if progress.is_some() { 32 } else { 1 };
+    match file {
+        ImageFile::Png => {
+            let image = match progress {
+                Some(report) => {
+                    offscreen.render_with_progress(scene, [width, height], backdrop, chunks, report)
+                }
+                None => offscreen.render(scene, width, height, backdrop),
+            }
+            .map_err(|e| e.to_string())?;
+            image
+                .to_png()
+                .map_err(|e| format!("PNG encoding failed: {e}"))
+        }
+        ImageFile::Exr => offscreen
+            .render_linear(scene, [width, height], backdrop, chunks, progress)
+            .map_err(|e| e.to_string())?
+            .to_exr(),
+    }
 }
 
 /// Writes a file ([`crate::files::write_atomic`]: on failure the old file, if any, is kept

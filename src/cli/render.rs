@@ -1,10 +1,10 @@
-//! `render`: a scene offscreen to PNG with the app's renderer, at full quality.
+//! `render`: a scene offscreen to PNG or EXR with the app's renderer, at full quality.
 
 use std::path::Path;
 
 use super::checkpoints::Checkpoints;
 use super::sequence::{Made, Pattern, Sequence, SequenceArgs, stable_hash};
-use super::{read_scene_or_link, write};
+use super::{ImageFile, read_scene_or_link, write};
 use crate::render::offscreen::{Backdrop, MAX_SIDE, Offscreen};
 use crate::scene::{Scene, set_by_pointer};
 
@@ -27,8 +27,12 @@ pub fn parse_size(text: &str) -> Result<(u32, u32), String> {
 pub struct Request<'a> {
     /// Scene file or link; the default scene when `None`.
     pub scene: Option<&'a str>,
-    /// Output PNG, or a sequence's name pattern.
+    /// Output image, or a sequence's name pattern.
     pub output: &'a Path,
+    /// `--format`: png or exr (else the output's extension says).
+    pub format: Option<&'a str>,
+    /// The cloud alone over a transparent background.
+    pub transparent: bool,
     /// `WIDTHxHEIGHT`.
     pub size: &'a str,
     /// `--set PATH=VALUE` overrides.
@@ -45,6 +49,12 @@ pub struct Request<'a> {
 /// | --frames A..B -o out/frame_####.png] [--shot]`.
 pub fn run(r: &Request) -> Result<(), String> {
     let (width, height) = parse_size(r.size)?;
+    let file = ImageFile::choose(r.format, r.output)?;
+    let backdrop = if r.transparent {
+        Backdrop::Transparent
+    } else {
+        Backdrop::Sky
+    };
     let inputs = r.scene.into_iter().collect::<Vec<_>>();
     if Pattern::of(r.output).is_none() {
         super::check_outputs(&inputs, &[r.output])?;
@@ -75,13 +85,15 @@ pub fn run(r: &Request) -> Result<(), String> {
         }
         posed
     };
-    let mut offscreen = Offscreen::new().map_err(|e| e.to_string())?;
+    let mut offscreen = Offscreen::with_output(file.output()).map_err(|e| e.to_string())?;
     if let Some(plan) = plan {
         let key = stable_hash(
             format!(
-                "{}\nrender {width}x{height} shot={} {}",
+                "{}\nrender {width}x{height} shot={} {} transparent={} {}",
                 scene.to_json(),
                 r.shot,
+                file.name(),
+                r.transparent,
                 env!("CARGO_PKG_VERSION")
             )
             .as_bytes(),
@@ -110,17 +122,19 @@ pub fn run(r: &Request) -> Result<(), String> {
                 }
                 _ => None,
             };
-            let image = offscreen
-                .render(&posed, width, height, Backdrop::Sky)
-                .map_err(|e| e.to_string())?;
+            let bytes = super::render_file(
+                &mut offscreen,
+                &posed,
+                [width, height],
+                backdrop,
+                file,
+                None,
+            )?;
             if let Some(c) = checkpoints.as_mut() {
                 c.save(offscreen.derived(), &posed);
             }
-            let png = image
-                .to_png()
-                .map_err(|e| format!("PNG encoding failed: {e}"))?;
             Ok(Made {
-                files: vec![(main.to_path_buf(), png)],
+                files: vec![(main.to_path_buf(), bytes)],
                 note,
             })
         });
@@ -131,13 +145,11 @@ pub fn run(r: &Request) -> Result<(), String> {
         None => scene,
     });
     let start = std::time::Instant::now();
-    let image = super::render_shown(&mut offscreen, &scene, [width, height], Backdrop::Sky)?;
-    let png = image
-        .to_png()
-        .map_err(|e| format!("PNG encoding failed: {e}"))?;
-    write(r.output, &png)?;
+    let bytes = super::render_shown(&mut offscreen, &scene, [width, height], backdrop, file)?;
+    write(r.output, &bytes)?;
     eprintln!(
-        "rendered {width}x{height}, {} slices on {} in {:.2} s → {}",
+        "rendered {width}x{height} {}, {} slices on {} in {:.2} s → {}",
+        file.name(),
         scene.render.slices,
         offscreen.adapter_name(),
         start.elapsed().as_secs_f64(),

@@ -270,7 +270,7 @@ impl Capture {
     }
 
     fn read(&self, buffer: &wgpu::Buffer, row: u32, bgra: bool) -> Result<Vec<u8>, String> {
-        let mut rgba = read_rows(buffer, self.size, row)?;
+        let mut rgba = read_rows(buffer, self.size, row, 4)?;
         if bgra {
             for p in rgba.chunks_exact_mut(4) {
                 p.swap(0, 2);

@@ -14,8 +14,28 @@ use crate::field::{DensityVolume, Field};
 use crate::scene::{Document, Scene};
 
 pub use crate::limits::MAX_RENDER_SIDE as MAX_SIDE;
-/// Output format: the same 8-bit, non-sRGB kind of target egui composites into.
-const OUTPUT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+
+/// What an offscreen renderer's images hold.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Output {
+    /// Display colour, tone-mapped and sRGB-encoded, 8 bits: what the viewport shows, what a
+    /// PNG holds ([`Offscreen::render`]).
+    Display,
+    /// Linear light before any tone map (exposure applied), half floats: what an EXR holds
+    /// ([`Offscreen::render_linear`]).
+    Linear,
+}
+
+impl Output {
+    /// The target format: the same 8-bit, non-sRGB kind of target egui composites into, or a
+    /// float one.
+    fn format(self) -> wgpu::TextureFormat {
+        match self {
+            Output::Display => wgpu::TextureFormat::Rgba8Unorm,
+            Output::Linear => wgpu::TextureFormat::Rgba16Float,
+        }
+    }
+}
 
 /// Errors of headless rendering.
 #[derive(Debug, thiserror::Error)]
@@ -34,9 +54,62 @@ pub enum OffscreenError {
     /// Reading the image back failed.
     #[error("reading the image back failed: {0}")]
     Readback(String),
+    /// An image of the other kind was asked of the renderer ([`Output`]).
+    #[error("this renderer makes {0:?} images, not the kind asked for")]
+    Output(Output),
     /// Marching the slices was asked of an adapter without compute shaders.
     #[error("this adapter cannot march the slices (it has no compute shaders or storage images)")]
     NoMarching,
+}
+
+/// A linear-light RGBA image, rows top to bottom, colours premultiplied by alpha (over the sky
+/// every pixel is opaque).
+#[derive(Clone, Debug, PartialEq)]
+pub struct LinearImage {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// `width * height * 4` values.
+    pub rgba: Vec<f32>,
+}
+
+impl LinearImage {
+    /// Encodes as OpenEXR: one RGBA layer of half floats (linear, premultiplied alpha, as EXR
+    /// has it), ZIP-compressed scan lines. The same image gives the same bytes.
+    pub fn to_exr(&self) -> Result<Vec<u8>, String> {
+        use exr::prelude::{Encoding, Image, SpecificChannels, Vec2, WritableImage, f16};
+        let width = self.width as usize;
+        let rgba = &self.rgba;
+        let pixels = SpecificChannels::rgba(|Vec2(x, y): Vec2<usize>| {
+            let i = 4 * (y * width + x);
+            let h = |v: f32| f16::from_f32(v);
+            (h(rgba[i]), h(rgba[i + 1]), h(rgba[i + 2]), h(rgba[i + 3]))
+        });
+        let image = Image::from_encoded_channels(
+            (width, self.height as usize),
+            Encoding::SMALL_LOSSLESS,
+            pixels,
+        );
+        let mut out = std::io::Cursor::new(Vec::new());
+        image
+            .write()
+            .non_parallel()
+            .to_buffered(&mut out)
+            .map_err(|e| format!("EXR encoding failed: {e}"))?;
+        Ok(out.into_inner())
+    }
+
+    /// The pixel at (x, y).
+    pub fn pixel(&self, x: u32, y: u32) -> [f32; 4] {
+        let i = 4 * (y * self.width + x) as usize;
+        [
+            self.rgba[i],
+            self.rgba[i + 1],
+            self.rgba[i + 2],
+            self.rgba[i + 3],
+        ]
+    }
 }
 
 /// An RGBA8 image, rows top to bottom.
@@ -105,6 +178,8 @@ pub struct Offscreen {
     stamps: Option<Stamps>,
     /// Whether the adapter can march the slices.
     can_march: bool,
+    /// What its images hold.
+    output: Output,
 }
 
 /// How a timed frame is drawn.
@@ -174,12 +249,18 @@ impl Stamps {
 }
 
 impl Offscreen {
-    /// Opens the first usable adapter (hardware first, then any, software included).
+    /// Opens the first usable adapter (hardware first, then any, software included), to make
+    /// display images.
     pub fn new() -> Result<Self, OffscreenError> {
-        pollster::block_on(Self::new_async())
+        Self::with_output(Output::Display)
     }
 
-    async fn new_async() -> Result<Self, OffscreenError> {
+    /// Opens the first usable adapter, to make images of `output`'s kind.
+    pub fn with_output(output: Output) -> Result<Self, OffscreenError> {
+        pollster::block_on(Self::new_async(output))
+    }
+
+    async fn new_async(output: Output) -> Result<Self, OffscreenError> {
         let instance =
             wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
         let mut adapter = None;
@@ -220,7 +301,7 @@ impl Offscreen {
         let mut renderer = VolumeRenderer::new(
             &device,
             &queue,
-            OUTPUT_FORMAT,
+            output.format(),
             accumulation_format(&adapter),
         );
         renderer.set_marching(&device, marches_by_default(&adapter, &device));
@@ -234,6 +315,7 @@ impl Offscreen {
             field_evaluator: None,
             stamps,
             can_march,
+            output,
         })
     }
 
@@ -315,8 +397,71 @@ impl Offscreen {
         [width, height]: [u32; 2],
         backdrop: Backdrop,
         chunks: u32,
-        mut progress: Option<&mut dyn FnMut(f32)>,
+        progress: Option<&mut dyn FnMut(f32)>,
     ) -> Result<Image, OffscreenError> {
+        self.expect(Output::Display)?;
+        let background = (backdrop == Backdrop::Sky).then_some(scene.light.background);
+        let (encoder, output) =
+            self.chunked(scene, [width, height], background, chunks, progress)?;
+        let mut image = self.read_back(encoder, &output, [width, height])?;
+        if backdrop == Backdrop::Transparent {
+            unpremultiply(&mut image.rgba);
+        }
+        Ok(image)
+    }
+
+    /// Renders `scene` as [`Offscreen::render_with_progress`] does, as linear light before
+    /// any tone map (exposure applied; the sky's colours decoded from sRGB), premultiplied:
+    /// what an EXR holds. Needs an offscreen made with [`Output::Linear`].
+    pub fn render_linear(
+        &mut self,
+        scene: &Scene,
+        [width, height]: [u32; 2],
+        backdrop: Backdrop,
+        chunks: u32,
+        progress: Option<&mut dyn FnMut(f32)>,
+    ) -> Result<LinearImage, OffscreenError> {
+        self.expect(Output::Linear)?;
+        let background = (backdrop == Backdrop::Sky).then_some(scene.light.background);
+        let (mut encoder, output) =
+            self.chunked(scene, [width, height], background, chunks, progress)?;
+        let size = [width, height];
+        let (readback, row) = copy_for_readback(&self.device, &mut encoder, &output, size);
+        self.queue.submit([encoder.finish()]);
+        self.map_for_reading(&readback)?;
+        let bytes = read_rows(&readback, size, row, 8).map_err(OffscreenError::Readback)?;
+        let rgba = bytes
+            .chunks_exact(2)
+            .map(|b| half::f16::from_le_bytes([b[0], b[1]]).to_f32())
+            .collect();
+        Ok(LinearImage {
+            width,
+            height,
+            rgba,
+        })
+    }
+
+    /// An error unless this offscreen makes `output`'s kind of image.
+    fn expect(&self, output: Output) -> Result<(), OffscreenError> {
+        if self.output == output {
+            Ok(())
+        } else {
+            Err(OffscreenError::Output(self.output))
+        }
+    }
+
+    /// Records the chunked render's image into a new output texture: all chunks in one
+    /// submission, or with `progress` each chunk in its own, waited for and reported; the
+    /// last chunk and the composite over `background` (none: transparent) are left in the
+    /// returned encoder.
+    fn chunked(
+        &mut self,
+        scene: &Scene,
+        [width, height]: [u32; 2],
+        background: Option<[f32; 3]>,
+        chunks: u32,
+        mut progress: Option<&mut dyn FnMut(f32)>,
+    ) -> Result<(wgpu::CommandEncoder, wgpu::Texture), OffscreenError> {
         check_size(width, height)?;
         let mut job = self.full_job(scene, width, height);
         let total = job.plan.total;
@@ -357,14 +502,7 @@ impl Offscreen {
             job.plan.clear = false;
             self.queue.submit([commands.finish()]);
         }
-        match backdrop {
-            Backdrop::Sky => self.draw(&job, Some(scene.light.background)),
-            Backdrop::Transparent => {
-                let mut image = self.draw(&job, None)?;
-                unpremultiply(&mut image.rgba);
-                Ok(image)
-            }
-        }
+        Ok(self.encode(&job, background, None))
     }
 
     /// Renders `scene` over its sky as the app's viewport draws it: the volume over the
@@ -376,6 +514,7 @@ impl Offscreen {
         width: u32,
         height: u32,
     ) -> Result<Image, OffscreenError> {
+        self.expect(Output::Display)?;
         check_size(width, height)?;
         let job = self.full_job(scene, width, height);
         let Some(crop) = self.viewport_crop(scene, [width, height]) else {
@@ -490,6 +629,30 @@ impl Offscreen {
         let aspect = size[0] as f32 / size[1].max(1) as f32;
         let ndc = scene.camera.ndc_bounds(lo, hi, aspect)?;
         Some(super::crop::PixelCrop::snap(ndc, size))
+    }
+
+    /// Plays `doc` as the app plays it live: for each of `times`, the document moved to that
+    /// time (posed), derived through the cache (only what moved), uploaded, and drawn whole at
+    /// full quality into a `size` image (no read-back). Returns each frame's wall-clock seconds,
+    /// from setting the time to the device being done.
+    pub fn time_playback(
+        &mut self,
+        doc: &mut Document,
+        [width, height]: [u32; 2],
+        times: &[f32],
+    ) -> Result<Vec<f64>, OffscreenError> {
+        check_size(width, height)?;
+        let mut out = Vec::with_capacity(times.len());
+        for &t in times {
+            let start = std::time::Instant::now();
+            doc.set_time(t);
+            let job = self.job_of(doc, width, height);
+            let background = Some(doc.scene().light.background);
+            let (encoder, _output) = self.encode(&job, background, None);
+            self.submit_and_wait(encoder)?;
+            out.push(start.elapsed().as_secs_f64());
+        }
+        Ok(out)
     }
 
     /// Times `runs` computations of `scene`'s light volume on the GPU (every slice marched
@@ -641,14 +804,21 @@ impl Offscreen {
         // the one the last render's history left), so the image depends on `scene` alone.
         let doc = Document::new(scene.clone());
         self.derived.forget_grid();
-        let mut volumes = self.derived.update(doc.scene(), doc.revisions());
+        self.job_of(&doc, width, height)
+    }
+
+    /// Derives `doc`'s scene through the cache as it stands (only what its revisions say
+    /// changed), uploads it and returns the full-quality job for a `width`×`height` image.
+    fn job_of(&mut self, doc: &Document, width: u32, height: u32) -> SliceJob {
+        let scene = doc.scene();
+        let mut volumes = self.derived.update(scene, doc.revisions());
         // A simulation far from its start catches up over several calls (the app spreads
         // them over frames); a render waits for it.
         for _ in 0..1000 {
             if !self.derived.catching_up {
                 break;
             }
-            volumes = self.derived.update(doc.scene(), doc.revisions());
+            volumes = self.derived.update(scene, doc.revisions());
         }
         self.renderer.begin_frame();
         self.renderer.upload(&self.device, &self.queue, &volumes);
@@ -714,7 +884,7 @@ impl Offscreen {
         let (readback, row) = copy_for_readback(&self.device, &mut encoder, output, size);
         self.queue.submit([encoder.finish()]);
         self.map_for_reading(&readback)?;
-        let rgba = read_rows(&readback, size, row).map_err(OffscreenError::Readback)?;
+        let rgba = read_rows(&readback, size, row, 4).map_err(OffscreenError::Readback)?;
         Ok(Image {
             width: size[0],
             height: size[1],

@@ -73,6 +73,32 @@ const PREMULTIPLIED_OVER: wgpu::BlendState = wgpu::BlendState {
     },
 };
 
+/// Whether a target of `format` holds linear light (a float target: the offscreen image an EXR
+/// holds) rather than display-encoded colour (8 bits: the screen, a PNG). The sky and the
+/// composite write it with their `_linear` entry points: no tone map, no sRGB encoding.
+pub fn linear_output(format: wgpu::TextureFormat) -> bool {
+    matches!(
+        format,
+        wgpu::TextureFormat::Rgba16Float | wgpu::TextureFormat::Rgba32Float
+    )
+}
+
+/// The fragment entry point of the sky and composite shaders that writes into `format`:
+/// `display` for display-encoded targets, its linear counterpart for linear ones.
+fn output_entry(format: wgpu::TextureFormat, display: &'static str) -> &'static str {
+    if !linear_output(format) {
+        return display;
+    }
+    match display {
+        "fs_main" => "fs_linear",
+        // Over a transparent background the linear composite is the same: light with no alpha
+        // is kept as it is.
+        "fs_shafts" | "fs_shafts_transparent" => "fs_shafts_linear",
+        "fs_shafts_beyond" | "fs_shafts_beyond_transparent" => "fs_shafts_beyond_linear",
+        other => other,
+    }
+}
+
 fn pipeline(
     device: &wgpu::Device,
     label: &str,
@@ -310,13 +336,13 @@ impl CompositePass {
                 uniform_entry(4, wgpu::ShaderStages::FRAGMENT, 16, false),
             ],
         });
-        let beyond = |label, entry| {
+        let beyond = |label: &str, entry: &'static str| {
             targets_pipeline(
                 device,
                 label,
                 shaders::COMPOSITE,
                 &[&beyond_layout],
-                entry,
+                output_entry(output_format, entry),
                 &[output_format],
                 Some(PREMULTIPLIED_OVER),
             )
@@ -330,12 +356,14 @@ impl CompositePass {
             beyond_pipeline,
             beyond_transparent_pipeline,
             beyond_layout,
-            pipeline: pipeline(
+            pipeline: targets_pipeline(
                 device,
                 "volume composite",
                 shaders::COMPOSITE,
-                &layout,
-                output_format,
+                &[&layout],
+                output_entry(output_format, "fs_main"),
+                &[output_format],
+                Some(PREMULTIPLIED_OVER),
             ),
             layout,
             shafts_pipeline: targets_pipeline(
@@ -343,7 +371,7 @@ impl CompositePass {
                 "volume composite with shafts",
                 shaders::COMPOSITE,
                 &[&shafts_layout],
-                "fs_shafts",
+                output_entry(output_format, "fs_shafts"),
                 &[output_format],
                 Some(PREMULTIPLIED_OVER),
             ),
@@ -352,7 +380,7 @@ impl CompositePass {
                 "volume composite with shafts, transparent",
                 shaders::COMPOSITE,
                 &[&shafts_layout],
-                "fs_shafts_transparent",
+                output_entry(output_format, "fs_shafts_transparent"),
                 &[output_format],
                 Some(PREMULTIPLIED_OVER),
             ),
@@ -464,7 +492,15 @@ impl SkyPass {
         });
         let bind_group = Self::group(device, &layout, &uniforms, light, sampler);
         Self {
-            pipeline: pipeline(device, "sky", shaders::SKY, &layout, output_format),
+            pipeline: targets_pipeline(
+                device,
+                "sky",
+                shaders::SKY,
+                &[&layout],
+                output_entry(output_format, "fs_main"),
+                &[output_format],
+                Some(PREMULTIPLIED_OVER),
+            ),
             uniforms,
             layout,
             bind_group,

@@ -910,6 +910,13 @@ impl VolumeRenderer {
         if sky {
             self.prepare_sky(queue, view);
         }
+        // A float target holds linear light: the sRGB-encoded background decoded.
+        let background = match background {
+            Some(c) if super::passes::linear_output(self.output_format) => {
+                Some(super::gpu_types::srgb_to_linear(c).to_array())
+            }
+            other => other,
+        };
         let clear = match background {
             Some([r, g, b]) => wgpu::Color {
                 r: r as f64,

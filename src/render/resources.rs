@@ -307,7 +307,8 @@ pub fn copy_for_readback(
     size: [u32; 2],
 ) -> (wgpu::Buffer, u32) {
     let [width, height] = size;
-    let row = (width * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
+    let pixel = texture.format().block_copy_size(None).unwrap_or(4);
+    let row = (width * pixel).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
         * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
     let buffer = device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("readback"),
@@ -339,17 +340,24 @@ pub fn copy_for_readback(
     (buffer, row)
 }
 
-/// The pixels of a mapped readback buffer without the rows' padding, then unmaps it.
-pub fn read_rows(buffer: &wgpu::Buffer, size: [u32; 2], row: u32) -> Result<Vec<u8>, String> {
+/// The pixels (`pixel` bytes each) of a mapped readback buffer without the rows' padding,
+/// then unmaps it.
+pub fn read_rows(
+    buffer: &wgpu::Buffer,
+    size: [u32; 2],
+    row: u32,
+    pixel: u32,
+) -> Result<Vec<u8>, String> {
     let [width, height] = size;
     let slice = buffer.slice(..);
     let mapped = slice
         .get_mapped_range()
         .map_err(|e| format!("the image could not be read back: {e}"))?;
-    let mut rgba = Vec::with_capacity((width * height * 4) as usize);
+    let line = (width * pixel) as usize;
+    let mut rgba = Vec::with_capacity(line * height as usize);
     for y in 0..height as usize {
         let start = y * row as usize;
-        rgba.extend_from_slice(&mapped[start..start + width as usize * 4]);
+        rgba.extend_from_slice(&mapped[start..start + line]);
     }
     drop(mapped);
     buffer.unmap();

@@ -204,7 +204,16 @@ impl Timeline {
         let what = if selection.is_empty() && self.shot_view {
             "the shot camera".to_owned()
         } else if selection.is_empty() {
-            "the sun".to_owned()
+            // The sun's values, and those of the media and tiers already keyed.
+            let others = channels
+                .iter()
+                .filter(|c| matches!(c, Channel::Media { .. } | Channel::Tier { .. }))
+                .count();
+            match others {
+                0 => "the sun".to_owned(),
+                1 => "the sun and 1 keyed media value".to_owned(),
+                k => format!("the sun and {k} keyed media values"),
+            }
         } else {
             match selection.items().len() {
                 1 => "the selection".to_owned(),
@@ -803,5 +812,19 @@ mod tests {
         let said = timeline.delete_keys(&mut doc, &selection);
         assert_eq!(said, "Deleted 4 keys");
         assert_eq!(doc.scene().animation.key_count(), 3);
+        // With a media value keyed, I with nothing selected keys it again with the sun, and
+        // says so (it used to say "the sun" alone).
+        let opacity = Channel::Media {
+            property: crate::scene::MediaProperty::Opacity,
+        };
+        let mut animation = doc.scene().animation.clone();
+        animation.key(opacity, 0.0, opacity.get(doc.scene()).unwrap());
+        doc.apply(Edit::SetAnimation(animation, "key"), None);
+        doc.set_time(doc.scene().clock.seconds(24));
+        let said = timeline.insert_keys(&mut doc, &Selection::default());
+        assert!(
+            said.starts_with("Keyed the sun and 1 keyed media value at frame 24 (4 values)"),
+            "{said}"
+        );
     }
 }
