@@ -900,7 +900,7 @@ fn live_playback(offscreen: &mut Offscreen) -> Result<Vec<BenchResult>, String> 
             .map_err(|e| e.to_string())?;
         let last = times[times.len() - 1];
         let mut still = offscreen
-            .time_playback(&mut doc, [1920, 1080], &vec![last; 25])
+            .time_playback(&mut doc, [1920, 1080], &[last; 25])
             .map_err(|e| e.to_string())?;
         out.push(result(
             &format!("gpu_live_playback_{name}_1920x1080_per_frame"),
