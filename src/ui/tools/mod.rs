@@ -107,6 +107,9 @@ pub struct Toolbox {
     modal: Option<modal::Modal>,
     /// A click confirmed a modal transform: the button is the toolbox's until it is released.
     swallow: bool,
+    /// This frame's pointer was the modal transform's (or swallowed), even where the transform
+    /// ended and the button was released within the frame: the camera takes none of it.
+    took_pointer: bool,
     /// The pointer and the view as of the last frame (where a modal transform starts from).
     last_pointer: Option<egui::Pos2>,
     last_rect: Option<Rect>,
@@ -153,11 +156,13 @@ impl Toolbox {
 
     /// Whose a drag is that egui never saw (pressed and released within a frame or two): none
     /// of the camera's while a modal transform has the pointer or its confirming click's
-    /// button is held (`None`); else the camera's, with the primary button's too where the
+    /// button is held, or was either this frame (`None`: a right-click that cancels a
+    /// transform, pressed, moved and released within one frame, pans nothing); else the
+    /// camera's, with the primary button's too where the
     /// tool that is out leaves its drags to the camera (Navigate, Ellipsoid) and no box
     /// selection is armed.
     pub fn quick_drags(&self) -> Option<bool> {
-        (self.modal.is_none() && !self.swallow).then(|| {
+        (self.modal.is_none() && !self.swallow && !self.took_pointer).then(|| {
             matches!(self.tool, Tool::Navigate | Tool::Ellipsoid) && !self.boxes.is_active()
         })
     }
@@ -314,7 +319,8 @@ impl Toolbox {
         let ui = view.ui;
         self.last_rect = Some(view.rect);
         self.last_pointer = ui.input(|i| i.pointer.latest_pos()).or(self.last_pointer);
-        if self.modal.is_some() || self.swallow {
+        self.took_pointer = self.modal.is_some() || self.swallow;
+        if self.took_pointer {
             // The pointer is the transform's: the samples a stroke would take are dropped.
             ui.input(crate::ui::platform::record_frame);
             let _ = crate::ui::press_record::take_pointer_samples();
