@@ -13,6 +13,41 @@ use crate::scene::Scene;
 /// Most bytes a checkpoint file may hold (a run's state is far below: its cells are bits).
 const MAX_CHECKPOINT_BYTES: u64 = 256 << 20;
 
+/// A sequence's checkpoints as its frames use them (`--checkpoints DIR`, or none): the first
+/// frame resumes its run from the furthest checkpoint at or before it, and every frame writes
+/// the snapshots its run passed. `render` and `export` sequences share it.
+pub struct FrameCheckpoints {
+    checkpoints: Option<Checkpoints>,
+    first: bool,
+}
+
+impl FrameCheckpoints {
+    /// The folder `dir` where given (made when missing), or why it cannot be written.
+    pub fn open(dir: Option<&Path>) -> Result<Self, String> {
+        Ok(Self {
+            checkpoints: dir.map(Checkpoints::open).transpose()?,
+            first: true,
+        })
+    }
+
+    /// Before a frame of `posed`: on the first, reads the furthest checkpoint into `derived`;
+    /// what the run starts from, for the frame's progress.
+    pub fn before(&mut self, derived: &mut Derived, posed: &Scene) -> Option<String> {
+        let checkpoints = self.checkpoints.as_mut()?;
+        if !std::mem::take(&mut self.first) {
+            return None;
+        }
+        checkpoints.resume(derived, posed, posed.time)
+    }
+
+    /// After a frame of `posed`: writes the snapshot its run in `derived` passed.
+    pub fn after(&mut self, derived: &mut Derived, posed: &Scene) {
+        if let Some(checkpoints) = self.checkpoints.as_mut() {
+            checkpoints.save(derived, posed);
+        }
+    }
+}
+
 /// A folder of checkpoints.
 pub struct Checkpoints {
     dir: PathBuf,

@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use super::checkpoints::Checkpoints;
+use super::checkpoints::FrameCheckpoints;
 use super::render::parse_size;
 use super::sequence::{FrameFiles, Made, Pattern, Sequence, SequenceArgs, stable_hash};
 use super::{check_outputs, read_scene_or_link, write};
@@ -183,13 +183,7 @@ fn sequence(
     );
     let mut offscreen: Option<Offscreen> = None;
     let mut own = crate::derive::Derived::default();
-    let mut checkpoints = r
-        .sequence
-        .checkpoints
-        .as_deref()
-        .map(Checkpoints::open)
-        .transpose()?;
-    let mut first = true;
+    let mut checkpoints = FrameCheckpoints::open(r.sequence.checkpoints.as_deref())?;
     Sequence {
         frames: plan.frames,
         pattern: &plan.pattern,
@@ -206,24 +200,17 @@ fn sequence(
         }
         // The renderer's derivation cache for a PNG, this sequence's own for the others: the
         // one whose simulation run steps on from frame to frame.
-        let note = match checkpoints.as_mut() {
-            Some(c) if std::mem::take(&mut first) => {
-                let derived = match offscreen.as_mut() {
-                    Some(o) => o.derived(),
-                    None => &mut own,
-                };
-                c.resume(derived, &posed, posed.time)
-            }
-            _ => None,
-        };
+        let note = checkpoints.before(derived_of(&mut offscreen, &mut own), &posed);
         let files: FrameFiles = match offscreen.as_mut() {
             Some(offscreen) => {
-                let image = offscreen
-                    .render(&posed, options.image[0], options.image[1], backdrop)
-                    .map_err(|e| e.to_string())?;
-                let png = image
-                    .to_png()
-                    .map_err(|e| format!("PNG encoding failed: {e}"))?;
+                let png = super::render_file(
+                    offscreen,
+                    &posed,
+                    options.image,
+                    backdrop,
+                    super::ImageFile::Png,
+                    None,
+                )?;
                 vec![(main.to_path_buf(), png)]
             }
             None => crate::export::export_frame(&mut own, &posed, format, options, &stem_of(main))
@@ -235,13 +222,19 @@ fn sequence(
                 .map(|(f, path)| (path, f.bytes))
                 .collect(),
         };
-        if let Some(c) = checkpoints.as_mut() {
-            let derived = match offscreen.as_mut() {
-                Some(o) => o.derived(),
-                None => &mut own,
-            };
-            c.save(derived, &posed);
-        }
+        checkpoints.after(derived_of(&mut offscreen, &mut own), &posed);
         Ok(Made { files, note })
     })
+}
+
+/// The derivation cache a sequence's frames step on: the renderer's where there is one (a PNG
+/// sequence), else the sequence's own.
+fn derived_of<'a>(
+    offscreen: &'a mut Option<Offscreen>,
+    own: &'a mut crate::derive::Derived,
+) -> &'a mut crate::derive::Derived {
+    match offscreen {
+        Some(o) => o.derived(),
+        None => own,
+    }
 }

@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use super::checkpoints::Checkpoints;
+use super::checkpoints::FrameCheckpoints;
 use super::sequence::{Made, Pattern, Sequence, SequenceArgs, stable_hash};
 use super::{ImageFile, read_scene_or_link, write};
 use crate::render::offscreen::{Backdrop, MAX_SIDE, Offscreen};
@@ -98,13 +98,7 @@ pub fn run(r: &Request) -> Result<(), String> {
             )
             .as_bytes(),
         );
-        let mut checkpoints = r
-            .sequence
-            .checkpoints
-            .as_deref()
-            .map(Checkpoints::open)
-            .transpose()?;
-        let mut first = true;
+        let mut checkpoints = FrameCheckpoints::open(r.sequence.checkpoints.as_deref())?;
         return Sequence {
             frames: plan.frames,
             pattern: &plan.pattern,
@@ -116,12 +110,7 @@ pub fn run(r: &Request) -> Result<(), String> {
         }
         .run(|frame, main| {
             let posed = framed(scene.posed_at(scene.clock.seconds(frame)));
-            let note = match checkpoints.as_mut() {
-                Some(c) if std::mem::take(&mut first) => {
-                    c.resume(offscreen.derived(), &posed, posed.time)
-                }
-                _ => None,
-            };
+            let note = checkpoints.before(offscreen.derived(), &posed);
             let bytes = super::render_file(
                 &mut offscreen,
                 &posed,
@@ -130,9 +119,7 @@ pub fn run(r: &Request) -> Result<(), String> {
                 file,
                 None,
             )?;
-            if let Some(c) = checkpoints.as_mut() {
-                c.save(offscreen.derived(), &posed);
-            }
+            checkpoints.after(offscreen.derived(), &posed);
             Ok(Made {
                 files: vec![(main.to_path_buf(), bytes)],
                 note,
