@@ -181,4 +181,60 @@ for (const backend of EDITING_BUILDS) {
       assert.ok(Math.abs(s.scene.shot.yaw_deg - yaw0) < 0.01, 'the shot is back at its first key');
     });
   });
+
+  // A tier's floor keyed by auto-key as an artist keys it: a tier added, Auto-key on, the floor
+  // slider pressed at frame 0 and again at frame 48; the floor is half way at frame 24 and back at
+  // each key; with nothing selected the timeline shows the two keys, I keys the floor with the
+  // sun (and says so), and undo takes back the key edits one by one.
+  test(`auto-key records a tier's floor, which the scrub bar poses between its keys (${backend})`, { timeout: 240_000 }, async () => {
+    await withApp({ base: server.url, webgpu: backend === 'webgpu', viewport: { width: 1280, height: 800 } }, async (page) => {
+      await openGroup(page, 'Render');
+      const header = await reveal(page, 'group:Tiers');
+      await page.mouse.click(header[0] + 12, header[1] + header[3] / 2);
+      await until(page, (s) => s.view.widgets['button:Add a tier'], 'the Tiers group open');
+      const add = await reveal(page, 'button:Add a tier');
+      await page.mouse.click(add[0] + add[2] / 2, add[1] + add[3] / 2);
+      let s = await until(page, (s) => s.scene.render.tiers.length === 1, 'a tier added');
+      assert.equal(s.view.timeline.key_count, 0, 'nothing keyed yet');
+      const auto = s.view.widgets['timeline:auto'];
+      await page.mouse.click(auto[0] + auto[2] / 2, auto[1] + auto[3] / 2);
+      s = await until(page, (s) => s.view.timeline.auto_key, 'auto-key on');
+      // Frame 0: the floor slider pressed at 30 % of its rail.
+      const press = async (share) => {
+        const rail = await reveal(page, 'param:floor');
+        await page.mouse.click(rail[0] + rail[2] * share, rail[1] + rail[3] / 2);
+      };
+      const floor0 = s.scene.render.tiers[0].floor;
+      await press(0.3);
+      s = await until(page, (s) => s.scene.render.tiers[0].floor !== floor0 && s.view.timeline.key_count === 1, 'the floor keyed at frame 0');
+      const a = s.scene.render.tiers[0].floor;
+      s = await scrubTo(page, 48);
+      assert.equal(s.scene.render.tiers[0].floor, a, 'one key holds its value');
+      await press(0.7);
+      s = await until(page, (s) => s.view.timeline.key_count === 2, 'the floor keyed at frame 48');
+      const b = s.scene.render.tiers[0].floor;
+      assert.ok(b > a + 1, `floors ${a} → ${b}`);
+      assert.deepEqual(s.view.timeline.keys.map((k) => k.t), [0, 2], 'the timeline shows the tier\'s keys');
+      // Between: half way (the ease is symmetric); at each key, its value.
+      s = await scrubTo(page, 24);
+      assert.ok(Math.abs(s.scene.render.tiers[0].floor - (a + b) / 2) < 1e-3, `frame 24: ${s.scene.render.tiers[0].floor}, want ${(a + b) / 2}`);
+      s = await scrubTo(page, 0);
+      assert.ok(Math.abs(s.scene.render.tiers[0].floor - a) < 1e-4, 'back at the first key');
+      // I with nothing selected, at frame 12: the sun's three values and the floor.
+      s = await scrubTo(page, 12);
+      const between = s.scene.render.tiers[0].floor;
+      await page.mouse.move(s.view.viewport[0] / 2, s.view.viewport[1] / 2);
+      await page.keyboard.press('i');
+      s = await until(page, (s) => s.view.timeline.key_count === 6, 'keyed at frame 12');
+      assert.match(s.view.notice.text, /Keyed the sun and 1 keyed media value at frame 12/);
+      assert.ok(Math.abs(s.scene.render.tiers[0].floor - between) < 1e-4, 'keying keeps the value');
+      // Undo: the I keys, then the frame-48 key with its value.
+      await page.keyboard.press('Control+z');
+      s = await until(page, (s) => s.view.timeline.key_count === 2, 'the I keys undone');
+      await page.keyboard.press('Control+z');
+      s = await until(page, (s) => s.view.timeline.key_count === 1, 'the frame-48 key undone');
+      s = await scrubTo(page, 48);
+      assert.ok(Math.abs(s.scene.render.tiers[0].floor - a) < 1e-4, 'one key left: its value everywhere');
+    });
+  });
 }
