@@ -102,14 +102,14 @@ impl LinearImage {
 
     /// The pixel at (x, y).
     pub fn pixel(&self, x: u32, y: u32) -> [f32; 4] {
-        let i = 4 * (y * self.width + x) as usize;
-        [
-            self.rgba[i],
-            self.rgba[i + 1],
-            self.rgba[i + 2],
-            self.rgba[i + 3],
-        ]
+        pixel_of(&self.rgba, self.width, x, y)
     }
+}
+
+/// The pixel at (x, y) of RGBA values `width` pixels a row.
+fn pixel_of<T: Copy>(rgba: &[T], width: u32, x: u32, y: u32) -> [T; 4] {
+    let i = 4 * (y * width + x) as usize;
+    [rgba[i], rgba[i + 1], rgba[i + 2], rgba[i + 3]]
 }
 
 /// An RGBA8 image, rows top to bottom.
@@ -126,13 +126,7 @@ pub struct Image {
 impl Image {
     /// The pixel at (x, y).
     pub fn pixel(&self, x: u32, y: u32) -> [u8; 4] {
-        let i = 4 * (y * self.width + x) as usize;
-        [
-            self.rgba[i],
-            self.rgba[i + 1],
-            self.rgba[i + 2],
-            self.rgba[i + 3],
-        ]
+        pixel_of(&self.rgba, self.width, x, y)
     }
 
     /// Encodes as PNG.
@@ -399,10 +393,14 @@ impl Offscreen {
         chunks: u32,
         progress: Option<&mut dyn FnMut(f32)>,
     ) -> Result<Image, OffscreenError> {
-        self.expect(Output::Display)?;
-        let background = (backdrop == Backdrop::Sky).then_some(scene.light.background);
-        let (encoder, output) =
-            self.chunked(scene, [width, height], background, chunks, progress)?;
+        let (encoder, output) = self.chunked(
+            Output::Display,
+            scene,
+            [width, height],
+            backdrop,
+            chunks,
+            progress,
+        )?;
         let mut image = self.read_back(encoder, &output, [width, height])?;
         if backdrop == Backdrop::Transparent {
             unpremultiply(&mut image.rgba);
@@ -421,15 +419,10 @@ impl Offscreen {
         chunks: u32,
         progress: Option<&mut dyn FnMut(f32)>,
     ) -> Result<LinearImage, OffscreenError> {
-        self.expect(Output::Linear)?;
-        let background = (backdrop == Backdrop::Sky).then_some(scene.light.background);
-        let (mut encoder, output) =
-            self.chunked(scene, [width, height], background, chunks, progress)?;
         let size = [width, height];
-        let (readback, row) = copy_for_readback(&self.device, &mut encoder, &output, size);
-        self.queue.submit([encoder.finish()]);
-        self.map_for_reading(&readback)?;
-        let bytes = read_rows(&readback, size, row, 8).map_err(OffscreenError::Readback)?;
+        let (encoder, output) =
+            self.chunked(Output::Linear, scene, size, backdrop, chunks, progress)?;
+        let bytes = self.read_pixels(encoder, &output, size, 8)?;
         let rgba = bytes
             .chunks_exact(2)
             .map(|b| half::f16::from_le_bytes([b[0], b[1]]).to_f32())
@@ -450,19 +443,22 @@ impl Offscreen {
         }
     }
 
-    /// Records the chunked render's image into a new output texture: all chunks in one
-    /// submission, or with `progress` each chunk in its own, waited for and reported; the
-    /// last chunk and the composite over `background` (none: transparent) are left in the
-    /// returned encoder.
+    /// Records the chunked render's image of `kind` (an error unless this offscreen makes
+    /// it) into a new output texture: all chunks in one submission, or with `progress` each
+    /// chunk in its own, waited for and reported; the last chunk and the composite over
+    /// `backdrop` are left in the returned encoder.
     fn chunked(
         &mut self,
+        kind: Output,
         scene: &Scene,
         [width, height]: [u32; 2],
-        background: Option<[f32; 3]>,
+        backdrop: Backdrop,
         chunks: u32,
         mut progress: Option<&mut dyn FnMut(f32)>,
     ) -> Result<(wgpu::CommandEncoder, wgpu::Texture), OffscreenError> {
+        self.expect(kind)?;
         check_size(width, height)?;
+        let background = (backdrop == Backdrop::Sky).then_some(scene.light.background);
         let mut job = self.full_job(scene, width, height);
         let total = job.plan.total;
         // One submission holds at most MAX_SLICE_DRAWS_PER_FRAME draws' uniforms; chunks
@@ -877,18 +873,30 @@ impl Offscreen {
     /// Submits `encoder` with a copy of `output` (`size` pixels) and reads the image back.
     fn read_back(
         &self,
-        mut encoder: wgpu::CommandEncoder,
+        encoder: wgpu::CommandEncoder,
         output: &wgpu::Texture,
         size: [u32; 2],
     ) -> Result<Image, OffscreenError> {
-        let (readback, row) = copy_for_readback(&self.device, &mut encoder, output, size);
-        self.queue.submit([encoder.finish()]);
-        self.map_for_reading(&readback)?;
-        let rgba = read_rows(&readback, size, row, 4).map_err(OffscreenError::Readback)?;
+        let rgba = self.read_pixels(encoder, output, size, 4)?;
         Ok(Image {
             width: size[0],
             height: size[1],
             rgba,
         })
+    }
+
+    /// Submits `encoder` with a copy of `output` (`size` pixels of `pixel` bytes) and reads
+    /// its pixels back, rows without padding.
+    fn read_pixels(
+        &self,
+        mut encoder: wgpu::CommandEncoder,
+        output: &wgpu::Texture,
+        size: [u32; 2],
+        pixel: u32,
+    ) -> Result<Vec<u8>, OffscreenError> {
+        let (readback, row) = copy_for_readback(&self.device, &mut encoder, output, size);
+        self.queue.submit([encoder.finish()]);
+        self.map_for_reading(&readback)?;
+        read_rows(&readback, size, row, pixel).map_err(OffscreenError::Readback)
     }
 }

@@ -28,8 +28,7 @@ fn draw_circle(
     frames: usize,
     radius: f32,
 ) -> (Document, Toolbox) {
-    use egui::{Event, Modifiers, PointerButton, RawInput, Sense, pos2};
-    let rect = crate::ui::test_view();
+    use egui::{Event, Modifiers, PointerButton, pos2};
     let at = |i: usize| {
         let a = i as f32 / 60.0 * std::f32::consts::TAU;
         pos2(640.0 + radius * a.cos(), 400.0 + radius * a.sin())
@@ -49,34 +48,50 @@ fn draw_circle(
     chunks.extend(events.chunks(per_frame).map(<[_]>::to_vec));
     chunks.extend([Vec::new(), Vec::new()]);
 
+    let mut selection = Selection::default();
+    run_frames(chunks, &mut doc, &mut selection, |_, view, _, tc| {
+        tool.input(view, tc);
+    });
+    (doc, tool)
+}
+
+/// Runs one egui frame of the test view per entry of `frames` (its events; frames 0.15 s
+/// apart, a slow adapter's), calling `each` with the frame's number, the view's input, its
+/// `Ui` and a tool context over `doc` and `selection`.
+fn run_frames(
+    frames: Vec<Vec<egui::Event>>,
+    doc: &mut Document,
+    selection: &mut Selection,
+    mut each: impl FnMut(usize, &ViewInput<'_>, &egui::Response, &mut ToolContext<'_>),
+) {
+    let rect = crate::ui::test_view();
     let ctx = egui::Context::default();
-    let (mut derived, mut selection, mut notices) = Default::default();
-    for (frame, events) in chunks.into_iter().enumerate() {
-        let raw = RawInput {
+    let (mut derived, mut notices) = Default::default();
+    for (frame, events) in frames.into_iter().enumerate() {
+        let raw = egui::RawInput {
             screen_rect: Some(rect),
             time: Some(frame as f64 * 0.15),
             events,
             ..Default::default()
         };
         let mut output = ctx.run_ui(raw, |ui| {
-            let response = ui.allocate_rect(rect, Sense::click_and_drag());
+            let response = ui.allocate_rect(rect, egui::Sense::click_and_drag());
             let view = ViewInput {
                 ui,
                 response: &response,
                 rect,
             };
             let mut tc = ToolContext {
-                doc: &mut doc,
+                doc,
                 derived: &mut derived,
-                selection: &mut selection,
+                selection,
                 notices: &mut notices,
             };
-            tool.input(&view, &mut tc);
+            each(frame, &view, &response, &mut tc);
         });
         // No painter here: the font atlas's first upload is dropped on purpose.
         output.textures_delta.clear();
     }
-    (doc, tool)
 }
 
 /// The depth along the view of the plane a small outline drawn over the default cumulus's
@@ -145,7 +160,7 @@ fn a_stroke_keeps_every_sample_however_its_events_fall_into_frames() {
 /// camera's quick-drag path panned by the whole move.
 #[test]
 fn a_right_click_that_cancels_a_grab_within_one_frame_moves_no_camera() {
-    use egui::{Event, Modifiers, PointerButton, RawInput, Sense, pos2};
+    use egui::{Event, Modifiers, PointerButton, pos2};
     let mut scene = crate::scene::Scene::preset(crate::scene::Preset::Empty);
     scene
         .ellipsoids
@@ -156,7 +171,6 @@ fn a_right_click_that_cancels_a_grab_within_one_frame_moves_no_camera() {
     let mut selection = Selection::default();
     selection.set(Item::Ellipsoid(0));
     let mut tool = Toolbox::default();
-    let rect = crate::ui::test_view();
     let (a, b) = (pos2(600.0, 400.0), pos2(650.0, 400.0));
     let button = |pos, pressed| Event::PointerButton {
         pos,
@@ -171,45 +185,27 @@ fn a_right_click_that_cancels_a_grab_within_one_frame_moves_no_camera() {
         vec![button(a, true), Event::PointerMoved(b), button(b, false)],
         Vec::new(),
     ];
-    let ctx = egui::Context::default();
-    let (mut derived, mut notices) = Default::default();
     let mut camera = doc.scene().camera.clone();
-    for (frame, events) in frames.into_iter().enumerate() {
-        let raw = RawInput {
-            screen_rect: Some(rect),
-            time: Some(frame as f64 * 0.15),
-            events,
-            ..Default::default()
-        };
-        let mut output = ctx.run_ui(raw, |ui| {
-            let response = ui.allocate_rect(rect, Sense::click_and_drag());
-            let view = ViewInput {
-                ui,
-                response: &response,
-                rect,
-            };
-            let mut tc = ToolContext {
-                doc: &mut doc,
-                derived: &mut derived,
-                selection: &mut selection,
-                notices: &mut notices,
-            };
+    run_frames(
+        frames.into(),
+        &mut doc,
+        &mut selection,
+        |frame, view, response, tc| {
             // As the viewport runs it: the tool, then the camera with what the tool leaves.
-            let drawing = tool.input(&view, &mut tc);
+            let drawing = tool.input(view, tc);
             crate::ui::camera_input::handle(
-                ui,
-                &response,
+                view.ui,
+                response,
                 &mut camera,
                 !drawing,
                 tool.quick_drags(),
             );
             if frame == 0 {
-                tool.shortcut(Shortcut::Modal(ModalKind::Grab), &mut tc, 0.0);
+                tool.shortcut(Shortcut::Modal(ModalKind::Grab), tc, 0.0);
                 assert!(tool.modal_active(), "G starts a grab");
             }
-        });
-        output.textures_delta.clear();
-    }
+        },
+    );
     assert!(!tool.modal_active(), "the right-click cancels the grab");
     assert_eq!(
         doc.scene().ellipsoids,
