@@ -1440,7 +1440,7 @@ fn render_writes_linear_exr_images_and_sequences_the_same_wherever_made() {
     // Names and formats that disagree, or formats it does not know, are refused.
     let o = render(&["--format", "exr", "-o", &path("wrong.png")]);
     assert!(!o.status.success());
-    assert!(stderr(&o).contains("names a png file"), "{}", stderr(&o));
+    assert!(stderr(&o).contains("names a .png file"), "{}", stderr(&o));
     let o = render(&["--format", "tiff", "-o", &path("x.tif")]);
     assert!(!o.status.success());
     assert!(stderr(&o).contains("png or exr"), "{}", stderr(&o));

@@ -1814,6 +1814,11 @@ fn the_linear_image_is_the_display_image_before_its_tone_map() {
         .filter(|(a, b)| a[3] > 0.5 && (a[3] - b[3]).abs() < 1e-3 && a[1] > 0.01)
         .map(|(a, b)| b[1] as f64 / a[1] as f64)
         .collect();
+    assert!(
+        ratios.len() > 100,
+        "only {} opaque cloud pixels",
+        ratios.len()
+    );
     ratios.sort_by(f64::total_cmp);
     let median = ratios[ratios.len() / 2];
     assert!(
@@ -1831,4 +1836,56 @@ fn the_linear_image_is_the_display_image_before_its_tone_map() {
         );
     }
     assert!(over.rgba.chunks_exact(4).all(|p| (p[3] - 1.0).abs() < 1e-3));
+}
+
+/// With the sky gradient, the ground and the shafts of light on, where no cloud is: the linear
+/// image's sky and ground are the display's colours decoded (sky.wgsl's `fs_linear`), and the
+/// light its shafts add is the light whose `1 − exp(−light)` the display adds
+/// (composite.wgsl's `fs_shafts_linear`). A linear sky left encoded, or shafts added
+/// tone-mapped, fails it.
+#[test]
+fn the_linear_sky_ground_and_shafts_are_the_displays_light() {
+    let sky = with(&broken_layer(), &["/light/sky_gradient=true"]);
+    let shafts = with(&sky, &["/light/shafts=true", "/light/shaft_density=0.003"]);
+    let (display_off, display_on) = (render(&sky), render(&shafts));
+    let (linear_off, linear_on) = (
+        render_linear(&sky, Backdrop::Sky),
+        render_linear(&shafts, Backdrop::Sky),
+    );
+    let cloud = render_linear(&sky, Backdrop::Transparent);
+    let (mut sky_worst, mut shaft_worst, mut lit, mut clear) = (0.0f64, 0.0f64, 0usize, 0usize);
+    for y in 0..H {
+        for x in 0..W {
+            if cloud.pixel(x, y)[3] > 0.0 {
+                continue;
+            }
+            clear += 1;
+            let (d_off, d_on) = (display_off.pixel(x, y), display_on.pixel(x, y));
+            let (l_off, l_on) = (linear_off.pixel(x, y), linear_on.pixel(x, y));
+            for c in 0..3 {
+                let sky = 255.0 * encode_srgb(l_off[c] as f64);
+                sky_worst = sky_worst.max((sky - d_off[c] as f64).abs());
+                let added = (l_on[c] - l_off[c]) as f64;
+                if d_on[c] == 255 {
+                    continue;
+                }
+                lit += usize::from(added > 0.01);
+                let shown = d_on[c] as f64 - d_off[c] as f64;
+                shaft_worst = shaft_worst.max((255.0 * (1.0 - (-added).exp()) - shown).abs());
+            }
+        }
+    }
+    assert!(clear > (W * H / 2) as usize, "only {clear} clear pixels");
+    assert!(
+        lit > clear,
+        "the shafts lit only {lit} channels of {clear} clear pixels"
+    );
+    assert!(
+        sky_worst <= 1.0,
+        "the linear sky and ground, encoded, are {sky_worst:.2} levels off"
+    );
+    assert!(
+        shaft_worst <= 1.5,
+        "the shafts' linear light, mapped, is {shaft_worst:.2} levels off"
+    );
 }

@@ -466,7 +466,7 @@ impl ImageFile {
         };
         match by_name {
             Some(named) if named != asked => Err(format!(
-                "--format {format} but the output {} names a {} file",
+                "--format {format} but the output {} names a .{} file",
                 output.display(),
                 named.name()
             )),

@@ -54,6 +54,9 @@ pub enum OffscreenError {
     /// Reading the image back failed.
     #[error("reading the image back failed: {0}")]
     Readback(String),
+    /// Linear images were asked of an adapter without blendable float targets.
+    #[error("this adapter cannot render linear images (no blendable half-float target): use PNG")]
+    NoFloatTarget,
     /// An image of the other kind was asked of the renderer ([`Output`]).
     #[error("this renderer makes {0:?} images, not the kind asked for")]
     Output(Output),
@@ -279,6 +282,13 @@ impl Offscreen {
                 .next()
                 .ok_or(OffscreenError::NoAdapter)?,
         };
+        // Linear light needs float targets (the accumulation and the output): an 8-bit one
+        // would clip it at 1.
+        if output == Output::Linear
+            && accumulation_format(&adapter) != wgpu::TextureFormat::Rgba16Float
+        {
+            return Err(OffscreenError::NoFloatTarget);
+        }
         let info = adapter.get_info();
         let limits = wgpu::Limits::downlevel_defaults().using_resolution(adapter.limits());
         let features = adapter.features() & Stamps::FEATURES;

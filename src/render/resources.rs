@@ -298,8 +298,9 @@ pub fn marches_by_default(adapter: &wgpu::Adapter, device: &wgpu::Device) -> boo
     gpu && can_march(adapter, device)
 }
 
-/// Records a copy of a 2D RGBA8-sized `texture` of `size` into a new mappable buffer; returns
-/// it and its row pitch (rows padded to wgpu's copy alignment).
+/// Records a copy of a 2D `texture` of `size` (of any uncompressed format: 4 bytes a pixel for
+/// RGBA8, 8 for half floats) into a new mappable buffer; returns it and its row pitch (rows
+/// padded to wgpu's copy alignment).
 pub fn copy_for_readback(
     device: &wgpu::Device,
     encoder: &mut wgpu::CommandEncoder,

@@ -226,7 +226,7 @@ for (const backend of EDITING_BUILDS) {
       await page.mouse.move(s.view.viewport[0] / 2, s.view.viewport[1] / 2);
       await page.keyboard.press('i');
       s = await until(page, (s) => s.view.timeline.key_count === 6, 'keyed at frame 12');
-      assert.match(s.view.notice.text, /Keyed the sun and 1 keyed media value at frame 12/);
+      assert.match(s.view.notice.text, /Keyed the sun and 1 other keyed value at frame 12/);
       assert.ok(Math.abs(s.scene.render.tiers[0].floor - between) < 1e-4, 'keying keeps the value');
       // Undo: the I keys, then the frame-48 key with its value.
       await page.keyboard.press('Control+z');

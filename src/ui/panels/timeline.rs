@@ -204,15 +204,25 @@ impl Timeline {
         let what = if selection.is_empty() && self.shot_view {
             "the shot camera".to_owned()
         } else if selection.is_empty() {
-            // The sun's values, and those of the media and tiers already keyed.
+            // The sun's place and strength, and whatever else of the scene is keyed already
+            // (the light's other values, the media's, the tiers').
             let others = channels
                 .iter()
-                .filter(|c| matches!(c, Channel::Media { .. } | Channel::Tier { .. }))
+                .filter(|c| {
+                    !matches!(
+                        c,
+                        Channel::Light {
+                            property: LightProperty::SunAzimuth
+                                | LightProperty::SunElevation
+                                | LightProperty::SunIntensity
+                        }
+                    )
+                })
                 .count();
             match others {
                 0 => "the sun".to_owned(),
-                1 => "the sun and 1 keyed media value".to_owned(),
-                k => format!("the sun and {k} keyed media values"),
+                1 => "the sun and 1 other keyed value".to_owned(),
+                k => format!("the sun and {k} other keyed values"),
             }
         } else {
             match selection.items().len() {
@@ -823,7 +833,7 @@ mod tests {
         doc.set_time(doc.scene().clock.seconds(24));
         let said = timeline.insert_keys(&mut doc, &Selection::default());
         assert!(
-            said.starts_with("Keyed the sun and 1 keyed media value at frame 24 (4 values)"),
+            said.starts_with("Keyed the sun and 1 other keyed value at frame 24 (4 values)"),
             "{said}"
         );
     }
