@@ -5,7 +5,7 @@
 use std::sync::{Mutex, OnceLock};
 
 use cloudsketch::render::offscreen::{Backdrop, Image, LinearImage, Offscreen, Output};
-use cloudsketch::scene::{Preset, Scene, set_by_pointer};
+use cloudsketch::scene::{Channel, Preset, Scene, set_by_pointer};
 
 const W: u32 = 200;
 const H: u32 = 150;
@@ -1706,12 +1706,16 @@ fn the_developing_cumulus_rises_and_widens_frame_over_frame_by_its_motion() {
         &["/render/noise_amount=0", "/render/slices=64"],
     );
     let bg = background(&scene);
-    // The baseline: the same document with every motion taken off (its keys, the anvil's
-    // fade, stay).
+    // The baseline: the same document with every motion and the anvil's keys taken off (the
+    // noise's keys stay).
     let mut still = scene.clone();
     for e in &mut still.ellipsoids {
         std::sync::Arc::make_mut(e).motion = None;
     }
+    still
+        .animation
+        .tracks
+        .retain(|tr| !matches!(tr.channel, Channel::Ellipsoid { .. }));
     let at = |s: &Scene, t: f32| top_and_width(&render(&s.posed_at(t)), bg);
     let [a, b, c] = [0.0, 10.0, 20.0].map(|t| at(&scene, t));
     assert!(
@@ -1725,11 +1729,102 @@ fn the_developing_cumulus_rises_and_widens_frame_over_frame_by_its_motion() {
     let (s10, s20) = (at(&still, 10.0), at(&still, 20.0));
     assert!(
         b.0 + 8 < s10.0 && c.0 + 8 < s20.0 && c.1 > s20.1 + 20,
-        "the motion, not the keys, does it: moving {b:?} {c:?}, still {s10:?} {s20:?}"
+        "the motion and the anvil's keys, not the noise's keys, do it: moving {b:?} {c:?}, \
+         still {s10:?} {s20:?}"
     );
     // Scrubbing back gives what playing forward gave: the frame is a function of the time.
     let played = render(&scene.posed_at(10.0).posed_at(20.0).posed_at(10.0));
     assert_eq!(played, render(&scene.posed_at(10.0)));
+}
+
+/// The share of `image`'s cloud pixels (those that differ from `bg`) outside its largest
+/// 8-connected piece.
+fn detached_share(image: &Image, bg: [u8; 3]) -> f64 {
+    let (w, h) = (image.width as usize, image.height as usize);
+    let cloud: Vec<bool> = (0..w * h)
+        .map(|i| differs(image.pixel((i % w) as u32, (i / w) as u32), bg))
+        .collect();
+    let mut seen = vec![false; w * h];
+    let (mut total, mut largest) = (0usize, 0usize);
+    for start in 0..w * h {
+        if !cloud[start] || seen[start] {
+            continue;
+        }
+        seen[start] = true;
+        let (mut stack, mut size) = (vec![start], 0usize);
+        while let Some(i) = stack.pop() {
+            size += 1;
+            let (x, y) = ((i % w) as i64, (i / w) as i64);
+            for (dx, dy) in [(-1, -1), (0, -1), (1, -1), (-1, 0), (1, 0), (-1, 1), (0, 1), (1, 1)] {
+                let (nx, ny) = (x + dx, y + dy);
+                if nx < 0 || ny < 0 || nx >= w as i64 || ny >= h as i64 {
+                    continue;
+                }
+                let j = ny as usize * w + nx as usize;
+                if cloud[j] && !seen[j] {
+                    seen[j] = true;
+                    stack.push(j);
+                }
+            }
+        }
+        total += size;
+        largest = largest.max(size);
+    }
+    (total - largest) as f64 / total.max(1) as f64
+}
+
+/// The developing cumulus's anvil grows out of the column, with its noise: at no time while
+/// it forms does a faint disc of specks float apart from the tower (as when the anvil faded in
+/// by its strength above the crown, a weak field that only the noise's peaks lifted over the
+/// iso level). The baseline: the same anvil faded in by its strength where it ends up, which
+/// this measure must catch.
+#[test]
+fn the_developing_anvil_grows_out_of_the_column_in_one_piece() {
+    let scene = Scene::preset(Preset::Developing);
+    let bg = background(&scene);
+    let size = [400, 300];
+    let shot = |s: &Scene, t: f32| {
+        offscreen()
+            .render(&s.posed_at(t), size[0], size[1], Backdrop::Sky)
+            .expect("render")
+    };
+    let anvil = scene
+        .ellipsoids
+        .iter()
+        .position(|e| e.id == 100)
+        .expect("the anvil is ellipsoid 100");
+    // The baseline: the anvil standing where it is at 20 s from the start, faded in from 8 to
+    // 16 s by its strength.
+    let mut faded = scene.clone();
+    faded
+        .animation
+        .tracks
+        .retain(|tr| !matches!(tr.channel, Channel::Ellipsoid { id: 100, .. }));
+    {
+        let end = scene.posed_at(20.0);
+        let e = std::sync::Arc::make_mut(&mut faded.ellipsoids[anvil]);
+        (e.center, e.radii) = (end.ellipsoids[anvil].center, end.ellipsoids[anvil].radii);
+    }
+    let strength = Channel::Ellipsoid {
+        id: 100,
+        property: cloudsketch::scene::EllipsoidProperty::Strength,
+    };
+    for (t, v) in [(0.0, 0.0), (8.0, 0.0), (16.0, 1.0)] {
+        faded.animation.key(strength, t, vec![v]);
+    }
+    let baseline = detached_share(&shot(&faded, 12.0), bg);
+    assert!(
+        baseline > 0.02,
+        "the measure sees the faded anvil's specks: {baseline:.4} of the cloud apart"
+    );
+    for t in [6.0, 10.0, 12.0, 14.0, 17.0, 20.0] {
+        let apart = detached_share(&shot(&scene, t), bg);
+        assert!(
+            apart < 0.004,
+            "at {t} s, {apart:.4} of the cloud's pixels lie apart from it (the faded anvil: \
+             {baseline:.4})"
+        );
+    }
 }
 
 /// The tests' one offscreen device making linear images (what an EXR holds).

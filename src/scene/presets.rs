@@ -133,10 +133,13 @@ const SIMULATED_END: u32 = 2880;
 const DEVELOPING_END: u32 = 480;
 
 /// The developing cumulus (Schpok et al. 2003 §6, Figure 5): simple ascending implicits model
-/// the convection, puffs higher in the column rising faster and growing; a flat ellipsoid at
-/// the top, faded in by its strength's keys, spreads into the anvil while the wind, stronger
-/// aloft, carries it downwind. Its keys: the anvil's strength, and the noise slowing and
-/// scaling out as the plume spreads.
+/// the convection, puffs higher in the column rising faster and growing. The anvil grows out
+/// of the column's crown: a flat ellipsoid keyed to ride on the crown, hidden inside it until
+/// the tower has risen (8 s), then spreading downwind while the wind, stronger aloft, carries
+/// the plume. Its keys: the anvil's centre and radii, and the noise slowing and scaling out as
+/// the plume spreads. (Fading the anvil in by its strength floated a faint disc of noise
+/// specks above the column: a weak field lies below the iso level, and only the noise's peaks
+/// rise over it.)
 fn developing() -> (Vec<Ellipsoid>, super::Animation, super::WindField) {
     use super::{Channel, EllipsoidProperty, Motion};
     let mut rng = SplitMix::new(83);
@@ -151,6 +154,11 @@ fn developing() -> (Vec<Ellipsoid>, super::Animation, super::WindField) {
             size: radii,
         }),
         ..Ellipsoid::new(center, radii).billowed()
+    };
+    let wind = super::WindField {
+        velocity: [0.12, 0.0],
+        shear: 0.06,
+        turbulence: 0.25,
     };
     let mut v = Vec::new();
     // The base: broad puffs that barely move.
@@ -174,24 +182,55 @@ fn developing() -> (Vec<Ellipsoid>, super::Animation, super::WindField) {
             v.push(moving(c, Vec3::splat(r), rise, STRETCH, 0.0));
         }
     }
-    // The anvil: flat, where the column stops, spreading as it fades in.
-    let mut anvil = moving(
-        Vec3::new(0.3, 14.0, 0.0),
-        Vec3::new(2.2, 1.0, 1.8),
-        0.08,
-        0.01,
-        0.15,
-    );
-    anvil.id = 100;
-    v.push(anvil);
-    let mut keys = super::Animation::default();
-    let strength = Channel::Ellipsoid {
-        id: 100,
-        property: EllipsoidProperty::Strength,
+    // The anvil: keyed to ride on the crown (the top ring's centre, the wind's drift without
+    // its turbulence), small enough to hide inside it until the tower has risen, then
+    // spreading, its centre drifting downwind of the crown by a third of its growth.
+    let crown: Vec<Motion> = v[v.len() - 3..].iter().filter_map(|e| e.motion).collect();
+    let calm = super::WindField {
+        turbulence: 0.0,
+        ..wind
     };
-    keys.key(strength, 0.0, vec![0.0]);
-    keys.key(strength, 8.0, vec![0.0]);
-    keys.key(strength, 16.0, vec![1.0]);
+    let crown_at = |t: f32| {
+        let n = crown.len().max(1) as f32;
+        let (c, r) = crown.iter().fold((Vec3::ZERO, 0.0), |(c, r), m| {
+            let (centre, radii) = m.at(&calm, 0, t);
+            (c + centre / n, r + radii.y / n)
+        });
+        c + Vec3::Y * (0.6 * r)
+    };
+    let hidden = Vec3::new(0.9, 0.6, 0.8);
+    let spread = |t: f32| {
+        // Piecewise linear through these sizes, spreading fast and then slowing.
+        let sizes = [
+            (0.0, hidden),
+            (8.0, hidden),
+            (14.0, Vec3::new(5.2, 1.0, 3.9)),
+            (DEVELOPING_END as f32 / 24.0, Vec3::new(8.5, 1.3, 6.2)),
+        ];
+        let i = sizes.iter().rposition(|(k, _)| *k <= t).unwrap_or(0);
+        match sizes.get(i + 1) {
+            Some(&(t1, r1)) => {
+                let (t0, r0) = sizes[i];
+                r0.lerp(r1, (t - t0) / (t1 - t0))
+            }
+            None => sizes[i].1,
+        }
+    };
+    let mut anvil = Ellipsoid::new(crown_at(0.0), hidden).billowed();
+    anvil.id = 100;
+    let mut keys = super::Animation::default();
+    let channel = |property| Channel::Ellipsoid { id: 100, property };
+    for second in 0..=DEVELOPING_END / 24 {
+        let t = second as f32;
+        let radii = spread(t);
+        let downwind = Vec3::new(wind.velocity[0], 0.0, wind.velocity[1]).normalize_or_zero();
+        let centre = crown_at(t) + downwind * ((radii.x - hidden.x) / 3.0);
+        keys.key(channel(EllipsoidProperty::Center), t, centre.to_array().to_vec());
+        if matches!(second, 0 | 8 | 14) || second == DEVELOPING_END / 24 {
+            keys.key(channel(EllipsoidProperty::Radii), t, radii.to_array().to_vec());
+        }
+    }
+    v.push(anvil);
     let media = |property| Channel::Media { property };
     use super::MediaProperty as M;
     // The rolling turbulence slows and the noise scales out as the plume spreads.
@@ -203,11 +242,6 @@ fn developing() -> (Vec<Ellipsoid>, super::Animation, super::WindField) {
         keys.key(media(property), 0.0, start);
         keys.key(media(property), 20.0, end);
     }
-    let wind = super::WindField {
-        velocity: [0.12, 0.0],
-        shear: 0.06,
-        turbulence: 0.25,
-    };
     (v, keys, wind)
 }
 
