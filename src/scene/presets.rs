@@ -225,9 +225,17 @@ fn developing() -> (Vec<Ellipsoid>, super::Animation, super::WindField) {
         let radii = spread(t);
         let downwind = Vec3::new(wind.velocity[0], 0.0, wind.velocity[1]).normalize_or_zero();
         let centre = crown_at(t) + downwind * ((radii.x - hidden.x) / 3.0);
-        keys.key(channel(EllipsoidProperty::Center), t, centre.to_array().to_vec());
+        keys.key(
+            channel(EllipsoidProperty::Center),
+            t,
+            centre.to_array().to_vec(),
+        );
         if matches!(second, 0 | 8 | 14) || second == DEVELOPING_END / 24 {
-            keys.key(channel(EllipsoidProperty::Radii), t, radii.to_array().to_vec());
+            keys.key(
+                channel(EllipsoidProperty::Radii),
+                t,
+                radii.to_array().to_vec(),
+            );
         }
     }
     v.push(anvil);
