@@ -6,7 +6,7 @@
 // Screenshots: test-results/screenshots/flipbook-*.png.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { serve, state, screenshot, until, withApp, BOTH_BUILDS, COSTLY_BUILDS } from './harness.mjs';
+import { serve, state, screenshot, until, withApp, BOTH_BUILDS } from './harness.mjs';
 
 let server;
 before(async () => { server = await serve(); });
@@ -19,7 +19,7 @@ async function click(page, name) {
   await page.mouse.click(x + w / 2, y + h / 2);
 }
 
-for (const backend of COSTLY_BUILDS) {
+for (const backend of BOTH_BUILDS) {
   test(`Cache renders the range once, Play shows the cached frames at the frame rate, an edit re-renders what it changes (${backend})`, { timeout: 600_000 }, async () => {
     await withApp({ base: server.url, webgpu: backend === 'webgpu', query: '?preset=developing', viewport: { width: 1280, height: 800 } }, async (page) => {
       await page.evaluate(() => { window.cloudsketch.set('/clock/end=23'); window.cloudsketch.set('/render/slices=16'); });

@@ -66,7 +66,7 @@ async function outline(page, cx, cy, r) {
   await page.mouse.up();
 }
 
-for (const backend of COSTLY_BUILDS) {
+for (const backend of BOTH_BUILDS) {
   test(`frame time while dragging (${backend})`, { timeout: 420_000 }, async () => {
     const { browser, close } = await launch({ webgpu: backend === 'webgpu' });
     try {

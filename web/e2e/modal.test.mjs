@@ -1,11 +1,11 @@
-// Nothing in the way, in the browser at 1280×800 (the WebGPU build: see EDITING_BUILDS), driven as a person drives it:
+// Nothing in the way, in the browser at 1280×800 (both builds), driven as a person drives it:
 // Blender's modal G (X, a typed distance, Enter; then Esc putting it back exactly), R cancelled
 // by a right-click, S confirmed by a click; an outline drawn with "behind" (Q) lands beyond the
 // first and one drawn without lands in front; a plane drawn from the level default view stands
 // upright; the Tiers group stays open after "Add a tier".
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { serve, state, until, withApp, reveal, openGroup, screenshot, EDITING_BUILDS } from './harness.mjs';
+import { serve, state, until, withApp, reveal, openGroup, screenshot, BOTH_BUILDS } from './harness.mjs';
 
 let server;
 before(async () => { server = await serve(); });
@@ -58,7 +58,7 @@ function rotate([x, y, z, w], v) {
 
 const close = (a, b, eps) => a.every((v, k) => Math.abs(v - b[k]) <= eps);
 
-for (const backend of EDITING_BUILDS) {
+for (const backend of BOTH_BUILDS) {
   test(`modal G, R and S as in Blender (${backend})`, { timeout: 240_000 }, async () => {
     await withApp({ base: server.url, webgpu: backend === 'webgpu', query: '?preset=empty', viewport: VIEWPORT }, async (page) => {
       let s = await state(page);

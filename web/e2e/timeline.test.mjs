@@ -4,7 +4,7 @@
 // Screenshots: test-results/screenshots/timeline-*.png.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { serve, state, screenshot, countChanged, until, withApp, waitForFullQuality, openGroup, reveal, cloudColumns, frameX, scrubTo, EDITING_BUILDS, BOTH_BUILDS } from './harness.mjs';
+import { serve, state, screenshot, countChanged, until, withApp, waitForFullQuality, openGroup, reveal, cloudColumns, frameX, scrubTo, BOTH_BUILDS } from './harness.mjs';
 
 let server;
 before(async () => { server = await serve(); });
@@ -14,7 +14,7 @@ const toBytes = (rgb) => rgb.map((v) => Math.round(v * 255));
 
 const cloud = cloudColumns;
 
-for (const backend of EDITING_BUILDS) {
+for (const backend of BOTH_BUILDS) {
   test(`I keys an ellipsoid, the scrub bar poses it between its keys, undo removes a key, a dragged key retimes (${backend})`, { timeout: 300_000 }, async () => {
     await withApp({ base: server.url, webgpu: backend === 'webgpu', query: '?preset=empty', viewport: { width: 1280, height: 800 } }, async (page) => {
       let s = await state(page);
@@ -136,7 +136,7 @@ async function orbit(page, dx) {
   await page.mouse.up();
 }
 
-for (const backend of EDITING_BUILDS) {
+for (const backend of BOTH_BUILDS) {
   test(`a shot camera keyed at two frames: the view looks through it between its keys, orbiting leaves it (${backend})`, { timeout: 300_000 }, async () => {
     await withApp({ base: server.url, webgpu: backend === 'webgpu', viewport: { width: 1280, height: 800 } }, async (page) => {
       let s = await state(page);
