@@ -474,9 +474,9 @@ impl Derived {
         self.planes.derived(plane)
     }
 
-    /// Forgets the field grid (its texel size, kept across edits with hysteresis) and the
-    /// volumes, keeping the per-plane shapes: the next derivation samples the document on the
-    /// grid a fresh load would, so an image depends on the document alone (offscreen renders).
+    /// Forgets the last bakes and the volumes, keeping the per-plane shapes: the next
+    /// derivation bakes whole (the grid is the document's either way), so an offscreen render
+    /// reuses nothing an earlier frame left.
     pub fn forget_grid(&mut self) {
         self.baker = Baker::default();
         self.density = None;

@@ -179,8 +179,7 @@ fn cached_volumes_equal_a_fresh_derivation() {
     l.sun_elevation_deg = 70.0;
     doc.apply(Edit::SetLight(l), None);
     let cached = derived.update(doc.scene(), doc.revisions());
-    // The cached grid may keep its texel size (hysteresis), so compare values, not grids:
-    // every texel is the fresh field at its centre.
+    // Compare values, not only grids: every texel is the fresh field at its centre.
     let field = field_of(doc.scene());
     let v = &cached.density.data;
     for z in 0..v.dims.z {

@@ -682,13 +682,12 @@ pub struct Baked {
 
 /// Bakes a field after each edit, re-evaluating only what changed.
 ///
-/// The texel size follows the cloud's extent with hysteresis: it is kept until the extent
-/// differs by more than 2× from the one it was chosen for (or the grid would pass the caps), so
-/// a small cloud gets texels of its size while partial updates stay valid when a stroke grows
-/// the box. On a kept texel size the new grid is the field's box on the same lattice: texels
-/// the old grid had are copied unless a changed primitive reaches their brick (its old place or
-/// its new one), and only the other bricks are evaluated. The result equals [`bake`] on the same
-/// grid bit for bit (the grid alone may differ from a fresh bake's, by the hysteresis).
+/// The grid is the one a fresh bake of the field takes (from the field, the resolution and the
+/// budget alone, never from what was baked before), so a frame is the same wherever it is
+/// made. When the texel size is the last bake's, the new grid is the field's box on the same
+/// lattice: texels the old grid had are copied unless a changed primitive reaches their brick
+/// (its old place or its new one), and only the other bricks are evaluated. The result equals
+/// [`bake`] on the same grid bit for bit.
 #[derive(Default)]
 pub struct Baker {
     last: Option<LastBake>,
