@@ -413,4 +413,47 @@ mod tests {
             assert!(all.contains_key(name), "{name} has no staging");
         }
     }
+
+    /// The developing cumulus's anvil rides on the tower: at every second its centre stands
+    /// above every puff's and over the crown (the highest ring), within the crown's reach plus
+    /// its own downwind drift; until 8 s it is no wider than a crown puff, hidden inside it.
+    /// An anvil keyed to the wrong ring, or left where the tower has not yet risen, fails it.
+    #[test]
+    fn the_developing_anvil_rides_on_the_crown_and_hides_in_it_until_the_tower_has_risen() {
+        let scene = Scene::preset(Preset::Developing);
+        for second in 0..=DEVELOPING_END / 24 {
+            let posed = scene.posed_at(second as f32);
+            let (anvil, puffs): (Vec<_>, Vec<_>) =
+                posed.ellipsoids.iter().partition(|e| e.id == 100);
+            let anvil = anvil.first().expect("the anvil is ellipsoid 100");
+            let crown = puffs
+                .iter()
+                .max_by(|a, b| a.center.y.total_cmp(&b.center.y))
+                .expect("a column");
+            for p in &puffs {
+                assert!(
+                    anvil.center.y > p.center.y,
+                    "at {second} s the anvil ({}) is not above puff {} ({})",
+                    anvil.center,
+                    p.id,
+                    p.center
+                );
+            }
+            let drift = (anvil.radii.x - 0.9) / 3.0;
+            let apart = (anvil.center - crown.center).with_y(0.0).length();
+            assert!(
+                apart < 1.5 * crown.radii.x + drift,
+                "at {second} s the anvil stands {apart} from the crown's top puff"
+            );
+            if second <= 8 {
+                assert!(
+                    anvil.radii.x <= crown.radii.x
+                        && anvil.center.y < crown.center.y + crown.radii.y,
+                    "at {second} s the anvil shows before the tower has risen: {} {}",
+                    anvil.radii,
+                    crown.radii
+                );
+            }
+        }
+    }
 }

@@ -16,11 +16,13 @@ const here = path.dirname(fileURLToPath(import.meta.url));
  * translated to GLSL), the WebGPU build through the browser's WebGPU; tools, input handling,
  * undo, animation and the document are the same Rust in both. Tests of drawing, of the page's
  * speed, and of loading run in both builds, and so do the tests of the modal tools, the
- * outlines' planes, keys and the timeline, cached playback and frame times while dragging. The
- * other tests of tools and input (`EDITING_BUILDS`) run in the WebGPU build alone, which most
- * visitors get: the WebGL2 build draws the same kinds of scene in the tests that run in both
- * (ellipsoids: the parity test; every preset: the preset buttons test). Every test in both
- * builds adds about 9 minutes to the suite (65 minutes here), too close to CI's 90.
+ * outlines' planes and the Tiers group, I, auto-key and the shot camera on the timeline, cached
+ * playback and frame times while dragging. The other tests of tools and input, the developing
+ * preset scrubbed, and a preset opened from each link (`EDITING_BUILDS`) run in the WebGPU build
+ * alone, which most visitors get: the WebGL2 build draws the same kinds of scene in the tests
+ * that run in both (ellipsoids: the parity test; five presets: the preset buttons test; the
+ * developing preset: the flipbook test). Every test in both builds adds about 9 minutes to the
+ * suite, too close to CI's 90.
  */
 export const BOTH_BUILDS = ['webgpu', 'webgl2'];
 /** `CLOUDSKETCH_ALL_BUILDS=1` runs every test in both builds (about 9 minutes more here). */
