@@ -6,13 +6,15 @@
 //! - `axes`: Y-up or Z-up and the unit scale;
 //! - `vdb`: the OpenVDB writer; `mitsuba`: the Mitsuba scene; `formats`: glb, OBJ, PLY, `.vol`;
 //! - `mesh`: the surface by marching cubes (closed, manifold, outward);
-//! - `zip`: several files as one (stored) archive, for one browser download.
+//! - `zip`: several files as one (stored) archive, for one browser download;
+//! - `png`: an RGBA image as PNG, for the browser's recorded frames.
 
 mod axes;
 mod formats;
 mod grid;
 pub mod mesh;
 mod mitsuba;
+mod png;
 mod vdb;
 mod zip;
 
@@ -21,6 +23,7 @@ pub use formats::{grid_box, write_glb, write_obj, write_ply, write_vol};
 pub use grid::{DensityGrid, Sampling, sample};
 pub use mesh::{Mesh, mesh};
 pub use mitsuba::write_xml;
+pub use png::encode_rgba as encode_png;
 pub use vdb::write_vdb;
 pub use zip::zip;
 

@@ -4,7 +4,7 @@
 use super::File;
 
 /// CRC-32 (IEEE 802.3, reflected), as ZIP stores it.
-fn crc32(bytes: &[u8]) -> u32 {
+pub(super) fn crc32(bytes: &[u8]) -> u32 {
     let mut crc = !0u32;
     for &b in bytes {
         crc ^= b as u32;

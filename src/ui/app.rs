@@ -283,10 +283,7 @@ impl CloudApp {
                     self.viewport.stats.viewport_px,
                     &self.files.name,
                 );
-                if ask.capture.is_some() {
-                    self.stop_caching(now, "Caching stopped for the PNG export");
-                    self.viewport.capture_request = ask.capture;
-                }
+                self.export_asked(ask, now);
             }
             _ => {
                 let mut tc = ToolContext {
@@ -367,21 +364,47 @@ impl CloudApp {
             self.viewport.stats.viewport_px,
             &self.files.name,
         );
-        if ask.capture.is_some() {
-            let now = ui.input(|i| i.time);
+        self.export_asked(ask, ui.input(|i| i.time));
+        self.selection.retain_valid(self.doc.scene());
+    }
+
+    /// Does what the Export group asked: a capture of the view, a recording of the range
+    /// (through the flipbook's steps), or stopping either.
+    fn export_asked(&mut self, ask: super::panels::ExportAsk, now: f64) {
+        if ask.capture.is_some() || ask.record.is_some() {
             self.stop_caching(now, "Caching stopped for the PNG export");
+        }
+        if ask.capture.is_some() {
             self.viewport.capture_request = ask.capture;
+        }
+        if let Some(r) = ask.record {
+            self.panels.timeline.playing = false;
+            let said = self.flipbook.start_record(
+                self.doc.scene(),
+                r.size,
+                r.transparent,
+                &r.stem,
+                r.video,
+            );
+            self.notices.note(now, said);
         }
         if ask.cancel_capture {
             self.viewport.cancel_capture();
         }
-        self.selection.retain_valid(self.doc.scene());
+        if ask.cancel_record {
+            self.end_frames();
+        }
     }
 
     /// Cached playback: starts or cancels caching as the timeline asked, advances it a frame
     /// at a time through the viewport's capture, and while playing hands the viewport the
     /// kept frame of the time, if it is still what the view shows.
     fn cache_frames(&mut self, ctx: &egui::Context, now: f64) {
+        let timeline = &mut self.panels.timeline;
+        if self.flipbook.recording() && std::mem::take(&mut timeline.cache_asked) {
+            self.notices
+                .note(now, "A recording is under way: cache when it is done");
+        }
         let timeline = &mut self.panels.timeline;
         if std::mem::take(&mut timeline.cache_asked) && !self.flipbook.building() {
             if self.viewport.stats.backend.is_none() {
@@ -414,7 +437,7 @@ impl CloudApp {
                 self.doc.set_time(t);
                 if self.flipbook_capture.is_none() {
                     self.viewport.cancel_capture();
-                    self.flipbook_capture = Some((self.flipbook.size(), 0));
+                    self.flipbook_capture = Some((self.flipbook.size().0, 0));
                 }
             }
             // The capture's pixels, once the asked frame's came back (only the cache asks
@@ -435,10 +458,16 @@ impl CloudApp {
             if let Some(said) = ask.say {
                 self.notices.note(now, said);
             }
+            if let Some(recorded) = ask.recorded {
+                self.panels
+                    .export
+                    .recorded(recorded, &mut self.notices, now);
+            }
             // Asked once the view has derived the frame's time (a simulation caught up).
             if let Some((size, waited)) = self.flipbook_capture {
                 if waited >= 1 && !self.viewport.stats.catching_up {
-                    self.viewport.capture_request = Some((size, false));
+                    let transparent = self.flipbook.size().1;
+                    self.viewport.capture_request = Some((size, transparent));
                     self.flipbook_capture = None;
                 } else {
                     self.flipbook_capture = Some((size, waited + 1));
@@ -447,6 +476,7 @@ impl CloudApp {
             ctx.request_repaint();
         }
         self.viewport.caching = self.flipbook.building();
+        self.viewport.recording = self.flipbook.recording();
         if self.flipbook.building() {
             self.viewport.flipbook = self.flipbook.latest().cloned();
             self.flipbook.showing = false;
@@ -468,14 +498,23 @@ impl CloudApp {
 
     /// Stops caching, if it runs, back at the time it began from.
     fn stop_caching(&mut self, now: f64, why: &str) {
-        if let Some(t) = self.flipbook.cancel() {
-            self.flipbook_capture = None;
-            // A frame's capture finished or under way is the cache's: nobody else takes it.
-            self.viewport.captured = None;
-            self.viewport.cancel_capture();
-            self.doc.set_time(t);
+        if self.flipbook.building() && !self.flipbook.recording() && self.end_frames() {
             self.notices.note(now, why);
         }
+    }
+
+    /// Ends the caching or recording under way, if one is, back at the time it began from;
+    /// returns whether one was.
+    fn end_frames(&mut self) -> bool {
+        let Some(t) = self.flipbook.cancel() else {
+            return false;
+        };
+        self.flipbook_capture = None;
+        // A frame's capture finished or under way is the cache's: nobody else takes it.
+        self.viewport.captured = None;
+        self.viewport.cancel_capture();
+        self.doc.set_time(t);
+        true
     }
 
     /// The timeline under the view, or the button that shows it again.
@@ -502,7 +541,11 @@ impl CloudApp {
             .exact_size(height)
             .show(ui, |ui| {
                 ui.add_space(2.0);
-                self.panels.timeline.cache_progress = self.flipbook.progress();
+                // A recording's progress is the Export group's.
+                self.panels.timeline.cache_progress = self
+                    .flipbook
+                    .progress()
+                    .filter(|_| !self.flipbook.recording());
                 self.panels.timeline.cache_kept = self.flipbook.kept().0;
                 if let Some(said) = self.panels.timeline.ui(ui, &mut self.doc, &self.selection) {
                     self.notices.note(now, said);
@@ -647,6 +690,7 @@ impl CloudApp {
             "export": {
                 "format": self.panels.export.format.name(),
                 "transparent": self.panels.export.transparent,
+                "range": self.panels.export.range,
                 "png_width": self.panels.export.png_width,
                 "progress": self.panels.export.progress(),
                 "last": self.panels.export.last.as_ref().map(|r| match r {
@@ -762,7 +806,13 @@ impl eframe::App for CloudApp {
             ctx.request_repaint();
         }
         self.cache_frames(&ctx, now);
-        self.panels.export.capture_progress = self.viewport.capture_progress().unwrap_or(0.0);
+        let capture = self.viewport.capture_progress().unwrap_or(0.0);
+        self.panels.export.capture_progress = match self.flipbook.progress() {
+            Some((done, of)) if self.flipbook.recording() => {
+                (done as f32 + capture) / of.max(1) as f32
+            }
+            _ => capture,
+        };
         if let Some((size, pixels)) = self.viewport.captured.take() {
             self.panels
                 .export

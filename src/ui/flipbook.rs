@@ -9,6 +9,11 @@
 //! Within a memory cap ([`MEMORY_CAP`]): a range too long for it at the view's size is cached
 //! smaller (down to a quarter of each side), and past that only its first frames, said in a
 //! message.
+//!
+//! Recording (the Export group's PNG of every frame of the range) runs through the same steps:
+//! each frame captured at the export's size, with the document's light, and kept as a PNG file
+//! instead of a texture (within [`RECORD_CAP`]); the files are handed over when the range is
+//! done.
 
 use std::collections::BTreeMap;
 use std::hash::Hasher;
@@ -23,6 +28,57 @@ const MIN_SCALE: f32 = 0.25;
 
 /// Most frames cached (a range of a day at 120 frames a second has ten million).
 const MAX_FRAMES: usize = 10_000;
+
+/// Bytes of PNG files a recording holds (the browser's download copies them once more into
+/// its zip, within wasm32's 4 GiB).
+pub const RECORD_CAP: usize = 768 << 20;
+
+/// A video encoder a recording hands its frames to (the browser's WebM through WebCodecs).
+pub trait VideoSink {
+    /// Queues frame `index` of the recording (0 first): straight-alpha RGBA at its size.
+    /// An error ends the recording.
+    fn add(&mut self, rgba: &[u8], index: u32) -> Result<(), String>;
+    /// Encodes what is queued and saves the video as `name`; `done` gets what was saved (or
+    /// why not) once it is.
+    fn finish(self: Box<Self>, name: String, done: Box<dyn FnOnce(Result<String, String>)>);
+}
+
+/// A recording's frames: PNG files, or a video encoder's queue.
+pub enum Frames {
+    /// The PNG files, `STEM_####.png` (the frame number, zero-padded).
+    Pngs(Vec<crate::export::File>),
+    /// The encoder (finished by whoever saves it), and the frames handed to it.
+    Video(Box<dyn VideoSink>, u32),
+}
+
+impl std::fmt::Debug for Frames {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Frames::Pngs(files) => f.debug_tuple("Pngs").field(files).finish(),
+            Frames::Video(_, n) => write!(f, "Video({n} frames)"),
+        }
+    }
+}
+
+impl PartialEq for Frames {
+    fn eq(&self, other: &Self) -> bool {
+        match (self, other) {
+            (Frames::Pngs(a), Frames::Pngs(b)) => a == b,
+            _ => false,
+        }
+    }
+}
+
+/// A recording's frames so far.
+struct Recording {
+    frames: Frames,
+    /// Bytes of PNG files held.
+    bytes: usize,
+    stem: String,
+    transparent: bool,
+    /// The frame recorded last, shown in the view meanwhile.
+    latest: Option<egui::TextureHandle>,
+}
 
 /// One kept frame.
 struct Frame {
@@ -41,6 +97,10 @@ struct Build {
     time: f32,
     /// Frames in the range.
     total: usize,
+    /// The pixel size frames are captured at.
+    size: [u32; 2],
+    /// Recording: the frames go to PNG files, not textures.
+    record: Option<Recording>,
 }
 
 /// The cached frames of a document's range.
@@ -69,6 +129,8 @@ pub struct Ask {
     pub capture: Option<[u32; 2]>,
     /// Something to tell the user.
     pub say: Option<String>,
+    /// A recording ended: its frames, or why it stopped.
+    pub recorded: Option<Result<Frames, String>>,
 }
 
 /// A key of what `scene` shows at time `t` in a view `size` pixels: the scene posed there,
@@ -200,13 +262,86 @@ impl Flipbook {
             todo,
             waiting: None,
             time: scene.time,
+            size,
+            record: None,
         });
         said
     }
 
-    /// The pixel size frames are cached at.
-    pub fn size(&self) -> [u32; 2] {
-        self.size
+    /// Starts recording `scene`'s frame range at `size` pixels (over the sky or transparent)
+    /// into `video`, or without one as PNG files named `STEM_####.png`; the frames cached stay
+    /// as they are. Says what it records.
+    pub fn start_record(
+        &mut self,
+        scene: &Scene,
+        size: [u32; 2],
+        transparent: bool,
+        stem: &str,
+        video: Option<Box<dyn VideoSink>>,
+    ) -> String {
+        let clock = scene.clock;
+        let count = (clock.end.saturating_sub(clock.start) as usize).saturating_add(1);
+        let last = clock
+            .start
+            .saturating_add(count.min(MAX_FRAMES) as u32)
+            .saturating_sub(1)
+            .min(clock.end);
+        let frames = (last - clock.start) as usize + 1;
+        self.build = Some(Build {
+            total: frames,
+            todo: (clock.start..=last).rev().collect(),
+            waiting: None,
+            time: scene.time,
+            size,
+            record: Some(Recording {
+                frames: match video {
+                    Some(v) => Frames::Video(v, 0),
+                    None => Frames::Pngs(Vec::new()),
+                },
+                bytes: 0,
+                stem: stem.to_owned(),
+                transparent,
+                latest: None,
+            }),
+        });
+        let what = if self.recording_video() {
+            "a WebM"
+        } else {
+            "PNGs"
+        };
+        if frames < count {
+            format!(
+                "Recording the first {frames} of {count} frames at {}×{} as {what}: a recording holds at most {MAX_FRAMES}",
+                size[0], size[1]
+            )
+        } else {
+            format!(
+                "Recording {frames} frames at {}×{} as {what}",
+                size[0], size[1]
+            )
+        }
+    }
+
+    /// Whether it is recording (not caching).
+    pub fn recording(&self) -> bool {
+        self.build.as_ref().is_some_and(|b| b.record.is_some())
+    }
+
+    /// Whether it is recording into a video.
+    fn recording_video(&self) -> bool {
+        self.build
+            .as_ref()
+            .and_then(|b| b.record.as_ref())
+            .is_some_and(|r| matches!(r.frames, Frames::Video(..)))
+    }
+
+    /// The pixel size frames are captured at (cached, or recorded while recording), and
+    /// whether over a transparent background.
+    pub fn size(&self) -> ([u32; 2], bool) {
+        match &self.build {
+            Some(b) => (b.size, b.record.as_ref().is_some_and(|r| r.transparent)),
+            None => (self.size, false),
+        }
     }
 
     /// The time of the frame being cached, if one is.
@@ -235,9 +370,54 @@ impl Flipbook {
         if let (Some((frame, asked)), Some(result)) = (build.waiting, captured) {
             build.waiting = None;
             let t = scene.clock.seconds(frame);
+            let size = build.size;
             match result {
                 // The scene changed while it was drawn (an orbit, an edit): drawn again.
-                Ok(_) if frame_key(scene, t, self.size) != asked => build.todo.push(frame),
+                Ok(_) if frame_key(scene, t, size) != asked => build.todo.push(frame),
+                Ok(pixels) if build.record.is_some() => {
+                    let record = build.record.as_mut().expect("recording");
+                    if pixels.len() != size[0] as usize * size[1] as usize * 4 {
+                        ask.recorded = Some(Err(format!("frame {frame} came back the wrong size")));
+                        ask.time = self.cancel();
+                        return ask;
+                    }
+                    let image =
+                        egui::ColorImage::from_rgba_unmultiplied(size.map(|v| v as usize), &pixels);
+                    record.latest = Some(ctx.load_texture(
+                        "recorded frame",
+                        image,
+                        egui::TextureOptions::LINEAR,
+                    ));
+                    match &mut record.frames {
+                        Frames::Video(video, n) => {
+                            if let Err(e) = video.add(&pixels, *n) {
+                                ask.recorded = Some(Err(format!("the video encoder failed: {e}")));
+                                ask.time = self.cancel();
+                                return ask;
+                            }
+                            *n += 1;
+                        }
+                        Frames::Pngs(files) => {
+                            // (The size was checked above: the encoder always writes it.)
+                            let png = crate::export::encode_png(size[0], size[1], &pixels)
+                                .unwrap_or_default();
+                            record.bytes += png.len();
+                            files.push(crate::export::File {
+                                name: format!("{}_{frame:04}.png", record.stem),
+                                bytes: png,
+                            });
+                            if record.bytes > RECORD_CAP && !build.todo.is_empty() {
+                                ask.say = Some(format!(
+                                    "Recorded the first {} of {} frames: a recording holds at most {} MB",
+                                    files.len(),
+                                    build.total,
+                                    RECORD_CAP >> 20
+                                ));
+                                build.todo.clear();
+                            }
+                        }
+                    }
+                }
                 Ok(pixels) => {
                     let image = egui::ColorImage::from_rgba_unmultiplied(
                         self.size.map(|v| v as usize),
@@ -258,6 +438,11 @@ impl Flipbook {
                         },
                     );
                 }
+                Err(e) if build.record.is_some() => {
+                    ask.recorded = Some(Err(e));
+                    ask.time = self.cancel();
+                    return ask;
+                }
                 Err(e) => {
                     ask.say = Some(format!("Caching stopped: {e}"));
                     ask.time = self.cancel();
@@ -272,9 +457,14 @@ impl Flipbook {
             match build.todo.pop() {
                 Some(frame) => {
                     let t = scene.clock.seconds(frame);
-                    build.waiting = Some((frame, frame_key(scene, t, self.size)));
+                    build.waiting = Some((frame, frame_key(scene, t, build.size)));
                     ask.time = Some(t);
-                    ask.capture = Some(self.size);
+                    ask.capture = Some(build.size);
+                }
+                None if build.record.is_some() => {
+                    let record = build.record.take().expect("recording");
+                    ask.recorded = Some(Ok(record.frames));
+                    ask.time = self.cancel();
                 }
                 None => {
                     let (n, bytes) = self.kept();
@@ -305,8 +495,11 @@ impl Flipbook {
         (kept.key == frame_key(scene, clock.seconds(f as u32), self.size)).then_some(&kept.texture)
     }
 
-    /// The image cached last (shown while caching goes on).
+    /// The image cached last (shown while caching goes on), or recorded last.
     pub fn latest(&self) -> Option<&egui::TextureHandle> {
+        if let Some(record) = self.build.as_ref().and_then(|b| b.record.as_ref()) {
+            return record.latest.as_ref();
+        }
         self.frames.get(&self.latest?).map(|f| &f.texture)
     }
 
@@ -315,6 +508,7 @@ impl Flipbook {
         let (frames, bytes) = self.kept();
         serde_json::json!({
             "building": self.building(),
+            "recording": self.recording(),
             "progress": self.progress(),
             "frames": frames,
             "bytes": bytes,
@@ -425,6 +619,172 @@ mod tests {
         );
         // Another view size: nothing kept shows.
         assert!(book.frame(&scene, [1920, 1080]).is_none());
+    }
+
+    /// Steps a recording to its end with captures of `size` whose red is the frame's time in
+    /// tenths; returns what it handed over and how many captures it asked for.
+    fn record_all(
+        book: &mut Flipbook,
+        ctx: &egui::Context,
+        scene: &mut Scene,
+    ) -> (Vec<crate::export::File>, usize) {
+        let mut captured = None;
+        let mut asked = 0;
+        loop {
+            let ask = book.step(ctx, scene, captured.take());
+            if let Some(t) = ask.time {
+                *scene = scene.posed_at(t);
+            }
+            if let Some(recorded) = ask.recorded {
+                let Ok(Frames::Pngs(files)) = recorded else {
+                    panic!("{recorded:?}")
+                };
+                return (files, asked);
+            }
+            let size = ask.capture.expect("a capture until the recording ends");
+            asked += 1;
+            let red = (scene.time * 10.0).round() as u8;
+            captured = Some(Ok(
+                [red, 0, 0, 255].repeat(size[0] as usize * size[1] as usize)
+            ));
+        }
+    }
+
+    #[test]
+    fn a_recording_hands_over_a_png_of_every_frame_and_leaves_the_cache_as_it_was() {
+        let ctx = egui::Context::default();
+        let mut scene = keyed();
+        let mut book = Flipbook::default();
+        cache_all(&mut book, &ctx, &mut scene);
+        let kept = book.kept();
+        scene.clock.start = 3;
+        scene.clock.end = 8;
+        scene.time = 0.5;
+        let said = book.start_record(&scene, [5, 3], true, "storm", None);
+        assert_eq!(said, "Recording 6 frames at 5×3 as PNGs");
+        assert!(book.recording() && book.size() == ([5, 3], true));
+        assert!(book.latest().is_none(), "no frame recorded yet");
+        let (files, asked) = record_all(&mut book, &ctx, &mut scene);
+        assert_eq!(asked, 6);
+        assert!(!book.building() && !book.recording());
+        assert_eq!(scene.time, 0.5, "back at the time it began from");
+        let names: Vec<&str> = files.iter().map(|f| f.name.as_str()).collect();
+        assert_eq!(
+            names,
+            [
+                "storm_0003.png",
+                "storm_0004.png",
+                "storm_0005.png",
+                "storm_0006.png",
+                "storm_0007.png",
+                "storm_0008.png"
+            ]
+        );
+        // Each PNG holds its own frame's capture.
+        for (f, file) in (3..=8).zip(&files) {
+            let mut reader = png::Decoder::new(std::io::Cursor::new(&file.bytes))
+                .read_info()
+                .unwrap();
+            let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+            let info = reader.next_frame(&mut buf).unwrap();
+            assert_eq!((info.width, info.height), (5, 3));
+            let red = (scene.clock.seconds(f) * 10.0).round() as u8;
+            assert_eq!(&buf[..4], &[red, 0, 0, 255], "frame {f}");
+        }
+        assert_eq!(book.kept(), kept, "the cached frames stay");
+    }
+
+    #[test]
+    fn a_recording_cancelled_or_failed_hands_over_nothing_but_the_error() {
+        let ctx = egui::Context::default();
+        let mut scene = keyed();
+        let mut book = Flipbook::default();
+        book.start_record(&scene, [4, 4], false, "cloud", None);
+        let ask = book.step(&ctx, &scene, None);
+        assert_eq!(ask.capture, Some([4, 4]));
+        assert_eq!(book.cancel(), Some(0.0));
+        assert!(!book.building());
+        book.start_record(&scene, [4, 4], false, "cloud", None);
+        book.step(&ctx, &scene, None);
+        let ask = book.step(&ctx, &scene, Some(Err("the device was lost".into())));
+        assert_eq!(ask.recorded, Some(Err("the device was lost".into())));
+        assert!(!book.building());
+        // A capture of the wrong size is refused, not written.
+        book.start_record(&scene, [4, 4], false, "cloud", None);
+        book.step(&ctx, &scene, None);
+        let ask = book.step(&ctx, &scene, Some(Ok(vec![0; 7])));
+        assert!(
+            matches!(ask.recorded, Some(Err(ref e)) if e.contains("wrong size")),
+            "{:?}",
+            ask.recorded
+        );
+        // A range beyond the frame cap is recorded to the cap, and says so.
+        scene.clock.end = 20_000;
+        let said = book.start_record(&scene, [4, 4], false, "cloud", None);
+        assert!(said.contains("first 10000 of 20001"), "{said}");
+    }
+
+    /// A video sink that keeps each frame's first byte and index, and fails at index `.1`.
+    struct Probe(std::rc::Rc<std::cell::RefCell<Vec<(u8, u32)>>>, u32);
+    impl VideoSink for Probe {
+        fn add(&mut self, rgba: &[u8], index: u32) -> Result<(), String> {
+            if index == self.1 {
+                return Err("out of memory".into());
+            }
+            self.0.borrow_mut().push((rgba[0], index));
+            Ok(())
+        }
+        fn finish(self: Box<Self>, name: String, done: Box<dyn FnOnce(Result<String, String>)>) {
+            done(Ok(name));
+        }
+    }
+
+    /// Records `scene`'s range into `probe` at 4×2: what it said, and how it ended.
+    fn record_into(
+        scene: &mut Scene,
+        ctx: &egui::Context,
+        probe: Probe,
+    ) -> (String, Option<Result<Frames, String>>) {
+        let mut book = Flipbook::default();
+        let said = book.start_record(scene, [4, 2], false, "cloud", Some(Box::new(probe)));
+        let mut captured = None;
+        loop {
+            let ask = book.step(ctx, scene, captured.take());
+            if let Some(t) = ask.time {
+                *scene = scene.posed_at(t);
+            }
+            if ask.recorded.is_some() {
+                return (said, ask.recorded);
+            }
+            let size = ask.capture.expect("a capture");
+            let red = (scene.time * 10.0).round() as u8;
+            captured = Some(Ok(
+                [red, 0, 0, 255].repeat(size[0] as usize * size[1] as usize)
+            ));
+        }
+    }
+
+    #[test]
+    fn a_video_recording_hands_its_encoder_every_frame_in_order() {
+        let ctx = egui::Context::default();
+        let mut scene = keyed();
+        scene.clock.start = 2;
+        scene.clock.end = 6;
+        let seen = std::rc::Rc::new(std::cell::RefCell::new(Vec::new()));
+        let (said, ended) = record_into(&mut scene, &ctx, Probe(seen.clone(), u32::MAX));
+        assert_eq!(said, "Recording 5 frames at 4×2 as a WebM");
+        assert!(matches!(ended, Some(Ok(Frames::Video(_, 5)))), "{ended:?}");
+        let expected: Vec<(u8, u32)> = (2..=6)
+            .zip(0..)
+            .map(|(f, i)| ((scene.clock.seconds(f) * 10.0).round() as u8, i))
+            .collect();
+        assert_eq!(*seen.borrow(), expected);
+        // The encoder failing ends the recording with its error.
+        let (_, ended) = record_into(&mut scene, &ctx, Probe(seen.clone(), 2));
+        assert_eq!(
+            ended,
+            Some(Err("the video encoder failed: out of memory".into()))
+        );
     }
 
     #[test]

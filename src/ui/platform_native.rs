@@ -318,3 +318,8 @@ mod tests {
         assert!(r.take_samples().is_empty());
     }
 }
+
+/// A video encoder for Record: none natively (a recording writes PNGs beside the scene file).
+pub fn video_sink(_size: [u32; 2], _fps: f64) -> Option<Box<dyn super::flipbook::VideoSink>> {
+    None
+}

@@ -590,3 +590,59 @@ fn js_error(e: &JsValue) -> String {
         .map(|e| String::from(e.message()))
         .unwrap_or_else(|| format!("{e:?}"))
 }
+
+#[wasm_bindgen(module = "/web/record.js")]
+extern "C" {
+    #[wasm_bindgen(js_name = videoSupported)]
+    fn video_supported() -> bool;
+    type WebmRecorder;
+    #[wasm_bindgen(constructor)]
+    fn new(width: u32, height: u32, fps: f64) -> WebmRecorder;
+    #[wasm_bindgen(method, js_name = addFrame)]
+    fn add_frame(this: &WebmRecorder, rgba: &[u8], index: u32);
+    #[wasm_bindgen(method)]
+    fn failed(this: &WebmRecorder) -> Option<String>;
+    #[wasm_bindgen(method)]
+    fn finish(this: &WebmRecorder) -> js_sys::Promise;
+}
+
+/// Record's WebM: the browser's WebCodecs VP9 encoder and webm-muxer (`web/record.js`).
+struct Webm(WebmRecorder);
+
+impl super::flipbook::VideoSink for Webm {
+    fn add(&mut self, rgba: &[u8], index: u32) -> Result<(), String> {
+        if let Some(e) = self.0.failed() {
+            return Err(e);
+        }
+        self.0.add_frame(rgba, index);
+        Ok(())
+    }
+
+    fn finish(self: Box<Self>, name: String, done: Box<dyn FnOnce(Result<String, String>)>) {
+        let promise = self.0.finish();
+        wasm_bindgen_futures::spawn_local(async move {
+            let saved = match wasm_bindgen_futures::JsFuture::from(promise).await {
+                Ok(blob) => blob
+                    .dyn_into::<web_sys::Blob>()
+                    .map_err(|_| "the encoder gave no video".to_owned())
+                    .and_then(|blob| download_blob(&name, &blob)),
+                Err(e) => Err(format!("the video encoder failed: {}", js_error(&e))),
+            };
+            done(saved);
+        });
+    }
+}
+
+/// A video encoder for Record: the browser's WebM where it has WebCodecs, unless the address
+/// asks for PNGs (`?record=png`); `size` must be even.
+pub fn video_sink(size: [u32; 2], fps: f64) -> Option<Box<dyn super::flipbook::VideoSink>> {
+    let asks_png = web_sys::window()
+        .and_then(|w| w.location().search().ok())
+        .and_then(|q| web_sys::UrlSearchParams::new_with_str(&q).ok())
+        .and_then(|p| p.get("record"))
+        .is_some_and(|v| v == "png");
+    if asks_png || !video_supported() {
+        return None;
+    }
+    Some(Box::new(Webm(WebmRecorder::new(size[0], size[1], fps))))
+}

@@ -67,6 +67,9 @@ pub struct Viewport {
     /// Cached playback is caching: the view renders nothing of its own (its capture renders
     /// each frame), so the capture may take most of a frame.
     pub caching: bool,
+    /// The frames captured are a recording's (an export): drawn with the document's light,
+    /// not the view's preview of it.
+    pub recording: bool,
 }
 
 impl Viewport {
@@ -133,6 +136,7 @@ impl Viewport {
             captured: None,
             flipbook: None,
             caching: false,
+            recording: false,
         }
     }
 
@@ -242,9 +246,11 @@ impl Viewport {
                     ui.ctx().request_repaint();
                 }
                 // At the view's own quality (its light previewed on a CPU adapter): the
-                // frames play where the view shows them.
+                // frames play where the view shows them. A recording is an export: the
+                // document's light.
+                let drawn = if self.recording { &exported } else { &view };
                 let capture =
-                    self.drive_capture(ui, &mut cx, &view, &volumes.density, CACHE_BUDGET);
+                    self.drive_capture(ui, &mut cx, drawn, &volumes.density, CACHE_BUDGET);
                 if let Some(capture) = capture.filter(|_| self.stats.backend.is_some()) {
                     painter.add(paint_callback(
                         rect,

@@ -22,8 +22,8 @@ async function click(page, name) {
 for (const backend of BOTH_BUILDS) {
   test(`Cache renders the range once, Play shows the cached frames at the frame rate, an edit re-renders what it changes (${backend})`, { timeout: 600_000 }, async () => {
     await withApp({ base: server.url, webgpu: backend === 'webgpu', query: '?preset=developing', viewport: { width: 1280, height: 800 } }, async (page) => {
-      await page.evaluate(() => { window.cloudsketch.set('/clock/end=23'); window.cloudsketch.set('/render/slices=16'); });
-      let s = await until(page, (s) => s.scene.clock.end === 23 && s.scene.render.slices === 16, 'a 24-frame range');
+      await page.evaluate(() => { window.cloudsketch.set('/clock/end=11'); window.cloudsketch.set('/render/slices=16'); });
+      let s = await until(page, (s) => s.scene.clock.end === 11 && s.scene.render.slices === 16, 'a 12-frame range');
       assert.equal(s.view.timeline.cache.frames, 0);
 
       await click(page, 'timeline:cache');
@@ -35,16 +35,16 @@ for (const backend of BOTH_BUILDS) {
         if (p) seen.add(p[0]);
         return !s.view.timeline.cache.building;
       }, 'cached', 420_000);
-      assert.equal(s.view.timeline.cache.frames, 24, JSON.stringify(s.view.timeline.cache));
+      assert.equal(s.view.timeline.cache.frames, 12, JSON.stringify(s.view.timeline.cache));
       assert.ok(seen.size >= 4, `progress seen at ${[...seen]}`);
-      assert.match(s.view.notice.text, /Cached 24 frames/);
+      assert.match(s.view.notice.text, /Cached 12 frames/);
       assert.equal(Math.round(s.view.timeline.frame), 0, 'back where it began');
 
       // Loop and Play: the time runs at 24 frames a second and the kept frames are shown.
       await click(page, 'timeline:loop');
       await click(page, 'timeline:play');
       await sleep(500);
-      // Frames played (the range loops every 24), summed over page-state reads a few frames
+      // Frames played (the range loops every 12), summed over page-state reads a few frames
       // apart; where a second or more played between two reads (stalled frames), the whole
       // loops the frame number cannot show are counted from the time the page played.
       const t0 = Date.now();
@@ -54,9 +54,9 @@ for (const backend of BOTH_BUILDS) {
       while (Date.now() - t0 < 3000) {
         await sleep(100);
         b = await state(page);
-        const step = (b.view.timeline.frame - prev.view.timeline.frame + 24) % 24;
-        const loops = Math.round((24 * (playedS(b) - playedS(prev)) - step) / 24);
-        played += step + 24 * Math.max(0, loops);
+        const step = (b.view.timeline.frame - prev.view.timeline.frame + 12) % 12;
+        const loops = Math.round((24 * (playedS(b) - playedS(prev)) - step) / 12);
+        played += step + 12 * Math.max(0, loops);
         prev = b;
       }
       const seconds = (Date.now() - t0) / 1000;
@@ -82,12 +82,12 @@ for (const backend of BOTH_BUILDS) {
 
       // Nothing changed: caching again renders nothing.
       await click(page, 'timeline:cache');
-      s = await until(page, (s) => !s.view.timeline.cache.building && /Cached 24 frames/.test(s.view.notice.text) && s.view.timeline.cache.frames === 24, 'nothing to cache', 30_000);
+      s = await until(page, (s) => !s.view.timeline.cache.building && /Cached 12 frames/.test(s.view.notice.text) && s.view.timeline.cache.frames === 12, 'nothing to cache', 30_000);
       // The sun lower: every frame changes, and every frame is rendered again.
       await page.evaluate(() => window.cloudsketch.set('/light/sun_elevation_deg=15'));
       await until(page, (s) => s.scene.light.sun_elevation_deg === 15, 'sun lower');
       await click(page, 'timeline:cache');
-      s = await until(page, (s) => s.view.timeline.cache.progress?.[0] === 0 && s.view.timeline.cache.progress?.[1] === 24, 'every frame again');
+      s = await until(page, (s) => s.view.timeline.cache.progress?.[0] === 0 && s.view.timeline.cache.progress?.[1] === 12, 'every frame again');
       await click(page, 'timeline:cache');
       s = await until(page, (s) => !s.view.timeline.cache.building, 'cancelled');
       assert.match(s.view.notice.text, /Caching cancelled/);

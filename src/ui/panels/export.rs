@@ -7,6 +7,7 @@ use egui::Ui;
 
 use crate::export::{Format, Options, Sampling, Up, write, zip};
 use crate::scene::{Document, Scene};
+use crate::ui::flipbook::Frames;
 use crate::ui::notice::Notices;
 use crate::ui::platform;
 use crate::ui::widgets::mark;
@@ -26,6 +27,12 @@ enum Job {
     },
     /// Waiting for the renderer's capture of the view.
     Capture { place: Place },
+    /// Waiting for the frames of the range, captured one by one (the app's flipbook).
+    Record { place: Place },
+    /// A recording's video being finished by the encoder: what it saved, once it has.
+    Finishing {
+        saved: std::sync::Arc<std::sync::Mutex<Option<Result<String, String>>>>,
+    },
 }
 
 /// Where an export's files go: their common name and (natively) their folder.
@@ -66,6 +73,8 @@ pub struct ExportPanel {
     pub png_width: u32,
     /// PNG over a transparent background.
     pub transparent: bool,
+    /// PNG of every frame of the range (a recording), not of the view's frame.
+    pub range: bool,
     job: Option<Job>,
     /// The last export's result, for the page state: the file names or the error.
     pub last: Option<Result<Vec<String>, String>>,
@@ -80,11 +89,24 @@ impl Default for ExportPanel {
             options: Options::default(),
             png_width: 1920,
             transparent: false,
+            range: false,
             job: None,
             last: None,
             capture_progress: 0.0,
         }
     }
+}
+
+/// A recording of the range the Export group asks for.
+pub struct RecordAsk {
+    /// Pixel size of the frames.
+    pub size: [u32; 2],
+    /// Over a transparent background (PNGs only).
+    pub transparent: bool,
+    /// The files' common name.
+    pub stem: String,
+    /// The video encoder the frames go to; without one, PNG files.
+    pub video: Option<Box<dyn crate::ui::flipbook::VideoSink>>,
 }
 
 /// What the app must do for the group this frame.
@@ -94,6 +116,10 @@ pub struct ExportAsk {
     pub capture: Option<([u32; 2], bool)>,
     /// Drop the capture under way (Cancel).
     pub cancel_capture: bool,
+    /// Record every frame of the range.
+    pub record: Option<RecordAsk>,
+    /// Stop the recording under way (Cancel).
+    pub cancel_record: bool,
 }
 
 impl ExportPanel {
@@ -101,7 +127,8 @@ impl ExportPanel {
     pub fn progress(&self) -> Option<f32> {
         match &self.job {
             Some(Job::Sampling { sampling, .. }) => Some(sampling.progress() * 0.9),
-            Some(Job::Capture { .. }) => Some(self.capture_progress),
+            Some(Job::Capture { .. } | Job::Record { .. }) => Some(self.capture_progress),
+            Some(Job::Finishing { .. }) => Some(1.0),
             None => None,
         }
     }
@@ -137,6 +164,14 @@ impl ExportPanel {
                 });
                 let r = ui.checkbox(&mut self.transparent, "transparent background");
                 mark(ui, "export:transparent", r.rect);
+                let r = ui
+                    .checkbox(&mut self.range, "every frame of the range")
+                    .on_hover_text(if platform::HAS_PICKER {
+                        "Record: each frame of the timeline's range at full quality, one after another, as PNGs in one zip (STEM_####.png)"
+                    } else {
+                        "Record: each frame of the timeline's range at full quality, one after another, as STEM_####.png beside the scene file"
+                    });
+                mark(ui, "export:range", r.rect);
             } else {
                 ui.add(
                         egui::Slider::new(&mut o.resolution, 16..=crate::limits::MAX_EXPORT_RESOLUTION)
@@ -178,6 +213,7 @@ impl ExportPanel {
                     mark(ui, "export:cancel", cancel.rect);
                     if cancel.clicked() {
                         ask.cancel_capture = matches!(self.job, Some(Job::Capture { .. }));
+                        ask.cancel_record = matches!(self.job, Some(Job::Record { .. }));
                         self.job = None;
                         notices.note(ui.input(|i| i.time), "Export cancelled");
                     }
@@ -208,8 +244,28 @@ impl ExportPanel {
                 self.png_width.clamp(16, 8192),
                 png_height(self.png_width, view_px),
             ];
-            self.job = Some(Job::Capture { place });
             self.capture_progress = 0.0;
+            if self.range {
+                // A WebM over the sky (VP9 wants even sides; WebCodecs encodes no alpha), else
+                // PNGs.
+                let even = size.map(|v| (v & !1).max(2));
+                let fps = f64::from(doc.scene().clock.fps);
+                let video = (!self.transparent)
+                    .then(|| platform::video_sink(even, fps))
+                    .flatten();
+                let ask = RecordAsk {
+                    size: if video.is_some() { even } else { size },
+                    transparent: self.transparent,
+                    stem: place.stem.clone(),
+                    video,
+                };
+                self.job = Some(Job::Record { place });
+                return ExportAsk {
+                    record: Some(ask),
+                    ..Default::default()
+                };
+            }
+            self.job = Some(Job::Capture { place });
             return ExportAsk {
                 capture: Some((size, self.transparent)),
                 ..Default::default()
@@ -237,6 +293,14 @@ impl ExportPanel {
     /// Advances a running export within this frame's budget; saves its files when done.
     /// Returns whether one is still running (the app keeps repainting).
     pub fn step(&mut self, notices: &mut Notices, now: f64) -> bool {
+        if let Some(Job::Finishing { saved }) = &self.job {
+            let done = saved.lock().ok().and_then(|mut s| s.take());
+            if let Some(saved) = done {
+                self.job = None;
+                self.report(saved.map(|w| vec![w]), notices, now);
+            }
+            return self.job.is_some();
+        }
         let Some(Job::Sampling { sampling, .. }) = &mut self.job else {
             return self.job.is_some();
         };
@@ -287,6 +351,52 @@ impl ExportPanel {
         let saved = pixels
             .and_then(|rgba| platform::save_png(&path, size[0], size[1], rgba))
             .map(|w| vec![w]);
+        self.report(saved, notices, now);
+    }
+
+    /// Saves a finished recording's frames: a video as `STEM.webm` once its encoder is done;
+    /// PNGs in the browser as one zip download (`STEM-frames.zip`), natively each beside the
+    /// scene file.
+    pub fn recorded(&mut self, frames: Result<Frames, String>, notices: &mut Notices, now: f64) {
+        let Some(Job::Record { place }) = self.job.take() else {
+            return;
+        };
+        let frames = match frames {
+            Ok(Frames::Video(video, _)) => {
+                let saved = std::sync::Arc::new(std::sync::Mutex::new(None));
+                let into = saved.clone();
+                video.finish(
+                    place.path(&format!("{}.webm", place.stem)),
+                    Box::new(move |result| {
+                        if let Ok(mut s) = into.lock() {
+                            *s = Some(result);
+                        }
+                    }),
+                );
+                self.job = Some(Job::Finishing { saved });
+                return;
+            }
+            Ok(Frames::Pngs(files)) => Ok(files),
+            Err(e) => Err(e),
+        };
+        let saved = frames.and_then(|files| {
+            if platform::HAS_PICKER {
+                let name = format!("{}-frames.zip", place.stem);
+                platform::save_bytes(&name, &zip(&files), "application/zip").map(|w| vec![w])
+            } else {
+                files
+                    .iter()
+                    .map(|f| platform::save_bytes(&place.path(&f.name), &f.bytes, "image/png"))
+                    .collect()
+            }
+        });
+        // Natively a range writes a file a frame: the first and the last name them.
+        let saved = saved.map(|names| match names.as_slice() {
+            [first, .., last] if names.len() > 2 => {
+                vec![format!("{} frames, {first} … {last}", names.len())]
+            }
+            _ => names,
+        });
         self.report(saved, notices, now);
     }
 

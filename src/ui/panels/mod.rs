@@ -10,7 +10,7 @@ mod sketch;
 mod timeline;
 mod view;
 
-pub use export::ExportPanel;
+pub use export::{ExportAsk, ExportPanel};
 pub use light::LIGHT;
 pub use render::{RENDER, take_removed_tier};
 pub use scene::ScenePanel;
