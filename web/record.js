@@ -6,7 +6,8 @@
 let muxer = null;
 /** webm-muxer's module, from the folder Trunk copies next to index.html. */
 function loadMuxer() {
-  muxer ??= import(new URL('vendor/webm-muxer.js', document.baseURI).href);
+  // (A failed fetch is not kept: the next recording tries again.)
+  muxer ??= import(new URL('vendor/webm-muxer.js', document.baseURI).href).catch((e) => { muxer = null; throw e; });
   return muxer;
 }
 
@@ -26,7 +27,8 @@ export class WebmRecorder {
     this.fps = fps;
     this.problem = null;
     this.frames = 0;
-    this.ready = this.start();
+    // An error here (no muxer, no VP9 at this size) is kept and reported by the next frame.
+    this.ready = this.start().catch((e) => { this.problem ??= String(e?.message ?? e); });
   }
 
   async start() {
@@ -60,6 +62,7 @@ export class WebmRecorder {
     const data = rgba.slice();
     this.frames = Math.max(this.frames, index + 1);
     this.ready = this.ready.then(() => {
+      if (this.problem) return;
       const frame = new VideoFrame(data, {
         format: 'RGBA',
         codedWidth: this.width,
@@ -98,8 +101,9 @@ export class WebmRecorder {
     return new Blob([bytes], { type: 'video/webm' });
   }
 
-  /** Drops the recording. */
+  /** Drops the recording: the encoder stops (frames still queued are not encoded). */
   cancel() {
+    this.problem ??= 'cancelled';
     this.ready.then(() => { try { this.encoder?.close(); } catch { /* closed already */ } });
   }
 }

@@ -7,7 +7,7 @@
 //! - `vdb`: the OpenVDB writer; `mitsuba`: the Mitsuba scene; `formats`: glb, OBJ, PLY, `.vol`;
 //! - `mesh`: the surface by marching cubes (closed, manifold, outward);
 //! - `zip`: several files as one (stored) archive, for one browser download;
-//! - `png`: an RGBA image as PNG, for the browser's recorded frames.
+//! - `png`: an RGBA image as PNG, for Record's frames.
 
 mod axes;
 mod formats;

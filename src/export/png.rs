@@ -1,7 +1,7 @@
 //! PNG of an RGBA image, written with the deflate the page already carries (`miniz_oxide`, for
-//! share links): how the browser's Record packs each frame of a range without a codec crate or
-//! a round trip through the browser's asynchronous image encoder. The CLI keeps the `png`
-//! crate; both are read back the same.
+//! share links): how Record packs each frame of a range as PNG (the page's zip, the desktop's
+//! files) without a codec crate in the page or a round trip through the browser's asynchronous
+//! image encoder. The CLI keeps the `png` crate; both are read back the same.
 
 use super::zip::crc32;
 

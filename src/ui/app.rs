@@ -378,6 +378,14 @@ impl CloudApp {
             self.viewport.capture_request = ask.capture;
         }
         if let Some(r) = ask.record {
+            if self.viewport.stats.backend.is_none() {
+                self.panels.export.recorded(
+                    Err("no GPU renderer: there is nothing to record with".to_owned()),
+                    &mut self.notices,
+                    now,
+                );
+                return;
+            }
             self.panels.timeline.playing = false;
             let said = self.flipbook.start_record(
                 self.doc.scene(),
@@ -442,9 +450,12 @@ impl CloudApp {
             }
             // The capture's pixels, once the asked frame's came back (only the cache asks
             // for captures while it caches: a PNG export stops it first).
+            // A capture that came back while another is asked or under way (the time was
+            // moved meanwhile) is dropped: nobody else may take the flipbook's.
+            let arrived = self.viewport.captured.take();
             let captured =
                 if self.flipbook_capture.is_none() && self.viewport.capture_progress().is_none() {
-                    self.viewport.captured.take().map(|(_, pixels)| pixels)
+                    arrived.map(|(_, pixels)| pixels)
                 } else {
                     None
                 };

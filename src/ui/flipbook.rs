@@ -38,9 +38,15 @@ pub trait VideoSink {
     /// Queues frame `index` of the recording (0 first): straight-alpha RGBA at its size.
     /// An error ends the recording.
     fn add(&mut self, rgba: &[u8], index: u32) -> Result<(), String>;
-    /// Encodes what is queued and saves the video as `name`; `done` gets what was saved (or
-    /// why not) once it is.
-    fn finish(self: Box<Self>, name: String, done: Box<dyn FnOnce(Result<String, String>)>);
+    /// Encodes what is queued and saves the video as `name`, unless `cancelled` is set by
+    /// then; `done` gets what was saved (or why not) once it is. A sink dropped without
+    /// finishing stops its encoder.
+    fn finish(
+        self: Box<Self>,
+        name: String,
+        cancelled: std::sync::Arc<std::sync::atomic::AtomicBool>,
+        done: Box<dyn FnOnce(Result<String, String>)>,
+    );
 }
 
 /// A recording's frames: PNG files, or a video encoder's queue.
@@ -621,13 +627,27 @@ mod tests {
         assert!(book.frame(&scene, [1920, 1080]).is_none());
     }
 
-    /// Steps a recording to its end with captures of `size` whose red is the frame's time in
-    /// tenths; returns what it handed over and how many captures it asked for.
+    /// Steps a PNG recording to its end (see `drive_recording`): its files, and how many
+    /// captures it asked for.
     fn record_all(
         book: &mut Flipbook,
         ctx: &egui::Context,
         scene: &mut Scene,
     ) -> (Vec<crate::export::File>, usize) {
+        let (recorded, asked) = drive_recording(book, ctx, scene);
+        let Ok(Frames::Pngs(files)) = recorded else {
+            panic!("{recorded:?}")
+        };
+        (files, asked)
+    }
+
+    /// Steps a recording to its end with captures whose red is the frame's time in tenths;
+    /// returns how it ended and how many captures it asked for.
+    fn drive_recording(
+        book: &mut Flipbook,
+        ctx: &egui::Context,
+        scene: &mut Scene,
+    ) -> (Result<Frames, String>, usize) {
         let mut captured = None;
         let mut asked = 0;
         loop {
@@ -636,10 +656,7 @@ mod tests {
                 *scene = scene.posed_at(t);
             }
             if let Some(recorded) = ask.recorded {
-                let Ok(Frames::Pngs(files)) = recorded else {
-                    panic!("{recorded:?}")
-                };
-                return (files, asked);
+                return (recorded, asked);
             }
             let size = ask.capture.expect("a capture until the recording ends");
             asked += 1;
@@ -734,7 +751,12 @@ mod tests {
             self.0.borrow_mut().push((rgba[0], index));
             Ok(())
         }
-        fn finish(self: Box<Self>, name: String, done: Box<dyn FnOnce(Result<String, String>)>) {
+        fn finish(
+            self: Box<Self>,
+            name: String,
+            _: std::sync::Arc<std::sync::atomic::AtomicBool>,
+            done: Box<dyn FnOnce(Result<String, String>)>,
+        ) {
             done(Ok(name));
         }
     }
@@ -744,24 +766,10 @@ mod tests {
         scene: &mut Scene,
         ctx: &egui::Context,
         probe: Probe,
-    ) -> (String, Option<Result<Frames, String>>) {
+    ) -> (String, Result<Frames, String>) {
         let mut book = Flipbook::default();
         let said = book.start_record(scene, [4, 2], false, "cloud", Some(Box::new(probe)));
-        let mut captured = None;
-        loop {
-            let ask = book.step(ctx, scene, captured.take());
-            if let Some(t) = ask.time {
-                *scene = scene.posed_at(t);
-            }
-            if ask.recorded.is_some() {
-                return (said, ask.recorded);
-            }
-            let size = ask.capture.expect("a capture");
-            let red = (scene.time * 10.0).round() as u8;
-            captured = Some(Ok(
-                [red, 0, 0, 255].repeat(size[0] as usize * size[1] as usize)
-            ));
-        }
+        (said, drive_recording(&mut book, ctx, scene).0)
     }
 
     #[test]
@@ -773,7 +781,7 @@ mod tests {
         let seen = std::rc::Rc::new(std::cell::RefCell::new(Vec::new()));
         let (said, ended) = record_into(&mut scene, &ctx, Probe(seen.clone(), u32::MAX));
         assert_eq!(said, "Recording 5 frames at 4×2 as a WebM");
-        assert!(matches!(ended, Some(Ok(Frames::Video(_, 5)))), "{ended:?}");
+        assert!(matches!(ended, Ok(Frames::Video(_, 5))), "{ended:?}");
         let expected: Vec<(u8, u32)> = (2..=6)
             .zip(0..)
             .map(|(f, i)| ((scene.clock.seconds(f) * 10.0).round() as u8, i))
@@ -781,10 +789,7 @@ mod tests {
         assert_eq!(*seen.borrow(), expected);
         // The encoder failing ends the recording with its error.
         let (_, ended) = record_into(&mut scene, &ctx, Probe(seen.clone(), 2));
-        assert_eq!(
-            ended,
-            Some(Err("the video encoder failed: out of memory".into()))
-        );
+        assert_eq!(ended, Err("the video encoder failed: out of memory".into()));
     }
 
     #[test]

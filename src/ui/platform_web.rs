@@ -604,10 +604,21 @@ extern "C" {
     fn failed(this: &WebmRecorder) -> Option<String>;
     #[wasm_bindgen(method)]
     fn finish(this: &WebmRecorder) -> js_sys::Promise;
+    #[wasm_bindgen(method)]
+    fn cancel(this: &WebmRecorder);
 }
 
-/// Record's WebM: the browser's WebCodecs VP9 encoder and webm-muxer (`web/record.js`).
-struct Webm(WebmRecorder);
+/// Record's WebM: the browser's WebCodecs VP9 encoder and webm-muxer (`web/record.js`), and
+/// whether it was finished (one dropped unfinished, cancelled or failed, closes its encoder).
+struct Webm(WebmRecorder, bool);
+
+impl Drop for Webm {
+    fn drop(&mut self) {
+        if !self.1 {
+            self.0.cancel();
+        }
+    }
+}
 
 impl super::flipbook::VideoSink for Webm {
     fn add(&mut self, rgba: &[u8], index: u32) -> Result<(), String> {
@@ -618,10 +629,19 @@ impl super::flipbook::VideoSink for Webm {
         Ok(())
     }
 
-    fn finish(self: Box<Self>, name: String, done: Box<dyn FnOnce(Result<String, String>)>) {
+    fn finish(
+        mut self: Box<Self>,
+        name: String,
+        cancelled: std::sync::Arc<std::sync::atomic::AtomicBool>,
+        done: Box<dyn FnOnce(Result<String, String>)>,
+    ) {
+        self.1 = true;
         let promise = self.0.finish();
         wasm_bindgen_futures::spawn_local(async move {
             let saved = match wasm_bindgen_futures::JsFuture::from(promise).await {
+                _ if cancelled.load(std::sync::atomic::Ordering::Relaxed) => {
+                    Err("cancelled".to_owned())
+                }
                 Ok(blob) => blob
                     .dyn_into::<web_sys::Blob>()
                     .map_err(|_| "the encoder gave no video".to_owned())
@@ -644,5 +664,8 @@ pub fn video_sink(size: [u32; 2], fps: f64) -> Option<Box<dyn super::flipbook::V
     if asks_png || !video_supported() {
         return None;
     }
-    Some(Box::new(Webm(WebmRecorder::new(size[0], size[1], fps))))
+    Some(Box::new(Webm(
+        WebmRecorder::new(size[0], size[1], fps),
+        false,
+    )))
 }

@@ -242,14 +242,14 @@ function cloudMask(img, bg) {
 
 const NATIVE = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../../target/debug/cloudsketch');
 
-/** Renders frames 0..11 of `scene` at `w`×`h` with the CLI; returns them decoded. */
-function cliFrames(scene, w, h) {
+/** Renders frames `first`..`last` of `scene` at `w`×`h` with the CLI; returns them decoded. */
+function cliFrames(scene, w, h, first = 0, last = 11) {
   const dir = fs.mkdtempSync(path.join(os.tmpdir(), 'cloudsketch-record-'));
   try {
     const json = path.join(dir, 'scene.json');
     fs.writeFileSync(json, JSON.stringify(scene));
-    execFileSync(NATIVE, ['render', json, '--frames', '0..11', '-o', path.join(dir, 'frame_####.png'), '--size', `${w}x${h}`], { env: { ...process.env, NODEVICE_SELECT: '1' } });
-    return Array.from({ length: 12 }, (_, k) => PNG.sync.read(fs.readFileSync(path.join(dir, `frame_${String(k).padStart(4, '0')}.png`))));
+    execFileSync(NATIVE, ['render', json, '--frames', `${first}..${last}`, '-o', path.join(dir, 'frame_####.png'), '--size', `${w}x${h}`], { env: { ...process.env, NODEVICE_SELECT: '1' } });
+    return Array.from({ length: last - first + 1 }, (_, k) => PNG.sync.read(fs.readFileSync(path.join(dir, `frame_${String(first + k).padStart(4, '0')}.png`))));
   } finally {
     fs.rmSync(dir, { recursive: true, force: true });
   }
@@ -268,16 +268,16 @@ function coverageIoU(a, b) {
 /**
  * Records the developing cumulus's frames 0–11 (one a second: the tower's first 11 s) at 320
  * px wide through the Export group as a user would: the PNG format, a typed width, "every
- * frame of the range", Export. 16 slices and the view's light grid (24 texels, 2 octaves) so
+ * frame of the range", Export. 16 slices and a light grid of `light` (texels, octaves) so
  * that the run fits the suite's time; the CLI then renders the same document. Returns the
  * download, the document, and the progress values seen.
  */
-async function recordRange(page) {
-  await page.evaluate(() => {
-    for (const p of ['/clock/end=11', '/clock/fps=1', '/render/slices=16', '/render/light_resolution=24', '/render/light_octaves=2',
+async function recordRange(page, light = [24, 2]) {
+  await page.evaluate((light) => {
+    for (const p of ['/clock/end=11', '/clock/fps=1', '/render/slices=16', `/render/light_resolution=${light[0]}`, `/render/light_octaves=${light[1]}`,
       '/light/ground=false', '/light/sky_gradient=false', '/light/shafts=false']) window.cloudsketch.set(p);
-  });
-  let s = await until(page, (s) => s.scene.clock.end === 11 && s.scene.clock.fps === 1 && s.scene.render.light_octaves === 2 && !s.scene.light.shafts, 'a 12-frame range');
+  }, light);
+  let s = await until(page, (s) => s.scene.clock.end === 11 && s.scene.clock.fps === 1 && s.scene.render.light_octaves === light[1] && !s.scene.light.shafts, 'a 12-frame range');
   const [, vh] = s.view.viewport;
   const click = async (name) => { const r = await revealAtFoot(page, name); await page.mouse.click(r[0] + r[2] / 2, r[1] + r[3] / 2); };
   await page.mouse.click(5, vh - 5);
@@ -368,12 +368,15 @@ for (const backend of BOTH_BUILDS) {
 }
 
 // Where the browser has no WebCodecs (forced here with ?record=png), Record writes PNGs, one
-// zip download: 12 frames, each covering the pixels the CLI's frame covers (IoU ≥ 0.9). On
-// the WebGL2 build, which browsers without WebGPU (the likeliest to lack WebCodecs) load.
+// zip download: 12 frames, each covering the pixels the CLI's frame covers (IoU ≥ 0.9) and
+// closer to its own frame than to its neighbours'. On the WebGL2 build, which browsers without
+// WebGPU (the likeliest to lack WebCodecs) load. The document's light grid (32 texels, 3
+// octaves) is finer than the view's preview of it on this CPU adapter (24, 2): the frames must
+// be drawn with the document's, as the CLI draws them, not with the view's.
 test('Record without a video encoder: the range as PNGs in a zip, each the CLI\'s frame (webgl2)', { timeout: 600_000 }, async () => {
   assert.ok(fs.existsSync(NATIVE), `${NATIVE} missing: run cargo test (it builds the CLI) first`);
   await withApp({ base: server.url, webgpu: false, query: '?preset=developing&record=png', viewport: { width: 1280, height: 800 } }, async (page) => {
-    const { file, scene, last } = await recordRange(page);
+    const { file, scene, last } = await recordRange(page, [32, 3]);
     assert.equal(file.suggestedFilename(), 'untitled-frames.zip');
     assert.deepEqual(last.files, ['untitled-frames.zip (a download)']);
     const files = unzipStored(new Uint8Array(fs.readFileSync(await file.path())));
@@ -389,8 +392,21 @@ test('Record without a video encoder: the range as PNGs in a zip, each the CLI\'
     const covered = frames.map((f, k) => {
       const { iou, n } = coverageIoU(f, cli[k]);
       assert.ok(iou >= 0.9, `frame ${k}: page and CLI cover the same pixels: IoU ${iou.toFixed(3)}`);
+      for (const j of [k - 1, k + 1].filter((j) => j >= 0 && j < 12)) {
+        assert.ok(coverageIoU(f, cli[j]).iou < iou, `frame ${k} is closer to the CLI's frame ${j} than to its own`);
+      }
       return n;
     });
+    // Lit with the document's light: nearer the CLI's frame 11 than the same frame drawn with
+    // the view's preview light (the baseline a recording of the view's light would match).
+    const preview = structuredClone(scene);
+    preview.render.light_resolution = 24;
+    preview.render.light_octaves = 2;
+    const [previewed] = cliFrames(preview, 320, h, 11, 11);
+    const meanDiff = (a, b) => { let d = 0; for (let i = 0; i < a.data.length; i++) d += Math.abs(a.data[i] - b.data[i]); return d / a.data.length; };
+    const [toDocument, toPreview] = [meanDiff(frames[11], cli[11]), meanDiff(frames[11], previewed)];
+    console.log(`# webgl2: frame 11 differs from the CLI's by ${toDocument.toFixed(3)} a byte with the document's light, ${toPreview.toFixed(3)} with the preview's`);
+    assert.ok(toDocument < 0.5 * toPreview, `drawn with the document's light: ${toDocument.toFixed(3)} against ${toPreview.toFixed(3)}`);
     fs.writeFileSync('test-results/screenshots/record-png-11-webgl2.png', Buffer.from(files[11].bytes));
     console.log(`# webgl2: cloud pixels by frame ${covered.join(' ')}`);
     assert.ok(covered[11] > 1.3 * covered[0] && covered[0] > 200, `the tower grows over the range: ${covered[0]} → ${covered[11]} px`);

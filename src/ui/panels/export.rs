@@ -32,6 +32,8 @@ enum Job {
     /// A recording's video being finished by the encoder: what it saved, once it has.
     Finishing {
         saved: std::sync::Arc<std::sync::Mutex<Option<Result<String, String>>>>,
+        /// Set by Cancel: the encoder's file is then not saved.
+        cancelled: std::sync::Arc<std::sync::atomic::AtomicBool>,
     },
 }
 
@@ -167,7 +169,7 @@ impl ExportPanel {
                 let r = ui
                     .checkbox(&mut self.range, "every frame of the range")
                     .on_hover_text(if platform::HAS_PICKER {
-                        "Record: each frame of the timeline's range at full quality, one after another, as PNGs in one zip (STEM_####.png)"
+                        "Record: each frame of the timeline's range at full quality, one after another, as a WebM at the scene's frame rate (where the browser encodes video; else, and with a transparent background, PNGs in one zip: STEM_####.png)"
                     } else {
                         "Record: each frame of the timeline's range at full quality, one after another, as STEM_####.png beside the scene file"
                     });
@@ -214,6 +216,9 @@ impl ExportPanel {
                     if cancel.clicked() {
                         ask.cancel_capture = matches!(self.job, Some(Job::Capture { .. }));
                         ask.cancel_record = matches!(self.job, Some(Job::Record { .. }));
+                        if let Some(Job::Finishing { cancelled, .. }) = &self.job {
+                            cancelled.store(true, std::sync::atomic::Ordering::Relaxed);
+                        }
                         self.job = None;
                         notices.note(ui.input(|i| i.time), "Export cancelled");
                     }
@@ -293,7 +298,7 @@ impl ExportPanel {
     /// Advances a running export within this frame's budget; saves its files when done.
     /// Returns whether one is still running (the app keeps repainting).
     pub fn step(&mut self, notices: &mut Notices, now: f64) -> bool {
-        if let Some(Job::Finishing { saved }) = &self.job {
+        if let Some(Job::Finishing { saved, .. }) = &self.job {
             let done = saved.lock().ok().and_then(|mut s| s.take());
             if let Some(saved) = done {
                 self.job = None;
@@ -344,6 +349,10 @@ impl ExportPanel {
         notices: &mut Notices,
         now: f64,
     ) {
+        // (Only a capture's job: a recording's frames are the flipbook's.)
+        if !matches!(self.job, Some(Job::Capture { .. })) {
+            return;
+        }
         let Some(Job::Capture { place }) = self.job.take() else {
             return;
         };
@@ -358,22 +367,27 @@ impl ExportPanel {
     /// PNGs in the browser as one zip download (`STEM-frames.zip`), natively each beside the
     /// scene file.
     pub fn recorded(&mut self, frames: Result<Frames, String>, notices: &mut Notices, now: f64) {
+        if !matches!(self.job, Some(Job::Record { .. })) {
+            return;
+        }
         let Some(Job::Record { place }) = self.job.take() else {
             return;
         };
         let frames = match frames {
             Ok(Frames::Video(video, _)) => {
                 let saved = std::sync::Arc::new(std::sync::Mutex::new(None));
+                let cancelled = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
                 let into = saved.clone();
                 video.finish(
                     place.path(&format!("{}.webm", place.stem)),
+                    cancelled.clone(),
                     Box::new(move |result| {
                         if let Ok(mut s) = into.lock() {
                             *s = Some(result);
                         }
                     }),
                 );
-                self.job = Some(Job::Finishing { saved });
+                self.job = Some(Job::Finishing { saved, cancelled });
                 return;
             }
             Ok(Frames::Pngs(files)) => Ok(files),
