@@ -413,7 +413,6 @@ impl CloudApp {
             self.notices
                 .note(now, "A recording is under way: cache when it is done");
         }
-        let timeline = &mut self.panels.timeline;
         if std::mem::take(&mut timeline.cache_asked) && !self.flipbook.building() {
             if self.viewport.stats.backend.is_none() {
                 self.notices
@@ -448,10 +447,10 @@ impl CloudApp {
                     self.flipbook_capture = Some((self.flipbook.size().0, 0));
                 }
             }
-            // The capture's pixels, once the asked frame's came back (only the cache asks
-            // for captures while it caches: a PNG export stops it first).
-            // A capture that came back while another is asked or under way (the time was
-            // moved meanwhile) is dropped: nobody else may take the flipbook's.
+            // The capture's pixels, once the asked frame's came back (only the flipbook asks
+            // for captures while it runs: a PNG export stops caching first, and none starts
+            // during a recording). One that came back while another is asked or under way
+            // (the time was moved meanwhile) is dropped: nobody else may take it.
             let arrived = self.viewport.captured.take();
             let captured =
                 if self.flipbook_capture.is_none() && self.viewport.capture_progress().is_none() {
