@@ -6,10 +6,13 @@ independent readers:
   named "density"; at every probe point (world coordinates of the file) the grid holds the
   value the field gives there, evaluated directly by the test, to float precision.
 - Mitsuba 3 (pip's `mitsuba`, variant scalar_rgb) renders the exported scenes with and without
-  the noise, and through an orthographic camera: the cloud covers the same pixels as the app's
-  own render of that view (coverage IoU >= 0.8; coverage = pixels more than 6/255 from the
-  background), and the export with the noise matches the app's image better than the one
-  without.
+  the noise, and through an orthographic camera, laid over the app's background: the cloud
+  covers the same pixels as the app's own render of that view (coverage IoU >= 0.8; coverage
+  = pixels more than 6/255 from the background) and its pixels' contrast with the background
+  correlates with the app's (>= 0.9).
+- The XML of three lit scenes holds the app's light by the documented units (read back with
+  an XML parser), and their path traces are compared with the app's linear light inside the
+  cloud (printed: the calibration is not done).
 
 - OpenEXR (through Mitsuba's Bitmap) opens the app's EXR of the same view: RGBA half floats
   of the PNG's size, opaque, the sky the PNG's sky decoded from sRGB, light above 1 inside the
@@ -68,9 +71,13 @@ def check_mitsuba(d):
     def coverage(rgb8):
         return (np.abs(rgb8 - background) > 6).any(axis=2)
 
+    bg_linear = srgb_to_linear(background / 255)
+
     def render(stem):
-        scene = mi.load_file(os.path.join(d, f"{stem}.xml"))
-        linear = np.array(mi.render(scene, seed=1), dtype=np.float64)
+        # The export's image is the cloud alone, premultiplied (its emitters hidden): laid over
+        # the app's background as the app lays it.
+        rgba = np.array(mi.render(mi.load_file(os.path.join(d, f"{stem}.xml")), seed=1), dtype=np.float64)
+        linear = rgba[:, :, :3] + (1 - rgba[:, :, 3:4]) * bg_linear
         srgb = np.where(linear <= 0.0031308, linear * 12.92, 1.055 * np.power(np.clip(linear, 0, None), 1 / 2.4) - 0.055)
         return np.clip(np.round(srgb * 255), 0, 255)
 
@@ -89,17 +96,93 @@ def check_mitsuba(d):
         ious[stem] = (cover & app_cover).sum() / max(union, 1)
         corrs[stem] = np.corrcoef(contrast(rendered), contrast(app_rgb))[0, 1]
         print(f"check_exports: {stem}: coverage {cover.sum()} px vs the app's {app_cover.sum()}, "
-              f"IoU {ious[stem]:.3f}, contrast correlation {corrs[stem]:.3f}")
+              f"IoU {ious[stem]:.3f}, contrast correlation {corrs[stem]:.4f}")
     for stem in ["mitsuba_noise", "mitsuba_ortho"]:
         if ious[stem] < 0.8:
             fail(f"{stem}: Mitsuba's render covers other pixels than the app's (IoU {ious[stem]:.3f} < 0.8)")
-    # The noise shapes the cloud inside its outline more than at its faintest fringe (which the
-    # coverage's 6/255 threshold counts): the pixels' contrast with the background is what it
-    # must bring closer to the app's.
-    if not corrs["mitsuba_noise"] > corrs["mitsuba_plain"]:
-        fail(f"the noise in the export does not bring Mitsuba closer to the app "
-             f"(contrast correlation {corrs['mitsuba_noise']:.3f} with, "
-             f"{corrs['mitsuba_plain']:.3f} without)")
+    for stem in ious:
+        if corrs[stem] < 0.9:
+            fail(f"{stem}: Mitsuba's image is not the app's (contrast correlation {corrs[stem]:.3f} < 0.9)")
+    # Whether the export holds the noise is checked in its grid (tests/exports.rs: the .vol
+    # against the CPU media, which a compute probe holds against the shader's): at 160x90 the
+    # noise moves the app's image by under half a level on average, less than the path
+    # trace's own noise, so these images cannot tell the two exports apart.
+
+
+def srgb_to_linear(c):
+    import numpy as np
+    c = np.asarray(c, dtype=np.float64)
+    return np.where(c <= 0.04045, c / 12.92, np.power((np.clip(c, 0, None) + 0.055) / 1.055, 2.4))
+
+
+def check_units(d):
+    """The XML holds the app's light by the documented conversions (docs/export-formats.md,
+    "Units"), read back with an XML parser."""
+    import math
+    import xml.etree.ElementTree as ET
+    import numpy as np
+    suns = json.load(open(os.path.join(d, "app_view.json")))["suns"]
+    for name, light in suns.items():
+        root = ET.parse(os.path.join(d, f"light_{name}.xml")).getroot()
+        values = lambda el: np.array([float(v) for v in el.get("value").split(",")])
+        exposure = 2.0 ** light["exposure"]
+        want_sun = 4 * math.pi * srgb_to_linear(light["sun_color"]) * light["sun_intensity"] * exposure
+        want_sky = srgb_to_linear(light["sky_color"]) * light["ambient"] * exposure
+        sun = values(root.find("emitter[@type='directional']/rgb[@name='irradiance']"))
+        sky = values(root.find("emitter[@type='constant']/rgb[@name='radiance']"))
+        medium = root.find("shape/medium")
+        phase = medium.find("phase")
+        lobes = [float(p.find("float[@name='g']").get("value")) for p in phase.findall("phase")]
+        weight = float(phase.find("float[@name='weight']").get("value"))
+        albedo = values(medium.find("rgb[@name='albedo']"))
+        scale = float(medium.find("float[@name='scale']").get("value"))
+        hidden = root.find("integrator/boolean[@name='hide_emitters']").get("value")
+        g = light["forward_scattering"]
+        checks = {
+            "sun irradiance = 4π × linear sun × intensity × 2^exposure": np.allclose(sun, want_sun, rtol=1e-4),
+            "sky radiance = linear sky × ambient × 2^exposure": np.allclose(sky, want_sky, rtol=1e-4, atol=1e-6),
+            "phase = blendphase of hg(g) and hg(-g/3), weight 0.2": phase.get("type") == "blendphase"
+            and np.allclose(lobes, [g, -g / 3], atol=1e-4) and abs(weight - 0.2) < 1e-6,
+            "albedo 1": np.allclose(albedo, 1.0),
+            "sigma_t scale = opacity": abs(scale - light["opacity"]) < 1e-5,
+            "emitters hidden from the camera": hidden == "true",
+            "no emission in the medium": medium.find("*[@name='radiance']") is None,
+        }
+        for what, ok in checks.items():
+            if not ok:
+                fail(f"light_{name}.xml: not {what}")
+    print(f"check_exports: the light of {len(suns)} scenes is written by the documented units")
+
+
+def check_light(d):
+    """The app's light against Mitsuba's path trace of its export, in linear light inside the
+    cloud (the app's alpha over one half), for suns in front, to the side and behind: luminance
+    rank correlation, mean ratio, and the ratio of their 90th/10th-percentile contrasts. Printed
+    for each, not held: the app's light is not yet calibrated against the path trace (#37's
+    target is rank correlation >= 0.9 and both ratios within 0.8-1.25 for each sun)."""
+    import mitsuba as mi
+    import numpy as np
+    mi.set_variant("scalar_rgb")
+    suns = json.load(open(os.path.join(d, "app_view.json")))["suns"]
+    lum = lambda rgb: rgb @ np.array([0.2126, 0.7152, 0.0722])
+    rank = lambda v: np.argsort(np.argsort(v))
+    figures = {}
+    for name in suns:
+        app = np.array(mi.Bitmap(os.path.join(d, f"light_{name}.exr")), dtype=np.float64)
+        trace = np.array(mi.render(mi.load_file(os.path.join(d, f"light_{name}.xml")), seed=1), dtype=np.float64)
+        inside = app[:, :, 3] > 0.5
+        if inside.sum() < 200:
+            fail(f"light_{name}: the app's cloud covers {inside.sum()} pixels")
+        a, t = lum(app[:, :, :3])[inside], lum(trace[:, :, :3])[inside]
+        corr = np.corrcoef(rank(a), rank(t))[0, 1]
+        mean = t.mean() / a.mean()
+        spread = lambda v: np.percentile(v, 90) / max(np.percentile(v, 10), 1e-9)
+        contrast = spread(t) / spread(a)
+        figures[name] = (corr, mean, contrast)
+        print(f"check_exports: light_{name}: {inside.sum()} px inside; the path trace against the app: "
+              f"rank correlation {corr:.3f}, mean ratio {mean:.3f}, 90/10 contrast ratio {contrast:.3f}")
+    # Measured, not yet held: the app's light is not calibrated against the path trace (#37).
+    return figures
 
 
 def check_exr(d):
@@ -149,6 +232,9 @@ def main():
         check_mitsuba(d)
     if what in ("all", "exr"):
         check_exr(d)
+    if what in ("all", "light"):
+        check_units(d)
+        check_light(d)
     print("check_exports: ok")
 
 

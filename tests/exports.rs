@@ -388,13 +388,63 @@ fn mitsuba_scenes_and_the_apps_render_of_their_view() {
         image.to_png().unwrap(),
     )
     .unwrap();
+    // The light the path trace judges: the cloud alone, in linear light, from three suns (in
+    // front, to the side, behind), each beside Mitsuba's scene of the same light. Dirtiness 1
+    // and sharpness 0, which have no physical counterpart; the noise exported.
+    let mut linear = Offscreen::with_output(Output::Linear).expect("an offscreen adapter");
+    let mut suns = serde_json::Map::new();
+    for (name, azimuth, elevation) in SUNS {
+        let mut lit = scene.clone();
+        lit.light.sun_azimuth_deg = azimuth;
+        lit.light.sun_elevation_deg = elevation;
+        lit.render.dirtiness = 1.0;
+        lit.render.sharpness = 0.0;
+        let stem = format!("light_{name}");
+        let options = Options {
+            resolution: 96,
+            image: LIGHT_SIZE,
+            samples: 64,
+            ..Options::default()
+        };
+        for f in export(&lit, Format::Mitsuba, &options, &stem).unwrap() {
+            std::fs::write(out_dir().join(&f.name), &f.bytes).unwrap();
+        }
+        let cloud = linear
+            .render_linear(&lit, LIGHT_SIZE, Backdrop::Transparent, 1, None)
+            .unwrap();
+        std::fs::write(
+            out_dir().join(format!("{stem}.exr")),
+            cloud.to_exr().unwrap(),
+        )
+        .unwrap();
+        let l = &lit.light;
+        suns.insert(
+            name.to_string(),
+            serde_json::json!({
+                "sun_color": l.sun_color, "sun_intensity": l.sun_intensity,
+                "sky_color": l.sky_color, "ambient": l.ambient, "exposure": l.exposure,
+                "forward_scattering": l.forward_scattering, "opacity": lit.render.opacity,
+            }),
+        );
+    }
     let background = scene.light.background.map(|c| (c * 255.0).round() as u8);
     std::fs::write(
         out_dir().join("app_view.json"),
-        serde_json::json!({ "background": background }).to_string(),
+        serde_json::json!({ "background": background, "suns": suns }).to_string(),
     )
     .unwrap();
 }
+
+/// The suns the path trace compares the app's light under: (name, azimuth, elevation). The
+/// default camera looks toward −z, so azimuth 90° lies behind the viewer.
+const SUNS: [(&str, f32, f32); 3] = [
+    ("front", 90.0, 35.0),
+    ("side", 10.0, 25.0),
+    ("behind", -90.0, 20.0),
+];
+
+/// The size of the light comparison's images.
+const LIGHT_SIZE: [u32; 2] = [160, 90];
 
 #[test]
 fn a_transparent_png_has_the_clouds_alpha_and_no_sky() {

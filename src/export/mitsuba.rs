@@ -1,8 +1,22 @@
 //! A Mitsuba 3 scene (XML) around the cloud's `.vol` grid: the app's camera, the sun as a
-//! directional emitter, the sky (the app's background colour) as a constant emitter, and the
-//! grid as the extinction of a heterogeneous medium inside a null-surfaced box, with the
-//! app's opacity as its scale and its forward scattering as the Henyey–Greenstein phase.
-//! Mitsuba renders it with `mitsuba scene.xml` (any variant; `scalar_rgb` on a CPU).
+//! directional emitter, the sky's light as a constant emitter, and the grid as the extinction
+//! of a non-emissive heterogeneous medium inside a null-surfaced box. Mitsuba renders it with
+//! `mitsuba scene.xml` (any variant; `scalar_rgb` on a CPU).
+//!
+//! The app's light converts by one convention (docs/export-formats.md, "Units"), and by
+//! nothing else:
+//! - the app's phase function is normalised so isotropic scattering is 1, Mitsuba's so it is
+//!   1/4π: the sun's irradiance is 4π × its linear colour × intensity;
+//! - the sky's light reaches the cloud from every direction, so the constant emitter's radiance
+//!   is the sky colour × ambient (no phase factor: a normalised phase integrates to 1);
+//! - both are scaled by 2^exposure, as the app scales all the cloud's light (its EXR holds the
+//!   same exposed light);
+//! - the phase is the app's two lobes, Mitsuba's `blendphase` of hg(g) and hg(−g/3), 4:1;
+//! - the app's slices scatter all the light they take out (no absorption): albedo 1;
+//! - σt is the grid × the scene's opacity, per world unit.
+//! The emitters are hidden from the camera (`hide_emitters`) and the film keeps alpha: the
+//! image is the cloud alone, premultiplied, as the app's transparent export, to lay over any
+//! backdrop (the app's background colour is a backdrop, not light).
 
 use std::fmt::Write as _;
 
@@ -35,6 +49,48 @@ fn v3(v: Vec3) -> String {
     format!("{:.6}, {:.6}, {:.6}", v.x, v.y, v.z)
 }
 
+/// Paths longer than this many scatterings are cut (a dense cloud's light at albedo 1 needs
+/// many).
+const MAX_DEPTH: u32 = 256;
+
+/// The app's light in Mitsuba's units (the conversions of docs/export-formats.md, "Units").
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Units {
+    /// The directional emitter's irradiance: 4π × linear sun colour × intensity × 2^exposure.
+    pub sun_irradiance: Vec3,
+    /// The constant emitter's radiance: linear sky colour × ambient × 2^exposure.
+    pub sky_radiance: Vec3,
+    /// The medium's single-scattering albedo (the app absorbs nothing).
+    pub albedo: f32,
+    /// σt per world unit at density 1: the scene's opacity.
+    pub sigma_t_scale: f32,
+    /// The forward lobe's asymmetry: the scene's forward scattering g.
+    pub g_forward: f32,
+    /// The backward lobe's asymmetry: −g/3.
+    pub g_back: f32,
+    /// `blendphase`'s weight, the backward lobe's share: 0.2 (the app mixes 4:1).
+    pub back_weight: f32,
+}
+
+impl Units {
+    /// `scene`'s light, converted.
+    pub fn of(scene: &Scene) -> Self {
+        let light = &scene.light;
+        let exposure = light.exposure.exp2();
+        let g = light.forward_scattering;
+        Self {
+            sun_irradiance: srgb_to_linear(light.sun_color)
+                * (4.0 * std::f32::consts::PI * light.sun_intensity * exposure),
+            sky_radiance: srgb_to_linear(light.sky_color) * (light.ambient * exposure),
+            albedo: 1.0,
+            sigma_t_scale: scene.render.opacity,
+            g_forward: g,
+            g_back: -g / 3.0,
+            back_weight: 0.2,
+        }
+    }
+}
+
 /// The scene XML for `scene`, referring to its grid as `vol_name`, rendering `size` pixels
 /// with `samples` per pixel.
 pub fn write_xml(
@@ -46,9 +102,7 @@ pub fn write_xml(
 ) -> String {
     let camera = &scene.camera;
     let light = &scene.light;
-    let exposure = light.exposure.exp2();
-    let sun = srgb_to_linear(light.sun_color) * light.sun_intensity * exposure;
-    let sky = srgb_to_linear(light.background);
+    let units = Units::of(scene);
     let (lo, hi) = grid_box(grid);
     let center = (lo + hi) * 0.5;
     let half = (hi - lo) * 0.5;
@@ -59,7 +113,7 @@ pub fn write_xml(
     let _ = writeln!(x, "<scene version=\"3.0.0\">");
     let _ = writeln!(
         x,
-        "  <integrator type=\"volpath\"><integer name=\"max_depth\" value=\"64\"/></integrator>"
+        "  <integrator type=\"volpath\"><integer name=\"max_depth\" value=\"{MAX_DEPTH}\"/><boolean name=\"hide_emitters\" value=\"true\"/></integrator>"
     );
     if camera.orthographic {
         // Mitsuba's orthographic sensor spans [−1, 1] across the film's width: scaled by the
@@ -100,7 +154,7 @@ pub fn write_xml(
     );
     let _ = writeln!(
         x,
-        "    <film type=\"hdrfilm\"><integer name=\"width\" value=\"{}\"/><integer name=\"height\" value=\"{}\"/><string name=\"pixel_format\" value=\"rgb\"/><rfilter type=\"box\"/></film>",
+        "    <film type=\"hdrfilm\"><integer name=\"width\" value=\"{}\"/><integer name=\"height\" value=\"{}\"/><string name=\"pixel_format\" value=\"rgba\"/><rfilter type=\"box\"/></film>",
         size[0], size[1]
     );
     let _ = writeln!(x, "  </sensor>");
@@ -108,12 +162,12 @@ pub fn write_xml(
         x,
         "  <emitter type=\"directional\"><vector name=\"direction\" value=\"{}\"/><rgb name=\"irradiance\" value=\"{}\"/></emitter>",
         v3(-light.sun_direction()),
-        v3(sun)
+        v3(units.sun_irradiance)
     );
     let _ = writeln!(
         x,
         "  <emitter type=\"constant\"><rgb name=\"radiance\" value=\"{}\"/></emitter>",
-        v3(sky)
+        v3(units.sky_radiance)
     );
     let _ = writeln!(x, "  <shape type=\"cube\">");
     let _ = writeln!(
@@ -134,13 +188,17 @@ pub fn write_xml(
     let _ = writeln!(
         x,
         "      <float name=\"scale\" value=\"{:.6}\"/>",
-        scene.render.opacity
+        units.sigma_t_scale
     );
-    let _ = writeln!(x, "      <rgb name=\"albedo\" value=\"0.98, 0.98, 0.98\"/>");
     let _ = writeln!(
         x,
-        "      <phase type=\"hg\"><float name=\"g\" value=\"{:.4}\"/></phase>",
-        light.forward_scattering
+        "      <rgb name=\"albedo\" value=\"{a:.4}, {a:.4}, {a:.4}\"/>",
+        a = units.albedo
+    );
+    let _ = writeln!(
+        x,
+        "      <phase type=\"blendphase\"><float name=\"weight\" value=\"{:.4}\"/><phase type=\"hg\"><float name=\"g\" value=\"{:.4}\"/></phase><phase type=\"hg\"><float name=\"g\" value=\"{:.4}\"/></phase></phase>",
+        units.back_weight, units.g_forward, units.g_back
     );
     let _ = writeln!(x, "    </medium>");
     let _ = writeln!(x, "  </shape>");
