@@ -18,6 +18,9 @@ export function videoSupported() {
 
 /** A key frame every this many frames (seeking lands on one). */
 const KEY_EVERY = 24;
+/** Frames queued (copied, waiting for the encoder or in it) before the app waits: each holds
+ *  its pixels, 8 MB at 1080p. */
+const MAX_QUEUED = 3;
 
 /** One recording: frames `width`×`height` (even) at `fps` frames a second. */
 export class WebmRecorder {
@@ -27,8 +30,19 @@ export class WebmRecorder {
     this.fps = fps;
     this.problem = null;
     this.frames = 0;
-    // An error here (no muxer, no VP9 at this size) is kept and reported by the next frame.
-    this.ready = this.start().catch((e) => { this.problem ??= String(e?.message ?? e); });
+    // Frames handed over and not yet in the encoder.
+    this.pending = 0;
+    this.started = false;
+    // An error here (no muxer, no VP9 at this size) is kept: the app, which waits for the
+    // start (busy), then records PNGs instead.
+    this.ready = this.start()
+      .catch((e) => { this.problem ??= String(e?.message ?? e); })
+      .finally(() => { this.started = true; });
+  }
+
+  /** Whether the app should wait before the next frame: still starting, or enough queued. */
+  busy() {
+    return !this.started || this.pending + (this.encoder?.encodeQueueSize ?? 0) >= MAX_QUEUED;
   }
 
   async start() {
@@ -61,7 +75,9 @@ export class WebmRecorder {
   addFrame(rgba, index) {
     const data = rgba.slice();
     this.frames = Math.max(this.frames, index + 1);
+    this.pending += 1;
     this.ready = this.ready.then(() => {
+      this.pending -= 1;
       if (this.problem) return;
       const frame = new VideoFrame(data, {
         format: 'RGBA',

@@ -33,8 +33,23 @@ const MAX_FRAMES: usize = 10_000;
 /// its zip, within wasm32's 4 GiB).
 pub const RECORD_CAP: usize = 768 << 20;
 
+/// Whether a video sink takes a frame now.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SinkState {
+    /// It takes the next frame.
+    Ready,
+    /// It is still starting, or holds as many frames as it queues: the next waits.
+    Busy,
+    /// It cannot encode (its muxer did not load, its encoder refuses the size): before its
+    /// first frame the recording goes on as PNGs; after, it ends with this error.
+    Refused(String),
+}
+
 /// A video encoder a recording hands its frames to (the browser's WebM through WebCodecs).
 pub trait VideoSink {
+    /// Whether it takes a frame now: a recording captures the next frame only then, so
+    /// frames never pile up in memory faster than the encoder takes them.
+    fn state(&self) -> SinkState;
     /// Queues frame `index` of the recording (0 first): straight-alpha RGBA at its size.
     /// An error ends the recording.
     fn add(&mut self, rgba: &[u8], index: u32) -> Result<(), String>;
@@ -459,6 +474,25 @@ impl Flipbook {
         let Some(build) = self.build.as_mut() else {
             return ask;
         };
+        if build.waiting.is_none()
+            && let Some(record) = build.record.as_mut()
+            && let Frames::Video(video, n) = &record.frames
+        {
+            match (video.state(), *n) {
+                (SinkState::Ready, _) => {}
+                (SinkState::Busy, _) => return ask,
+                (SinkState::Refused(why), 0) => {
+                    // Nothing was encoded yet: the same frames, as PNGs.
+                    ask.say = Some(format!("{why}: recording PNGs instead"));
+                    record.frames = Frames::Pngs(Vec::new());
+                }
+                (SinkState::Refused(why), _) => {
+                    ask.recorded = Some(Err(format!("the video encoder failed: {why}")));
+                    ask.time = self.cancel();
+                    return ask;
+                }
+            }
+        }
         if build.waiting.is_none() {
             match build.todo.pop() {
                 Some(frame) => {
@@ -650,7 +684,7 @@ mod tests {
     ) -> (Result<Frames, String>, usize) {
         let mut captured = None;
         let mut asked = 0;
-        loop {
+        for _ in 0..100_000 {
             let ask = book.step(ctx, scene, captured.take());
             if let Some(t) = ask.time {
                 *scene = scene.posed_at(t);
@@ -658,13 +692,17 @@ mod tests {
             if let Some(recorded) = ask.recorded {
                 return (recorded, asked);
             }
-            let size = ask.capture.expect("a capture until the recording ends");
+            // (A busy video sink holds the next capture back.)
+            let Some(size) = ask.capture else {
+                continue;
+            };
             asked += 1;
             let red = (scene.time * 10.0).round() as u8;
             captured = Some(Ok(
                 [red, 0, 0, 255].repeat(size[0] as usize * size[1] as usize)
             ));
         }
+        panic!("the recording never ended");
     }
 
     #[test]
@@ -744,6 +782,9 @@ mod tests {
     /// A video sink that keeps each frame's first byte and index, and fails at index `.1`.
     struct Probe(std::rc::Rc<std::cell::RefCell<Vec<(u8, u32)>>>, u32);
     impl VideoSink for Probe {
+        fn state(&self) -> SinkState {
+            SinkState::Ready
+        }
         fn add(&mut self, rgba: &[u8], index: u32) -> Result<(), String> {
             if index == self.1 {
                 return Err("out of memory".into());
@@ -790,6 +831,109 @@ mod tests {
         // The encoder failing ends the recording with its error.
         let (_, ended) = record_into(&mut scene, &ctx, Probe(seen.clone(), 2));
         assert_eq!(ended, Err("the video encoder failed: out of memory".into()));
+    }
+
+    /// A video sink that is busy for its first `starting` calls, then once after each frame
+    /// it takes (counted in `waits`), and refuses, once started, with `refuse`.
+    struct Slow {
+        seen: std::rc::Rc<std::cell::RefCell<Vec<u32>>>,
+        starting: std::cell::Cell<u32>,
+        pending: std::cell::Cell<bool>,
+        waits: std::rc::Rc<std::cell::Cell<u32>>,
+        refuse: Option<String>,
+    }
+    impl VideoSink for Slow {
+        fn state(&self) -> SinkState {
+            if self.starting.get() > 0 {
+                self.starting.set(self.starting.get() - 1);
+                return SinkState::Busy;
+            }
+            if let Some(why) = &self.refuse {
+                return SinkState::Refused(why.clone());
+            }
+            if self.pending.replace(false) {
+                self.waits.set(self.waits.get() + 1);
+                return SinkState::Busy;
+            }
+            SinkState::Ready
+        }
+        fn add(&mut self, _: &[u8], index: u32) -> Result<(), String> {
+            self.seen.borrow_mut().push(index);
+            self.pending.set(true);
+            Ok(())
+        }
+        fn finish(
+            self: Box<Self>,
+            name: String,
+            _: std::sync::Arc<std::sync::atomic::AtomicBool>,
+            done: Box<dyn FnOnce(Result<String, String>)>,
+        ) {
+            done(Ok(name));
+        }
+    }
+
+    #[test]
+    fn a_busy_encoder_holds_the_next_capture_back_and_a_refusing_one_leaves_pngs() {
+        let ctx = egui::Context::default();
+        let mut scene = keyed();
+        scene.clock.end = 3;
+        // Starting (busy for 3 calls), then busy once after every odd frame: no capture is
+        // asked while it is busy, and every frame still reaches it once, in order.
+        let seen = std::rc::Rc::new(std::cell::RefCell::new(Vec::new()));
+        let waits = std::rc::Rc::new(std::cell::Cell::new(0));
+        let slow = |starting: u32, refuse: Option<&str>| {
+            Box::new(Slow {
+                seen: seen.clone(),
+                starting: starting.into(),
+                pending: false.into(),
+                waits: waits.clone(),
+                refuse: refuse.map(str::to_owned),
+            })
+        };
+        let mut book = Flipbook::default();
+        book.start_record(&scene, [4, 2], false, "cloud", Some(slow(3, None)));
+        for _ in 0..3 {
+            let ask = book.step(&ctx, &scene, None);
+            assert_eq!((ask.time, ask.capture), (None, None), "held while starting");
+        }
+        let (ended, asked) = drive_recording(&mut book, &ctx, &mut scene);
+        assert!(matches!(ended, Ok(Frames::Video(_, 4))), "{ended:?}");
+        assert_eq!(asked, 4, "one capture a frame");
+        assert_eq!(*seen.borrow(), [0, 1, 2, 3]);
+        assert_eq!(waits.get(), 4, "held back after each frame it took");
+        // Refused before its first frame (a size VP9 cannot encode): the same frames, as PNGs,
+        // and it says so.
+        let mut book = Flipbook::default();
+        book.start_record(
+            &scene,
+            [4, 2],
+            false,
+            "cloud",
+            Some(slow(0, Some("this browser cannot encode VP9 at 4×2"))),
+        );
+        let ask = book.step(&ctx, &scene, None);
+        assert_eq!(
+            ask.say.as_deref(),
+            Some("this browser cannot encode VP9 at 4×2: recording PNGs instead")
+        );
+        assert_eq!(ask.capture, Some([4, 2]), "the first frame asked at once");
+        let mut captured = Some(Ok([0u8, 0, 0, 255].repeat(8)));
+        let mut time = ask.time;
+        let ended = loop {
+            if let Some(t) = time {
+                scene = scene.posed_at(t);
+            }
+            let ask = book.step(&ctx, &scene, captured.take());
+            time = ask.time;
+            if let Some(ended) = ask.recorded {
+                break ended;
+            }
+            captured = Some(Ok([0u8, 0, 0, 255].repeat(8)));
+        };
+        let Ok(Frames::Pngs(files)) = ended else {
+            panic!("{ended:?}")
+        };
+        assert_eq!(files.len(), 4);
     }
 
     #[test]

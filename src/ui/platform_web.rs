@@ -603,6 +603,8 @@ extern "C" {
     #[wasm_bindgen(method)]
     fn failed(this: &WebmRecorder) -> Option<String>;
     #[wasm_bindgen(method)]
+    fn busy(this: &WebmRecorder) -> bool;
+    #[wasm_bindgen(method)]
     fn finish(this: &WebmRecorder) -> js_sys::Promise;
     #[wasm_bindgen(method)]
     fn cancel(this: &WebmRecorder);
@@ -621,6 +623,15 @@ impl Drop for Webm {
 }
 
 impl super::flipbook::VideoSink for Webm {
+    fn state(&self) -> super::flipbook::SinkState {
+        use super::flipbook::SinkState;
+        match self.0.failed() {
+            Some(e) => SinkState::Refused(e),
+            None if self.0.busy() => SinkState::Busy,
+            None => SinkState::Ready,
+        }
+    }
+
     fn add(&mut self, rgba: &[u8], index: u32) -> Result<(), String> {
         if let Some(e) = self.0.failed() {
             return Err(e);

@@ -103,8 +103,10 @@ export async function launch({ webgpu, webgl = true }) {
 }
 
 /** Opens the app in a new page and records console errors and page errors. */
-export async function openApp(browser, base, query = '', viewport = { width: 900, height: 560 }, options = {}) {
+export async function openApp(browser, base, query = '', viewport = { width: 900, height: 560 }, options = {}, init = null) {
   const page = await browser.newPage({ viewport, ...options });
+  // A script run in the page before the app's own (to stand in for a browser's features).
+  if (init) await page.addInitScript(init);
   const errors = [];
   const log = [];
   page.on('console', (m) => { log.push(`[${m.type()}] ${m.text()}`); if (m.type() === 'error') errors.push(m.text()); });
@@ -297,10 +299,10 @@ export async function until(page, pred, what, timeout = 60_000) {
  * Runs `body(page)` in a fresh Chromium (WebGPU on or off) with the app at `base + query` open
  * and ready; on failure prints the page's last log lines; fails if the page logged an error.
  */
-export async function withApp({ base, webgpu, query = '', viewport }, body) {
+export async function withApp({ base, webgpu, query = '', viewport, init = null }, body) {
   const { browser, close } = await launch({ webgpu });
   try {
-    const { page, errors, log } = await openApp(browser, base, query, viewport);
+    const { page, errors, log } = await openApp(browser, base, query, viewport, {}, init);
     try {
       await waitForBody(page, 'data-ready', (v) => v === 'true');
       await body(page);
