@@ -75,7 +75,8 @@ def check_mitsuba(d):
 
     def render(stem):
         # The export's image is the cloud alone, premultiplied (its emitters hidden): laid over
-        # the app's background as the app lays it.
+        # the app's background in linear light, then encoded (the app tone-maps its cloud and
+        # lays it in sRGB; coverage and contrast correlation do not need the same curve).
         rgba = np.array(mi.render(mi.load_file(os.path.join(d, f"{stem}.xml")), seed=1), dtype=np.float64)
         linear = rgba[:, :, :3] + (1 - rgba[:, :, 3:4]) * bg_linear
         srgb = np.where(linear <= 0.0031308, linear * 12.92, 1.055 * np.power(np.clip(linear, 0, None), 1 / 2.4) - 0.055)
@@ -132,7 +133,9 @@ def check_units(d):
         sky = values(root.find("emitter[@type='constant']/rgb[@name='radiance']"))
         medium = root.find("shape/medium")
         phase = medium.find("phase")
-        lobes = [float(p.find("float[@name='g']").get("value")) for p in phase.findall("phase")]
+        # (Mitsuba hands nested objects over in the order of their names.)
+        lobes = [float(p.find("float[@name='g']").get("value"))
+                 for p in sorted(phase.findall("phase"), key=lambda p: p.get("name", ""))]
         weight = float(phase.find("float[@name='weight']").get("value"))
         albedo = values(medium.find("rgb[@name='albedo']"))
         scale = float(medium.find("float[@name='scale']").get("value"))

@@ -393,10 +393,11 @@ fn mitsuba_scenes_and_the_apps_render_of_their_view() {
     // and sharpness 0, which have no physical counterpart; the noise exported.
     let mut linear = Offscreen::with_output(Output::Linear).expect("an offscreen adapter");
     let mut suns = serde_json::Map::new();
-    for (name, azimuth, elevation) in SUNS {
+    for (name, azimuth, elevation, exposure) in SUNS {
         let mut lit = scene.clone();
         lit.light.sun_azimuth_deg = azimuth;
         lit.light.sun_elevation_deg = elevation;
+        lit.light.exposure = exposure;
         lit.render.dirtiness = 1.0;
         lit.render.sharpness = 0.0;
         let stem = format!("light_{name}");
@@ -435,12 +436,13 @@ fn mitsuba_scenes_and_the_apps_render_of_their_view() {
     .unwrap();
 }
 
-/// The suns the path trace compares the app's light under: (name, azimuth, elevation). The
-/// default camera looks toward −z, so azimuth 90° lies behind the viewer.
-const SUNS: [(&str, f32, f32); 3] = [
-    ("front", 90.0, 35.0),
-    ("side", 10.0, 25.0),
-    ("behind", -90.0, 20.0),
+/// The suns the path trace compares the app's light under: (name, azimuth, elevation,
+/// exposure). The default camera looks toward −z, so azimuth 90° lies behind the viewer. One
+/// has an exposure, which the app and the export both scale their light by.
+const SUNS: [(&str, f32, f32, f32); 3] = [
+    ("front", 90.0, 35.0, 0.0),
+    ("side", 10.0, 25.0, 0.5),
+    ("behind", -90.0, 20.0, 0.0),
 ];
 
 /// The size of the light comparison's images.

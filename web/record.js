@@ -21,6 +21,8 @@ const KEY_EVERY = 24;
 /** Frames queued (copied, waiting for the encoder or in it) before the app waits: each holds
  *  its pixels, 8 MB at 1080p. */
 const MAX_QUEUED = 3;
+/** How long a recording's encoder may take to start before the app records PNGs instead. */
+const START_WITHIN_MS = 20_000;
 
 /** One recording: frames `width`×`height` (even) at `fps` frames a second. */
 export class WebmRecorder {
@@ -35,7 +37,9 @@ export class WebmRecorder {
     this.started = false;
     // An error here (no muxer, no VP9 at this size) is kept: the app, which waits for the
     // start (busy), then records PNGs instead.
-    this.ready = this.start()
+    // A start that hangs (a module fetch that never answers) counts as failed.
+    const late = new Promise((_, fail) => setTimeout(() => fail(new Error('the video encoder did not start within 20 s')), START_WITHIN_MS));
+    this.ready = Promise.race([this.start(), late])
       .catch((e) => { this.problem ??= String(e?.message ?? e); })
       .finally(() => { this.started = true; });
   }
@@ -68,6 +72,14 @@ export class WebmRecorder {
       error: (e) => { this.problem ??= String(e?.message ?? e); },
     });
     this.encoder.configure(config);
+    // Configuring is reported through the error callback, later: an empty flush waits for it
+    // (and rejects if it failed), so a refusing encoder is known before the first frame.
+    await this.encoder.flush();
+    if (this.problem) {
+      // (Failed, or given up on by the time it started: nothing will use it.)
+      try { this.encoder.close(); } catch { /* closed by its error already */ }
+      throw new Error(this.problem);
+    }
   }
 
   /** Queues frame `index` (0 first): straight-alpha RGBA bytes, copied here (they are a view

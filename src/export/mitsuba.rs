@@ -8,7 +8,9 @@
 //! - the app's phase function is normalised so isotropic scattering is 1, Mitsuba's so it is
 //!   1/4π: the sun's irradiance is 4π × its linear colour × intensity;
 //! - the sky's light reaches the cloud from every direction, so the constant emitter's radiance
-//!   is the sky colour × ambient (no phase factor: a normalised phase integrates to 1);
+//!   is the sky colour × ambient (no phase factor: a normalised phase integrates to 1). The
+//!   app takes it from above only (its transmittance toward the zenith); the constant emitter
+//!   lights the base from below too;
 //! - both are scaled by 2^exposure, as the app scales all the cloud's light (its EXR holds the
 //!   same exposed light);
 //! - the phase is the app's two lobes, Mitsuba's `blendphase` of hg(g) and hg(−g/3), 4:1;
@@ -197,7 +199,7 @@ pub fn write_xml(
     );
     let _ = writeln!(
         x,
-        "      <phase type=\"blendphase\"><float name=\"weight\" value=\"{:.4}\"/><phase type=\"hg\"><float name=\"g\" value=\"{:.4}\"/></phase><phase type=\"hg\"><float name=\"g\" value=\"{:.4}\"/></phase></phase>",
+        "      <phase type=\"blendphase\"><float name=\"weight\" value=\"{:.4}\"/><phase type=\"hg\" name=\"phase_0\"><float name=\"g\" value=\"{:.4}\"/></phase><phase type=\"hg\" name=\"phase_1\"><float name=\"g\" value=\"{:.4}\"/></phase></phase>",
         units.back_weight, units.g_forward, units.g_back
     );
     let _ = writeln!(x, "    </medium>");

@@ -409,33 +409,38 @@ impl Flipbook {
                         image,
                         egui::TextureOptions::LINEAR,
                     ));
-                    match &mut record.frames {
-                        Frames::Video(video, n) => {
-                            if let Err(e) = video.add(&pixels, *n) {
+                    if let Frames::Video(video, n) = &mut record.frames {
+                        match video.add(&pixels, *n) {
+                            Ok(()) => *n += 1,
+                            // Nothing was encoded yet: this frame and the rest, as PNGs.
+                            Err(e) if *n == 0 => {
+                                ask.say = Some(format!("{e}: recording PNGs instead"));
+                                record.frames = Frames::Pngs(Vec::new());
+                            }
+                            Err(e) => {
                                 ask.recorded = Some(Err(format!("the video encoder failed: {e}")));
                                 ask.time = self.cancel();
                                 return ask;
                             }
-                            *n += 1;
                         }
-                        Frames::Pngs(files) => {
-                            // (The size was checked above: the encoder always writes it.)
-                            let png = crate::export::encode_png(size[0], size[1], &pixels)
-                                .unwrap_or_default();
-                            record.bytes += png.len();
-                            files.push(crate::export::File {
-                                name: format!("{}_{frame:04}.png", record.stem),
-                                bytes: png,
-                            });
-                            if record.bytes > RECORD_CAP && !build.todo.is_empty() {
-                                ask.say = Some(format!(
-                                    "Recorded the first {} of {} frames: a recording holds at most {} MB",
-                                    files.len(),
-                                    build.total,
-                                    RECORD_CAP >> 20
-                                ));
-                                build.todo.clear();
-                            }
+                    }
+                    if let Frames::Pngs(files) = &mut record.frames {
+                        // (The size was checked above: the encoder always writes it.)
+                        let png = crate::export::encode_png(size[0], size[1], &pixels)
+                            .unwrap_or_default();
+                        record.bytes += png.len();
+                        files.push(crate::export::File {
+                            name: format!("{}_{frame:04}.png", record.stem),
+                            bytes: png,
+                        });
+                        if record.bytes > RECORD_CAP && !build.todo.is_empty() {
+                            ask.say = Some(format!(
+                                "Recorded the first {} of {} frames: a recording holds at most {} MB",
+                                files.len(),
+                                build.total,
+                                RECORD_CAP >> 20
+                            ));
+                            build.todo.clear();
                         }
                     }
                 }
@@ -831,6 +836,13 @@ mod tests {
         // The encoder failing ends the recording with its error.
         let (_, ended) = record_into(&mut scene, &ctx, Probe(seen.clone(), 2));
         assert_eq!(ended, Err("the video encoder failed: out of memory".into()));
+        // Failing at its first frame (it took none): that frame and the rest as PNGs.
+        let (_, ended) = record_into(&mut scene, &ctx, Probe(seen.clone(), 0));
+        let Ok(Frames::Pngs(files)) = ended else {
+            panic!("{ended:?}")
+        };
+        assert_eq!(files.len(), 5);
+        assert_eq!(files[0].name, "cloud_0002.png");
     }
 
     /// A video sink that is busy for its first `starting` calls, then once after each frame
@@ -840,22 +852,25 @@ mod tests {
         starting: std::cell::Cell<u32>,
         pending: std::cell::Cell<bool>,
         waits: std::rc::Rc<std::cell::Cell<u32>>,
+        /// Whether the last `state()` said busy.
+        busy: std::rc::Rc<std::cell::Cell<bool>>,
         refuse: Option<String>,
     }
     impl VideoSink for Slow {
         fn state(&self) -> SinkState {
-            if self.starting.get() > 0 {
+            let state = if self.starting.get() > 0 {
                 self.starting.set(self.starting.get() - 1);
-                return SinkState::Busy;
-            }
-            if let Some(why) = &self.refuse {
-                return SinkState::Refused(why.clone());
-            }
-            if self.pending.replace(false) {
+                SinkState::Busy
+            } else if let Some(why) = &self.refuse {
+                SinkState::Refused(why.clone())
+            } else if self.pending.replace(false) {
                 self.waits.set(self.waits.get() + 1);
-                return SinkState::Busy;
-            }
-            SinkState::Ready
+                SinkState::Busy
+            } else {
+                SinkState::Ready
+            };
+            self.busy.set(state == SinkState::Busy);
+            state
         }
         fn add(&mut self, _: &[u8], index: u32) -> Result<(), String> {
             self.seen.borrow_mut().push(index);
@@ -881,26 +896,68 @@ mod tests {
         // asked while it is busy, and every frame still reaches it once, in order.
         let seen = std::rc::Rc::new(std::cell::RefCell::new(Vec::new()));
         let waits = std::rc::Rc::new(std::cell::Cell::new(0));
+        let busy = std::rc::Rc::new(std::cell::Cell::new(false));
         let slow = |starting: u32, refuse: Option<&str>| {
             Box::new(Slow {
                 seen: seen.clone(),
                 starting: starting.into(),
                 pending: false.into(),
                 waits: waits.clone(),
+                busy: busy.clone(),
                 refuse: refuse.map(str::to_owned),
             })
         };
         let mut book = Flipbook::default();
         book.start_record(&scene, [4, 2], false, "cloud", Some(slow(3, None)));
-        for _ in 0..3 {
-            let ask = book.step(&ctx, &scene, None);
-            assert_eq!((ask.time, ask.capture), (None, None), "held while starting");
-        }
-        let (ended, asked) = drive_recording(&mut book, &ctx, &mut scene);
+        let (mut captured, mut asked, mut held) = (None, 0, 0);
+        let ended = loop {
+            let ask = book.step(&ctx, &scene, captured.take());
+            if busy.get() {
+                // Nothing is asked in a step the sink was busy in.
+                assert_eq!((ask.time, ask.capture), (None, None), "held while busy");
+                held += 1;
+            }
+            if let Some(t) = ask.time {
+                scene = scene.posed_at(t);
+            }
+            if let Some(ended) = ask.recorded {
+                break ended;
+            }
+            if let Some(size) = ask.capture {
+                asked += 1;
+                captured = Some(Ok([0u8, 0, 0, 255].repeat((size[0] * size[1]) as usize)));
+            }
+        };
         assert!(matches!(ended, Ok(Frames::Video(_, 4))), "{ended:?}");
         assert_eq!(asked, 4, "one capture a frame");
         assert_eq!(*seen.borrow(), [0, 1, 2, 3]);
         assert_eq!(waits.get(), 4, "held back after each frame it took");
+        assert_eq!(held, 3 + 4, "while starting, and after each frame");
+        // Refusing after it took frames ends the recording with the error.
+        let mut book = Flipbook::default();
+        book.start_record(&scene, [4, 2], false, "cloud", Some(slow(0, None)));
+        let ask = book.step(&ctx, &scene, None);
+        let t = ask.time.expect("frame 0");
+        scene = scene.posed_at(t);
+        let ask = book.step(&ctx, &scene, Some(Ok([0u8; 32].to_vec())));
+        assert!(ask.recorded.is_none(), "frame 0 taken");
+        let Some(Build {
+            record:
+                Some(Recording {
+                    frames: Frames::Video(video, 1),
+                    ..
+                }),
+            ..
+        }) = book.build.as_mut()
+        else {
+            panic!("recording a video, one frame in");
+        };
+        *video = slow(0, Some("the encoder crashed"));
+        let ask = book.step(&ctx, &scene, None);
+        assert_eq!(
+            ask.recorded.map(|r| r.map(|_| ())),
+            Some(Err("the video encoder failed: the encoder crashed".into()))
+        );
         // Refused before its first frame (a size VP9 cannot encode): the same frames, as PNGs,
         // and it says so.
         let mut book = Flipbook::default();

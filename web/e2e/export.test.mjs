@@ -370,8 +370,9 @@ for (const backend of BOTH_BUILDS) {
 }
 
 // Where the browser cannot encode the video (its VP9 encoder refuses the size, stood in for
-// here; the same path as no WebCodecs at all, or ?record=png), Record says so and writes PNGs,
-// one zip download: 12 frames, each covering the pixels the CLI's frame covers (IoU ≥ 0.9) and
+// here), Record says so and writes PNGs at the size it began with (even, for the video), one
+// zip download; without WebCodecs at all, or with ?record=png, it starts with PNGs at the
+// natural size and the same frames (not tested apart: one check of the address). 12 frames, each covering the pixels the CLI's frame covers (IoU ≥ 0.9) and
 // closer to its own frame than to its neighbours'. On the WebGL2 build, which browsers without
 // WebGPU (the likeliest to lack WebCodecs) load. The document's light grid (32 texels, 3
 // octaves) is finer than the view's preview of it on this CPU adapter (24, 2): the frames must
