@@ -786,17 +786,57 @@ mod tests {
         assert!(said.contains("first 10000 of 20001"), "{said}");
     }
 
-    /// A video sink that keeps each frame's first byte and index, and fails at index `.1`.
-    struct Probe(std::rc::Rc<std::cell::RefCell<Vec<(u8, u32)>>>, u32);
+    /// A video sink for the tests: it keeps each frame's first byte and index and fails at
+    /// index `fail_at`; it is busy for its first `starting` calls to `state`, then, with
+    /// `hold`, once after each frame it takes (counted in `waits`); once started it refuses
+    /// with `refuse`.
+    #[derive(Default)]
+    struct Probe {
+        seen: std::rc::Rc<std::cell::RefCell<Vec<(u8, u32)>>>,
+        fail_at: Option<u32>,
+        starting: std::cell::Cell<u32>,
+        hold: bool,
+        pending: std::cell::Cell<bool>,
+        waits: std::rc::Rc<std::cell::Cell<u32>>,
+        /// Whether the last `state()` said busy.
+        busy: std::rc::Rc<std::cell::Cell<bool>>,
+        refuse: Option<String>,
+    }
+    impl Probe {
+        /// Always ready; keeps frames in `seen`, fails at `fail_at`.
+        fn failing_at(
+            seen: &std::rc::Rc<std::cell::RefCell<Vec<(u8, u32)>>>,
+            fail_at: Option<u32>,
+        ) -> Self {
+            Self {
+                seen: seen.clone(),
+                fail_at,
+                ..Self::default()
+            }
+        }
+    }
     impl VideoSink for Probe {
         fn state(&self) -> SinkState {
-            SinkState::Ready
+            let state = if self.starting.get() > 0 {
+                self.starting.set(self.starting.get() - 1);
+                SinkState::Busy
+            } else if let Some(why) = &self.refuse {
+                SinkState::Refused(why.clone())
+            } else if self.pending.replace(false) {
+                self.waits.set(self.waits.get() + 1);
+                SinkState::Busy
+            } else {
+                SinkState::Ready
+            };
+            self.busy.set(state == SinkState::Busy);
+            state
         }
         fn add(&mut self, rgba: &[u8], index: u32) -> Result<(), String> {
-            if index == self.1 {
+            if Some(index) == self.fail_at {
                 return Err("out of memory".into());
             }
-            self.0.borrow_mut().push((rgba[0], index));
+            self.seen.borrow_mut().push((rgba[0], index));
+            self.pending.set(self.hold);
             Ok(())
         }
         fn finish(
@@ -827,7 +867,7 @@ mod tests {
         scene.clock.start = 2;
         scene.clock.end = 6;
         let seen = std::rc::Rc::new(std::cell::RefCell::new(Vec::new()));
-        let (said, ended) = record_into(&mut scene, &ctx, Probe(seen.clone(), u32::MAX));
+        let (said, ended) = record_into(&mut scene, &ctx, Probe::failing_at(&seen, None));
         assert_eq!(said, "Recording 5 frames at 4×2 as a WebM");
         assert!(matches!(ended, Ok(Frames::Video(_, 5))), "{ended:?}");
         let expected: Vec<(u8, u32)> = (2..=6)
@@ -836,10 +876,10 @@ mod tests {
             .collect();
         assert_eq!(*seen.borrow(), expected);
         // The encoder failing ends the recording with its error.
-        let (_, ended) = record_into(&mut scene, &ctx, Probe(seen.clone(), 2));
+        let (_, ended) = record_into(&mut scene, &ctx, Probe::failing_at(&seen, Some(2)));
         assert_eq!(ended, Err("the video encoder failed: out of memory".into()));
         // Failing at its first frame (it took none): that frame and the rest as PNGs.
-        let (_, ended) = record_into(&mut scene, &ctx, Probe(seen.clone(), 0));
+        let (_, ended) = record_into(&mut scene, &ctx, Probe::failing_at(&seen, Some(0)));
         let Ok(Frames::Pngs(files)) = ended else {
             panic!("{ended:?}")
         };
@@ -847,66 +887,25 @@ mod tests {
         assert_eq!(files[0].name, "cloud_0002.png");
     }
 
-    /// A video sink that is busy for its first `starting` calls, then once after each frame
-    /// it takes (counted in `waits`), and refuses, once started, with `refuse`.
-    struct Slow {
-        seen: std::rc::Rc<std::cell::RefCell<Vec<u32>>>,
-        starting: std::cell::Cell<u32>,
-        pending: std::cell::Cell<bool>,
-        waits: std::rc::Rc<std::cell::Cell<u32>>,
-        /// Whether the last `state()` said busy.
-        busy: std::rc::Rc<std::cell::Cell<bool>>,
-        refuse: Option<String>,
-    }
-    impl VideoSink for Slow {
-        fn state(&self) -> SinkState {
-            let state = if self.starting.get() > 0 {
-                self.starting.set(self.starting.get() - 1);
-                SinkState::Busy
-            } else if let Some(why) = &self.refuse {
-                SinkState::Refused(why.clone())
-            } else if self.pending.replace(false) {
-                self.waits.set(self.waits.get() + 1);
-                SinkState::Busy
-            } else {
-                SinkState::Ready
-            };
-            self.busy.set(state == SinkState::Busy);
-            state
-        }
-        fn add(&mut self, _: &[u8], index: u32) -> Result<(), String> {
-            self.seen.borrow_mut().push(index);
-            self.pending.set(true);
-            Ok(())
-        }
-        fn finish(
-            self: Box<Self>,
-            name: String,
-            _: std::sync::Arc<std::sync::atomic::AtomicBool>,
-            done: Box<dyn FnOnce(Result<String, String>)>,
-        ) {
-            done(Ok(name));
-        }
-    }
-
     #[test]
     fn a_busy_encoder_holds_the_next_capture_back_and_a_refusing_one_leaves_pngs() {
         let ctx = egui::Context::default();
         let mut scene = keyed();
         scene.clock.end = 3;
-        // Starting (busy for 3 calls), then busy once after every odd frame: no capture is
-        // asked while it is busy, and every frame still reaches it once, in order.
+        // Starting (busy for 3 calls), then busy once after each frame: no capture is asked
+        // while it is busy, and every frame still reaches it once, in order.
         let seen = std::rc::Rc::new(std::cell::RefCell::new(Vec::new()));
         let waits = std::rc::Rc::new(std::cell::Cell::new(0));
         let busy = std::rc::Rc::new(std::cell::Cell::new(false));
         let slow = |starting: u32, refuse: Option<&str>| {
-            Box::new(Slow {
+            Box::new(Probe {
                 seen: seen.clone(),
                 starting: starting.into(),
-                pending: false.into(),
+                hold: true,
                 waits: waits.clone(),
                 busy: busy.clone(),
                 refuse: refuse.map(str::to_owned),
+                ..Probe::default()
             })
         };
         let mut book = Flipbook::default();
@@ -932,7 +931,8 @@ mod tests {
         };
         assert!(matches!(ended, Ok(Frames::Video(_, 4))), "{ended:?}");
         assert_eq!(asked, 4, "one capture a frame");
-        assert_eq!(*seen.borrow(), [0, 1, 2, 3]);
+        let indices: Vec<u32> = seen.borrow().iter().map(|&(_, i)| i).collect();
+        assert_eq!(indices, [0, 1, 2, 3]);
         assert_eq!(waits.get(), 4, "held back after each frame it took");
         assert_eq!(held, 3 + 4, "while starting, and after each frame");
         // Refusing after it took frames ends the recording with the error.
