@@ -205,7 +205,16 @@ pub struct Progressive {
     /// resolution is chosen for the time refinements really take.
     late: f64,
     last_frame: Option<f64>,
+    /// What a slice costs relative to a plain one ([`Progressive::weigh_slices`]): the work
+    /// is counted in weighted pixel·slices, so the cost learnt stays one figure.
+    weight: f64,
 }
+
+/// What a slice with shafts of light costs relative to a plain one: the slice pass then writes
+/// and blends two targets, and the eye's shells come among the slices. Measured at about 2×
+/// (`cloudsketch bench shafts`: a frame with shafts 2.0× one without on lavapipe; refinement
+/// chunks in the page on SwiftShader about twice the plain ones).
+pub const SHAFTS_SLICE_WEIGHT: f64 = 2.0;
 
 /// Fewest slices a preview uses.
 const MIN_PREVIEW_SLICES: u32 = 16;
@@ -243,6 +252,7 @@ impl Progressive {
             finishing: None,
             late: 1.0,
             last_frame: None,
+            weight: 1.0,
         }
     }
 
@@ -251,6 +261,17 @@ impl Progressive {
     pub fn fenced(mut self, on: bool) -> Self {
         self.fence_silent = !on;
         self
+    }
+
+    /// Tells the planner what each slice of the view costs relative to a plain slice
+    /// ([`SHAFTS_SLICE_WEIGHT`] with shafts of light, else 1), before [`Progressive::plan`].
+    /// Turning the shafts on then plans the next preview and refinement for their cost at
+    /// once, instead of the first refinement overrunning its budget while the cost is
+    /// relearnt (and turning them off gives the plain resolution back at once).
+    pub fn weigh_slices(&mut self, weight: f64) {
+        if weight.is_finite() && weight > 0.0 {
+            self.weight = weight;
+        }
     }
 
     /// Current cost estimate in seconds per pixel·slice of refinement's work (the GPU's
@@ -405,7 +426,7 @@ impl Progressive {
         } else {
             1.0
         };
-        let per_chunk = (vary * chunk_seconds / (cost * pixels))
+        let per_chunk = (vary * chunk_seconds / (cost * pixels * self.weight))
             .floor()
             .clamp(1.0, u32::MAX as f64) as u32;
         let start = refine.next;
@@ -453,8 +474,10 @@ impl Progressive {
         refining: Option<f32>,
         chunk: bool,
     ) -> FramePlan {
-        let work =
-            job.size[0] as f64 * job.size[1] as f64 * (job.range.end - job.range.start) as f64;
+        let work = job.size[0] as f64
+            * job.size[1] as f64
+            * (job.range.end - job.range.start) as f64
+            * self.weight;
         self.jobs += 1;
         // A chunk is followed by a frame only once the GPU reports it done: a frame drawn
         // meanwhile would only queue more work behind it.
@@ -611,7 +634,8 @@ impl Progressive {
             let work = self.cost()
                 * (viewport[0] as f64 * scale).round().max(1.0)
                 * (viewport[1] as f64 * scale).round().max(1.0)
-                * full_slices as f64;
+                * full_slices as f64
+                * self.weight;
             // Each chunk also costs a frame's overhead; a timed one also waits for its report.
             let fixed = if self.fence_silent {
                 self.overhead
@@ -631,7 +655,7 @@ impl Progressive {
 
     fn preview_level(&self, viewport: [u32; 2], full_slices: u32) -> ([u32; 2], u32) {
         let pixels = viewport[0] as f64 * viewport[1] as f64;
-        let predicted = self.cost * pixels * full_slices as f64;
+        let predicted = self.cost * pixels * full_slices as f64 * self.weight;
         // What the frame's overhead leaves of the interactive budget (a little at least).
         let budget = (self.budget.interactive - self.overhead).max(0.3 * self.budget.interactive);
         if predicted <= budget {
@@ -916,6 +940,8 @@ mod tests {
         /// around the cloud) share the cores with the chunk while it runs, and its timing
         /// holds what it did, not what slowed it.
         seen: f64,
+        /// What a slice costs relative to a plain one (2 with shafts of light).
+        weight: f64,
         t: f64,
         gpu_free: f64,
         /// GPU end times of the frames not yet finished, oldest first.
@@ -933,6 +959,7 @@ mod tests {
                 unfenced,
                 delay,
                 seen: 1.0,
+                weight: 1.0,
                 t: 0.0,
                 gpu_free: 0.0,
                 queued: Default::default(),
@@ -963,6 +990,7 @@ mod tests {
                 let work = plan.job.as_ref().map_or(0.0, |j| {
                     j.size[0] as f64 * j.size[1] as f64 * (j.range.end - j.range.start) as f64
                 });
+                let work = work * self.weight;
                 let end = self.gpu_free.max(t) + self.overhead + work * self.cost;
                 // A drag starting right after this frame waits until the GPU is through.
                 stall = stall.max(end - t);
@@ -1053,6 +1081,46 @@ mod tests {
             p.late
         );
         assert!(p.late > 1.2, "late {:.2}", p.late);
+    }
+
+    #[test]
+    fn shafts_turned_on_are_planned_for_from_their_first_refinement() {
+        // SwiftShader at 1280×800, as above; then the shafts of light go on, and every slice
+        // costs twice as much (two targets written and blended, the shells among the slices).
+        let cost = 6.0 / (800.0 * 600.0 * 128.0);
+        let run = |told: f64| {
+            let mut b = Browser::new(cost, 0.067, false, 0.0);
+            let mut p = Progressive::new(cost / 3.0, Budget::default());
+            for key in 1..6 {
+                b.refine(&mut p, key, VIEW);
+            }
+            b.weight = 2.0;
+            p.weigh_slices(told);
+            let (_, seconds) = b.refine(&mut p, 9, VIEW);
+            (seconds, p.refine_size(VIEW, 128))
+        };
+        let (told, size) = run(SHAFTS_SLICE_WEIGHT);
+        // Baseline: a planner not told, which relearns the cost during the refinement.
+        let (untold, untold_size) = run(1.0);
+        let budget = Budget::default().refine_total;
+        assert!(
+            told <= budget * 1.15 && untold > 1.15 * told,
+            "with shafts: {told:.2} s at {size:?} told, {untold:.2} s untold ({untold_size:?})"
+        );
+        // Turned off again: the plain resolution at once.
+        let mut b = Browser::new(cost, 0.067, false, 0.0);
+        let mut p = Progressive::new(cost / 3.0, Budget::default());
+        for key in 1..6 {
+            b.refine(&mut p, key, VIEW);
+        }
+        let plain = p.refine_size(VIEW, 128);
+        p.weigh_slices(SHAFTS_SLICE_WEIGHT);
+        let shafts = p.refine_size(VIEW, 128);
+        p.weigh_slices(1.0);
+        assert!(
+            shafts[0] < plain[0] && p.refine_size(VIEW, 128) == plain,
+            "{plain:?} {shafts:?}"
+        );
     }
 
     #[test]

@@ -21,7 +21,7 @@ const CAPTURE_BUDGET: f64 = 0.04;
 /// interactive frame's 0.3 s.
 const CACHE_BUDGET: f64 = 0.2;
 use crate::derive::PUFFS_OVER_CAP;
-use crate::render::progressive::{Budget, Progressive};
+use crate::render::progressive::{Budget, Progressive, SHAFTS_SLICE_WEIGHT};
 use crate::render::viewport::{BackdropPaint, ShaftsApart, ViewportPaint, paint_callback};
 use crate::render::viewport::{JobFence, ReportPoll};
 use crate::scene::Document;
@@ -383,6 +383,12 @@ impl Viewport {
                 fence
             })
             .clone();
+        // The slices' cost with the shafts' second target and shells among them.
+        self.progressive.weigh_slices(if shells_apart {
+            SHAFTS_SLICE_WEIGHT
+        } else {
+            1.0
+        });
         let plan = self.progressive.plan(
             now,
             key,
