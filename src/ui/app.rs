@@ -557,11 +557,26 @@ impl CloudApp {
                     .progress()
                     .filter(|_| !self.flipbook.recording());
                 self.panels.timeline.cache_kept = self.flipbook.kept().0;
+                self.panels.timeline.record_progress = self.panels.export.recording();
+                self.panels.timeline.record_blocked = self.panels.export.running();
                 if let Some(said) = self.panels.timeline.ui(ui, &mut self.doc, &self.selection) {
                     self.notices.note(now, said);
                 }
                 ui.add_space(2.0);
             });
+        // Record and its Stop are the Export group's recording.
+        if std::mem::take(&mut self.panels.timeline.record_asked) {
+            let ask = self.panels.export.record(
+                &self.doc,
+                self.viewport.stats.viewport_px,
+                &self.files.name,
+            );
+            self.export_asked(ask, now);
+        }
+        if std::mem::take(&mut self.panels.timeline.record_cancel) {
+            let ask = self.panels.export.cancel(&mut self.notices, now);
+            self.export_asked(ask, now);
+        }
         self.selection.retain_valid(self.doc.scene());
     }
 

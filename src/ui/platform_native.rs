@@ -12,6 +12,10 @@ pub const GL_BACKEND_NAME: &str = "gl";
 /// Whether this platform has a file picker button (the browser's file input).
 pub const HAS_PICKER: bool = false;
 
+/// What Record makes here (the timeline's button and the Export group's "every frame of the
+/// range").
+pub const RECORD_HINT: &str = "Record every frame of the timeline's range at full quality, one after another, at the Export group's PNG width and the view's shape: STEM_####.png beside the scene file";
+
 /// Whether refinement waits for the GPU's report of each chunk before the next: not natively
 /// (the desktop window has no measure of its drags; the page does).
 pub const FENCED_REFINEMENT: bool = false;

@@ -20,6 +20,10 @@ pub const GL_BACKEND_NAME: &str = "webgl2";
 /// Whether this platform has a file picker button.
 pub const HAS_PICKER: bool = true;
 
+/// What Record makes here (the timeline's button and the Export group's "every frame of the
+/// range").
+pub const RECORD_HINT: &str = "Record every frame of the timeline's range at full quality, one after another, at the Export group's PNG width and the view's shape: a WebM at the scene's frame rate where the browser encodes video (else, and with a transparent background, PNGs in one zip: STEM_####.png)";
+
 /// Whether refinement waits for the GPU's report of each chunk before the next: a browser runs
 /// frames ahead of the GPU, so chunks queued there would hold up the first frame of a drag.
 /// WebGPU reports as soon as the work is done; WebGL2's reports come through [`poll_reports`].

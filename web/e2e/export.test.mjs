@@ -267,12 +267,14 @@ function coverageIoU(a, b) {
 
 /**
  * Records the developing cumulus's frames 0–11 (one a second: the tower's first 11 s) at 320
- * px wide through the Export group as a user would: the PNG format, a typed width, "every
- * frame of the range", Export. 16 slices and a light grid of `light` (texels, octaves) so
- * that the run fits the suite's time; the CLI then renders the same document. Returns the
- * download, the document, and the progress values seen.
+ * px wide as a user would: in the Export group, the PNG format and a typed width; then either
+ * "every frame of the range" and Export (`via` 'export'), or, with the group back on glb, the
+ * timeline's Record (`via` 'timeline': Record takes the group's PNG width whatever format it
+ * shows). 16 slices and a light grid of `light` (texels, octaves) so that the run fits the
+ * suite's time; the CLI then renders the same document. Returns the download, the document,
+ * and the progress values seen.
  */
-async function recordRange(page, light = [24, 2]) {
+async function recordRange(page, light = [24, 2], via = 'export') {
   await page.evaluate((light) => {
     for (const p of ['/clock/end=11', '/clock/fps=1', '/render/slices=16', `/render/light_resolution=${light[0]}`, `/render/light_octaves=${light[1]}`,
       '/light/ground=false', '/light/sky_gradient=false', '/light/shafts=false']) window.cloudsketch.set(p);
@@ -289,18 +291,32 @@ async function recordRange(page, light = [24, 2]) {
   await page.keyboard.type('320');
   await page.keyboard.press('Enter');
   await until(page, (s) => s.view.export.png_width === 320, 'a width of 320 px');
-  await click('export:range');
-  s = await until(page, (s) => s.view.export.range === true, 'every frame of the range ticked');
+  if (via === 'export') {
+    await click('export:range');
+    s = await until(page, (s) => s.view.export.range === true, 'every frame of the range ticked');
+  } else {
+    await click('export:glb');
+    s = await until(page, (s) => s.view.export.format === 'glb', 'glb chosen again');
+  }
   const scene = s.scene;
   const seen = new Set();
   const notices = new Set();
+  const labels = new Set();
   const download = page.waitForEvent('download', { timeout: 480_000 });
-  await click('export:run');
+  if (via === 'export') {
+    await click('export:run');
+  } else {
+    const [x, y, w, h] = s.view.widgets['timeline:record'];
+    await page.mouse.click(x + w / 2, y + h / 2);
+  }
   s = await until(page, (s) => {
     if (s.view.export.progress != null) seen.add(Math.round(100 * s.view.export.progress));
     if (s.view.notice?.text) notices.add(s.view.notice.text);
+    if (s.view.timeline.record) labels.add(s.view.timeline.record);
     return s.view.export.progress == null;
   }, 'recorded', 480_000);
+  // The timeline's button shows the recording's progress (and stops it) whichever started it.
+  assert.ok([...labels].some((l) => /^Stop \d+%$/.test(l)), `the timeline's Record read ${[...labels].join(', ')}`);
   assert.equal(s.view.export.last?.error, undefined, 'the recording did not fail');
   assert.ok(seen.size >= 4, `progress seen at ${[...seen]}%`);
   assert.equal(s.scene.time, scene.time, 'back at the time it began from');
@@ -316,7 +332,8 @@ for (const backend of BOTH_BUILDS) {
   test(`Record: the range as a WebM that plays, its frames the CLI's (${backend})`, { timeout: 600_000 }, async () => {
     assert.ok(fs.existsSync(NATIVE), `${NATIVE} missing: run cargo test (it builds the CLI) first`);
     await withApp({ base: server.url, webgpu: backend === 'webgpu', query: '?preset=developing', viewport: { width: 1280, height: 800 } }, async (page) => {
-      const { file, scene, last } = await recordRange(page);
+      // Started from the timeline's Record on one build, the Export group's on the other.
+      const { file, scene, last } = await recordRange(page, undefined, backend === 'webgpu' ? 'timeline' : 'export');
       assert.equal(file.suggestedFilename(), 'untitled.webm');
       assert.deepEqual(last.files, ['untitled.webm (a download)']);
       const bytes = fs.readFileSync(await file.path());
@@ -381,7 +398,7 @@ test('Record where the video encoder refuses: the range as PNGs in a zip, each t
   assert.ok(fs.existsSync(NATIVE), `${NATIVE} missing: run cargo test (it builds the CLI) first`);
   const refuse = () => { VideoEncoder.isConfigSupported = async () => ({ supported: false }); };
   await withApp({ base: server.url, webgpu: false, query: '?preset=developing', viewport: { width: 1280, height: 800 }, init: refuse }, async (page) => {
-    const { file, scene, last, notices } = await recordRange(page, [32, 3]);
+    const { file, scene, last, notices } = await recordRange(page, [32, 3], 'timeline');
     assert.ok([...notices].some((n) => /cannot encode VP9 at \d+×\d+: recording PNGs instead/.test(n)), `said so: ${[...notices].join(' | ')}`);
     assert.equal(file.suggestedFilename(), 'untitled-frames.zip');
     assert.deepEqual(last.files, ['untitled-frames.zip (a download)']);

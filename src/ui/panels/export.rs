@@ -168,11 +168,7 @@ impl ExportPanel {
                 mark(ui, "export:transparent", r.rect);
                 let r = ui
                     .checkbox(&mut self.range, "every frame of the range")
-                    .on_hover_text(if platform::HAS_PICKER {
-                        "Record: each frame of the timeline's range at full quality, one after another, as a WebM at the scene's frame rate (where the browser encodes video; else, and with a transparent background, PNGs in one zip: STEM_####.png)"
-                    } else {
-                        "Record: each frame of the timeline's range at full quality, one after another, as STEM_####.png beside the scene file"
-                    });
+                    .on_hover_text(platform::RECORD_HINT);
                 mark(ui, "export:range", r.rect);
             } else {
                 ui.add(
@@ -214,13 +210,7 @@ impl ExportPanel {
                     let cancel = ui.button("Cancel");
                     mark(ui, "export:cancel", cancel.rect);
                     if cancel.clicked() {
-                        ask.cancel_capture = matches!(self.job, Some(Job::Capture { .. }));
-                        ask.cancel_record = matches!(self.job, Some(Job::Record { .. }));
-                        if let Some(Job::Finishing { cancelled, .. }) = &self.job {
-                            cancelled.store(true, std::sync::atomic::Ordering::Relaxed);
-                        }
-                        self.job = None;
-                        notices.note(ui.input(|i| i.time), "Export cancelled");
+                        ask = self.cancel(notices, ui.input(|i| i.time));
                     }
                 }
             });
@@ -243,6 +233,9 @@ impl ExportPanel {
         if self.job.is_some() {
             return ExportAsk::default();
         }
+        if self.format == Format::Png && self.range {
+            return self.record(doc, view_px, scene_file);
+        }
         let place = Place::of(scene_file);
         if self.format == Format::Png {
             let size = [
@@ -250,26 +243,6 @@ impl ExportPanel {
                 png_height(self.png_width, view_px),
             ];
             self.capture_progress = 0.0;
-            if self.range {
-                // A WebM over the sky (VP9 wants even sides; WebCodecs encodes no alpha), else
-                // PNGs.
-                let even = size.map(|v| (v & !1).max(2));
-                let fps = f64::from(doc.scene().clock.fps);
-                let video = (!self.transparent)
-                    .then(|| platform::video_sink(even, fps))
-                    .flatten();
-                let ask = RecordAsk {
-                    size: if video.is_some() { even } else { size },
-                    transparent: self.transparent,
-                    stem: place.stem.clone(),
-                    video,
-                };
-                self.job = Some(Job::Record { place });
-                return ExportAsk {
-                    record: Some(ask),
-                    ..Default::default()
-                };
-            }
             self.job = Some(Job::Capture { place });
             return ExportAsk {
                 capture: Some((size, self.transparent)),
@@ -293,6 +266,68 @@ impl ExportPanel {
             }
         }
         ExportAsk::default()
+    }
+
+    /// Starts a recording of every frame of the range (the timeline's Record, or Export with
+    /// "every frame of the range"), whatever format the group shows: at the group's PNG width
+    /// and the view's shape, over the sky or transparent as the group is set. Nothing starts
+    /// while another export runs.
+    pub fn record(&mut self, doc: &Document, view_px: [u32; 2], scene_file: &str) -> ExportAsk {
+        if self.job.is_some() {
+            return ExportAsk::default();
+        }
+        let place = Place::of(scene_file);
+        let size = [
+            self.png_width.clamp(16, 8192),
+            png_height(self.png_width, view_px),
+        ];
+        self.capture_progress = 0.0;
+        // A WebM over the sky (VP9 wants even sides; WebCodecs encodes no alpha), else PNGs.
+        let even = size.map(|v| (v & !1).max(2));
+        let fps = f64::from(doc.scene().clock.fps);
+        let video = (!self.transparent)
+            .then(|| platform::video_sink(even, fps))
+            .flatten();
+        let ask = RecordAsk {
+            size: if video.is_some() { even } else { size },
+            transparent: self.transparent,
+            stem: place.stem.clone(),
+            video,
+        };
+        self.job = Some(Job::Record { place });
+        ExportAsk {
+            record: Some(ask),
+            ..Default::default()
+        }
+    }
+
+    /// Stops the export under way (Cancel): nothing of it is saved.
+    pub fn cancel(&mut self, notices: &mut Notices, now: f64) -> ExportAsk {
+        let ask = ExportAsk {
+            cancel_capture: matches!(self.job, Some(Job::Capture { .. })),
+            cancel_record: matches!(self.job, Some(Job::Record { .. })),
+            ..Default::default()
+        };
+        if let Some(Job::Finishing { cancelled, .. }) = &self.job {
+            cancelled.store(true, std::sync::atomic::Ordering::Relaxed);
+        }
+        if self.job.take().is_some() {
+            notices.note(now, "Export cancelled");
+        }
+        ask
+    }
+
+    /// A recording's progress (its frames, then its video's finishing), if one runs.
+    pub fn recording(&self) -> Option<f32> {
+        match self.job {
+            Some(Job::Record { .. } | Job::Finishing { .. }) => self.progress(),
+            _ => None,
+        }
+    }
+
+    /// Whether an export of any kind runs.
+    pub fn running(&self) -> bool {
+        self.job.is_some()
     }
 
     /// Advances a running export within this frame's budget; saves its files when done.
@@ -436,5 +471,55 @@ fn mime(format: Format) -> &'static str {
         Format::Vdb => "application/octet-stream",
         Format::Mitsuba => "application/xml",
         Format::Png => "image/png",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Preset;
+
+    /// The timeline's Record starts a recording whatever format the group shows, at the PNG
+    /// width and the view's shape; a second press while it runs starts nothing; Stop (the
+    /// group's Cancel) asks the flipbook to end it and leaves no job behind.
+    #[test]
+    fn record_starts_from_any_format_once_and_cancel_ends_it() {
+        let doc = Document::new(Scene::preset(Preset::Cumulus));
+        let mut notices = Notices::default();
+        let mut panel = ExportPanel {
+            format: Format::Glb,
+            png_width: 320,
+            ..Default::default()
+        };
+        assert_eq!(panel.recording(), None);
+        let ask = panel.record(&doc, [1000, 500], "clouds/storm.json");
+        let record = ask.record.expect("a recording starts");
+        assert_eq!(record.size, [320, 160]);
+        assert_eq!(record.stem, "storm");
+        assert_eq!(panel.recording(), Some(0.0));
+        assert!(panel.record(&doc, [1000, 500], "x.json").record.is_none());
+        // An export of the group's format waits too.
+        assert!(
+            panel
+                .start(&doc, &mut notices, 0.0, [1000, 500], "x.json")
+                .record
+                .is_none()
+        );
+        let ask = panel.cancel(&mut notices, 1.0);
+        assert!(ask.cancel_record && !ask.cancel_capture);
+        assert!(!panel.running());
+        assert_eq!(panel.recording(), None);
+        assert_eq!(
+            notices.latest.as_ref().map(|n| (n.text.as_str(), n.at)),
+            Some(("Export cancelled", 1.0))
+        );
+        // Nothing to cancel: nothing asked, nothing said.
+        let ask = panel.cancel(&mut notices, 2.0);
+        assert!(!ask.cancel_record && !ask.cancel_capture);
+        assert_eq!(notices.latest.as_ref().map(|n| n.at), Some(1.0));
+        // A Sampling export is running but not a recording.
+        let ask = panel.start(&doc, &mut notices, 3.0, [1000, 500], "x.json");
+        assert!(ask.record.is_none() && panel.running());
+        assert_eq!(panel.recording(), None);
     }
 }

@@ -68,6 +68,14 @@ pub struct Timeline {
     pub cache_asked: bool,
     /// Cancel was pressed while caching.
     pub cache_cancel: bool,
+    /// A recording's progress (0–1) while Record runs (the Export group's job).
+    pub record_progress: Option<f32>,
+    /// Another export runs: Record waits for it.
+    pub record_blocked: bool,
+    /// Record was pressed: record the range.
+    pub record_asked: bool,
+    /// Stop was pressed while recording.
+    pub record_cancel: bool,
     /// Wall seconds ticked while playing, in all.
     pub ticked_s: f64,
     /// Of those, the seconds not played: a stalled frame's time past the half second it may
@@ -95,6 +103,10 @@ impl Default for Timeline {
             cache_kept: 0,
             cache_asked: false,
             cache_cancel: false,
+            record_progress: None,
+            record_blocked: false,
+            record_asked: false,
+            record_cancel: false,
             ticked_s: 0.0,
             stalled_s: 0.0,
         }
@@ -304,12 +316,20 @@ impl Timeline {
         doc.set_time(clock.seconds(frame.min(u32::MAX as i64) as u32));
     }
 
+    /// The Record button's label: "Record", or "Stop N%" while a recording runs.
+    pub fn record_label(&self) -> String {
+        match self.record_progress {
+            Some(p) => format!("Stop {:.0}%", 100.0 * p.clamp(0.0, 1.0)),
+            None => "Record".to_owned(),
+        }
+    }
+
     /// Decides the strip's rows for a strip `width` points wide and returns its height, so
     /// the panel is laid out at its height from the first frame (egui sizes a panel from the
     /// frame before: the view's first frame was 38 points too tall under two rows).
     pub fn fit(&mut self, width: f32) -> f32 {
-        // The controls left of the bar take about 470 points, the range and rate 230.
-        self.narrow = width < 470.0 + 240.0 + 230.0;
+        // The controls left of the bar take about 550 points, the range and rate 230.
+        self.narrow = width < 550.0 + 240.0 + 230.0;
         if self.narrow { 63.0 } else { 36.0 }
     }
 
@@ -396,6 +416,27 @@ impl Timeline {
                     self.cache_cancel = true;
                 } else {
                     self.cache_asked = true;
+                }
+            }
+            // Record: the range at full quality into a video (or PNGs), the Export group's job.
+            let record = match self.record_progress {
+                Some(_) => ui
+                    .add_sized([72.0, 20.0], egui::Button::new(self.record_label()))
+                    .on_hover_text("Recording the range; click to stop (nothing is saved)"),
+                None => ui
+                    .add_enabled_ui(!self.record_blocked, |ui| {
+                        ui.add_sized([72.0, 20.0], egui::Button::new(self.record_label()))
+                    })
+                    .inner
+                    .on_hover_text(crate::ui::platform::RECORD_HINT)
+                    .on_disabled_hover_text("An export is under way: record when it is done"),
+            };
+            mark(ui, "timeline:record", record.rect);
+            if record.clicked() {
+                if self.record_progress.is_some() {
+                    self.record_cancel = true;
+                } else {
+                    self.record_asked = true;
                 }
             }
             // The range and the rate at the right (or under it), the bar between.
@@ -719,6 +760,7 @@ pub fn state(timeline: &Timeline, doc: &Document) -> serde_json::Value {
         "keys": timeline.drawn.iter().map(|(t, x)| serde_json::json!({"t": t, "x": x, "y": timeline.keys_y})).collect::<Vec<_>>(),
         "selected_keys": timeline.selected,
         "key_count": doc.scene().animation.key_count(),
+        "record": timeline.record_label(),
     })
 }
 
