@@ -166,24 +166,24 @@ struct Finishing {
 #[derive(Clone, Debug)]
 pub struct Progressive {
     budget: Budget,
-    /// Seconds per pixel·slice as frame intervals tell it (previews; chunks where the GPU
+    /// Seconds per weighted pixel·slice as frame intervals tell it (previews; chunks where the GPU
     /// does not time them): what sizes previews.
     cost: f64,
-    /// Seconds per pixel·slice as the GPU's timing of refinement chunks tells it, once it
+    /// Seconds per weighted pixel·slice as the GPU's timing of refinement chunks tells it, once it
     /// has timed one: what sizes chunks and the refined image. Frame intervals after a drag's
     /// previews count the frames' other work too: sizing chunks by them made them half as
     /// big as they could be, twice as many, each with a frame's overhead.
     chunk_cost: Option<f64>,
     /// Seconds every frame takes besides its volume work.
     overhead: f64,
-    /// Recent frames with volume work: (pixel·slices, seconds).
+    /// Recent frames with volume work: (weighted pixel·slices, seconds).
     samples: std::collections::VecDeque<(f64, f64)>,
     /// Seconds a timed chunk takes besides its work, from its planning to the frame that sees
     /// its report (the frame, the GPU's other work, the report's delay).
     per_chunk: f64,
     /// Since when the GPU has been behind the jobs planned (fenced refinement waits).
     behind_since: Option<f64>,
-    /// Recent refinement chunks the GPU timed: (pixel·slices, seconds).
+    /// Recent refinement chunks the GPU timed: (weighted pixel·slices, seconds).
     timed: std::collections::VecDeque<(f64, f64)>,
     /// Seconds every timed chunk took besides its work (fitted through `timed`): on a CPU
     /// adapter the GPU's report of a chunk comes a good while after the work is done.
@@ -215,6 +215,12 @@ pub struct Progressive {
 /// (`cloudsketch bench shafts`: a frame with shafts 2.0× one without on lavapipe; refinement
 /// chunks in the page on SwiftShader about twice the plain ones).
 pub const SHAFTS_SLICE_WEIGHT: f64 = 2.0;
+
+/// The weight ([`Progressive::weigh_slices`]) of a slice of a view with shafts of light drawn
+/// among its slices, or without.
+pub fn slice_weight(shafts: bool) -> f64 {
+    if shafts { SHAFTS_SLICE_WEIGHT } else { 1.0 }
+}
 
 /// Fewest slices a preview uses.
 const MIN_PREVIEW_SLICES: u32 = 16;
@@ -274,8 +280,9 @@ impl Progressive {
         }
     }
 
-    /// Current cost estimate in seconds per pixel·slice of refinement's work (the GPU's
-    /// timing of chunks where it has timed one, else frame intervals).
+    /// Current cost estimate in seconds per weighted pixel·slice of refinement's work (the
+    /// GPU's timing of chunks where it has timed one, else frame intervals): a plain slice's
+    /// cost; a slice of weight `w` ([`slice_weight`]) costs `w` times it.
     pub fn cost(&self) -> f64 {
         match self.chunk_cost {
             // Chunks no longer timed (the fence went silent) are measured as previews are.

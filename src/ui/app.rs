@@ -372,7 +372,7 @@ impl CloudApp {
     /// (through the flipbook's steps), or stopping either.
     fn export_asked(&mut self, ask: super::panels::ExportAsk, now: f64) {
         if ask.capture.is_some() || ask.record.is_some() {
-            self.stop_caching(now, "Caching stopped for the PNG export");
+            self.stop_caching(now, "Caching stopped for the export");
         }
         if ask.capture.is_some() {
             self.viewport.capture_request = ask.capture;
@@ -530,6 +530,9 @@ impl CloudApp {
     /// The timeline under the view, or the button that shows it again.
     fn timeline_strip(&mut self, ui: &mut egui::Ui, ctx: &egui::Context) {
         let now = ctx.input(|i| i.time);
+        // (Also while the strip is hidden: the page state reports the Record button.)
+        self.panels.timeline.record_progress = self.panels.export.recording();
+        self.panels.timeline.record_blocked = self.panels.export.running();
         if !self.panels.timeline.open {
             self.panels.timeline.hovered = false;
             egui::Area::new(egui::Id::unique("show timeline"))
@@ -557,8 +560,6 @@ impl CloudApp {
                     .progress()
                     .filter(|_| !self.flipbook.recording());
                 self.panels.timeline.cache_kept = self.flipbook.kept().0;
-                self.panels.timeline.record_progress = self.panels.export.recording();
-                self.panels.timeline.record_blocked = self.panels.export.running();
                 if let Some(said) = self.panels.timeline.ui(ui, &mut self.doc, &self.selection) {
                     self.notices.note(now, said);
                 }

@@ -21,7 +21,7 @@ const CAPTURE_BUDGET: f64 = 0.04;
 /// interactive frame's 0.3 s.
 const CACHE_BUDGET: f64 = 0.2;
 use crate::derive::PUFFS_OVER_CAP;
-use crate::render::progressive::{Budget, Progressive, SHAFTS_SLICE_WEIGHT};
+use crate::render::progressive::{Budget, Progressive, slice_weight};
 use crate::render::viewport::{BackdropPaint, ShaftsApart, ViewportPaint, paint_callback};
 use crate::render::viewport::{JobFence, ReportPoll};
 use crate::scene::Document;
@@ -384,11 +384,7 @@ impl Viewport {
             })
             .clone();
         // The slices' cost with the shafts' second target and shells among them.
-        self.progressive.weigh_slices(if shells_apart {
-            SHAFTS_SLICE_WEIGHT
-        } else {
-            1.0
-        });
+        self.progressive.weigh_slices(slice_weight(shells_apart));
         let plan = self.progressive.plan(
             now,
             key,
@@ -501,7 +497,9 @@ impl Viewport {
             let chunks = capture_chunks(
                 pixels,
                 exported.render.slices,
-                self.progressive.cost(),
+                // The planner's cost is a plain slice's: a capture with shafts costs more.
+                self.progressive.cost()
+                    * slice_weight(exported.light.shafts && !density.is_empty()),
                 budget,
             );
             self.capture = Some(Capture::new(exported, size, transparent, chunks));
