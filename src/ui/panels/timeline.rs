@@ -328,7 +328,8 @@ impl Timeline {
     /// the panel is laid out at its height from the first frame (egui sizes a panel from the
     /// frame before: the view's first frame was 38 points too tall under two rows).
     pub fn fit(&mut self, width: f32) -> f32 {
-        // The controls left of the bar take about 550 points, the range and rate 230.
+        // The controls left of the bar take about 550 points (Cache and Record 170 of them,
+        // which go to the second row with the range and the rate), the range and rate 230.
         self.narrow = width < 550.0 + 240.0 + 230.0;
         if self.narrow { 63.0 } else { 36.0 }
     }
@@ -394,50 +395,8 @@ impl Timeline {
             if auto_r.changed() {
                 doc.set_auto_key(auto);
             }
-            // Cached playback: the range rendered once at full quality, then played from it.
-            let cache = match self.cache_progress {
-                Some((done, of)) => ui
-                    .add_sized(
-                        [84.0, 20.0],
-                        egui::Button::new(format!("Stop {}%", 100 * done / of.max(1))),
-                    )
-                    .on_hover_text(format!("Caching the range: {done} of {of} frames; click to stop (the frames cached so far are kept)")),
-                None => ui
-                    .add_sized([84.0, 20.0], egui::Button::new(if self.cache_kept > 0 {
-                        format!("Cache ({})", self.cache_kept)
-                    } else {
-                        "Cache".to_owned()
-                    }))
-                    .on_hover_text("Render every frame of the range at full quality once, then Play shows them at the frame rate (an edit re-renders only the frames it changes)"),
-            };
-            mark(ui, "timeline:cache", cache.rect);
-            if cache.clicked() {
-                if self.cache_progress.is_some() {
-                    self.cache_cancel = true;
-                } else {
-                    self.cache_asked = true;
-                }
-            }
-            // Record: the range at full quality into a video (or PNGs), the Export group's job.
-            let record = match self.record_progress {
-                Some(_) => ui
-                    .add_sized([72.0, 20.0], egui::Button::new(self.record_label()))
-                    .on_hover_text("Recording the range; click to stop (nothing is saved)"),
-                None => ui
-                    .add_enabled_ui(!self.record_blocked, |ui| {
-                        ui.add_sized([72.0, 20.0], egui::Button::new(self.record_label()))
-                    })
-                    .inner
-                    .on_hover_text(crate::ui::platform::RECORD_HINT)
-                    .on_disabled_hover_text("An export is under way: record when it is done"),
-            };
-            mark(ui, "timeline:record", record.rect);
-            if record.clicked() {
-                if self.record_progress.is_some() {
-                    self.record_cancel = true;
-                } else {
-                    self.record_asked = true;
-                }
+            if !narrow {
+                self.jobs_ui(ui);
             }
             // The range and the rate at the right (or under it), the bar between.
             let right = if narrow { 0.0 } else { 230.0 };
@@ -448,9 +407,61 @@ impl Timeline {
             }
         });
         if narrow {
-            ui.horizontal(|ui| self.range_ui(ui, doc));
+            ui.horizontal(|ui| {
+                self.jobs_ui(ui);
+                self.range_ui(ui, doc);
+            });
         }
         said
+    }
+
+    /// Cache and Record: the range rendered at full quality, for playback or to a file.
+    fn jobs_ui(&mut self, ui: &mut Ui) {
+        // Cached playback: the range rendered once at full quality, then played from it.
+        let cache = match self.cache_progress {
+            Some((done, of)) => ui
+                .add_sized(
+                    [84.0, 20.0],
+                    egui::Button::new(format!("Stop {}%", 100 * done / of.max(1))),
+                )
+                .on_hover_text(format!("Caching the range: {done} of {of} frames; click to stop (the frames cached so far are kept)")),
+            None => ui
+                .add_sized([84.0, 20.0], egui::Button::new(if self.cache_kept > 0 {
+                    format!("Cache ({})", self.cache_kept)
+                } else {
+                    "Cache".to_owned()
+                }))
+                .on_hover_text("Render every frame of the range at full quality once, then Play shows them at the frame rate (an edit re-renders only the frames it changes)"),
+        };
+        mark(ui, "timeline:cache", cache.rect);
+        if cache.clicked() {
+            if self.cache_progress.is_some() {
+                self.cache_cancel = true;
+            } else {
+                self.cache_asked = true;
+            }
+        }
+        // Record: the range at full quality into a video (or PNGs), the Export group's job.
+        let record = match self.record_progress {
+            Some(_) => ui
+                .add_sized([72.0, 20.0], egui::Button::new(self.record_label()))
+                .on_hover_text("Recording the range; click to stop (nothing is saved)"),
+            None => ui
+                .add_enabled_ui(!self.record_blocked, |ui| {
+                    ui.add_sized([72.0, 20.0], egui::Button::new(self.record_label()))
+                })
+                .inner
+                .on_hover_text(crate::ui::platform::RECORD_HINT)
+                .on_disabled_hover_text("An export is under way: record when it is done"),
+        };
+        mark(ui, "timeline:record", record.rect);
+        if record.clicked() {
+            if self.record_progress.is_some() {
+                self.record_cancel = true;
+            } else {
+                self.record_asked = true;
+            }
+        }
     }
 
     /// The frame range and the rate (one undo step each drag).
