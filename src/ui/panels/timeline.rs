@@ -329,7 +329,7 @@ impl Timeline {
     /// frame before: the view's first frame was 38 points too tall under two rows).
     pub fn fit(&mut self, width: f32) -> f32 {
         // The controls left of the bar take about 550 points (Cache and Record 170 of them,
-        // which go to the second row with the range and the rate), the range and rate 230.
+        // which go to the second row after the range and the rate), the range and rate 230.
         self.narrow = width < 550.0 + 240.0 + 230.0;
         if self.narrow { 63.0 } else { 36.0 }
     }
@@ -407,9 +407,12 @@ impl Timeline {
             }
         });
         if narrow {
+            // The range first: the row's left corner keeps what was there (a click near the
+            // view's corner must not start a job).
             ui.horizontal(|ui| {
-                self.jobs_ui(ui);
                 self.range_ui(ui, doc);
+                ui.add_space(12.0);
+                self.jobs_ui(ui);
             });
         }
         said
