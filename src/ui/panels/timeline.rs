@@ -329,8 +329,9 @@ impl Timeline {
     /// frame before: the view's first frame was 38 points too tall under two rows).
     pub fn fit(&mut self, width: f32) -> f32 {
         // The controls left of the bar take about 550 points (Cache and Record 170 of them,
-        // which go to the second row after the range and the rate), the range and rate 230.
-        self.narrow = width < 550.0 + 240.0 + 230.0;
+        // which go to the second row after the range and the rate), the range and rate 230,
+        // the bar at least 160 (one row at 1280 px, as before Record).
+        self.narrow = width < 550.0 + 160.0 + 230.0;
         if self.narrow { 63.0 } else { 36.0 }
     }
 
