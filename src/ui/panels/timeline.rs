@@ -76,6 +76,11 @@ pub struct Timeline {
     pub record_asked: bool,
     /// Stop was pressed while recording.
     pub record_cancel: bool,
+    /// When Cache's and Record's jobs last ended (UI seconds), and whether each ran last
+    /// frame: a click meant for "Stop" that lands in the frame its job ends must not start
+    /// the job again ([`JUST_ENDED`]).
+    ended: [Option<f64>; 2],
+    ran: [bool; 2],
     /// Wall seconds ticked while playing, in all.
     pub ticked_s: f64,
     /// Of those, the seconds not played: a stalled frame's time past the half second it may
@@ -107,11 +112,17 @@ impl Default for Timeline {
             record_blocked: false,
             record_asked: false,
             record_cancel: false,
+            ended: [None; 2],
+            ran: [false; 2],
             ticked_s: 0.0,
             stalled_s: 0.0,
         }
     }
 }
+
+/// Seconds after Cache's or Record's job ends in which a click on its button starts nothing:
+/// the click was aimed at "Stop" (a press, then the release, a frame or two later).
+const JUST_ENDED: f64 = 0.5;
 
 /// The channels the timeline shows and deletes keys of: every keyable value of the selected
 /// ellipsoids and planes; with nothing selected, the shot camera's while the view looks
@@ -421,6 +432,20 @@ impl Timeline {
 
     /// Cache and Record: the range rendered at full quality, for playback or to a file.
     fn jobs_ui(&mut self, ui: &mut Ui) {
+        // A job that ended a moment ago: its button read "Stop" when the user aimed at it.
+        let now = ui.input(|i| i.time);
+        let running = [
+            self.cache_progress.is_some(),
+            self.record_progress.is_some(),
+        ];
+        let mut just_ended = [false; 2];
+        for k in 0..2 {
+            if self.ran[k] && !running[k] {
+                self.ended[k] = Some(now);
+            }
+            self.ran[k] = running[k];
+            just_ended[k] = self.ended[k].is_some_and(|t| now - t < JUST_ENDED);
+        }
         // Cached playback: the range rendered once at full quality, then played from it.
         let cache = match self.cache_progress {
             Some((done, of)) => ui
@@ -441,7 +466,7 @@ impl Timeline {
         if cache.clicked() {
             if self.cache_progress.is_some() {
                 self.cache_cancel = true;
-            } else {
+            } else if !just_ended[0] {
                 self.cache_asked = true;
             }
         }
@@ -462,7 +487,7 @@ impl Timeline {
         if record.clicked() {
             if self.record_progress.is_some() {
                 self.record_cancel = true;
-            } else {
+            } else if !just_ended[1] {
                 self.record_asked = true;
             }
         }
@@ -834,6 +859,69 @@ mod tests {
             "{} s, not {past}",
             doc.scene().time
         );
+    }
+
+    #[test]
+    fn a_click_aimed_at_stop_as_its_job_ends_starts_nothing() {
+        let ctx = egui::Context::default();
+        let mut doc = Document::new(Scene::default());
+        let selection = Selection::default();
+        let mut timeline = Timeline::default();
+        let mut frame = |timeline: &mut Timeline, t: f64, events: Vec<egui::Event>| {
+            let raw = egui::RawInput {
+                time: Some(t),
+                events,
+                screen_rect: Some(egui::Rect::from_min_size(
+                    egui::Pos2::ZERO,
+                    egui::vec2(1280.0, 800.0),
+                )),
+                ..Default::default()
+            };
+            let mut out = ctx.run_ui(raw, |ui| {
+                timeline.fit(1280.0);
+                timeline.ui(ui, &mut doc, &selection);
+            });
+            out.textures_delta.clear();
+            crate::ui::widgets::take_marks(&ctx)
+        };
+        let button = |at: egui::Pos2, pressed| egui::Event::PointerButton {
+            pos: at,
+            button: egui::PointerButton::Primary,
+            pressed,
+            modifiers: egui::Modifiers::NONE,
+        };
+        for (name, job) in [("timeline:cache", 0), ("timeline:record", 1)] {
+            let run = |timeline: &mut Timeline, on: bool| {
+                if job == 0 {
+                    timeline.cache_progress = on.then_some((7, 10));
+                } else {
+                    timeline.record_progress = on.then_some(0.7);
+                }
+            };
+            let asked = |timeline: &Timeline| [timeline.cache_asked, timeline.record_asked][job];
+            let t0 = 10.0 * job as f64;
+            run(&mut timeline, true);
+            let [x, y, w, h] = frame(&mut timeline, t0, Vec::new())[name];
+            let at = egui::pos2(x + w / 2.0, y + h / 2.0);
+            frame(
+                &mut timeline,
+                t0 + 0.05,
+                vec![egui::Event::PointerMoved(at)],
+            );
+            // Pressed on "Stop"; the job ends before the release.
+            frame(&mut timeline, t0 + 0.1, vec![button(at, true)]);
+            run(&mut timeline, false);
+            frame(&mut timeline, t0 + 0.15, vec![button(at, false)]);
+            frame(&mut timeline, t0 + 0.2, Vec::new());
+            assert!(!asked(&timeline), "{name}: the click meant Stop");
+            // The same click a moment later starts the job (the baseline).
+            frame(&mut timeline, t0 + 2.0, vec![button(at, true)]);
+            frame(&mut timeline, t0 + 2.05, vec![button(at, false)]);
+            assert!(
+                asked(&timeline),
+                "{name}: a click on the button's own label"
+            );
+        }
     }
 
     #[test]
