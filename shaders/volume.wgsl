@@ -292,17 +292,39 @@ fn fs_outside_shafts(in: VsOut) -> ShaftsOut {
     let a = in.near.xyz / in.near.w;
     let b = in.far.xyz / in.far.w;
     let apart = i32(u.air.z);
-    var beyond = vec3<f32>(0.0);
-    var all = vec3<f32>(0.0);
+    // shaft() of every shell, with what the shells of a pixel share worked out once (the ray,
+    // its jitter, the phase, the share a stretch scatters): the loop keeps the part that
+    // differs, the sun through the clouds and the air in front. A CPU adapter pays for each
+    // shell of each pixel: this pass was most of the frame that turns shafts on.
+    let dir = normalize(b - a);
+    let origin = a - dir * dot(a - u.eye.xyz, dir);
+    let jitter = fract(52.9829189 * fract(dot(in.clip.xy, vec2<f32>(0.06711056, 0.00583715))));
+    let spacing = u.shafts.y;
+    let sigma = u.shafts.z;
+    let size = 1.0 / u.grid_inv_size.xyz;
+    var beyond = 0.0;
+    var all = 0.0;
     for (var k = 0; k < i32(u.shells.w); k = k + 1) {
-        let light = shaft(a, b, in.clip.xy, k);
+        let r = u.shafts.x - (f32(k) + jitter) * spacing;
+        if r <= 0.0 {
+            // Nearer with every shell: the rest lie behind the eye.
+            break;
+        }
+        let p = origin + dir * r;
+        if p.y < u.air.x {
+            continue;
+        }
+        let sun = sun_through_clouds(p, u.grid_min.xyz, size, u.sun_dir.xyz, light_tex, clamp_smp);
+        let light = sun * exp(-sigma * r);
         all = all + light;
         if k < apart {
             beyond = beyond + light;
         }
     }
+    let scale = u.sun_color.rgb
+        * (u.shafts.w * (1.0 - exp(-sigma * spacing)) * hg(dot(dir, u.sun_dir.xyz), u.air.y));
     var out: ShaftsOut;
-    out.cloud = vec4<f32>(beyond, 0.0);
-    out.shafts = vec4<f32>(all, 0.0);
+    out.cloud = vec4<f32>(scale * beyond, 0.0);
+    out.shafts = vec4<f32>(scale * all, 0.0);
     return out;
 }

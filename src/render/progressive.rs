@@ -67,6 +67,13 @@ pub struct FramePlan {
     /// GPU's fence reports it (the fence wakes the UI), or after a short while where nothing
     /// polls the GPU meanwhile (natively, callbacks run when a frame is submitted).
     pub waiting_for_gpu: bool,
+    /// While waiting for the GPU: seconds until the last chunk is due on it, when the next
+    /// frame may queue the next chunk whether its report came or not.
+    pub wake_after: Option<f64>,
+    /// A fenced chunk with more to come: seconds after the GPU starts it when it is due (the
+    /// GPU's report that it is free for the chunk wakes the next frame then; see
+    /// [`GpuReport::started`]).
+    pub due_after_start: Option<f64>,
     /// The job's number (jobs are numbered from 1 as planned), which the GPU's fence reports
     /// back once the job is done ([`GpuReport::done`]).
     pub job_id: u64,
@@ -86,12 +93,18 @@ pub struct GpuReport {
     /// The last job finished whose own time is known: its number, and the seconds from the
     /// GPU's report that it was free for the job to its report of the job done.
     pub timed: Option<(u64, f64)>,
+    /// The last job the GPU reported it was free to start, and the seconds since that report.
+    pub started: Option<(u64, f64)>,
 }
 
 impl GpuReport {
     /// Jobs up to `done` finished, none timed.
     pub fn upto(done: u64) -> Self {
-        Self { done, timed: None }
+        Self {
+            done,
+            timed: None,
+            started: None,
+        }
     }
 }
 
@@ -123,6 +136,9 @@ struct Shown {
     key: u64,
     target: usize,
     quality: Quality,
+    /// When the view changed to it, or the pointer was last held on it, if later
+    /// (seconds): when its refinement could begin.
+    since: f64,
 }
 
 /// A job not yet measured.
@@ -137,6 +153,10 @@ struct Pending {
     /// untimed, from its planning until its report is seen), where a preview is measured by
     /// the interval to the next frame.
     chunk: bool,
+    /// When the model expects the GPU to be done with it (seconds): its report may come a
+    /// good while later (0.1–0.16 s in SwiftShader's WebGPU), and the next chunk may queue
+    /// behind it from then on.
+    due: f64,
 }
 
 #[derive(Clone, Debug)]
@@ -188,7 +208,11 @@ pub struct Progressive {
     /// Seconds every timed chunk took besides its work (fitted through `timed`): on a CPU
     /// adapter the GPU's report of a chunk comes a good while after the work is done.
     delay: f64,
-    pending: Option<Pending>,
+    /// Jobs handed to the GPU and not yet measured, oldest first (a preview, fenced chunks).
+    pending: std::collections::VecDeque<Pending>,
+    /// When the report of the last fenced chunk was seen: a chunk queued behind another
+    /// starts on the GPU no sooner.
+    last_seen: f64,
     /// Jobs planned so far (the last job's number).
     jobs: u64,
     /// Fences off ([`Progressive::fenced`]), or the GPU never reported a job within
@@ -222,6 +246,12 @@ pub fn slice_weight(shafts: bool) -> f64 {
     if shafts { SHAFTS_SLICE_WEIGHT } else { 1.0 }
 }
 
+/// How much longer than the model's time for a chunk the next one waits for its report before
+/// it queues behind it anyway.
+const DUE_MARGIN: f64 = 1.3;
+/// Jobs kept for measuring at most (older ones are forgotten unmeasured).
+const PENDING_KEPT: usize = 8;
+
 /// Fewest slices a preview uses.
 const MIN_PREVIEW_SLICES: u32 = 16;
 /// Smallest preview resolution scale.
@@ -250,7 +280,8 @@ impl Progressive {
             delay: 0.0,
             behind_since: None,
             per_chunk: 0.0,
-            pending: None,
+            pending: std::collections::VecDeque::new(),
+            last_seen: f64::NEG_INFINITY,
             jobs: 0,
             fence_silent: false,
             shown: None,
@@ -312,7 +343,7 @@ impl Progressive {
         self.shown = None;
         self.refine = None;
         self.finishing = None;
-        self.pending = None;
+        self.pending.clear();
     }
 
     /// Plans the frame at time `now` (seconds) for a view identified by `key` in a viewport of
@@ -331,6 +362,13 @@ impl Progressive {
         gpu: GpuReport,
     ) -> FramePlan {
         self.measure(now, gpu);
+        // The GPU has started a chunk: it is due once the chunk's work is done.
+        if let Some((id, ago)) = gpu.started {
+            let cost = self.cost();
+            if let Some(p) = self.pending.iter_mut().find(|p| p.id == id && p.chunk) {
+                p.due = p.due.min(now - ago + DUE_MARGIN * cost * p.work);
+            }
+        }
         let viewport = [viewport[0].max(1), viewport[1].max(1)];
         let full_slices = full_slices.max(1);
 
@@ -347,6 +385,7 @@ impl Progressive {
                 key,
                 target: 0,
                 quality,
+                since: now,
             });
             return self.submit(
                 now,
@@ -365,9 +404,12 @@ impl Progressive {
         let Some(shown) = self.shown.clone() else {
             unreachable!("set above")
         };
-        let chunk_on_gpu = self.pending.as_ref().is_some_and(|p| p.chunk);
+        let chunk_on_gpu = self.pending.iter().any(|p| p.chunk);
         if interacting && let Some(r) = &mut self.refine {
             r.interrupted = true;
+        }
+        if interacting && let Some(s) = &mut self.shown {
+            s.since = now;
         }
         if shown.quality.full || interacting {
             return FramePlan {
@@ -378,13 +420,25 @@ impl Progressive {
                 repaint: false,
                 // The last chunk is measured when the GPU reports it, not at the next input.
                 waiting_for_gpu: chunk_on_gpu,
+                wake_after: None,
+                due_after_start: None,
                 job_id: 0,
                 own_submission: false,
             };
         }
         // The GPU has yet to report the last job (a chunk, or the preview before the first):
-        // a chunk now would queue behind it. Past the fence's patience, stop waiting for it.
-        let behind = !self.fence_silent && gpu.done < self.jobs;
+        // a chunk now would queue behind it. Unless that job is a chunk the GPU should be done
+        // with by now: its report is on its way, and waiting for it would leave the GPU idle
+        // (half of a chunk's time in SwiftShader's WebGPU). Past the fence's patience, stop
+        // waiting for reports.
+        let outstanding = self.jobs.saturating_sub(gpu.done);
+        let last_due = self
+            .pending
+            .back()
+            .filter(|p| p.chunk && p.id == self.jobs)
+            .map(|p| p.due);
+        let done_by_now = outstanding == 1 && last_due.is_some_and(|due| now >= due);
+        let behind = !self.fence_silent && outstanding > 0 && !done_by_now;
         if behind {
             let since = *self.behind_since.get_or_insert(now);
             if now - since > FENCE_PATIENCE {
@@ -393,8 +447,9 @@ impl Progressive {
         } else {
             self.behind_since = None;
         }
-        if chunk_on_gpu || (behind && !self.fence_silent) {
-            // The last job is still on the GPU: show what there is and look again.
+        if behind && !self.fence_silent {
+            // The last job is still on the GPU: show what there is and look again (when the
+            // fence reports it, or when the chunk is due).
             return FramePlan {
                 job: None,
                 display: Some(shown.target),
@@ -406,11 +461,20 @@ impl Progressive {
                     .map(|r| r.next as f32 / r.total as f32),
                 repaint: false,
                 waiting_for_gpu: true,
+                wake_after: last_due
+                    .filter(|&due| due > now && due.is_finite())
+                    .map(|due| due - now),
+                due_after_start: None,
                 job_id: 0,
                 own_submission: false,
             };
         }
-        let (size, predicted) = self.refine_plan(viewport, full_slices);
+        // Full quality is due within the budget of the change, the frames before the first
+        // chunk included (the one that turns the ground or the shafts on draws the view
+        // behind the cloud: a third of a second on a CPU adapter).
+        let spent = (now - shown.since).max(0.0);
+        let within = (self.budget.refine_total - spent).max(0.5 * self.budget.refine_total);
+        let (size, predicted) = self.refine_plan_within(viewport, full_slices, within);
         let chunk_seconds = self.chunk_seconds();
         let cost = self.cost();
         let refine = match &mut self.refine {
@@ -457,6 +521,7 @@ impl Progressive {
                 key,
                 target: 1,
                 quality,
+                since: shown.since,
             });
             self.finishing = self
                 .refine
@@ -489,11 +554,18 @@ impl Progressive {
         // A chunk is followed by a frame only once the GPU reports it done: a frame drawn
         // meanwhile would only queue more work behind it.
         let fenced = chunk && !self.fence_silent;
-        self.pending = Some(Pending {
+        if self.pending.len() >= PENDING_KEPT {
+            self.pending.pop_front();
+        }
+        // Due once the GPU has started it and done its work, with a margin (a chunk queued
+        // behind one still at work would hold a drag starting then for both).
+        let seconds = DUE_MARGIN * self.cost() * work;
+        self.pending.push_back(Pending {
             id: self.jobs,
             then: now,
             work,
             chunk: fenced,
+            due: f64::INFINITY,
         });
         FramePlan {
             job: Some(job),
@@ -502,6 +574,9 @@ impl Progressive {
             refining,
             repaint: !fenced,
             waiting_for_gpu: fenced,
+            wake_after: None,
+            // More chunks to come: the next when this one is due, if its report is late.
+            due_after_start: (fenced && refining.is_some()).then_some(seconds),
             job_id: self.jobs,
             own_submission: fenced,
         }
@@ -515,12 +590,22 @@ impl Progressive {
     /// frame took beyond it.
     fn measure(&mut self, now: f64, gpu: GpuReport) {
         let gpu_done = gpu.done;
-        let Some(pending) = self
-            .pending
-            .take_if(|p| !p.chunk || gpu_done >= p.id || now - p.then > FENCE_PATIENCE)
-        else {
-            return;
-        };
+        let ready = |p: &Pending| !p.chunk || gpu_done >= p.id || now - p.then > FENCE_PATIENCE;
+        while let Some(k) = self.pending.iter().position(ready) {
+            if let Some(pending) = self.pending.remove(k) {
+                self.measure_job(now, gpu, pending);
+            }
+        }
+    }
+
+    /// [`Progressive::measure`] of one job.
+    fn measure_job(&mut self, now: f64, gpu: GpuReport, pending: Pending) {
+        let gpu_done = gpu.done;
+        // A chunk queued behind another started on the GPU once that one was done.
+        let seen = self.last_seen;
+        if pending.chunk && gpu_done >= pending.id {
+            self.last_seen = now;
+        }
         if let Some(f) = self.finishing.take_if(|f| f.job == pending.id)
             && f.predicted > 0.0
         {
@@ -559,7 +644,7 @@ impl Progressive {
                 self.cost = self.cost.max(cost);
                 // What a chunk costs in time besides its work, from its planning until the
                 // frame that saw its report: what refining at a resolution must count per chunk.
-                let beyond = (now - then - cost * work).max(0.0);
+                let beyond = (now - then.max(seen) - cost * work).max(0.0);
                 self.per_chunk = if self.per_chunk > 0.0 {
                     0.7 * self.per_chunk + 0.3 * beyond
                 } else {
@@ -568,7 +653,11 @@ impl Progressive {
             }
             return;
         }
-        let dt = now - then;
+        if pending.chunk && gpu.timed.is_some() && gpu_done >= pending.id {
+            // Reported with a later chunk, which the GPU timed: its own time is not known.
+            return;
+        }
+        let dt = now - if pending.chunk { then.max(seen) } else { then };
         if pending.chunk && gpu_done < pending.id {
             // No word from the GPU: stop waiting for it from now on.
             self.fence_silent = true;
@@ -637,6 +726,16 @@ impl Progressive {
     /// [`Progressive::refine_size`], and the seconds the model predicts for it before
     /// [`Progressive::late`] (which the choice counts).
     fn refine_plan(&self, viewport: [u32; 2], full_slices: u32) -> ([u32; 2], f64) {
+        self.refine_plan_within(viewport, full_slices, self.budget.refine_total)
+    }
+
+    /// [`Progressive::refine_plan`] within `budget` seconds.
+    fn refine_plan_within(
+        &self,
+        viewport: [u32; 2],
+        full_slices: u32,
+        budget: f64,
+    ) -> ([u32; 2], f64) {
         let seconds = |scale: f64| {
             let work = self.cost()
                 * (viewport[0] as f64 * scale).round().max(1.0)
@@ -652,7 +751,7 @@ impl Progressive {
             work + (work / self.chunk_seconds()).ceil() * fixed
         };
         let mut scale: f64 = 1.0;
-        while scale > MIN_REFINE_SCALE && self.late * seconds(scale) > self.budget.refine_total {
+        while scale > MIN_REFINE_SCALE && self.late * seconds(scale) > budget {
             scale *= 0.95;
         }
         let scale = scale.max(MIN_REFINE_SCALE);
@@ -949,6 +1048,9 @@ mod tests {
         seen: f64,
         /// What a slice costs relative to a plain one (2 with shafts of light).
         weight: f64,
+        /// The GPU reports when it starts a job (as the fence's report that the work before
+        /// the job is done): off, as before the planner used it.
+        starts: bool,
         t: f64,
         gpu_free: f64,
         /// GPU end times of the frames not yet finished, oldest first.
@@ -967,6 +1069,7 @@ mod tests {
                 delay,
                 seen: 1.0,
                 weight: 1.0,
+                starts: true,
                 t: 0.0,
                 gpu_free: 0.0,
                 queued: Default::default(),
@@ -985,9 +1088,18 @@ mod tests {
                 } else {
                     let reported = self.jobs.iter().filter(|(end, ..)| end + self.delay <= t);
                     let last = reported.max_by(|a, b| a.1.cmp(&b.1));
+                    // The GPU's report that it is free for a job comes as it starts it.
+                    let started = self
+                        .jobs
+                        .iter()
+                        .filter(|&&(end, _, seconds)| end - seconds <= t)
+                        .max_by(|a, b| a.1.cmp(&b.1))
+                        .map(|&(end, id, seconds)| (id, t - (end - seconds)))
+                        .filter(|_| self.starts);
                     GpuReport {
                         done: last.map_or(0, |j| j.1),
                         timed: last.map(|&(_, id, seconds)| (id, self.seen * seconds + self.delay)),
+                        started,
                     }
                 };
                 let plan = p.plan(t, key, view, 128, false, report);
@@ -1008,9 +1120,27 @@ mod tests {
                 self.queued.push_back(end);
                 let mut next = t + 1.0 / 60.0;
                 if plan.waiting_for_gpu {
-                    // No frame until the fence wakes the page.
-                    let chunk = self.jobs.last().map_or(next, |&(end, ..)| end + self.delay);
-                    next = next.max(chunk);
+                    // No frame until the fence wakes the page: the last job's report (an
+                    // earlier job's wakes nothing).
+                    let report = self
+                        .jobs
+                        .last()
+                        .map(|&(end, ..)| end + self.delay)
+                        .filter(|&at| at > t)
+                        .unwrap_or(next);
+                    // Or when the chunk is due: after its start, or, once started, from now.
+                    let started = |id: u64| {
+                        self.jobs
+                            .iter()
+                            .find(|j| j.1 == id)
+                            .map(|&(end, _, seconds)| end - seconds)
+                    };
+                    let due = match (plan.due_after_start, plan.wake_after) {
+                        (Some(after), _) => started(plan.job_id).map_or(report, |s| s + after),
+                        (None, Some(w)) => t + w,
+                        (None, None) => report,
+                    };
+                    next = next.max(report.min(due));
                 }
                 self.queued.retain(|&e| e > next);
                 while self.queued.len() >= self.ahead {
@@ -1065,6 +1195,73 @@ mod tests {
                  {seconds_before:.2} s at {size_before:?}"
             );
         }
+    }
+
+    #[test]
+    fn a_chunk_follows_the_one_before_once_it_is_due_not_when_its_late_report_comes() {
+        // SwiftShader at 1280×800 as above, its reports 0.16 s late: the GPU would wait for
+        // each report; queued once the chunk before is due, the next keeps it busy.
+        let cost = 6.0 / (800.0 * 600.0 * 128.0);
+        let run = |starts: bool| {
+            let mut b = Browser::new(cost, 0.067, false, 0.16);
+            b.starts = starts;
+            let mut p = Progressive::new(cost / 3.0, Budget::default());
+            for key in 1..4 {
+                b.refine(&mut p, key, VIEW);
+            }
+            let (stall, seconds) = b.refine(&mut p, 9, VIEW);
+            let size = p.refine_size(VIEW, 128);
+            (stall, seconds, size[0] as f64 * size[1] as f64)
+        };
+        let (stall, seconds, pixels) = run(true);
+        // Baseline: a planner that waits for every report.
+        let (stall_before, seconds_before, pixels_before) = run(false);
+        let pace = pixels / seconds;
+        let pace_before = pixels_before / seconds_before;
+        assert!(
+            pace > 1.25 * pace_before,
+            "{pixels} px in {seconds:.2} s, waiting for reports {pixels_before} px in \
+             {seconds_before:.2} s"
+        );
+        // A drag starting meanwhile still waits for about one chunk.
+        assert!(
+            stall < 0.3 && stall < stall_before + 0.1,
+            "{stall:.2} s, waiting for reports {stall_before:.2} s"
+        );
+    }
+
+    #[test]
+    fn time_spent_before_the_first_chunk_is_taken_from_the_refinements_budget() {
+        // A preview frame that took 0.6 s (the view behind the cloud drawn with it): the
+        // refinement after it is planned for what is left of the budget.
+        let refined = |preview_seconds: f64| {
+            let mut p = Progressive::new(2e-8, Budget::default());
+            let preview = p.plan(0.0, 1, VIEW, 128, false, GpuReport::upto(0));
+            let first = p.plan(
+                preview_seconds,
+                1,
+                VIEW,
+                128,
+                false,
+                GpuReport::upto(preview.job_id),
+            );
+            first.job.map(|j| j.size).unwrap_or_default()
+        };
+        let (quick, slow) = (refined(0.02), refined(0.6));
+        assert!(
+            slow[0] < quick[0],
+            "{slow:?} after a slow preview, {quick:?} after a quick one"
+        );
+        // The pointer held still for a second before its release: the refinement could not
+        // begin before, and keeps its whole budget.
+        let mut p = Progressive::new(2e-8, Budget::default());
+        let preview = p.plan(0.0, 1, VIEW, 128, true, GpuReport::upto(0));
+        for k in 1..50 {
+            let t = k as f64 * 0.02;
+            p.plan(t, 1, VIEW, 128, true, GpuReport::upto(preview.job_id));
+        }
+        let first = p.plan(1.02, 1, VIEW, 128, false, GpuReport::upto(preview.job_id));
+        assert_eq!(first.job.map(|j| j.size), Some(quick));
     }
 
     #[test]

@@ -33,7 +33,8 @@ struct FenceState {
     done: AtomicU64,
     times: Mutex<Times>,
     clock: fn() -> f64,
-    wake: Box<dyn Fn() + Send + Sync>,
+    /// Wakes the app after the given seconds.
+    wake: Box<dyn Fn(f64) + Send + Sync>,
 }
 
 /// What a [`JobFence`] knows of the jobs' times.
@@ -46,9 +47,10 @@ struct Times {
 }
 
 impl JobFence {
-    /// A fence that calls `wake` whenever a job is reported done, timing jobs by `clock`
-    /// (seconds).
-    pub fn new(wake: impl Fn() + Send + Sync + 'static, clock: fn() -> f64) -> Self {
+    /// A fence that calls `wake` (with the seconds after which to wake the app) whenever a
+    /// job is reported done, or a chunk started that is due a while after, timing jobs by
+    /// `clock` (seconds).
+    pub fn new(wake: impl Fn(f64) + Send + Sync + 'static, clock: fn() -> f64) -> Self {
         Self(Arc::new(FenceState {
             sent: AtomicU64::new(0),
             in_frame: AtomicU64::new(0),
@@ -61,10 +63,16 @@ impl JobFence {
 
     /// What the GPU has reported so far.
     pub fn report(&self) -> GpuReport {
-        let timed = self.0.times.lock().map_or(None, |t| t.timed);
+        let (timed, free) = self
+            .0
+            .times
+            .lock()
+            .map_or((None, None), |t| (t.timed, t.free));
+        let now = (self.0.clock)();
         GpuReport {
             done: self.0.done.load(Ordering::Acquire),
             timed,
+            started: free.map(|(job, at)| (job, (now - at).max(0.0))),
         }
     }
 
@@ -94,11 +102,15 @@ impl JobFence {
         }
     }
 
-    /// The work submitted before job `job` is done: the GPU can start it.
-    fn free_for(&self, job: u64) {
+    /// The work submitted before job `job` is done: the GPU can start it. A job `due` seconds
+    /// later ([`super::progressive::FramePlan::due_after_start`]) wakes the app then.
+    fn free_for(&self, job: u64, due: Option<f64>) {
         let now = (self.0.clock)();
         if let Ok(mut t) = self.0.times.lock() {
             t.free = Some((job, now));
+        }
+        if let Some(due) = due {
+            (self.0.wake)(due);
         }
     }
 
@@ -112,7 +124,11 @@ impl JobFence {
             t.timed = Some((job, (now - at).max(0.0)));
         }
         self.0.done.fetch_max(job, Ordering::AcqRel);
-        (self.0.wake)();
+        // A later job on the GPU wakes the app itself (when due, or done): a frame now would
+        // plan nothing and only delay it.
+        if job >= self.0.sent.load(Ordering::Acquire) {
+            (self.0.wake)(0.0);
+        }
     }
 }
 
@@ -137,6 +153,9 @@ pub struct ViewportPaint {
     /// Whether the job goes to the GPU on its own, ahead of the frame, timed by the fence
     /// ([`super::progressive::FramePlan::own_submission`]); else with the frame's commands.
     pub own_submission: bool,
+    /// Seconds after the GPU starts the job when the next frame may queue another behind it
+    /// ([`super::progressive::FramePlan::due_after_start`]).
+    pub due_after_start: Option<f64>,
 }
 
 impl RendererPaint for ViewportPaint {
@@ -163,9 +182,9 @@ impl RendererPaint for ViewportPaint {
                 renderer.update_light(device, queue, &mut own, &job.view);
                 renderer.draw_slices(device, queue, &mut own, job, None);
                 if let Some(fence) = self.fence.clone() {
-                    let id = self.job_id;
+                    let (id, due) = (self.job_id, self.due_after_start);
                     fence.sent(id);
-                    queue.on_submitted_work_done(move || fence.free_for(id));
+                    queue.on_submitted_work_done(move || fence.free_for(id, due));
                 }
                 queue.submit([own.finish()]);
                 if let Some(fence) = self.fence.clone() {
