@@ -414,7 +414,7 @@ impl Viewport {
         }
         self.drive_capture(ui, &mut cx, &exported, &volumes.density, CAPTURE_BUDGET);
         if plan.job.is_none() && plan.shown.is_some_and(|q| q.full) && !density.is_empty() {
-            self.warm_up(ui, &exported);
+            self.warm_up(ui, &view);
         }
         let capture = self.capture.clone().or_else(|| self.warm.clone());
         if crop.is_none() && capture.is_some() && self.stats.backend.is_some() {
@@ -483,10 +483,11 @@ impl Viewport {
     /// pixels with the ground and the shafts of light on, never shown, so that the adapter
     /// compiles their passes now. SwiftShader compiles a pass on its first draw: turning the
     /// ground and the shafts on took 0.3–0.5 s longer the first time than the next.
-    fn warm_up(&mut self, ui: &egui::Ui, exported: &View) {
+    /// `view` is the view's own (its light previewed on a CPU adapter).
+    fn warm_up(&mut self, ui: &egui::Ui, view: &View) {
         if !self.warmed && self.ready && self.capture.is_none() && self.stats.backend.is_some() {
             self.warmed = true;
-            let mut view = exported.clone();
+            let mut view = view.clone();
             view.light.ground = true;
             view.light.shafts = true;
             // As few slices as show the passes.
