@@ -70,10 +70,6 @@ pub struct Viewport {
     /// The frames captured are a recording's (an export): drawn with the document's light,
     /// not the view's preview of it.
     pub recording: bool,
-    /// The warm-up ([`Viewport::warm_up`]) is done or under way.
-    warmed: bool,
-    /// The warm-up's capture, until it is read back (its pixels are dropped).
-    warm: Option<Capture>,
 }
 
 impl Viewport {
@@ -141,8 +137,6 @@ impl Viewport {
             flipbook: None,
             caching: false,
             recording: false,
-            warmed: false,
-            warm: None,
         }
     }
 
@@ -413,10 +407,7 @@ impl Viewport {
             self.ready = true;
         }
         self.drive_capture(ui, &mut cx, &exported, &volumes.density, CAPTURE_BUDGET);
-        if plan.job.is_none() && plan.shown.is_some_and(|q| q.full) && !density.is_empty() {
-            self.warm_up(ui, &view);
-        }
-        let capture = self.capture.clone().or_else(|| self.warm.clone());
+        let capture = self.capture.clone();
         if crop.is_none() && capture.is_some() && self.stats.backend.is_some() {
             // Nothing of the cloud in view: the capture still needs the callback to run.
             painter.add(paint_callback(
@@ -477,30 +468,6 @@ impl Viewport {
             ui.ctx().request_repaint_after(due.min(FENCE_POLL));
         }
         self.overlays(ui, rect, &mut cx, tool, guide, now);
-    }
-
-    /// Once the first full-quality image is shown and the view is still: a capture of a few
-    /// pixels with the ground and the shafts of light on, never shown, so that the adapter
-    /// compiles their passes now. SwiftShader compiles a pass on its first draw: turning the
-    /// ground and the shafts on took 0.3–0.5 s longer the first time than the next.
-    /// `view` is the view's own (its light previewed on a CPU adapter).
-    fn warm_up(&mut self, ui: &egui::Ui, view: &View) {
-        if !self.warmed && self.ready && self.capture.is_none() && self.stats.backend.is_some() {
-            self.warmed = true;
-            let mut view = view.clone();
-            view.light.ground = true;
-            view.light.shafts = true;
-            // As few slices as show the passes.
-            view.render.slices = WARM_UP_SLICES.min(view.render.slices.max(1));
-            self.warm = Some(Capture::new(&view, WARM_UP_SIZE, false, 1));
-        }
-        if let Some(warm) = &self.warm {
-            if warm.take().is_some() {
-                self.warm = None;
-            } else {
-                ui.ctx().request_repaint();
-            }
-        }
     }
 
     /// Starts the capture asked for (its slices over the cloud's box, `density`'s, spread
@@ -746,10 +713,6 @@ fn strips_around([w, h]: [u32; 2], area: Option<[u32; 4]>) -> Vec<[u32; 4]> {
     .filter(|[a, b, c, d]| c > a && d > b)
     .collect()
 }
-
-/// The warm-up's size in pixels and slices ([`Viewport::warm_up`]).
-const WARM_UP_SIZE: [u32; 2] = [32, 20];
-const WARM_UP_SLICES: u32 = 8;
 
 /// While a drag is under way the view behind the cloud is drawn at 1/this of the view's size
 /// (each side).
