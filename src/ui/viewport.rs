@@ -367,7 +367,12 @@ impl Viewport {
                 let ctx = ui.ctx().clone();
                 let fence = JobFence::new(
                     move |after| {
-                        let after = std::time::Duration::from_secs_f64(after.clamp(0.0, 5.0));
+                        let after = if after.is_finite() {
+                            after.clamp(0.0, 5.0)
+                        } else {
+                            0.0
+                        };
+                        let after = std::time::Duration::from_secs_f64(after);
                         ctx.request_repaint_after(WAKE.max(after));
                     },
                     super::platform::now,
@@ -465,7 +470,8 @@ impl Viewport {
             let due = plan
                 .wake_after
                 .map_or(FENCE_POLL, std::time::Duration::from_secs_f64);
-            ui.ctx().request_repaint_after(due.min(FENCE_POLL));
+            ui.ctx()
+                .request_repaint_after(due.min(FENCE_POLL).max(WAKE));
         }
         self.overlays(ui, rect, &mut cx, tool, guide, now);
     }

@@ -81,6 +81,9 @@ pub struct Timeline {
     /// the job again ([`JUST_ENDED`]).
     ended: [Option<f64>; 2],
     ran: [bool; 2],
+    /// The frame the buttons were last drawn in: a job that ended while the strip was hidden
+    /// was not aimed at.
+    drawn_frame: u64,
     /// Wall seconds ticked while playing, in all.
     pub ticked_s: f64,
     /// Of those, the seconds not played: a stalled frame's time past the half second it may
@@ -114,6 +117,7 @@ impl Default for Timeline {
             record_cancel: false,
             ended: [None; 2],
             ran: [false; 2],
+            drawn_frame: 0,
             ticked_s: 0.0,
             stalled_s: 0.0,
         }
@@ -434,13 +438,16 @@ impl Timeline {
     fn jobs_ui(&mut self, ui: &mut Ui) {
         // A job that ended a moment ago: its button read "Stop" when the user aimed at it.
         let now = ui.input(|i| i.time);
+        let frame = ui.ctx().cumulative_frame_nr();
+        let shown_before = self.drawn_frame + 1 == frame;
+        self.drawn_frame = frame;
         let running = [
             self.cache_progress.is_some(),
             self.record_progress.is_some(),
         ];
         let mut just_ended = [false; 2];
         for k in 0..2 {
-            if self.ran[k] && !running[k] {
+            if self.ran[k] && !running[k] && shown_before {
                 self.ended[k] = Some(now);
             }
             self.ran[k] = running[k];
