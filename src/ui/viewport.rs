@@ -366,14 +366,10 @@ impl Viewport {
             .get_or_insert_with(|| {
                 let ctx = ui.ctx().clone();
                 let fence = JobFence::new(
-                    move |after| {
-                        let after = if after.is_finite() {
-                            after.clamp(0.0, 5.0)
-                        } else {
-                            0.0
-                        };
-                        let after = std::time::Duration::from_secs_f64(after);
-                        ctx.request_repaint_after(WAKE.max(after));
+                    move |after: f64| {
+                        // NaN or negative: at once.
+                        let after = std::time::Duration::try_from_secs_f64(after.min(5.0));
+                        ctx.request_repaint_after(WAKE.max(after.unwrap_or_default()));
                     },
                     super::platform::now,
                 );
