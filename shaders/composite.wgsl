@@ -1,7 +1,12 @@
 // Composites the linear, premultiplied volume image into the output (egui's frame or the
-// offscreen image): tone map, encode sRGB, premultiplied "over" blending; with shafts of
-// light (fs_shafts) their light is added on top. Into a float target (the offscreen linear
-// image an EXR holds) the `_linear` entry points lay the same light before any tone map.
+// offscreen image). Over a background the view behind the cloud (its display colour D, as
+// the backdrop texture or the flat background holds it) is turned back into light B, and the
+// pixel's light B·(1 − alpha) + the cloud's + the shafts' is mapped once by the one tone map
+// (tone.wgsl); it is blended "over" D so that over D it gives exactly that, and a guide image
+// egui drew between the two still shows through the cloud's thin parts. Over no background (a
+// transparent image) the cloud's mean light is mapped alone, premultiplied. Into a float
+// target (the offscreen linear image an EXR holds) the `_linear` entry points lay the same
+// light before any tone map. Composed after fullscreen.wgsl and tone.wgsl.
 
 @group(0) @binding(0) var src: texture_2d<f32>;
 @group(0) @binding(1) var src_smp: sampler;
@@ -13,21 +18,45 @@
 @group(0) @binding(3) var beyond_tex: texture_2d<f32>;
 @group(0) @binding(4) var<uniform> beyond_uv: vec4<f32>;
 
+// What lies behind the cloud (`BehindUniforms` in src/render/gpu_types.rs).
+struct Behind {
+    // Where this image lies in the view behind it: uv = xy + uv · zw.
+    place: vec4<f32>,
+    // rgb: the flat background's display colour; w: 1 when it is that colour, not the texture.
+    flat: vec4<f32>,
+};
+
+// The view behind the cloud as drawn (display colours), and where it lies.
+@group(1) @binding(0) var behind_tex: texture_2d<f32>;
+@group(1) @binding(1) var<uniform> behind: Behind;
+
 @vertex
 fn vs_main(@builtin(vertex_index) vi: u32) -> Fullscreen {
     return fullscreen_vertex(vi);
 }
 
-fn linear_to_srgb(x: vec3<f32>) -> vec3<f32> {
-    let lo = x * 12.92;
-    let hi = 1.055 * pow(x, vec3<f32>(1.0 / 2.4)) - 0.055;
-    return select(hi, lo, x <= vec3<f32>(0.0031308));
+// The display colour of what lies behind this image's pixel `uv`.
+fn behind_at(uv: vec2<f32>) -> vec3<f32> {
+    if behind.flat.w > 0.5 {
+        return behind.flat.rgb;
+    }
+    return textureSampleLevel(behind_tex, src_smp, behind.place.xy + uv * behind.place.zw, 0.0).rgb;
 }
 
-// The cloud's premultiplied pixel: its mean light tone-mapped, then encoded.
+// The premultiplied pixel that, blended "over" what lies behind (`d`, its display colour),
+// shows the one tone map of its light behind the cloud's `alpha`, the cloud's premultiplied
+// `cloud` light and the `added` light. Its alpha is the cloud's, raised where a channel would
+// need less than nothing added (a dark thin cloud over a bright sky).
+fn over_behind(d: vec3<f32>, alpha: f32, cloud: vec3<f32>, added: vec3<f32>) -> vec4<f32> {
+    let shown = display(light_of(d) * (1.0 - alpha) + cloud + added);
+    let ratio = select(vec3<f32>(1.0), shown / max(d, vec3<f32>(1e-6)), d > vec3<f32>(1e-6));
+    let a = clamp(max(alpha, 1.0 - min(ratio.r, min(ratio.g, ratio.b))), 0.0, 1.0);
+    return vec4<f32>(max(shown - (1.0 - a) * d, vec3<f32>(0.0)), a);
+}
+
+// The cloud's premultiplied pixel over no background: its mean light tone-mapped, encoded.
 fn cloud(p: vec4<f32>) -> vec4<f32> {
-    let colour = 1.0 - exp(-p.rgb / p.a);
-    return vec4<f32>(linear_to_srgb(colour) * p.a, p.a);
+    return vec4<f32>(display(p.rgb / p.a) * p.a, p.a);
 }
 
 @fragment
@@ -36,55 +65,64 @@ fn fs_main(in: Fullscreen) -> @location(0) vec4<f32> {
     if p.a <= 1e-4 {
         discard;
     }
+    return over_behind(behind_at(in.uv), p.a, p.rgb, vec3<f32>(0.0));
+}
+
+@fragment
+fn fs_transparent(in: Fullscreen) -> @location(0) vec4<f32> {
+    let p = textureSampleLevel(src, src_smp, in.uv, 0.0);
+    if p.a <= 1e-4 {
+        discard;
+    }
     return cloud(p);
 }
 
-// The cloud as fs_main draws it with the shafts' light added on top, over the cloud and the
-// sky behind it alike (alpha stays the cloud's).
-fn with_shafts(uv: vec2<f32>) -> vec4<f32> {
-    return with_light(uv, textureSampleLevel(shafts_tex, src_smp, uv, 0.0).rgb);
+// The cloud with the shafts' `light` added, over what lies behind.
+fn with_light(uv: vec2<f32>, light: vec3<f32>) -> vec4<f32> {
+    let p = textureSampleLevel(src, src_smp, uv, 0.0);
+    let cloud = p.a > 1e-4;
+    return over_behind(behind_at(uv), select(0.0, p.a, cloud), select(vec3<f32>(0.0), p.rgb, cloud), light);
 }
 
-// The cloud with `shafts` light added on top.
-fn with_light(uv: vec2<f32>, shafts: vec3<f32>) -> vec4<f32> {
+// The same over no background: the cloud alone, with the display of the shafts' light added
+// (what that light shows over black: mapped alone, sRGB-encoded).
+fn with_light_transparent(uv: vec2<f32>, light: vec3<f32>) -> vec4<f32> {
     let p = textureSampleLevel(src, src_smp, uv, 0.0);
     var out = vec4<f32>(0.0);
     if p.a > 1e-4 {
         out = cloud(p);
     }
-    // Added as is (not sRGB-encoded): about what adding that light to mid-tones does, where
-    // encoding would brighten faint light five-fold.
-    return vec4<f32>(out.rgb + (1.0 - exp(-shafts)), out.a);
+    return vec4<f32>(out.rgb + display(light), out.a);
 }
 
 @fragment
 fn fs_shafts(in: Fullscreen) -> @location(0) vec4<f32> {
-    return with_shafts(in.uv);
+    return with_light(in.uv, textureSampleLevel(shafts_tex, src_smp, in.uv, 0.0).rgb);
 }
 
 // A cropped image's shafts (the viewport's): its own shells' light, and that of the shells
 // beyond the box, drawn apart, seen through the whole cloud, as the slices would have hidden
 // them had they been drawn among them.
-fn with_beyond(uv: vec2<f32>) -> vec4<f32> {
+fn beyond_light(uv: vec2<f32>) -> vec3<f32> {
     let alpha = textureSampleLevel(src, src_smp, uv, 0.0).a;
     let beyond = textureSampleLevel(beyond_tex, src_smp, beyond_uv.xy + uv * beyond_uv.zw, 0.0).rgb;
     let own = textureSampleLevel(shafts_tex, src_smp, uv, 0.0).rgb;
-    return with_light(uv, own + (1.0 - alpha) * beyond);
+    return own + (1.0 - alpha) * beyond;
 }
 
 @fragment
 fn fs_shafts_beyond(in: Fullscreen) -> @location(0) vec4<f32> {
-    return with_beyond(in.uv);
+    return with_light(in.uv, beyond_light(in.uv));
 }
 
 @fragment
 fn fs_shafts_beyond_transparent(in: Fullscreen) -> @location(0) vec4<f32> {
-    return glow(with_beyond(in.uv));
+    return glow(with_light_transparent(in.uv, beyond_light(in.uv)));
 }
 
-// The same over no background (a transparent image): light added to nothing has no alpha,
-// and a straight-alpha PNG would lose it, so the shafts' light covers the pixel as much as
-// its brightest channel (a glow: over a background B it gives light + (1 − a)·B).
+// Over no background (a transparent image): light added to nothing has no alpha, and a
+// straight-alpha PNG would lose it, so the shafts' light covers the pixel as much as its
+// brightest channel (a glow: over a background B it gives light + (1 − a)·B).
 fn glow(c: vec4<f32>) -> vec4<f32> {
     let a = clamp(max(c.a, max(c.r, max(c.g, c.b))), 0.0, 1.0);
     return vec4<f32>(min(c.rgb, vec3<f32>(a)), a);
@@ -92,13 +130,13 @@ fn glow(c: vec4<f32>) -> vec4<f32> {
 
 @fragment
 fn fs_shafts_transparent(in: Fullscreen) -> @location(0) vec4<f32> {
-    return glow(with_shafts(in.uv));
+    return glow(with_light_transparent(in.uv, textureSampleLevel(shafts_tex, src_smp, in.uv, 0.0).rgb));
 }
 
 // Into a float target: the cloud's premultiplied light as the slices accumulated it (exposure
-// applied there), no tone map and no encoding, with `shafts` light added as is. Premultiplied
-// light over nothing stays light with no alpha (it adds to whatever lies under it), so over a
-// transparent background it needs no glow.
+// applied there), no tone map and no encoding, with `shafts` light added as is, blended over
+// the linear light behind it. Premultiplied light over nothing stays light with no alpha (it
+// adds to whatever lies under it), so over a transparent background it needs no glow.
 fn linear_with_light(uv: vec2<f32>, shafts: vec3<f32>) -> vec4<f32> {
     let p = textureSampleLevel(src, src_smp, uv, 0.0);
     var out = vec4<f32>(0.0);
@@ -124,8 +162,5 @@ fn fs_shafts_linear(in: Fullscreen) -> @location(0) vec4<f32> {
 
 @fragment
 fn fs_shafts_beyond_linear(in: Fullscreen) -> @location(0) vec4<f32> {
-    let alpha = textureSampleLevel(src, src_smp, in.uv, 0.0).a;
-    let beyond = textureSampleLevel(beyond_tex, src_smp, beyond_uv.xy + in.uv * beyond_uv.zw, 0.0).rgb;
-    let own = textureSampleLevel(shafts_tex, src_smp, in.uv, 0.0).rgb;
-    return linear_with_light(in.uv, own + (1.0 - alpha) * beyond);
+    return linear_with_light(in.uv, beyond_light(in.uv));
 }

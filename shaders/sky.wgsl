@@ -2,9 +2,12 @@
 // the background colour at the zenith, the horizon colour at eye level, and below the horizon
 // a darker haze, by each pixel's view ray; and with Lighting::ground a ground plane whose
 // every point is darkened by the clouds' transmittance toward the sun (the light volume where
-// the sun's ray from that point enters the clouds' box: nothing shades it before). Colours
-// are sRGB-encoded, as the flat background (the clear colour) is. `Sky` mirrors `SkyUniforms`
-// in src/render/gpu_types.rs. Composed after sun_shadow.wgsl.
+// the sun's ray from that point enters the clouds' box: nothing shades it before); and the
+// shafts of light drawn apart from the clouds' box added outside the box's rectangle. The
+// picked colours are display colours: their light (tone.wgsl's `light_of`) is scaled by the
+// exposure, the shafts' light added, and the sum mapped by the one tone map. `Sky` mirrors
+// `SkyUniforms` in src/render/gpu_types.rs. Composed after sun_shadow.wgsl, fullscreen.wgsl
+// and tone.wgsl.
 
 struct Sky {
     // Unit view direction (xyz).
@@ -25,16 +28,22 @@ struct Sky {
     // there is a light volume).
     grid_min: vec4<f32>,
     grid_size: vec4<f32>,
-    // Toward the sun (xyz).
+    // Toward the sun (xyz); w: 2^exposure.
     sun_dir: vec4<f32>,
     // The ground's sRGB colour in full sun.
     ground_lit: vec4<f32>,
+    // Where the shafts' light is not added (texture coordinates, v down: x0, y0, x1, y1): the
+    // clouds' box, whose composite adds its own; the whole target when there are no shafts.
+    keep_out: vec4<f32>,
 };
 
 @group(0) @binding(0) var<uniform> sky: Sky;
 // Transmittance toward the sun, stored as T^(1/8) (light_march.wgsl).
 @group(0) @binding(1) var light_tex: texture_3d<f32>;
 @group(0) @binding(2) var light_smp: sampler;
+// The light of the shafts' shells summed over the whole view (rgb), drawn apart from the
+// clouds' box (VolumeRenderer::draw_outside_shafts).
+@group(0) @binding(3) var shafts_tex: texture_2d<f32>;
 
 // The clouds' transmittance toward the sun from ground point `p` (sun_shadow.wgsl).
 fn ground_sun(p: vec3<f32>) -> f32 {
@@ -53,23 +62,28 @@ fn vs_main(@builtin(vertex_index) vi: u32) -> Fullscreen {
 
 @fragment
 fn fs_main(in: Fullscreen) -> @location(0) vec4<f32> {
-    return vec4<f32>(sky_colour(in), 1.0);
+    return vec4<f32>(display(sky_light(in)), 1.0);
 }
 
-// Into a float target (the offscreen linear image an EXR holds): the same colour as linear
-// light.
+// Into a float target (the offscreen linear image an EXR holds): the same light before the
+// tone map.
 @fragment
 fn fs_linear(in: Fullscreen) -> @location(0) vec4<f32> {
-    return vec4<f32>(srgb_to_linear(sky_colour(in)), 1.0);
+    return vec4<f32>(sky_light(in), 1.0);
 }
 
-fn srgb_to_linear(c: vec3<f32>) -> vec3<f32> {
-    let lo = c / 12.92;
-    let hi = pow((max(c, vec3<f32>(0.0)) + 0.055) / 1.055, vec3<f32>(2.4));
-    return select(hi, lo, c <= vec3<f32>(0.04045));
+// This pixel's linear light: the picked colours' light at this exposure, and the shafts'
+// outside the clouds' box.
+fn sky_light(in: Fullscreen) -> vec3<f32> {
+    var light = light_of(sky_colour(in)) * sky.sun_dir.w;
+    let k = sky.keep_out;
+    if any(in.uv < k.xy) || any(in.uv >= k.zw) {
+        light = light + textureSampleLevel(shafts_tex, light_smp, in.uv, 0.0).rgb;
+    }
+    return light;
 }
 
-// This pixel's sRGB-encoded colour: the gradient or the flat background, the ground over it.
+// This pixel's display colour (sRGB-encoded, as picked at exposure 0): the gradient or the flat background, the ground over it.
 fn sky_colour(in: Fullscreen) -> vec3<f32> {
     let d = normalize(sky.forward.xyz + in.ndc.x * sky.right.xyz + in.ndc.y * sky.up.xyz);
     let e = d.y;

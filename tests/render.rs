@@ -733,8 +733,10 @@ fn an_upper_tier_moves_with_its_own_wind_and_its_floor_shows_no_step() {
     eprintln!(
         "hard {hard:.2} (typical {typical_hard:.2}), blended {soft:.2} (typical {typical:.2})"
     );
+    // 2.0× under the old tone map (`1 − exp(−x)`); 1.8× under ACES's, whose toe shows the
+    // rows' darker light with more contrast. Without the blend the two are the same.
     assert!(
-        hard > 2.0 * soft,
+        hard > 1.5 * soft,
         "hard floor {hard:.2} vs blended {soft:.2}"
     );
     assert!(
@@ -831,23 +833,27 @@ fn a_broken_layer_casts_a_dappled_shadow_when_the_light_volume_sees_the_noise() 
     );
 }
 
+/// Exposure scales all the light before the one tone map: the cloud's and the sky's alike. At
+/// exposure 0 the flat background shows as picked; the old renderer, which tone-mapped the
+/// cloud alone, left the sky as picked at every exposure and fails it.
 #[test]
-fn exposure_brightens_the_cloud_by_stops_and_leaves_the_background() {
+fn exposure_brightens_the_cloud_and_the_sky_by_stops_and_the_sky_shows_as_picked_at_0() {
     let scene = Scene::default();
     let bg = background(&scene);
     let stats = |s: &Scene| {
         let image = render(s);
+        let corner = image.pixel(2, 2);
         let (mut sum, mut n) = (0.0, 0usize);
         for y in 0..image.height {
             for x in 0..image.width {
                 let p = image.pixel(x, y);
-                if differs(p, bg) {
+                if differs(p, [corner[0], corner[1], corner[2]]) {
                     sum += luminance(p);
                     n += 1;
                 }
             }
         }
-        (sum / n.max(1) as f64, image.pixel(2, 2))
+        (sum / n.max(1) as f64, corner)
     };
     let (dark, corner_dark) = stats(&with(&scene, &["/light/exposure=-1.5"]));
     let (plain, corner) = stats(&scene);
@@ -856,10 +862,20 @@ fn exposure_brightens_the_cloud_by_stops_and_leaves_the_background() {
         dark + 10.0 < plain && plain + 10.0 < bright,
         "mean cloud luminance at −1.5 / 0 / +1.5 EV: {dark:.1} / {plain:.1} / {bright:.1}"
     );
-    assert_eq!(
-        (corner_dark, corner_bright),
-        (corner, corner),
-        "the sky keeps its colour"
+    for c in 0..3 {
+        assert!(
+            (corner[c] as i32 - bg[c] as i32).abs() <= 1,
+            "the sky at exposure 0 is {corner:?}, picked {bg:?}"
+        );
+    }
+    let (l_dark, l, l_bright) = (
+        luminance(corner_dark),
+        luminance(corner),
+        luminance(corner_bright),
+    );
+    assert!(
+        l_dark + 10.0 < l && l + 10.0 < l_bright,
+        "the sky's luminance at −1.5 / 0 / +1.5 EV: {l_dark:.1} / {l:.1} / {l_bright:.1}"
     );
 }
 
@@ -938,6 +954,26 @@ fn broken_layer() -> Scene {
     scene
 }
 
+/// The light the shafts add, pixel by pixel: the linear image of `on` less that of `off` (over
+/// the sky, the same scene with and without shafts: exactly the shafts' light where they lie
+/// in front), as the luminance of `1 − exp(−light)` in levels (0–255), the scale these tests
+/// were calibrated on. Measured as light, not as the display's difference: under the one tone
+/// map the same light shows more over a dark pixel than over a bright one.
+fn shaft_term(on: &Scene, off: &Scene) -> Vec<f64> {
+    let (on, off) = (
+        render_linear(on, Backdrop::Sky),
+        render_linear(off, Backdrop::Sky),
+    );
+    on.rgba
+        .chunks(4)
+        .zip(off.rgba.chunks(4))
+        .map(|(a, b)| {
+            let m = |c: usize| 255.0 * (1.0 - (-f64::from(a[c] - b[c])).exp());
+            0.2126 * m(0) + 0.7152 * m(1) + 0.0722 * m(2)
+        })
+        .collect()
+}
+
 /// Luminance of `on` less that of `off`, pixel by pixel.
 fn added_light(on: &Image, off: &Image) -> Vec<f64> {
     on.rgba
@@ -958,8 +994,8 @@ fn shafts_of_light_brighten_the_air_in_the_gaps_and_add_nothing_when_off() {
     let on = render(&with(&layer, &on_sets));
     // The baseline: the same clouds too thin to shade the air (and so to cast shafts).
     let thin = with(&layer, &["/render/opacity=0.01"]);
-    let thin_term = added_light(&render(&with(&thin, &on_sets)), &render(&thin));
-    let term = added_light(&on, &off);
+    let thin_term = shaft_term(&with(&thin, &on_sets), &thin);
+    let term = shaft_term(&with(&layer, &on_sets), &layer);
     if let Ok(dir) = std::env::var("CLOUDSKETCH_TEST_IMAGES") {
         std::fs::write(format!("{dir}/shafts_on.png"), on.to_png().unwrap()).unwrap();
         std::fs::write(format!("{dir}/shafts_off.png"), off.to_png().unwrap()).unwrap();
@@ -1008,22 +1044,31 @@ fn shafts_of_light_brighten_the_air_in_the_gaps_and_add_nothing_when_off() {
 #[test]
 fn a_transparent_image_keeps_the_shafts_light() {
     // Over no background the shafts' light has nothing to be added to: it needs alpha of its
-    // own, or a straight-alpha image drops it (as this renderer did). Open air, transparent
-    // without shafts, carries with them about the light the opaque image adds there.
+    // own, or a straight-alpha image drops it (as this renderer once did). Open air,
+    // transparent without shafts, carries with them the display of their light (what they
+    // show over black: the one tone map of the light alone, sRGB-encoded).
     let layer = broken_layer();
-    let on_sets = ["/light/shafts=true", "/light/shaft_density=0.003"];
+    let lit_layer = with(
+        &layer,
+        &["/light/shafts=true", "/light/shaft_density=0.003"],
+    );
     let transparent = |s: &Scene| {
         offscreen()
             .render(s, W, H, Backdrop::Transparent)
             .expect("render")
     };
     let clear = transparent(&layer);
-    let glowing = transparent(&with(&layer, &on_sets));
-    let opaque_on = render(&with(&layer, &on_sets));
-    let term = added_light(&opaque_on, &render(&layer));
+    let glowing = transparent(&lit_layer);
+    let (on, off) = (
+        render_linear(&lit_layer, Backdrop::Sky),
+        render_linear(&layer, Backdrop::Sky),
+    );
+    let shows = |i: usize| {
+        let c = |k: usize| shown(f64::from(on.rgba[4 * i + k] - off.rgba[4 * i + k]));
+        0.2126 * c(0) + 0.7152 * c(1) + 0.0722 * c(2)
+    };
     let air: Vec<usize> = (0..(W * H) as usize)
-        .filter(|&i| clear.rgba[4 * i + 3] == 0 && term[i] > 10.0)
-        .filter(|&i| opaque_on.rgba[4 * i..4 * i + 3].iter().all(|&c| c < 250))
+        .filter(|&i| clear.rgba[4 * i + 3] == 0 && shows(i) > 10.0)
         .collect();
     assert!(
         air.len() > (W * H / 4) as usize,
@@ -1035,7 +1080,7 @@ fn a_transparent_image_keeps_the_shafts_light() {
         .filter(|&&i| {
             let p = &glowing.rgba[4 * i..4 * i + 4];
             let light = luminance([p[0], p[1], p[2], 255]) * p[3] as f64 / 255.0;
-            (light - term[i]).abs() < 3.0 + 0.1 * term[i]
+            (light - shows(i)).abs() < 3.0 + 0.1 * shows(i)
         })
         .count();
     assert!(
@@ -1068,11 +1113,13 @@ fn a_cloud_hides_the_shafts_behind_it_and_not_those_in_front() {
     // after every slice they would add all of it, before every slice none.
     let scene = shafts_behind_a_cloud();
     let off = render(&scene);
-    let on = render(&with(
+    let term = shaft_term(
+        &with(
+            &scene,
+            &["/light/shafts=true", "/light/shaft_density=0.004"],
+        ),
         &scene,
-        &["/light/shafts=true", "/light/shaft_density=0.004"],
-    ));
-    let term = added_light(&on, &off);
+    );
     let bg = background(&scene);
     let x = W / 2;
     let cloud_rows: Vec<u32> = (0..H).filter(|&y| differs(off.pixel(x, y), bg)).collect();
@@ -1289,9 +1336,21 @@ fn marched_slices_give_the_rasterised_slices_image() {
         for chunks in [1, 3, 20] {
             let [marched, raster] = marched_and_rasterised(scene, chunks);
             let (mean, max) = image_difference(&marched, &raster);
+            let over = marched
+                .rgba
+                .iter()
+                .zip(&raster.rgba)
+                .filter(|(a, b)| a.abs_diff(**b) > 5)
+                .count();
+            eprintln!(
+                "{name} in {chunks} draws: mean {mean:.3}, max {max}, {over} channels over 5"
+            );
+            // Within 5 levels but at a few pixels of thin, bright wisps (the cirrus: 68 of
+            // 90,000 channels, 17 levels at most), where the one tone map shows the two
+            // accumulations' rounding more than mapping the cloud alone did.
             assert!(
-                mean <= 0.5 && max <= 5,
-                "{name} in {chunks} draws: marched and rasterised differ by {mean:.3} on average, {max} at most"
+                mean <= 0.5 && over * 500 <= marched.rgba.len() && max <= 24,
+                "{name} in {chunks} draws: marched and rasterised differ by {mean:.3} on average, {max} at most ({over} channels over 5)"
             );
             identical &= marched.rgba == raster.rgba;
             if name == "empty" {
@@ -1556,7 +1615,7 @@ fn the_previewed_light_and_the_documents_each_draw_their_own_shadows() {
         .filter(|(a, b)| a.iter().zip(b.iter()).any(|(x, y)| x.abs_diff(*y) > 8))
         .count();
     assert!(
-        differing > 500,
+        differing > 250,
         "the preview's coarser light changes the shading: {differing} pixels"
     );
     assert!(
@@ -1853,18 +1912,16 @@ fn render_linear(scene: &Scene, backdrop: Backdrop) -> LinearImage {
         .expect("linear render")
 }
 
-fn encode_srgb(v: f64) -> f64 {
-    if v <= 0.003_130_8 {
-        v * 12.92
-    } else {
-        1.055 * v.powf(1.0 / 2.4) - 0.055
-    }
+/// The display level (0–255) of linear `light`: the one tone map, sRGB-encoded.
+fn shown(light: f64) -> f64 {
+    use cloudsketch::render::tone::{linear_to_srgb, tone_map};
+    255.0 * linear_to_srgb(tone_map(light as f32)) as f64
 }
 
 /// The linear image (an EXR's) is the display image before its tone map: the display's
-/// colour is `1 − exp(−light)` of the linear image's light, sRGB-encoded, with the same
+/// colour is the one tone map of the linear image's light, sRGB-encoded, with the same
 /// alpha. Writing display values, or tone-mapping twice, fails it. Exposure scales the linear
-/// light by its stops, and the flat background is its sRGB colour decoded.
+/// light by its stops, and the flat background is the light that shows as its picked colour.
 #[test]
 fn the_linear_image_is_the_display_image_before_its_tone_map() {
     let mut scene = smooth_cumulus();
@@ -1893,7 +1950,7 @@ fn the_linear_image_is_the_display_image_before_its_tone_map() {
             for c in 0..3 {
                 let light = l[c] as f64 / l[3] as f64;
                 bright += usize::from(light > 1.0);
-                let expected = 255.0 * encode_srgb(1.0 - (-light).exp());
+                let expected = shown(light);
                 let error = (expected - d[c] as f64).abs();
                 worst = worst.max(error);
                 sum += error;
@@ -1932,64 +1989,76 @@ fn the_linear_image_is_the_display_image_before_its_tone_map() {
     // Over the sky: every pixel opaque, the corner the background decoded.
     let over = render_linear(&scene, Backdrop::Sky);
     let corner = over.pixel(1, 1);
-    let bg = cloudsketch::scene::srgb_to_linear(scene.light.background);
+    let bg = cloudsketch::render::tone::light_of(scene.light.background);
     for (c, want) in bg.to_array().into_iter().enumerate() {
         assert!(
-            (corner[c] - want).abs() < 2e-3,
+            (corner[c] - want).abs() < 2e-3 * want.max(1.0),
             "corner {corner:?}, background {bg:?}"
         );
     }
     assert!(over.rgba.chunks_exact(4).all(|p| (p[3] - 1.0).abs() < 1e-3));
 }
 
-/// With the sky gradient, the ground and the shafts of light on, where no cloud is: the linear
-/// image's sky and ground are the display's colours decoded (sky.wgsl's `fs_linear`), and the
-/// light its shafts add is the light whose `1 − exp(−light)` the display adds
-/// (composite.wgsl's `fs_shafts_linear`). A linear sky left encoded, or shafts added
-/// tone-mapped, fails it.
+/// One tone map, once: with the sky gradient, the ground, the shafts of light and the cloud
+/// all on, every display pixel is the tone map of the linear image's light there (the sky,
+/// the ground, the cloud over them and the shafts added up first), the sky at exposure 0 its
+/// picked colour. The renderer before mapped the cloud alone, laid it over the sky as picked
+/// and added the shafts' light mapped on its own: it fails by tens of levels at the cloud's
+/// thin edges, at the sky and where shafts cross the cloud. The shafts light the air.
 #[test]
-fn the_linear_sky_ground_and_shafts_are_the_displays_light() {
-    let sky = with(&broken_layer(), &["/light/sky_gradient=true"]);
-    let shafts = with(&sky, &["/light/shafts=true", "/light/shaft_density=0.003"]);
-    let (display_off, display_on) = (render(&sky), render(&shafts));
-    let (linear_off, linear_on) = (
-        render_linear(&sky, Backdrop::Sky),
-        render_linear(&shafts, Backdrop::Sky),
+fn one_tone_map_maps_the_sky_the_cloud_and_the_shafts_together() {
+    let sky = with(
+        &broken_layer(),
+        &["/light/sky_gradient=true", "/light/exposure=0.5"],
     );
+    let shafts = with(&sky, &["/light/shafts=true", "/light/shaft_density=0.003"]);
+    for (name, scene) in [("sky and ground", &sky), ("with shafts", &shafts)] {
+        let display = render(scene);
+        let linear = render_linear(scene, Backdrop::Sky);
+        let cloud = render_linear(scene, Backdrop::Transparent);
+        let (mut worst, mut sum, mut n, mut edge) = (0.0f64, 0.0f64, 0usize, 0usize);
+        for y in 0..H {
+            for x in 0..W {
+                let (d, l) = (display.pixel(x, y), linear.pixel(x, y));
+                let a = cloud.pixel(x, y)[3];
+                edge += usize::from(a > 0.05 && a < 0.95);
+                for c in 0..3 {
+                    let error = (shown(l[c] as f64) - d[c] as f64).abs();
+                    worst = worst.max(error);
+                    sum += error;
+                    n += 1;
+                }
+            }
+        }
+        let mean = sum / n as f64;
+        eprintln!(
+            "{name}: display vs the tone-mapped linear light: worst {worst:.2}, mean {mean:.3} levels, {edge} edge pixels"
+        );
+        assert!(
+            edge > 100,
+            "{name}: only {edge} pixels of the cloud's thin edge"
+        );
+        assert!(
+            worst <= 4.0 && mean <= 0.5,
+            "{name}: display vs the tone-mapped linear light: worst {worst:.2}, mean {mean:.3} levels"
+        );
+    }
+    // The shafts light the clear air.
+    let (off, on) = (render(&sky), render(&shafts));
     let cloud = render_linear(&sky, Backdrop::Transparent);
-    let (mut sky_worst, mut shaft_worst, mut lit, mut clear) = (0.0f64, 0.0f64, 0usize, 0usize);
+    let (mut lit, mut clear) = (0usize, 0usize);
     for y in 0..H {
         for x in 0..W {
             if cloud.pixel(x, y)[3] > 0.0 {
                 continue;
             }
             clear += 1;
-            let (d_off, d_on) = (display_off.pixel(x, y), display_on.pixel(x, y));
-            let (l_off, l_on) = (linear_off.pixel(x, y), linear_on.pixel(x, y));
-            for c in 0..3 {
-                let sky = 255.0 * encode_srgb(l_off[c] as f64);
-                sky_worst = sky_worst.max((sky - d_off[c] as f64).abs());
-                let added = (l_on[c] - l_off[c]) as f64;
-                if d_on[c] == 255 {
-                    continue;
-                }
-                lit += usize::from(added > 0.01);
-                let shown = d_on[c] as f64 - d_off[c] as f64;
-                shaft_worst = shaft_worst.max((255.0 * (1.0 - (-added).exp()) - shown).abs());
-            }
+            lit += usize::from(luminance(on.pixel(x, y)) > luminance(off.pixel(x, y)) + 1.0);
         }
     }
     assert!(clear > (W * H / 2) as usize, "only {clear} clear pixels");
     assert!(
-        lit > clear,
-        "the shafts lit only {lit} channels of {clear} clear pixels"
-    );
-    assert!(
-        sky_worst <= 1.0,
-        "the linear sky and ground, encoded, are {sky_worst:.2} levels off"
-    );
-    assert!(
-        shaft_worst <= 1.5,
-        "the shafts' linear light, mapped, is {shaft_worst:.2} levels off"
+        lit > clear / 3,
+        "the shafts lit only {lit} of {clear} clear pixels"
     );
 }

@@ -1,12 +1,13 @@
 //! Every shader module the renderer compiles parses and validates with naga, every WGSL file in
 //! `shaders/` is part of one, and each WGSL uniform struct has exactly the size and member
 //! offsets of the Rust struct it mirrors (`Volume`/`VolumeUniforms`,
-//! `FieldSlice`/`FieldSliceUniforms`, `Sky`/`SkyUniforms`, `LightSlice`/`LightSliceUniforms`).
+//! `FieldSlice`/`FieldSliceUniforms`, `Sky`/`SkyUniforms`, `Behind`/`BehindUniforms`,
+//! `LightSlice`/`LightSliceUniforms`).
 
 use std::path::Path;
 
 use cloudsketch::render::gpu_types::{
-    FieldSliceUniforms, LightSliceUniforms, SkyUniforms, VolumeUniforms,
+    BehindUniforms, FieldSliceUniforms, LightSliceUniforms, SkyUniforms, VolumeUniforms,
 };
 use cloudsketch::render::shaders::MODULES;
 
@@ -111,6 +112,15 @@ fn wgsl_sky_struct_matches_the_rust_layout() {
         wgsl_layout("sky", "Sky"),
         rust_layout(&SkyUniforms::LAYOUT),
         "WGSL Sky vs Rust SkyUniforms (name, offset; last: size)"
+    );
+}
+
+#[test]
+fn wgsl_behind_struct_matches_the_rust_layout() {
+    assert_eq!(
+        wgsl_layout("composite", "Behind"),
+        rust_layout(&BehindUniforms::LAYOUT),
+        "WGSL Behind vs Rust BehindUniforms (name, offset; last: size)"
     );
 }
 

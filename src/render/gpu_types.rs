@@ -198,15 +198,19 @@ pub struct SkyUniforms {
     pub grid_min: [f32; 4],
     /// Its size (xyz); w: 1 when there is a light volume to shade the ground with.
     pub grid_size: [f32; 4],
-    /// Unit vector toward the sun (xyz).
+    /// Unit vector toward the sun (xyz); w: 2^exposure, which scales the picked colours'
+    /// light (`tone::light_of`).
     pub sun_dir: [f32; 4],
     /// The ground's sRGB colour in full sun (rgb).
     pub ground_lit: [f32; 4],
+    /// Where the shafts drawn apart from the clouds' box are not added (texture coordinates,
+    /// v down: x0, y0, x1, y1): the box's rectangle; the whole target without shafts.
+    pub keep_out: [f32; 4],
 }
 
 impl SkyUniforms {
     /// Names and byte offsets of the members, in order (checked against the WGSL struct).
-    pub const LAYOUT: [(&'static str, usize); 14] = [
+    pub const LAYOUT: [(&'static str, usize); 15] = [
         ("forward", offset_of!(Self, forward)),
         ("right", offset_of!(Self, right)),
         ("up", offset_of!(Self, up)),
@@ -220,6 +224,7 @@ impl SkyUniforms {
         ("grid_size", offset_of!(Self, grid_size)),
         ("sun_dir", offset_of!(Self, sun_dir)),
         ("ground_lit", offset_of!(Self, ground_lit)),
+        ("keep_out", offset_of!(Self, keep_out)),
         ("", std::mem::size_of::<Self>()),
     ];
 
@@ -247,7 +252,10 @@ impl SkyUniforms {
             origin_up: origin_up.extend(0.0).to_array(),
             grid_min: min.extend(light.ground_height).to_array(),
             grid_size: size.extend(grid.is_some() as u8 as f32).to_array(),
-            sun_dir: light.sun_direction().extend(0.0).to_array(),
+            sun_dir: light
+                .sun_direction()
+                .extend(light.exposure.exp2())
+                .to_array(),
             ground_lit: Vec3::from(light.ground_color).extend(1.0).to_array(),
             forward: camera.forward().extend(0.0).to_array(),
             right: (camera.right() * t * aspect).extend(0.0).to_array(),
@@ -257,8 +265,34 @@ impl SkyUniforms {
             horizon: [hr, hg, hb, light.sky_gradient as u8 as f32],
             // A darker, slightly warmer haze below the horizon.
             ground: [hr * 0.62, hg * 0.6, hb * 0.56, 1.0],
+            keep_out: SkyUniforms::NO_SHAFTS,
         }
     }
+}
+
+impl SkyUniforms {
+    /// A `keep_out` over the whole target: no shafts' light added anywhere.
+    pub const NO_SHAFTS: [f32; 4] = [-1.0, -1.0, 2.0, 2.0];
+}
+
+/// What lies behind the cloud for the composite (`struct Behind` in
+/// `shaders/composite.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct BehindUniforms {
+    /// Where the composited image lies in the view behind it: uv = xy + uv · zw.
+    pub place: [f32; 4],
+    /// The flat background's display colour (rgb); w: 1 when there is no texture behind.
+    pub flat: [f32; 4],
+}
+
+impl BehindUniforms {
+    /// Names and byte offsets of the members, in order (checked against the WGSL struct).
+    pub const LAYOUT: [(&'static str, usize); 3] = [
+        ("place", offset_of!(Self, place)),
+        ("flat", offset_of!(Self, flat)),
+        ("", std::mem::size_of::<Self>()),
+    ];
 }
 
 /// Uniforms of one slice of the light volume pass (`struct LightSlice` in

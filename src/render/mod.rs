@@ -6,6 +6,7 @@
 //! - [`gpu_types`]: the Pod structs mirrored in WGSL, and the plain [`View`] snapshot;
 //! - [`field_gpu`]: the field evaluated on the GPU, the baseline of the CPU bake in `bench`;
 //! - [`shaders`]: WGSL sources, composed;
+//! - [`tone`]: the one tone map (pure), the sky's and the composite's shared curve;
 //! - [`progressive`]: the frame-time budget that picks preview and refinement work (pure);
 //! - [`crop`]: the pixels the cloud's box covers on screen, which the viewport draws the
 //!   volume over;
@@ -23,6 +24,7 @@ pub mod progressive;
 pub mod renderer;
 pub mod resources;
 pub mod shaders;
+pub mod tone;
 pub mod viewport;
 
 #[cfg(not(target_arch = "wasm32"))]

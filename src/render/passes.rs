@@ -6,7 +6,7 @@
 
 use std::num::NonZeroU64;
 
-use super::gpu_types::{LightSliceUniforms, SkyUniforms, VolumeUniforms};
+use super::gpu_types::{BehindUniforms, LightSliceUniforms, SkyUniforms, VolumeUniforms};
 use super::shaders;
 
 /// Slice draws one frame (one submit) may record.
@@ -90,7 +90,7 @@ fn output_entry(format: wgpu::TextureFormat, display: &'static str) -> &'static 
         return display;
     }
     match display {
-        "fs_main" => "fs_linear",
+        "fs_main" | "fs_transparent" => "fs_linear",
         // Over a transparent background the linear composite is the same: light with no alpha
         // is kept as it is.
         "fs_shafts" | "fs_shafts_transparent" => "fs_shafts_linear",
@@ -285,10 +285,14 @@ impl SlicePass {
     }
 }
 
-/// The composite pass: draws an accumulation target over the output.
+/// The composite pass: draws an accumulation target over the output. Every pipeline's group 1
+/// says what lies behind the cloud ([`CompositePass::behind_group`]): over a background the
+/// display composites read it, to map the light of the two together once.
 pub struct CompositePass {
     /// The composite pipeline.
     pub pipeline: wgpu::RenderPipeline,
+    /// The same over a transparent background: the cloud alone (`fs_transparent`).
+    pub transparent_pipeline: wgpu::RenderPipeline,
     /// Layout of its bind group (source texture, sampler).
     pub layout: wgpu::BindGroupLayout,
     /// The composite of a target with its shafts of light added (`fs_shafts`).
@@ -306,6 +310,9 @@ pub struct CompositePass {
     /// Layout of their bind group: the shafts layout's, then the beyond light's texture and
     /// where the target lies in it (a uniform `vec4`).
     pub beyond_layout: wgpu::BindGroupLayout,
+    /// Layout of group 1: the view behind the cloud (a 2D texture of display colours) and a
+    /// [`BehindUniforms`].
+    pub behind_layout: wgpu::BindGroupLayout,
 }
 
 impl CompositePass {
@@ -336,56 +343,78 @@ impl CompositePass {
                 uniform_entry(4, wgpu::ShaderStages::FRAGMENT, 16, false),
             ],
         });
-        let beyond = |label: &str, entry: &'static str| {
+        let behind_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("composite: behind the cloud"),
+            entries: &[
+                texture_entry(0, wgpu::TextureViewDimension::D2),
+                uniform_entry(
+                    1,
+                    wgpu::ShaderStages::FRAGMENT,
+                    std::mem::size_of::<BehindUniforms>() as u64,
+                    false,
+                ),
+            ],
+        });
+        let make = |label: &str, layout: &wgpu::BindGroupLayout, entry: &'static str| {
             targets_pipeline(
                 device,
                 label,
                 shaders::COMPOSITE,
-                &[&beyond_layout],
+                &[layout, &behind_layout],
                 output_entry(output_format, entry),
                 &[output_format],
                 Some(PREMULTIPLIED_OVER),
             )
         };
-        let beyond_pipeline = beyond("volume composite with shafts beyond", "fs_shafts_beyond");
-        let beyond_transparent_pipeline = beyond(
-            "volume composite with shafts beyond, transparent",
-            "fs_shafts_beyond_transparent",
-        );
         Self {
-            beyond_pipeline,
-            beyond_transparent_pipeline,
-            beyond_layout,
-            pipeline: targets_pipeline(
-                device,
-                "volume composite",
-                shaders::COMPOSITE,
-                &[&layout],
-                output_entry(output_format, "fs_main"),
-                &[output_format],
-                Some(PREMULTIPLIED_OVER),
+            pipeline: make("volume composite", &layout, "fs_main"),
+            transparent_pipeline: make("volume composite, transparent", &layout, "fs_transparent"),
+            shafts_pipeline: make("volume composite with shafts", &shafts_layout, "fs_shafts"),
+            shafts_transparent_pipeline: make(
+                "volume composite with shafts, transparent",
+                &shafts_layout,
+                "fs_shafts_transparent",
+            ),
+            beyond_pipeline: make(
+                "volume composite with shafts beyond",
+                &beyond_layout,
+                "fs_shafts_beyond",
+            ),
+            beyond_transparent_pipeline: make(
+                "volume composite with shafts beyond, transparent",
+                &beyond_layout,
+                "fs_shafts_beyond_transparent",
             ),
             layout,
-            shafts_pipeline: targets_pipeline(
-                device,
-                "volume composite with shafts",
-                shaders::COMPOSITE,
-                &[&shafts_layout],
-                output_entry(output_format, "fs_shafts"),
-                &[output_format],
-                Some(PREMULTIPLIED_OVER),
-            ),
-            shafts_transparent_pipeline: targets_pipeline(
-                device,
-                "volume composite with shafts, transparent",
-                shaders::COMPOSITE,
-                &[&shafts_layout],
-                output_entry(output_format, "fs_shafts_transparent"),
-                &[output_format],
-                Some(PREMULTIPLIED_OVER),
-            ),
             shafts_layout,
+            beyond_layout,
+            behind_layout,
         }
+    }
+
+    /// The group 1 that says what lies behind the cloud: `texture` (display colours over the
+    /// whole view) and `uniforms` (a [`BehindUniforms`]: where the image lies in it, or a flat
+    /// colour instead).
+    pub fn behind_group(
+        &self,
+        device: &wgpu::Device,
+        texture: &wgpu::TextureView,
+        uniforms: &wgpu::Buffer,
+    ) -> wgpu::BindGroup {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("composite: behind the cloud"),
+            layout: &self.behind_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::TextureView(texture),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: uniforms.as_entire_binding(),
+                },
+            ],
+        })
     }
 
     /// The bind group that composites `source`, with the shafts of light in `shafts` (for
@@ -458,21 +487,34 @@ impl CompositePass {
     }
 }
 
-/// The sky pass: a gradient over the whole view, drawn before the cloud's composite.
+/// Which of the sky pass's two uniform slots a draw uses: the viewport's view behind the
+/// cloud and an image's (a PNG export's capture) may both be drawn before one submission.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SkySlot {
+    /// The viewport's.
+    Viewport = 0,
+    /// An image's (offscreen renders, captures).
+    Image = 1,
+}
+
+/// The sky pass: the sky (gradient, flat colour, ground and the shafts around the clouds' box)
+/// over a whole target, drawn before the cloud's composite.
 pub struct SkyPass {
     pipeline: wgpu::RenderPipeline,
-    uniforms: wgpu::Buffer,
+    uniforms: [wgpu::Buffer; 2],
     layout: wgpu::BindGroupLayout,
-    bind_group: wgpu::BindGroup,
+    bind_groups: [wgpu::BindGroup; 2],
 }
 
 impl SkyPass {
     /// Creates the pass writing into `output_format`, shading the ground through `light` (a
-    /// 3D texture of transmittance; rebind with [`SkyPass::bind_light`] when it changes).
+    /// 3D texture of transmittance) and adding the shafts' light in `shafts` (a 2D texture);
+    /// rebind with [`SkyPass::bind`] when either changes.
     pub fn new(
         device: &wgpu::Device,
         output_format: wgpu::TextureFormat,
         light: &wgpu::TextureView,
+        shafts: &wgpu::TextureView,
         sampler: &wgpu::Sampler,
     ) -> Self {
         let size = std::mem::size_of::<SkyUniforms>() as u64;
@@ -482,15 +524,19 @@ impl SkyPass {
                 uniform_entry(0, wgpu::ShaderStages::FRAGMENT, size, false),
                 texture_3d(1),
                 sampler_entry(2),
+                texture_entry(3, wgpu::TextureViewDimension::D2),
             ],
         });
-        let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("sky uniforms"),
-            size,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
+        let uniforms = [0, 1].map(|_| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("sky uniforms"),
+                size,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
         });
-        let bind_group = Self::group(device, &layout, &uniforms, light, sampler);
+        let bind_groups =
+            [0, 1].map(|i| Self::group(device, &layout, &uniforms[i], light, shafts, sampler));
         Self {
             pipeline: targets_pipeline(
                 device,
@@ -499,11 +545,11 @@ impl SkyPass {
                 &[&layout],
                 output_entry(output_format, "fs_main"),
                 &[output_format],
-                Some(PREMULTIPLIED_OVER),
+                None,
             ),
             uniforms,
             layout,
-            bind_group,
+            bind_groups,
         }
     }
 
@@ -512,6 +558,7 @@ impl SkyPass {
         layout: &wgpu::BindGroupLayout,
         uniforms: &wgpu::Buffer,
         light: &wgpu::TextureView,
+        shafts: &wgpu::TextureView,
         sampler: &wgpu::Sampler,
     ) -> wgpu::BindGroup {
         device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -530,29 +577,47 @@ impl SkyPass {
                     binding: 2,
                     resource: wgpu::BindingResource::Sampler(sampler),
                 },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: wgpu::BindingResource::TextureView(shafts),
+                },
             ],
         })
     }
 
-    /// Shades the ground through this light volume from now on.
-    pub fn bind_light(
+    /// Shades the ground through this light volume, and adds these shafts, from now on.
+    pub fn bind(
         &mut self,
         device: &wgpu::Device,
         light: &wgpu::TextureView,
+        shafts: &wgpu::TextureView,
         sampler: &wgpu::Sampler,
     ) {
-        self.bind_group = Self::group(device, &self.layout, &self.uniforms, light, sampler);
+        self.bind_groups = [0, 1].map(|i| {
+            Self::group(
+                device,
+                &self.layout,
+                &self.uniforms[i],
+                light,
+                shafts,
+                sampler,
+            )
+        });
     }
 
-    /// Sets the sky the next [`SkyPass::draw`] draws.
-    pub fn write(&self, queue: &wgpu::Queue, uniforms: &SkyUniforms) {
-        queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(uniforms));
+    /// Sets the sky the next [`SkyPass::draw`] in `slot` draws.
+    pub fn write(&self, queue: &wgpu::Queue, slot: SkySlot, uniforms: &SkyUniforms) {
+        queue.write_buffer(
+            &self.uniforms[slot as usize],
+            0,
+            bytemuck::bytes_of(uniforms),
+        );
     }
 
-    /// Draws the sky over the current render pass's viewport.
-    pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>) {
+    /// Draws the sky of `slot` over the current render pass's viewport, replacing what is there.
+    pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>, slot: SkySlot) {
         pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &self.bind_group, &[]);
+        pass.set_bind_group(0, &self.bind_groups[slot as usize], &[]);
         pass.draw(0..3, 0..1);
     }
 }

@@ -1,10 +1,12 @@
 //! The volume renderer: passes and resources together, used by the app's viewport (through an
 //! egui paint callback) and by offscreen rendering alike.
 
-use super::gpu_types::{LightSliceUniforms, Shells, SkyUniforms, View, VolumeUniforms};
+use super::gpu_types::{
+    BehindUniforms, LightSliceUniforms, Shells, SkyUniforms, View, VolumeUniforms,
+};
 use super::passes::{
     BackdropPass, CompositePass, FillPass, LIGHT_FORMAT, LightPass, MARCH_WORKGROUP,
-    MAX_LIGHT_SLICES, MarchPass, SkyPass, SlicePass,
+    MAX_LIGHT_SLICES, MarchPass, SkyPass, SkySlot, SlicePass,
 };
 use super::progressive::JobPlan;
 use super::resources::{
@@ -37,6 +39,20 @@ pub struct VolumeRenderer {
     /// The view behind the cloud as the viewport last drew it
     /// ([`VolumeRenderer::draw_backdrop`]).
     backdrop: Option<Backdrop>,
+    /// The view behind an image's cloud (offscreen renders and captures), drawn for each.
+    image_backdrop: Option<Backdrop>,
+    /// The [`BehindUniforms`] of the viewport's composite and of an image's (the groups of
+    /// [`Backdrop`]s bind them).
+    behind_uniforms: [wgpu::Buffer; 2],
+    /// The composite's group 1 where no texture lies behind the cloud: a flat background (the
+    /// viewport's, its colour in its own uniforms), or none at all (transparent and linear
+    /// images, whose composites do not read it).
+    flat_behind: (wgpu::Buffer, wgpu::BindGroup),
+    /// Whether the viewport's composite has the flat background behind it, not its backdrop
+    /// ([`VolumeRenderer::prepare_behind`]).
+    viewport_flat: bool,
+    /// No light: the sky's shafts texture until there are shafts drawn apart.
+    shafts_placeholder: wgpu::TextureView,
     clamp_sampler: wgpu::Sampler,
     repeat_sampler: wgpu::Sampler,
     textures: VolumeTextures,
@@ -79,23 +95,25 @@ struct BeyondComposite {
     group: wgpu::BindGroup,
 }
 
-/// The view behind the cloud in a texture of the viewport's size, and its group for
-/// [`BackdropPass::draw`].
+/// The view behind the cloud in a texture of the viewport's size (or an image's), its group
+/// for [`BackdropPass::draw`] and its group 1 for the composite.
 struct Backdrop {
     size: [u32; 2],
     view: wgpu::TextureView,
     group: wgpu::BindGroup,
+    behind: wgpu::BindGroup,
     /// What it was last drawn for ([`VolumeRenderer::draw_backdrop`]'s `key`).
     key: Option<u64>,
 }
 
-/// Draws a full-screen composite with `group`: the `transparent` pipeline of the pair over a
-/// transparent image, else the `opaque` one.
+/// Draws a full-screen composite with `group` and `behind` (its group 1): the `transparent`
+/// pipeline of the pair over a transparent image, else the `opaque` one.
 fn lay(
     pass: &mut wgpu::RenderPass<'_>,
     [opaque, transparent_pipeline]: [&wgpu::RenderPipeline; 2],
     transparent: bool,
     group: &wgpu::BindGroup,
+    behind: &wgpu::BindGroup,
 ) {
     pass.set_pipeline(if transparent {
         transparent_pipeline
@@ -103,7 +121,33 @@ fn lay(
         opaque
     });
     pass.set_bind_group(0, group, &[]);
+    pass.set_bind_group(1, behind, &[]);
     pass.draw(0..3, 0..1);
+}
+
+/// Where an image cropped to `crop` (normalised device coordinates, x0, y0, x1, y1; y up) lies
+/// in the whole view, as texture coordinates (y down): uv = xy + uv · zw.
+fn place_of([x0, y0, x1, y1]: [f32; 4]) -> [f32; 4] {
+    [
+        0.5 * (x0 + 1.0),
+        0.5 * (1.0 - y1),
+        0.5 * (x1 - x0),
+        0.5 * (y1 - y0),
+    ]
+}
+
+/// The sky's `keep_out` (texture coordinates) for a target `size` pixels: none of it with
+/// no shafts laid, else the box `crop` (pixels; none when out of view, and the shafts are
+/// laid everywhere).
+fn keep_out(shafts: bool, crop: Option<[u32; 4]>, [w, h]: [u32; 2]) -> [f32; 4] {
+    match (shafts, crop) {
+        (false, _) => SkyUniforms::NO_SHAFTS,
+        (true, None) => [0.0; 4],
+        (true, Some([x0, y0, x1, y1])) => {
+            let (w, h) = (w.max(1) as f32, h.max(1) as f32);
+            [x0 as f32 / w, y0 as f32 / h, x1 as f32 / w, y1 as f32 / h]
+        }
+    }
 }
 
 /// The light volume on the GPU. Each z-slice is rendered into `slice` (2D) and copied into
@@ -151,15 +195,42 @@ impl VolumeRenderer {
         let clamp_sampler = sampler(device, wgpu::AddressMode::ClampToEdge);
         let composite = CompositePass::new(device, output_format);
         let backdrop_pass = BackdropPass::new(device, output_format, &composite.layout);
+        let shafts_placeholder = super::resources::render_texture(
+            device,
+            "no shafts, nothing behind",
+            [1, 1],
+            output_format,
+        );
+        let behind_buffer = || {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("what lies behind the cloud"),
+                size: std::mem::size_of::<BehindUniforms>() as u64,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        };
+        let flat_buffer = behind_buffer();
+        let flat_group = composite.behind_group(device, &shafts_placeholder, &flat_buffer);
         Self {
             accum_format,
             output_format,
             slices: SlicePass::new(device, accum_format),
-            sky: SkyPass::new(device, output_format, &placeholder, &clamp_sampler),
+            sky: SkyPass::new(
+                device,
+                output_format,
+                &placeholder,
+                &shafts_placeholder,
+                &clamp_sampler,
+            ),
             composite,
             fill: FillPass::new(device, output_format),
             backdrop_pass,
             backdrop: None,
+            image_backdrop: None,
+            behind_uniforms: [behind_buffer(), behind_buffer()],
+            flat_behind: (flat_buffer, flat_group),
+            viewport_flat: true,
+            shafts_placeholder,
             clamp_sampler,
             repeat_sampler: sampler(device, wgpu::AddressMode::Repeat),
             textures: VolumeTextures::new(),
@@ -223,11 +294,7 @@ impl VolumeRenderer {
     /// The slice group (and the light pass's, which lacks the light texture) over the current
     /// textures.
     fn rebuild_bind_groups(&mut self, device: &wgpu::Device) {
-        let light = self
-            .light
-            .as_ref()
-            .map_or(&self.light_placeholder, |l| &l.view);
-        self.sky.bind_light(device, light, &self.clamp_sampler);
+        self.rebind_sky(device);
         let Some(entries) = self.volume_entries() else {
             return;
         };
@@ -253,6 +320,22 @@ impl VolumeRenderer {
         if let Some((_, group)) = &mut self.march {
             *group = march;
         }
+    }
+
+    /// Binds the sky to the current light volume and the shafts drawn apart.
+    fn rebind_sky(&mut self, device: &wgpu::Device) {
+        let light = self
+            .light
+            .as_ref()
+            .map_or(&self.light_placeholder, |l| &l.view);
+        let shafts = match &self.outside {
+            Some(Target {
+                shafts: Some((view, _)),
+                ..
+            }) => view,
+            _ => &self.shafts_placeholder,
+        };
+        self.sky.bind(device, light, shafts, &self.clamp_sampler);
     }
 
     /// The slice group's entries over the current textures (none before both are uploaded).
@@ -572,6 +655,8 @@ impl VolumeRenderer {
                 has_shafts: true,
                 marched: None,
             });
+            // The sky adds their light around the box.
+            self.rebind_sky(device);
         }
         let (Some(target), Some(bind_group)) = (&self.outside, &self.bind_group) else {
             return false;
@@ -626,6 +711,7 @@ impl VolumeRenderer {
                 [&c.shafts_pipeline, &c.shafts_transparent_pipeline],
                 transparent,
                 group,
+                &self.flat_behind.1,
             );
         }
     }
@@ -772,15 +858,29 @@ impl VolumeRenderer {
         let view = output.create_view(&wgpu::TextureViewDescriptor::default());
         self.update_light(device, queue, encoder, &job.view);
         self.draw_slices(device, queue, encoder, job, pipeline);
-        let mut pass = self.backdrop_pass(
-            queue,
-            encoder,
-            &view,
-            &job.view,
-            background,
-            "image composite",
-        );
-        self.composite(&mut pass, job.plan.target, background.is_none());
+        if let Some(background) = background {
+            // The shafts are among the slices over the whole image: none laid apart.
+            self.draw_image_backdrop(
+                device,
+                queue,
+                encoder,
+                &job.view,
+                job.plan.size,
+                background,
+                None,
+            );
+            queue.write_buffer(
+                &self.behind_uniforms[SkySlot::Image as usize],
+                0,
+                bytemuck::bytes_of(&BehindUniforms {
+                    place: [0.0, 0.0, 1.0, 1.0],
+                    flat: [0.0; 4],
+                }),
+            );
+        }
+        let mut pass = self.image_pass(encoder, &view, background.is_some(), "image composite");
+        let behind = self.image_behind(background.is_some());
+        self.composite(&mut pass, job.plan.target, background.is_none(), behind);
         drop(pass);
         output
     }
@@ -857,18 +957,39 @@ impl VolumeRenderer {
         if let Some(backdrop) = &mut self.backdrop {
             backdrop.key = None;
         }
-        self.prepare_cropped_composite(device, queue, job.plan.target, crop.ndc(job.plan.size));
-        let mut pass = self.backdrop_pass(
-            queue,
+        let ndc = crop.ndc(job.plan.size);
+        self.prepare_cropped_composite(device, queue, job.plan.target, ndc);
+        if let Some(background) = background {
+            // The sky with the shafts around the box in it, mapped once with them.
+            let keep_out = keep_out(outside, Some(crop.px), job.plan.size);
+            self.draw_image_backdrop(
+                device,
+                queue,
+                encoder,
+                &job.view,
+                job.plan.size,
+                background,
+                Some(keep_out),
+            );
+            queue.write_buffer(
+                &self.behind_uniforms[SkySlot::Image as usize],
+                0,
+                bytemuck::bytes_of(&BehindUniforms {
+                    place: place_of(ndc),
+                    flat: [0.0; 4],
+                }),
+            );
+        }
+        let mut pass = self.image_pass(
             encoder,
             &view,
-            &job.view,
-            background,
+            background.is_some(),
             "cropped image composite",
         );
         let [x0, y0, x1, y1] = crop.px;
-        if outside {
-            // The strips around the crop: above, below, left, right.
+        if outside && background.is_none() {
+            // Over transparency, the shafts' glow in the strips around the crop: above, below,
+            // left, right.
             for [x, y, w, h] in [
                 [0, 0, width, y0],
                 [0, y1, width, height - y1],
@@ -877,7 +998,7 @@ impl VolumeRenderer {
             ] {
                 if w > 0 && h > 0 {
                     pass.set_scissor_rect(x, y, w, h);
-                    self.composite_outside_shafts(&mut pass, background.is_none());
+                    self.composite_outside_shafts(&mut pass, true);
                 }
             }
             pass.set_scissor_rect(0, 0, width, height);
@@ -890,42 +1011,29 @@ impl VolumeRenderer {
             0.0,
             1.0,
         );
-        self.composite_cropped(&mut pass, job.plan.target, background.is_none());
+        let behind = self.image_behind(background.is_some());
+        self.composite_cropped(&mut pass, job.plan.target, background.is_none(), behind);
         drop(pass);
         output
     }
 
-    /// Begins the render pass that lays an image over `target`: cleared to `background`
-    /// (transparent without one) with `view`'s sky gradient or ground drawn over it.
-    fn backdrop_pass<'e>(
+    /// The composite's group 1 for an image: its backdrop's over a background, else none.
+    fn image_behind(&self, background: bool) -> &wgpu::BindGroup {
+        match &self.image_backdrop {
+            Some(b) if background => &b.behind,
+            _ => &self.flat_behind.1,
+        }
+    }
+
+    /// Begins the render pass that lays an image over `target`: the image's backdrop laid
+    /// when it has a `background`, else cleared to transparency.
+    fn image_pass<'e>(
         &self,
-        queue: &wgpu::Queue,
         encoder: &'e mut wgpu::CommandEncoder,
         target: &wgpu::TextureView,
-        view: &View,
-        background: Option<[f32; 3]>,
+        background: bool,
         label: &str,
     ) -> wgpu::RenderPass<'e> {
-        let sky = (view.light.sky_gradient || view.light.ground) && background.is_some();
-        if sky {
-            self.prepare_sky(queue, view);
-        }
-        // A float target holds linear light: the sRGB-encoded background decoded.
-        let background = match background {
-            Some(c) if super::passes::linear_output(self.output_format) => {
-                Some(super::gpu_types::srgb_to_linear(c).to_array())
-            }
-            other => other,
-        };
-        let clear = match background {
-            Some([r, g, b]) => wgpu::Color {
-                r: r as f64,
-                g: g as f64,
-                b: b as f64,
-                a: 1.0,
-            },
-            None => wgpu::Color::TRANSPARENT,
-        };
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(label),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -933,7 +1041,7 @@ impl VolumeRenderer {
                 depth_slice: None,
                 resolve_target: None,
                 ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(clear),
+                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
                     store: wgpu::StoreOp::Store,
                 },
             })],
@@ -942,10 +1050,105 @@ impl VolumeRenderer {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        if sky {
-            self.draw_sky(&mut pass);
+        if let (true, Some(b)) = (background, &self.image_backdrop) {
+            self.backdrop_pass.draw(&mut pass, &b.group);
         }
         pass
+    }
+
+    /// Draws an image's view behind the cloud (its sky and the shafts outside `keep_out`) into
+    /// the image backdrop, `size` pixels.
+    #[allow(clippy::too_many_arguments)]
+    fn draw_image_backdrop(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        view: &View,
+        size: [u32; 2],
+        background: [f32; 3],
+        keep_out: Option<[f32; 4]>,
+    ) {
+        let mut slot = self.image_backdrop.take();
+        self.draw_behind(
+            device,
+            queue,
+            encoder,
+            &mut slot,
+            SkySlot::Image,
+            view,
+            size,
+            background,
+            keep_out.unwrap_or(SkyUniforms::NO_SHAFTS),
+        );
+        self.image_backdrop = slot;
+    }
+
+    /// Draws the sky of `view` over `background` (sRGB-encoded, as picked) and the shafts drawn
+    /// apart outside `keep_out` into `backdrop` (made `size` pixels), with the sky's `slot`.
+    #[allow(clippy::too_many_arguments)]
+    fn draw_behind(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        backdrop: &mut Option<Backdrop>,
+        slot: SkySlot,
+        view: &View,
+        size: [u32; 2],
+        background: [f32; 3],
+        keep_out: [f32; 4],
+    ) {
+        let size = [size[0].max(1), size[1].max(1)];
+        if backdrop.as_ref().is_none_or(|b| b.size != size) {
+            let texture = super::resources::render_texture(
+                device,
+                "view behind the cloud",
+                size,
+                self.output_format,
+            );
+            let group = self
+                .composite
+                .bind_group(device, &texture, None, &self.clamp_sampler);
+            let behind =
+                self.composite
+                    .behind_group(device, &texture, &self.behind_uniforms[slot as usize]);
+            *backdrop = Some(Backdrop {
+                size,
+                view: texture,
+                group,
+                behind,
+                key: None,
+            });
+        }
+        let Some(backdrop) = backdrop else {
+            return;
+        };
+        let mut light = view.light.clone();
+        light.background = background;
+        let mut uniforms = self.sky_uniforms(&View {
+            light,
+            ..view.clone()
+        });
+        uniforms.keep_out = keep_out;
+        self.sky.write(queue, slot, &uniforms);
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("view behind the cloud"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &backdrop.view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        self.sky.draw(&mut pass, slot);
     }
 
     /// A new output-format texture `size` pixels, to render into and copy from.
@@ -966,30 +1169,22 @@ impl VolumeRenderer {
         })
     }
 
-    /// Sets the sky gradient of `view` (call before [`VolumeRenderer::draw_sky`]).
-    pub fn prepare_sky(&self, queue: &wgpu::Queue, view: &View) {
-        // The ground is shaded through the light volume, which spans the density's box.
+    /// The sky of `view`: its ground shaded through the light volume, which spans the
+    /// density's box; no shafts.
+    fn sky_uniforms(&self, view: &View) -> SkyUniforms {
         let volume = &self.textures.density_volume;
         let grid =
             (self.light.is_some() && !volume.is_empty()).then_some((volume.min, volume.size));
-        self.sky.write(
-            queue,
-            &SkyUniforms::new(&view.camera, &view.light, view.aspect, grid),
-        );
-    }
-
-    /// Draws the sky gradient over the current render pass's viewport.
-    pub fn draw_sky(&self, pass: &mut wgpu::RenderPass<'_>) {
-        self.sky.draw(pass);
+        SkyUniforms::new(&view.camera, &view.light, view.aspect, grid)
     }
 
     /// Draws the view behind the cloud into a texture `size` pixels (the viewport's), which
     /// [`VolumeRenderer::lay_backdrop`] then lays on every frame until it changes: `background`
-    /// (sRGB-encoded, as egui's colours) with `view`'s sky gradient or ground drawn over it, and
-    /// the shafts of light [`VolumeRenderer::draw_outside_shafts`] drew (call it first) laid
-    /// over `strips`, the pixel rectangles (x0, y0, x1, y1) around the cloud's box; `key` is
-    /// what it is drawn for ([`VolumeRenderer::backdrop_key`]). On CPU adapters the ground's
-    /// shading and the shafts' lay took over half of each refining frame.
+    /// (sRGB-encoded, as picked) with `view`'s sky gradient or ground, and the shafts of light
+    /// [`VolumeRenderer::draw_outside_shafts`] drew (call it first) when `shafts`, added
+    /// outside `crop` (the cloud's box in its pixels; none when out of view), all mapped by the
+    /// one tone map; `key` is what it is drawn for ([`VolumeRenderer::backdrop_key`]). On CPU
+    /// adapters the ground's shading and the shafts' lay took over half of each refining frame.
     #[allow(clippy::too_many_arguments)]
     pub fn draw_backdrop(
         &mut self,
@@ -999,48 +1194,26 @@ impl VolumeRenderer {
         view: &View,
         size: [u32; 2],
         background: [f32; 3],
-        strips: &[[u32; 4]],
+        shafts: bool,
+        crop: Option<[u32; 4]>,
         key: u64,
     ) {
         let size = [size[0].max(1), size[1].max(1)];
-        if self.backdrop.as_ref().is_none_or(|b| b.size != size) {
-            let texture = super::resources::render_texture(
-                device,
-                "view behind the cloud",
-                size,
-                self.output_format,
-            );
-            let group = self
-                .composite
-                .bind_group(device, &texture, None, &self.clamp_sampler);
-            self.backdrop = Some(Backdrop {
-                size,
-                view: texture,
-                group,
-                key: None,
-            });
-        }
-        if let Some(backdrop) = &mut self.backdrop {
-            backdrop.key = Some(key);
-        }
-        let Some(backdrop) = &self.backdrop else {
-            return;
-        };
-        let mut pass = self.backdrop_pass(
+        let mut slot = self.backdrop.take();
+        self.draw_behind(
+            device,
             queue,
             encoder,
-            &backdrop.view,
+            &mut slot,
+            SkySlot::Viewport,
             view,
-            Some(background),
-            "view behind the cloud",
+            size,
+            background,
+            keep_out(shafts, crop, size),
         );
-        for &[x0, y0, x1, y1] in strips {
-            let (x0, y0) = (x0.min(size[0]), y0.min(size[1]));
-            let (x1, y1) = (x1.clamp(x0, size[0]), y1.clamp(y0, size[1]));
-            if x1 > x0 && y1 > y0 {
-                pass.set_scissor_rect(x0, y0, x1 - x0, y1 - y0);
-                self.composite_outside_shafts(&mut pass, false);
-            }
+        self.backdrop = slot;
+        if let Some(backdrop) = &mut self.backdrop {
+            backdrop.key = Some(key);
         }
     }
 
@@ -1061,6 +1234,40 @@ impl VolumeRenderer {
     /// Fills the current render pass's viewport with `colour` (the values the target stores).
     pub fn draw_fill(&self, pass: &mut wgpu::RenderPass<'_>, colour: wgpu::Color) {
         self.fill.draw(pass, colour);
+    }
+
+    /// Says what lies behind the viewport's cloud, cropped to `crop` (normalised device
+    /// coordinates, x0, y0, x1, y1; y up): the flat background of display colour `flat`
+    /// (the frame's clear colour, `tone::background_display`), or without one the backdrop
+    /// [`VolumeRenderer::draw_backdrop`] drew. Call before [`VolumeRenderer::composite_cropped`]
+    /// with [`VolumeRenderer::viewport_behind`].
+    pub fn prepare_behind(&mut self, queue: &wgpu::Queue, crop: [f32; 4], flat: Option<[f32; 3]>) {
+        self.viewport_flat = flat.is_some() || self.backdrop.is_none();
+        let (buffer, uniforms) = match flat {
+            Some([r, g, b]) => (
+                &self.flat_behind.0,
+                BehindUniforms {
+                    place: place_of(crop),
+                    flat: [r, g, b, 1.0],
+                },
+            ),
+            None => (
+                &self.behind_uniforms[SkySlot::Viewport as usize],
+                BehindUniforms {
+                    place: place_of(crop),
+                    flat: [0.0; 4],
+                },
+            ),
+        };
+        queue.write_buffer(buffer, 0, bytemuck::bytes_of(&uniforms));
+    }
+
+    /// The viewport composite's group 1, as [`VolumeRenderer::prepare_behind`] chose it.
+    pub fn viewport_behind(&self) -> &wgpu::BindGroup {
+        match &self.backdrop {
+            Some(b) if !self.viewport_flat => &b.behind,
+            _ => &self.flat_behind.1,
+        }
     }
 
     /// Readies the composite of target `index`, drawn of a view cropped to `crop` (normalised
@@ -1096,15 +1303,7 @@ impl VolumeRenderer {
         {
             return;
         }
-        // NDC (y up) to texture coordinates (y down).
-        let [x0, y0, x1, y1] = crop;
-        let place = [
-            0.5 * (x0 + 1.0),
-            0.5 * (1.0 - y1),
-            0.5 * (x1 - x0),
-            0.5 * (y1 - y0),
-        ];
-        queue.write_buffer(&self.beyond_place, 0, bytemuck::cast_slice(&place));
+        queue.write_buffer(&self.beyond_place, 0, bytemuck::cast_slice(&place_of(crop)));
         let group = self.composite.beyond_bind_group(
             device,
             [source, shafts, beyond],
@@ -1122,12 +1321,13 @@ impl VolumeRenderer {
     /// Draws accumulation target `index` of a cropped view as
     /// [`VolumeRenderer::composite`] does, with the light of the shafts' shells beyond the
     /// clouds' box seen through the cloud, where
-    /// [`VolumeRenderer::prepare_cropped_composite`] readied it.
+    /// [`VolumeRenderer::prepare_cropped_composite`] readied it, over `behind`.
     pub fn composite_cropped(
         &self,
         pass: &mut wgpu::RenderPass<'_>,
         index: usize,
         transparent: bool,
+        behind: &wgpu::BindGroup,
     ) {
         let c = &self.composite;
         match &self.beyond {
@@ -1136,14 +1336,22 @@ impl VolumeRenderer {
                 [&c.beyond_pipeline, &c.beyond_transparent_pipeline],
                 transparent,
                 &b.group,
+                behind,
             ),
-            _ => self.composite(pass, index, transparent),
+            _ => self.composite(pass, index, transparent, behind),
         }
     }
 
-    /// Draws accumulation target `index` over the current render pass's viewport; over a
-    /// `transparent` one the shafts of light get alpha of their own.
-    pub fn composite(&self, pass: &mut wgpu::RenderPass<'_>, index: usize, transparent: bool) {
+    /// Draws accumulation target `index` over the current render pass's viewport, mapping its
+    /// light with that of what lies `behind` it (the composite's group 1); over a
+    /// `transparent` one the cloud alone, the shafts of light with alpha of their own.
+    pub fn composite(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        index: usize,
+        transparent: bool,
+        behind: &wgpu::BindGroup,
+    ) {
         let Some(target) = self.targets.get(index).and_then(|t| t.as_ref()) else {
             return;
         };
@@ -1154,8 +1362,51 @@ impl VolumeRenderer {
                 [&c.shafts_pipeline, &c.shafts_transparent_pipeline],
                 transparent,
                 group,
+                behind,
             ),
-            _ => lay(pass, [&c.pipeline, &c.pipeline], false, &target.composite),
+            _ => lay(
+                pass,
+                [&c.pipeline, &c.transparent_pipeline],
+                transparent,
+                &target.composite,
+                behind,
+            ),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The sky adds the shafts drawn apart at every pixel outside the cloud's box and at none
+    /// inside it (where the box's composite adds its own), as `sky.wgsl` tests a pixel's centre.
+    #[test]
+    fn the_skys_shafts_cover_the_view_around_the_box_once() {
+        let view = [40, 30];
+        let inside =
+            |[x0, y0, x1, y1]: [u32; 4], x: u32, y: u32| x >= x0 && x < x1 && y >= y0 && y < y1;
+        for area in [
+            None,
+            Some([5, 7, 20, 25]),
+            Some([0, 0, 40, 30]),
+            Some([0, 3, 12, 30]),
+            Some([30, 20, 60, 90]),
+        ] {
+            let k = keep_out(true, area, view);
+            for y in 0..view[1] {
+                for x in 0..view[0] {
+                    let (u, v) = (
+                        (x as f32 + 0.5) / view[0] as f32,
+                        (y as f32 + 0.5) / view[1] as f32,
+                    );
+                    let added = u < k[0] || v < k[1] || u >= k[2] || v >= k[3];
+                    let boxed = area.is_some_and(|a| inside(a, x, y));
+                    assert_eq!(added, !boxed, "{area:?} at {x}, {y}");
+                }
+            }
+        }
+        let none = keep_out(false, Some([5, 7, 20, 25]), view);
+        assert!(none[0] < 0.0 && none[1] < 0.0 && none[2] > 1.0 && none[3] > 1.0);
     }
 }

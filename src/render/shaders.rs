@@ -53,9 +53,10 @@ pub const PLAIN_SLICES: &str = concat!(
     include_str!("../../shaders/plain_slices.wgsl")
 );
 
-/// `fullscreen.wgsl` + `composite.wgsl`.
+/// `fullscreen.wgsl` + `tone.wgsl` + `composite.wgsl`.
 pub const COMPOSITE: &str = concat!(
     include_str!("../../shaders/fullscreen.wgsl"),
+    include_str!("../../shaders/tone.wgsl"),
     include_str!("../../shaders/composite.wgsl")
 );
 
@@ -66,10 +67,12 @@ pub const FIELD_EVAL: &str = concat!(
     include_str!("../../shaders/field_eval.wgsl")
 );
 
-/// The sky gradient behind the cloud: `sun_shadow.wgsl` + `fullscreen.wgsl` + `sky.wgsl`.
+/// The sky gradient behind the cloud: `sun_shadow.wgsl` + `fullscreen.wgsl` + `tone.wgsl` +
+/// `sky.wgsl`.
 pub const SKY: &str = concat!(
     include_str!("../../shaders/sun_shadow.wgsl"),
     include_str!("../../shaders/fullscreen.wgsl"),
+    include_str!("../../shaders/tone.wgsl"),
     include_str!("../../shaders/sky.wgsl")
 );
 
@@ -139,7 +142,7 @@ pub const MODULES: [(&str, &[&str], &str); 11] = [
     ),
     (
         "composite",
-        &["fullscreen.wgsl", "composite.wgsl"],
+        &["fullscreen.wgsl", "tone.wgsl", "composite.wgsl"],
         COMPOSITE,
     ),
     (
@@ -149,7 +152,12 @@ pub const MODULES: [(&str, &[&str], &str); 11] = [
     ),
     (
         "sky",
-        &["sun_shadow.wgsl", "fullscreen.wgsl", "sky.wgsl"],
+        &[
+            "sun_shadow.wgsl",
+            "fullscreen.wgsl",
+            "tone.wgsl",
+            "sky.wgsl",
+        ],
         SKY,
     ),
     ("fill", &["fullscreen.wgsl", "fill.wgsl"], FILL),

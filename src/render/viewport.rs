@@ -156,6 +156,9 @@ pub struct ViewportPaint {
     /// Seconds after the GPU starts the job when the next frame may queue another behind it
     /// ([`super::progressive::FramePlan::due_after_start`]).
     pub due_after_start: Option<f64>,
+    /// The flat background's display colour (the frame's clear colour) where the view has no
+    /// backdrop ([`BackdropPaint`]); the composite maps the cloud's light with its light.
+    pub flat: Option<[f32; 3]>,
 }
 
 impl RendererPaint for ViewportPaint {
@@ -208,12 +211,13 @@ impl RendererPaint for ViewportPaint {
         // Every callback's `prepare` is done: the shafts beyond the box are drawn by now.
         if let Some(target) = self.display {
             renderer.prepare_cropped_composite(frame.device, frame.queue, target, self.crop);
+            renderer.prepare_behind(frame.queue, self.crop, self.flat);
         }
     }
 
     fn paint(&self, renderer: &VolumeRenderer, pass: &mut wgpu::RenderPass<'static>) {
         if let Some(target) = self.display {
-            renderer.composite_cropped(pass, target, false);
+            renderer.composite_cropped(pass, target, false, renderer.viewport_behind());
         }
     }
 }
@@ -235,9 +239,9 @@ pub struct BackdropPaint {
     pub volumes: Option<Volumes>,
     /// The shafts of light drawn apart from the cloud's box, if the view has shafts.
     pub shafts: Option<ShaftsApart>,
-    /// The pixel rectangles (x0, y0, x1, y1) around the cloud's box, where the shafts are laid
-    /// (the whole view when the box is out of view; none when it covers the view).
-    pub strips: Vec<[u32; 4]>,
+    /// The cloud's box in the backdrop's pixels (x0, y0, x1, y1; none when out of view): the
+    /// shafts drawn apart are added around it, and its composite adds its own.
+    pub crop: Option<[u32; 4]>,
     /// Everything it is drawn from: the renderer draws it again when this differs from what
     /// it last drew (kept by the renderer, so a frame the GPU never got draws it again).
     pub key: u64,
@@ -280,7 +284,6 @@ impl RendererPaint for BackdropPaint {
                 shafts.size,
             )
         });
-        let strips: &[[u32; 4]] = if laid { &self.strips } else { &[] };
         renderer.draw_backdrop(
             device,
             queue,
@@ -288,7 +291,8 @@ impl RendererPaint for BackdropPaint {
             &self.view,
             self.size,
             self.background,
-            strips,
+            laid,
+            self.crop,
             self.key,
         );
     }

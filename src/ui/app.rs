@@ -806,8 +806,10 @@ impl eframe::App for CloudApp {
     }
 
     fn clear_color(&self, _visuals: &egui::Visuals) -> [f32; 4] {
-        // The sky behind the cloud, sRGB-encoded like egui's colours.
-        let [r, g, b] = self.doc.scene().light.background;
+        // The flat background as it shows at the document's exposure, sRGB-encoded like
+        // egui's colours (as picked at exposure 0: the one tone map, `render::tone`).
+        let light = &self.doc.scene().light;
+        let [r, g, b] = crate::render::tone::background_display(light.background, light.exposure);
         [r, g, b, 1.0]
     }
 

@@ -264,6 +264,7 @@ impl Viewport {
                             own_submission: false,
                             due_after_start: None,
                             crop: crate::render::FULL_VIEW,
+                            flat: None,
                         },
                     ));
                 }
@@ -343,9 +344,13 @@ impl Viewport {
             size: px.map(|v| v.div_ceil(OUTSIDE_SHAFTS_DIVISOR * if dragging { 2 } else { 1 })),
         });
         let shells_apart = shafts.is_some();
-        if (scene.light.sky_gradient || scene.light.ground || shafts.is_some())
-            && self.stats.backend.is_some()
-        {
+        let has_backdrop = scene.light.sky_gradient || scene.light.ground || shafts.is_some();
+        // Without a backdrop the cloud's composite maps its light with the flat background's
+        // (the frame's clear colour, `CloudApp::clear_color`).
+        let flat = (!has_backdrop).then(|| {
+            crate::render::tone::background_display(scene.light.background, scene.light.exposure)
+        });
+        if has_backdrop && self.stats.backend.is_some() {
             let volumes = (!density.is_empty()).then(|| volumes.clone());
             let paint = backdrop(
                 cx.doc,
@@ -423,6 +428,7 @@ impl Viewport {
                     own_submission: false,
                     due_after_start: None,
                     crop: crate::render::FULL_VIEW,
+                    flat: None,
                 },
             ));
         }
@@ -454,6 +460,7 @@ impl Viewport {
                         own_submission: plan.own_submission,
                         due_after_start: plan.due_after_start,
                         crop: crop.ndc(px),
+                        flat,
                     },
                 ));
             }
@@ -641,8 +648,6 @@ impl Viewport {
     }
 }
 
-/// The strips of `rect` around `area` (top, bottom, left, right; the whole of `rect` without
-/// an area), leaving out empty ones.
 /// The view behind the cloud over a view of `px` pixels whose cloud's box on screen is `crop`
 /// (pixels; none when out of view), shaded through `volumes`' light, with `shafts` of light
 /// around the box: drawn again when the view, the light, the clouds or the size changed (or a
@@ -687,33 +692,9 @@ fn backdrop(
         size,
         volumes,
         shafts,
-        strips: strips_around(size, crop),
+        crop,
         key,
     }
-}
-
-/// The pixel rectangles (x0, y0, x1, y1) of a view `px` pixels around the box `area` (the
-/// whole view without one), leaving out the empty ones.
-fn strips_around([w, h]: [u32; 2], area: Option<[u32; 4]>) -> Vec<[u32; 4]> {
-    let Some([x0, y0, x1, y1]) = area.map(|[x0, y0, x1, y1]| {
-        [
-            x0.min(w),
-            y0.min(h),
-            x1.clamp(x0.min(w), w),
-            y1.clamp(y0.min(h), h),
-        ]
-    }) else {
-        return vec![[0, 0, w, h]];
-    };
-    [
-        [0, 0, w, y0],
-        [0, y1, w, h],
-        [0, y0, x0, y1],
-        [x1, y0, w, y1],
-    ]
-    .into_iter()
-    .filter(|[a, b, c, d]| c > a && d > b)
-    .collect()
 }
 
 /// While a drag is under way the view behind the cloud is drawn at 1/this of the view's size
@@ -742,29 +723,6 @@ fn view_key(doc: &Document, density: u64, px: [u32; 2], crop: Option<[u32; 4]>) 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn the_strips_around_the_box_cover_the_rest_of_the_view_once() {
-        let view = [40, 30];
-        let inside =
-            |[x0, y0, x1, y1]: [u32; 4], x: u32, y: u32| x >= x0 && x < x1 && y >= y0 && y < y1;
-        for area in [
-            None,
-            Some([5, 7, 20, 25]),
-            Some([0, 0, 40, 30]),
-            Some([0, 3, 12, 30]),
-            Some([30, 20, 60, 90]),
-        ] {
-            let strips = strips_around(view, area);
-            for y in 0..view[1] {
-                for x in 0..view[0] {
-                    let covered = strips.iter().filter(|&&s| inside(s, x, y)).count();
-                    let boxed = area.is_some_and(|a| inside(a, x, y));
-                    assert_eq!(covered, usize::from(!boxed), "{area:?} at {x}, {y}");
-                }
-            }
-        }
-    }
 
     #[test]
     fn a_pixel_crop_covers_its_rectangle_and_maps_back() {
