@@ -97,6 +97,29 @@ for (const backend of BOTH_BUILDS) {
       const zenith = s.scene.light.background.map((v) => Math.round(v * 255));
       const dist = (a, b) => a.reduce((m, v, i) => Math.max(m, Math.abs(v - b[i])), 0);
       assert.ok(dist(top, zenith) < dist(top, horizon), `the top ${top} leans to the zenith ${zenith}`);
+      // One tone map: exposure scales the sky's light too (the picked colours show as picked at
+      // exposure 0 only), the gradient and the flat background alike. The renderer before left
+      // the sky as picked at every exposure.
+      const lum = (p) => 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+      const exposed = async (exposure, gradient, name) => {
+        await page.evaluate(([e, g]) => {
+          window.cloudsketch.set(`/light/exposure=${e}`);
+          window.cloudsketch.set(`/light/sky_gradient=${g}`);
+        }, [exposure, gradient]);
+        await until(page, (s) => s.scene.light.exposure === exposure && s.scene.light.sky_gradient === gradient, name);
+        await page.waitForTimeout(500);
+        const shot = await screenshot(page, `media-sky-${name}-${backend}`);
+        const px = (x, y) => { const i = 4 * (Math.round(y) * shot.width + Math.round(x)); return [shot.data[i], shot.data[i + 1], shot.data[i + 2]]; };
+        return [px(vw * 0.4, 3), px(vw * 0.4, vh / 2 - 2)];
+      };
+      const [topLit, midLit] = await exposed(1, true, 'gradient-plus-1');
+      console.log(`# ${backend} sky at +1 EV: top ${top} → ${topLit}, eye level ${mid} → ${midLit}`);
+      assert.ok(lum(topLit) > lum(top) + 8, `+1 EV brightens the zenith: ${top} → ${topLit}`);
+      assert.ok(lum(midLit) > lum(mid) + 3, `+1 EV brightens the horizon: ${mid} → ${midLit}`);
+      const [flatDark] = await exposed(-1, false, 'flat-minus-1');
+      assert.ok(lum(flatDark) + 8 < lum(zenith), `−1 EV darkens the flat background ${zenith}: ${flatDark}`);
+      const [flat] = await exposed(0, false, 'flat-0');
+      assert.ok(dist(flat, zenith) <= 2, `at 0 EV the flat background ${flat} shows as picked ${zenith}`);
     });
   });
 }
@@ -163,7 +186,6 @@ for (const backend of BOTH_BUILDS) {
       assert.equal(s.scene.light.sky_gradient, false, 'cumulus has a flat sky (coverage is measured against it)');
       const bg = s.scene.light.background.map((v) => Math.round(v * 255));
       const coverage = (img) => countDiffering(img, body, bg, 18);
-
       // Opacity: a press near the right end of its slider's rail raises it; more pixels cover.
       const opacity = s.scene.render.opacity;
       const rail = await reveal('param:opacity');
@@ -172,8 +194,13 @@ for (const backend of BOTH_BUILDS) {
       await away();
       await waitForFullQuality(page);
       const opaque = await screenshot(page, `widgets-opacity-${backend}`);
-      assert.ok(coverage(opaque) > coverage(last) * 1.02,
-        `opacity ${opacity} → ${s.scene.render.opacity.toFixed(2)}: coverage ${coverage(last)} → ${coverage(opaque)} px`);
+      // Under the one tone map a thin sunlit veil already shows (its light adds to the sky's),
+      // so more opacity covers only a little more (1.7% more pixels at 18 levels) and changes
+      // the body's shading instead: its self-shadowing deepens.
+      const changed = countChanged(last, opaque, body);
+      console.log(`# ${backend} opacity: coverage ${coverage(last)} → ${coverage(opaque)} px, ${changed} px changed`);
+      assert.ok(coverage(opaque) >= coverage(last) && changed > 0.1 * body.w * body.h,
+        `opacity ${opacity} → ${s.scene.render.opacity.toFixed(2)}: coverage ${coverage(last)} → ${coverage(opaque)} px, ${changed} px changed`);
 
       // The sun: drag on the orb to its right, then to its left (a drag at pointer-move rate,
       // one undo step each); the cloud's bright side follows it.
