@@ -80,8 +80,8 @@ fn fs_transparent(in: Fullscreen) -> @location(0) vec4<f32> {
 // The cloud with the shafts' `light` added, over what lies behind.
 fn with_light(uv: vec2<f32>, light: vec3<f32>) -> vec4<f32> {
     let p = textureSampleLevel(src, src_smp, uv, 0.0);
-    let cloud = p.a > 1e-4;
-    return over_behind(behind_at(uv), select(0.0, p.a, cloud), select(vec3<f32>(0.0), p.rgb, cloud), light);
+    let some = p.a > 1e-4;
+    return over_behind(behind_at(uv), select(0.0, p.a, some), select(vec3<f32>(0.0), p.rgb, some), light);
 }
 
 // The same over no background: the cloud alone, with the display of the shafts' light added

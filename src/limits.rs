@@ -344,10 +344,11 @@ pub const MULTIPLE_SCATTERING: Param = Param::linear(
     1.0,
     0.5,
 );
-/// Exposure in stops: the cloud's light (sun and sky) times 2^EV before tone mapping.
+/// Exposure in stops: all the light (the cloud's, the sky's, the shafts') times 2^EV before the
+/// one tone map.
 pub const EXPOSURE: Param = Param::linear(
     "exposure (EV)",
-    "Brightens or darkens the cloud's light before tone mapping, in photographic stops; the background keeps its colour",
+    "Brightens or darkens all the light before tone mapping, the sky's and the cloud's alike, in photographic stops; at 0 the background shows as picked",
     -4.0,
     4.0,
     0.0,

@@ -2000,7 +2000,7 @@ fn the_linear_image_is_the_display_image_before_its_tone_map() {
 }
 
 /// One tone map, once: with the sky gradient, the ground, the shafts of light and the cloud
-/// all on, every display pixel is the tone map of the linear image's light there (the sky,
+/// all on, and over a flat background, every display pixel is the tone map of the linear image's light there (the sky,
 /// the ground, the cloud over them and the shafts added up first), the sky at exposure 0 its
 /// picked colour. The renderer before mapped the cloud alone, laid it over the sky as picked
 /// and added the shafts' light mapped on its own: it fails by tens of levels at the cloud's
@@ -2012,7 +2012,14 @@ fn one_tone_map_maps_the_sky_the_cloud_and_the_shafts_together() {
         &["/light/sky_gradient=true", "/light/exposure=0.5"],
     );
     let shafts = with(&sky, &["/light/shafts=true", "/light/shaft_density=0.003"]);
-    for (name, scene) in [("sky and ground", &sky), ("with shafts", &shafts)] {
+    // A flat background, which images and the viewport take as their clear colour (no sky
+    // pass): the composite maps the cloud's light with the light that shows as it.
+    let flat = with(&smooth_cumulus(), &["/light/exposure=0.7"]);
+    for (name, scene) in [
+        ("sky and ground", &sky),
+        ("with shafts", &shafts),
+        ("flat background", &flat),
+    ] {
         let display = render(scene);
         let linear = render_linear(scene, Backdrop::Sky);
         let cloud = render_linear(scene, Backdrop::Transparent);

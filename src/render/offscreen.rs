@@ -419,7 +419,8 @@ impl Offscreen {
     }
 
     /// Renders `scene` as [`Offscreen::render_with_progress`] does, as linear light before
-    /// any tone map (exposure applied; the sky's colours decoded from sRGB), premultiplied:
+    /// any tone map (exposure applied; the sky's colours as the light the tone map shows as
+    /// them, `tone::light_of`), premultiplied:
     /// what an EXR holds. Needs an offscreen made with [`Output::Linear`].
     pub fn render_linear(
         &mut self,

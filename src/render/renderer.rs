@@ -48,6 +48,9 @@ pub struct VolumeRenderer {
     /// viewport's, its colour in its own uniforms), or none at all (transparent and linear
     /// images, whose composites do not read it).
     flat_behind: (wgpu::Buffer, wgpu::BindGroup),
+    /// The same for an image over a flat background (its own uniforms: a capture and the
+    /// viewport may both composite before one submission).
+    flat_image: (wgpu::Buffer, wgpu::BindGroup),
     /// Whether the viewport's composite has the flat background behind it, not its backdrop
     /// ([`VolumeRenderer::prepare_behind`]).
     viewport_flat: bool,
@@ -123,6 +126,17 @@ fn lay(
     pass.set_bind_group(0, group, &[]);
     pass.set_bind_group(1, behind, &[]);
     pass.draw(0..3, 0..1);
+}
+
+/// What lies behind an image's cloud ([`VolumeRenderer::prepare_image_behind`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum ImageBehind {
+    /// Nothing: a transparent image.
+    Nothing,
+    /// The flat background, the image's clear colour.
+    Flat(wgpu::Color),
+    /// The image backdrop (sky, ground, shafts around the box).
+    Backdrop,
 }
 
 /// Where an image cropped to `crop` (normalised device coordinates, x0, y0, x1, y1; y up) lies
@@ -211,6 +225,9 @@ impl VolumeRenderer {
         };
         let flat_buffer = behind_buffer();
         let flat_group = composite.behind_group(device, &shafts_placeholder, &flat_buffer);
+        let flat_image_buffer = behind_buffer();
+        let flat_image_group =
+            composite.behind_group(device, &shafts_placeholder, &flat_image_buffer);
         Self {
             accum_format,
             output_format,
@@ -229,6 +246,7 @@ impl VolumeRenderer {
             image_backdrop: None,
             behind_uniforms: [behind_buffer(), behind_buffer()],
             flat_behind: (flat_buffer, flat_group),
+            flat_image: (flat_image_buffer, flat_image_group),
             viewport_flat: true,
             shafts_placeholder,
             clamp_sampler,
@@ -618,7 +636,8 @@ impl VolumeRenderer {
     /// image of `total` slices (as [`Shells::new`] counts them), with no slice among them, into
     /// a target of its own `size` pixels (the light is soft: a fraction of the view's size
     /// does). The viewport draws the cloud's box with its slices and shells interleaved, and
-    /// lays this over the rest of the view ([`VolumeRenderer::composite_outside_shafts`]), so
+    /// the sky adds this over the rest of the view (`SkyUniforms::keep_out`; over a
+    /// transparent image [`VolumeRenderer::composite_outside_shafts`] lays it), so
     /// shafts no longer make every slice cover the whole view. Returns whether there are
     /// shafts to lay.
     pub fn draw_outside_shafts(
@@ -697,9 +716,9 @@ impl VolumeRenderer {
     }
 
     /// Lays the shafts of light [`VolumeRenderer::draw_outside_shafts`] drew over the current
-    /// render pass's viewport (the whole view; its scissor keeps them off the cloud's box);
-    /// over a `transparent` image with alpha of their own.
-    pub fn composite_outside_shafts(&self, pass: &mut wgpu::RenderPass<'_>, transparent: bool) {
+    /// render pass's viewport of a transparent image, with alpha of their own (the whole view;
+    /// its scissor keeps them off the cloud's box). Over a background the sky adds them.
+    pub fn composite_outside_shafts(&self, pass: &mut wgpu::RenderPass<'_>) {
         if let Some(Target {
             shafts: Some((_, group)),
             ..
@@ -709,7 +728,7 @@ impl VolumeRenderer {
             lay(
                 pass,
                 [&c.shafts_pipeline, &c.shafts_transparent_pipeline],
-                transparent,
+                true,
                 group,
                 &self.flat_behind.1,
             );
@@ -858,30 +877,26 @@ impl VolumeRenderer {
         let view = output.create_view(&wgpu::TextureViewDescriptor::default());
         self.update_light(device, queue, encoder, &job.view);
         self.draw_slices(device, queue, encoder, job, pipeline);
-        if let Some(background) = background {
-            // The shafts are among the slices over the whole image: none laid apart.
-            self.draw_image_backdrop(
-                device,
-                queue,
-                encoder,
-                &job.view,
-                job.plan.size,
-                background,
-                None,
-            );
-            queue.write_buffer(
-                &self.behind_uniforms[SkySlot::Image as usize],
-                0,
-                bytemuck::bytes_of(&BehindUniforms {
-                    place: [0.0, 0.0, 1.0, 1.0],
-                    flat: [0.0; 4],
-                }),
-            );
-        }
-        let mut pass = self.image_pass(encoder, &view, background.is_some(), "image composite");
-        let behind = self.image_behind(background.is_some());
-        self.composite(&mut pass, job.plan.target, background.is_none(), behind);
+        // The shafts are among the slices over the whole image: none laid apart.
+        let behind = self.prepare_image_behind(
+            device,
+            queue,
+            encoder,
+            &job.view,
+            job.plan.size,
+            background,
+            [0.0, 0.0, 1.0, 1.0],
+            None,
+        );
+        let mut pass = self.image_pass(encoder, &view, behind, "image composite");
+        self.composite(
+            &mut pass,
+            job.plan.target,
+            background.is_none(),
+            self.image_behind(behind),
+        );
         drop(pass);
+        self.release_large_backdrop();
         output
     }
 
@@ -959,33 +974,18 @@ impl VolumeRenderer {
         }
         let ndc = crop.ndc(job.plan.size);
         self.prepare_cropped_composite(device, queue, job.plan.target, ndc);
-        if let Some(background) = background {
-            // The sky with the shafts around the box in it, mapped once with them.
-            let keep_out = keep_out(outside, Some(crop.px), job.plan.size);
-            self.draw_image_backdrop(
-                device,
-                queue,
-                encoder,
-                &job.view,
-                job.plan.size,
-                background,
-                Some(keep_out),
-            );
-            queue.write_buffer(
-                &self.behind_uniforms[SkySlot::Image as usize],
-                0,
-                bytemuck::bytes_of(&BehindUniforms {
-                    place: place_of(ndc),
-                    flat: [0.0; 4],
-                }),
-            );
-        }
-        let mut pass = self.image_pass(
+        // The sky with the shafts around the box in it, mapped once with them.
+        let behind = self.prepare_image_behind(
+            device,
+            queue,
             encoder,
-            &view,
-            background.is_some(),
-            "cropped image composite",
+            &job.view,
+            job.plan.size,
+            background,
+            place_of(ndc),
+            outside.then(|| keep_out(true, Some(crop.px), job.plan.size)),
         );
+        let mut pass = self.image_pass(encoder, &view, behind, "cropped image composite");
         let [x0, y0, x1, y1] = crop.px;
         if outside && background.is_none() {
             // Over transparency, the shafts' glow in the strips around the crop: above, below,
@@ -998,7 +998,7 @@ impl VolumeRenderer {
             ] {
                 if w > 0 && h > 0 {
                     pass.set_scissor_rect(x, y, w, h);
-                    self.composite_outside_shafts(&mut pass, true);
+                    self.composite_outside_shafts(&mut pass);
                 }
             }
             pass.set_scissor_rect(0, 0, width, height);
@@ -1011,29 +1011,115 @@ impl VolumeRenderer {
             0.0,
             1.0,
         );
-        let behind = self.image_behind(background.is_some());
-        self.composite_cropped(&mut pass, job.plan.target, background.is_none(), behind);
+        self.composite_cropped(
+            &mut pass,
+            job.plan.target,
+            background.is_none(),
+            self.image_behind(behind),
+        );
         drop(pass);
+        self.release_large_backdrop();
         output
     }
 
-    /// The composite's group 1 for an image: its backdrop's over a background, else none.
-    fn image_behind(&self, background: bool) -> &wgpu::BindGroup {
-        match &self.image_backdrop {
-            Some(b) if background => &b.behind,
+    /// Readies what lies behind an image's cloud: nothing (no `background`: transparent), the
+    /// flat background as the output's clear colour (no sky gradient, no ground, no shafts
+    /// laid apart: `shafts_keep_out` none), or the image backdrop, its sky drawn with the
+    /// shafts outside `shafts_keep_out`. `place` is where the composited image lies in it.
+    #[allow(clippy::too_many_arguments)]
+    fn prepare_image_behind(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        view: &View,
+        size: [u32; 2],
+        background: Option<[f32; 3]>,
+        place: [f32; 4],
+        shafts_keep_out: Option<[f32; 4]>,
+    ) -> ImageBehind {
+        let Some(background) = background else {
+            return ImageBehind::Nothing;
+        };
+        let light = &view.light;
+        if !light.sky_gradient && !light.ground && shafts_keep_out.is_none() {
+            let shown = super::tone::background_display(background, light.exposure);
+            let [r, g, b] = if super::passes::linear_output(self.output_format) {
+                // A float target holds the light itself.
+                (super::tone::light_of(background) * light.exposure.exp2()).to_array()
+            } else {
+                shown
+            };
+            let [sr, sg, sb] = shown;
+            queue.write_buffer(
+                &self.flat_image.0,
+                0,
+                bytemuck::bytes_of(&BehindUniforms {
+                    place,
+                    flat: [sr, sg, sb, 1.0],
+                }),
+            );
+            return ImageBehind::Flat(wgpu::Color {
+                r: r.into(),
+                g: g.into(),
+                b: b.into(),
+                a: 1.0,
+            });
+        }
+        self.draw_image_backdrop(
+            device,
+            queue,
+            encoder,
+            view,
+            size,
+            background,
+            shafts_keep_out,
+        );
+        queue.write_buffer(
+            &self.behind_uniforms[SkySlot::Image as usize],
+            0,
+            bytemuck::bytes_of(&BehindUniforms {
+                place,
+                flat: [0.0; 4],
+            }),
+        );
+        ImageBehind::Backdrop
+    }
+
+    /// Drops the image backdrop when it is large (an export's 8K image holds half a
+    /// gigabyte of it); a smaller one is kept for the next image (a recording's frames).
+    fn release_large_backdrop(&mut self) {
+        if self
+            .image_backdrop
+            .as_ref()
+            .is_some_and(|b| u64::from(b.size[0]) * u64::from(b.size[1]) > 1 << 22)
+        {
+            self.image_backdrop = None;
+        }
+    }
+
+    /// The composite's group 1 for an image with `behind` it.
+    fn image_behind(&self, behind: ImageBehind) -> &wgpu::BindGroup {
+        match (behind, &self.image_backdrop) {
+            (ImageBehind::Backdrop, Some(b)) => &b.behind,
+            (ImageBehind::Flat(_), _) => &self.flat_image.1,
             _ => &self.flat_behind.1,
         }
     }
 
-    /// Begins the render pass that lays an image over `target`: the image's backdrop laid
-    /// when it has a `background`, else cleared to transparency.
+    /// Begins the render pass that lays an image over `target`: cleared to the flat
+    /// background, or to transparency with the image's backdrop laid over it, or not.
     fn image_pass<'e>(
         &self,
         encoder: &'e mut wgpu::CommandEncoder,
         target: &wgpu::TextureView,
-        background: bool,
+        behind: ImageBehind,
         label: &str,
     ) -> wgpu::RenderPass<'e> {
+        let clear = match behind {
+            ImageBehind::Flat(colour) => colour,
+            _ => wgpu::Color::TRANSPARENT,
+        };
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(label),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -1041,7 +1127,7 @@ impl VolumeRenderer {
                 depth_slice: None,
                 resolve_target: None,
                 ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                    load: wgpu::LoadOp::Clear(clear),
                     store: wgpu::StoreOp::Store,
                 },
             })],
@@ -1050,7 +1136,7 @@ impl VolumeRenderer {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        if let (true, Some(b)) = (background, &self.image_backdrop) {
+        if let (ImageBehind::Backdrop, Some(b)) = (behind, &self.image_backdrop) {
             self.backdrop_pass.draw(&mut pass, &b.group);
         }
         pass
