@@ -1066,15 +1066,19 @@ impl VolumeRenderer {
                 a: 1.0,
             });
         }
-        self.draw_image_backdrop(
+        let mut slot = self.image_backdrop.take();
+        self.draw_behind(
             device,
             queue,
             encoder,
+            &mut slot,
+            SkySlot::Image,
             view,
             size,
             background,
-            shafts_keep_out,
+            shafts_keep_out.unwrap_or(SkyUniforms::NO_SHAFTS),
         );
+        self.image_backdrop = slot;
         queue.write_buffer(
             &self.behind_uniforms[SkySlot::Image as usize],
             0,
@@ -1140,34 +1144,6 @@ impl VolumeRenderer {
             self.backdrop_pass.draw(&mut pass, &b.group);
         }
         pass
-    }
-
-    /// Draws an image's view behind the cloud (its sky and the shafts outside `keep_out`) into
-    /// the image backdrop, `size` pixels.
-    #[allow(clippy::too_many_arguments)]
-    fn draw_image_backdrop(
-        &mut self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        encoder: &mut wgpu::CommandEncoder,
-        view: &View,
-        size: [u32; 2],
-        background: [f32; 3],
-        keep_out: Option<[f32; 4]>,
-    ) {
-        let mut slot = self.image_backdrop.take();
-        self.draw_behind(
-            device,
-            queue,
-            encoder,
-            &mut slot,
-            SkySlot::Image,
-            view,
-            size,
-            background,
-            keep_out.unwrap_or(SkyUniforms::NO_SHAFTS),
-        );
-        self.image_backdrop = slot;
     }
 
     /// Draws the sky of `view` over `background` (sRGB-encoded, as picked) and the shafts drawn
