@@ -24,6 +24,14 @@ struct Behind {
     place: vec4<f32>,
     // rgb: the flat background's display colour; w: 1 when it is that colour, not the texture.
     flat: vec4<f32>,
+    // rgb: the flat background's light (`light_of(flat.rgb)`, worked out once on the CPU).
+    flat_light: vec4<f32>,
+};
+
+// What lies behind one pixel: its display colour and its light.
+struct Seen {
+    shown: vec3<f32>,
+    light: vec3<f32>,
 };
 
 // The view behind the cloud as drawn (display colours), and where it lies.
@@ -35,20 +43,23 @@ fn vs_main(@builtin(vertex_index) vi: u32) -> Fullscreen {
     return fullscreen_vertex(vi);
 }
 
-// The display colour of what lies behind this image's pixel `uv`.
-fn behind_at(uv: vec2<f32>) -> vec3<f32> {
+// What lies behind this image's pixel `uv`: the flat background, or the backdrop's colour
+// there turned back into light.
+fn behind_at(uv: vec2<f32>) -> Seen {
     if behind.flat.w > 0.5 {
-        return behind.flat.rgb;
+        return Seen(behind.flat.rgb, behind.flat_light.rgb);
     }
-    return textureSampleLevel(behind_tex, src_smp, behind.place.xy + uv * behind.place.zw, 0.0).rgb;
+    let d = textureSampleLevel(behind_tex, src_smp, behind.place.xy + uv * behind.place.zw, 0.0).rgb;
+    return Seen(d, light_of(d));
 }
 
-// The premultiplied pixel that, blended "over" what lies behind (`d`, its display colour),
-// shows the one tone map of its light behind the cloud's `alpha`, the cloud's premultiplied
-// `cloud` light and the `added` light. Its alpha is the cloud's, raised where a channel would
-// need less than nothing added (a dark thin cloud over a bright sky).
-fn over_behind(d: vec3<f32>, alpha: f32, cloud: vec3<f32>, added: vec3<f32>) -> vec4<f32> {
-    let shown = display(light_of(d) * (1.0 - alpha) + cloud + added);
+// The premultiplied pixel that, blended "over" what lies behind (`seen`: its display colour
+// and light), shows the one tone map of that light behind the cloud's `alpha`, the cloud's
+// premultiplied `cloud` light and the `added` light. Its alpha is the cloud's, raised where a
+// channel would need less than nothing added (a dark thin cloud over a bright sky).
+fn over_behind(seen: Seen, alpha: f32, cloud: vec3<f32>, added: vec3<f32>) -> vec4<f32> {
+    let d = seen.shown;
+    let shown = display(seen.light * (1.0 - alpha) + cloud + added);
     let ratio = select(vec3<f32>(1.0), shown / max(d, vec3<f32>(1e-6)), d > vec3<f32>(1e-6));
     let a = clamp(max(alpha, 1.0 - min(ratio.r, min(ratio.g, ratio.b))), 0.0, 1.0);
     return vec4<f32>(max(shown - (1.0 - a) * d, vec3<f32>(0.0)), a);

@@ -284,15 +284,36 @@ pub struct BehindUniforms {
     pub place: [f32; 4],
     /// The flat background's display colour (rgb); w: 1 when there is no texture behind.
     pub flat: [f32; 4],
+    /// The flat background's light (rgb): `tone::light_of` of its display colour.
+    pub flat_light: [f32; 4],
 }
 
 impl BehindUniforms {
     /// Names and byte offsets of the members, in order (checked against the WGSL struct).
-    pub const LAYOUT: [(&'static str, usize); 3] = [
+    pub const LAYOUT: [(&'static str, usize); 4] = [
         ("place", offset_of!(Self, place)),
         ("flat", offset_of!(Self, flat)),
+        ("flat_light", offset_of!(Self, flat_light)),
         ("", std::mem::size_of::<Self>()),
     ];
+
+    /// Over the flat background of display colour `shown`, the image lying at `place`.
+    pub fn flat(place: [f32; 4], [r, g, b]: [f32; 3]) -> Self {
+        let [lr, lg, lb] = super::tone::light_of([r, g, b]).to_array();
+        Self {
+            place,
+            flat: [r, g, b, 1.0],
+            flat_light: [lr, lg, lb, 0.0],
+        }
+    }
+
+    /// Over a backdrop texture, the image lying at `place` in it.
+    pub fn backdrop(place: [f32; 4]) -> Self {
+        Self {
+            place,
+            ..Self::default()
+        }
+    }
 }
 
 /// Uniforms of one slice of the light volume pass (`struct LightSlice` in

@@ -128,6 +128,31 @@ fn lay(
     pass.draw(0..3, 0..1);
 }
 
+/// Begins a render pass into the one `target`, cleared to `colour` first.
+fn clear_pass<'e>(
+    encoder: &'e mut wgpu::CommandEncoder,
+    label: &str,
+    target: &wgpu::TextureView,
+    colour: wgpu::Color,
+) -> wgpu::RenderPass<'e> {
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view: target,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load: wgpu::LoadOp::Clear(colour),
+                store: wgpu::StoreOp::Store,
+            },
+        })],
+        depth_stencil_attachment: None,
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    })
+}
+
 /// What lies behind an image's cloud ([`VolumeRenderer::prepare_image_behind`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum ImageBehind {
@@ -554,22 +579,12 @@ impl VolumeRenderer {
             .collect();
         let offsets = self.light_pass.write(queue, &slices);
         for (z, slice_offset) in offsets.into_iter().enumerate() {
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("light volume slice"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &light.slice_view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::WHITE),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: None,
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
+            let mut pass = clear_pass(
+                encoder,
+                "light volume slice",
+                &light.slice_view,
+                wgpu::Color::WHITE,
+            );
             pass.set_pipeline(&self.light_pass.pipeline);
             pass.set_bind_group(0, group, &[offset]);
             pass.set_bind_group(1, &self.light_pass.slice_group, &[slice_offset]);
@@ -1050,14 +1065,10 @@ impl VolumeRenderer {
             } else {
                 shown
             };
-            let [sr, sg, sb] = shown;
             queue.write_buffer(
                 &self.flat_image.0,
                 0,
-                bytemuck::bytes_of(&BehindUniforms {
-                    place,
-                    flat: [sr, sg, sb, 1.0],
-                }),
+                bytemuck::bytes_of(&BehindUniforms::flat(place, shown)),
             );
             return ImageBehind::Flat(wgpu::Color {
                 r: r.into(),
@@ -1082,10 +1093,7 @@ impl VolumeRenderer {
         queue.write_buffer(
             &self.behind_uniforms[SkySlot::Image as usize],
             0,
-            bytemuck::bytes_of(&BehindUniforms {
-                place,
-                flat: [0.0; 4],
-            }),
+            bytemuck::bytes_of(&BehindUniforms::backdrop(place)),
         );
         ImageBehind::Backdrop
     }
@@ -1124,22 +1132,7 @@ impl VolumeRenderer {
             ImageBehind::Flat(colour) => colour,
             _ => wgpu::Color::TRANSPARENT,
         };
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some(label),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: target,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(clear),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: None,
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let mut pass = clear_pass(encoder, label, target, clear);
         if let (ImageBehind::Backdrop, Some(b)) = (behind, &self.image_backdrop) {
             self.backdrop_pass.draw(&mut pass, &b.group);
         }
@@ -1194,22 +1187,12 @@ impl VolumeRenderer {
         });
         uniforms.keep_out = keep_out;
         self.sky.write(queue, slot, &uniforms);
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("view behind the cloud"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &backdrop.view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: None,
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let mut pass = clear_pass(
+            encoder,
+            "view behind the cloud",
+            &backdrop.view,
+            wgpu::Color::BLACK,
+        );
         self.sky.draw(&mut pass, slot);
     }
 
@@ -1306,19 +1289,13 @@ impl VolumeRenderer {
     pub fn prepare_behind(&mut self, queue: &wgpu::Queue, crop: [f32; 4], flat: Option<[f32; 3]>) {
         self.viewport_flat = flat.is_some() || self.backdrop.is_none();
         let (buffer, uniforms) = match flat {
-            Some([r, g, b]) => (
+            Some(shown) => (
                 &self.flat_behind.0,
-                BehindUniforms {
-                    place: place_of(crop),
-                    flat: [r, g, b, 1.0],
-                },
+                BehindUniforms::flat(place_of(crop), shown),
             ),
             None => (
                 &self.behind_uniforms[SkySlot::Viewport as usize],
-                BehindUniforms {
-                    place: place_of(crop),
-                    flat: [0.0; 4],
-                },
+                BehindUniforms::backdrop(place_of(crop)),
             ),
         };
         queue.write_buffer(buffer, 0, bytemuck::bytes_of(&uniforms));
