@@ -1,5 +1,6 @@
-// The sky behind the cloud when the document asks for a gradient (Lighting::sky_gradient):
-// the background colour at the zenith, the horizon colour at eye level, and below the horizon
+// The sky behind the cloud when the document asks for one: the physical sky
+// (Lighting::physical_sky: src/atmosphere.rs's view table, the sun's disk), or a gradient
+// (Lighting::sky_gradient): the background colour at the zenith, the horizon colour at eye level, and below the horizon
 // a darker haze, by each pixel's view ray; and with Lighting::ground a ground plane whose
 // every point is darkened by the clouds' transmittance toward the sun (the light volume where
 // the sun's ray from that point enters the clouds' box: nothing shades it before); and the
@@ -35,6 +36,14 @@ struct Sky {
     // Where the shafts' light is not added (texture coordinates, v down: x0, y0, x1, y1): the
     // clouds' box, whose composite adds its own; the whole target when there are no shafts.
     keep_out: vec4<f32>,
+    // The physical sky: x: the light of one unit of the view table; y: 1 with the physical
+    // sky; z: the cosine of the sun's angular radius; w: the sun's azimuth (radians).
+    atmosphere: vec4<f32>,
+    // The sun disk's light (rgb).
+    sun_disk: vec4<f32>,
+    // The sunlight on a white ground facing the sun, and the sky's light on it (rgb).
+    ground_sun: vec4<f32>,
+    ground_sky: vec4<f32>,
 };
 
 @group(0) @binding(0) var<uniform> sky: Sky;
@@ -44,6 +53,10 @@ struct Sky {
 // The light of the shafts' shells summed over the whole view (rgb), drawn apart from the
 // clouds' box (VolumeRenderer::draw_outside_shafts).
 @group(0) @binding(3) var shafts_tex: texture_2d<f32>;
+// The physical sky's radiance seen from the eye (src/atmosphere.rs, SkyTables::view): u the
+// azimuth from the sun over π, v the elevation (finer near the horizon); texel i at
+// u = i / (w - 1).
+@group(0) @binding(4) var atmosphere_tex: texture_2d<f32>;
 
 // The clouds' transmittance toward the sun from ground point `p` (sun_shadow.wgsl).
 fn ground_sun(p: vec3<f32>) -> f32 {
@@ -72,10 +85,15 @@ fn fs_linear(in: Fullscreen) -> @location(0) vec4<f32> {
     return vec4<f32>(sky_light(in), 1.0);
 }
 
-// This pixel's linear light: the picked colours' light at this exposure, and the shafts'
-// outside the clouds' box.
+// This pixel's linear light: the physical sky's, or the picked colours' at this exposure,
+// and the shafts' outside the clouds' box.
 fn sky_light(in: Fullscreen) -> vec3<f32> {
-    var light = light_of(sky_colour(in)) * sky.sun_dir.w;
+    var light: vec3<f32>;
+    if sky.atmosphere.y > 0.5 {
+        light = physical_sky(in);
+    } else {
+        light = light_of(sky_colour(in)) * sky.sun_dir.w;
+    }
     let k = sky.keep_out;
     if any(in.uv < k.xy) || any(in.uv >= k.zw) {
         light = light + textureSampleLevel(shafts_tex, light_smp, in.uv, 0.0).rgb;
@@ -114,4 +132,44 @@ fn sky_colour(in: Fullscreen) -> vec3<f32> {
         }
     }
     return colour;
+}
+
+// The physical sky along this pixel's ray (the view table's light, the sun's disk), and the
+// ground plane's light where the ray meets it, fading into the sky with distance.
+fn physical_sky(in: Fullscreen) -> vec3<f32> {
+    let d = normalize(sky.forward.xyz + in.ndc.x * sky.right.xyz + in.ndc.y * sky.up.xyz);
+    let size = vec2<f32>(textureDimensions(atmosphere_tex));
+    let across = length(d.xz);
+    let sun_across = vec2<f32>(cos(sky.atmosphere.w), sin(sky.atmosphere.w));
+    var cos_azimuth = 1.0;
+    if across > 1e-5 {
+        cos_azimuth = dot(d.xz / across, sun_across);
+    }
+    let pi = 3.14159265;
+    let u = acos(clamp(cos_azimuth, -1.0, 1.0)) / pi;
+    let l = clamp(asin(clamp(d.y, -1.0, 1.0)) / (0.5 * pi), -1.0, 1.0);
+    let v = 0.5 + 0.5 * sign(l) * sqrt(abs(l));
+    let uv = (vec2<f32>(u, v) * (size - 1.0) + 0.5) / size;
+    var light = textureSampleLevel(atmosphere_tex, light_smp, uv, 0.0).rgb * sky.atmosphere.x;
+    // The sun's disk, its edge softened over a tenth of its radius.
+    let c = dot(d, sky.sun_dir.xyz);
+    let edge = 1.0 - sky.atmosphere.z;
+    let disk = smoothstep(sky.atmosphere.z - 0.1 * edge, sky.atmosphere.z + 0.1 * edge, c);
+    light = light + sky.sun_disk.rgb * disk;
+    if sky.eye.w > 0.5 {
+        let ortho = dot(sky.origin_right.xyz, sky.origin_right.xyz) > 0.0;
+        let dir = select(d, sky.forward.xyz, ortho);
+        let origin = sky.eye.xyz + in.ndc.x * sky.origin_right.xyz + in.ndc.y * sky.origin_up.xyz;
+        let t = (sky.grid_min.w - origin.y) / dir.y;
+        if dir.y < 0.0 && t > 0.0 {
+            let p = origin + dir * t;
+            // A Lambertian ground of the picked colour (its albedo), lit by the sun through
+            // the clouds and by the sky.
+            let sun = max(sky.sun_dir.y, 0.0) * ground_sun(p);
+            let albedo = srgb_to_linear(sky.ground_lit.rgb);
+            let lit = albedo * (sky.ground_sun.rgb * sun + sky.ground_sky.rgb);
+            light = mix(light, lit, smoothstep(0.0, 0.25, -dir.y));
+        }
+    }
+    return light;
 }

@@ -3,6 +3,7 @@
 //! One crate for the browser (wasm32, WebGPU with a WebGL2 fallback) and native (desktop
 //! window and a headless CLI). See ARCHITECTURE.md for the map; in short:
 //!
+//! - [`atmosphere`]: the physical sky's tables (pure);
 //! - [`scene`]: the document, the only state a user makes, with undo and revisions (pure);
 //! - [`sketch`]: stroke → skeleton → spheres (pure);
 //! - [`density`]: the density volume every source lands in (pure);
@@ -16,6 +17,7 @@
 //! - `files` (native): the one safe writer and the one bounded reader;
 //! - `cli`, `bench` (native) and `web` (wasm32): the entry points of each target.
 
+pub mod atmosphere;
 pub mod density;
 pub mod derive;
 pub mod export;

@@ -58,7 +58,8 @@ fn uses(code: &str, name: &str) -> bool {
     })
 }
 
-const PURE: [&str; 10] = [
+const PURE: [&str; 11] = [
+    "src/atmosphere.rs",
     "src/density.rs",
     "src/export/",
     "src/simulate/",

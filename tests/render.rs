@@ -974,15 +974,6 @@ fn shaft_term(on: &Scene, off: &Scene) -> Vec<f64> {
         .collect()
 }
 
-/// Luminance of `on` less that of `off`, pixel by pixel.
-fn added_light(on: &Image, off: &Image) -> Vec<f64> {
-    on.rgba
-        .chunks(4)
-        .zip(off.rgba.chunks(4))
-        .map(|(a, b)| luminance([a[0], a[1], a[2], 255]) - luminance([b[0], b[1], b[2], 255]))
-        .collect()
-}
-
 #[test]
 fn shafts_of_light_brighten_the_air_in_the_gaps_and_add_nothing_when_off() {
     let layer = broken_layer();
@@ -2067,5 +2058,125 @@ fn one_tone_map_maps_the_sky_the_cloud_and_the_shafts_together() {
     assert!(
         lit > clear / 3,
         "the shafts lit only {lit} of {clear} clear pixels"
+    );
+}
+
+/// The unit view ray through the centre of pixel (x, y) of a W × H image of `scene`.
+fn pixel_ray(scene: &Scene, x: u32, y: u32) -> glam::Vec3 {
+    let c = &scene.camera;
+    let t = (c.fov_y_deg.to_radians() * 0.5).tan();
+    let aspect = W as f32 / H as f32;
+    let nx = 2.0 * (x as f32 + 0.5) / W as f32 - 1.0;
+    let ny = 1.0 - 2.0 * (y as f32 + 0.5) / H as f32;
+    (c.forward() + c.right() * (nx * t * aspect) + c.up() * (ny * t)).normalize()
+}
+
+/// The mean colour of the pixels the cloud covers (alpha over a half) of a transparent image,
+/// its straight colour.
+fn cloud_colour(image: &Image) -> [f64; 3] {
+    let (mut sum, mut n) = ([0.0; 3], 0.0_f64);
+    for p in image.rgba.chunks(4).filter(|p| p[3] > 128) {
+        for c in 0..3 {
+            sum[c] += p[c] as f64;
+        }
+        n += 1.0;
+    }
+    sum.map(|s| s / n.max(1.0))
+}
+
+#[test]
+fn the_physical_sky_is_the_atmospheres_light_and_a_low_sun_reddens_the_sky_and_the_cloud() {
+    // The default cumulus seen level, the sun to the back left and in view.
+    let base = with(
+        &smooth_cumulus(),
+        &["/camera/pitch_deg=-4", "/light/sun_azimuth_deg=245"],
+    );
+    let physical = |elevation: &str| {
+        with(
+            &base,
+            &[
+                "/light/physical_sky=true",
+                &format!("/light/sun_elevation_deg={elevation}"),
+            ],
+        )
+    };
+    // The sky's linear light is the atmosphere's (src/atmosphere.rs) along each pixel's ray, in
+    // the app's units: a plausible wrong version (the table read transposed, the azimuth from
+    // the wrong side, the wrong units) misses by far more than the half floats' and the
+    // table's interpolation.
+    let noon = physical("60");
+    let linear = render_linear(&noon, Backdrop::Sky);
+    let tables = cloudsketch::atmosphere::sky(60.0);
+    let scale = noon.light.physical_scale();
+    let mut worst: f32 = 0.0;
+    for (x, y) in [(2, 2), (100, 3), (197, 10), (5, 70), (190, 60)] {
+        let expected = tables.radiance(pixel_ray(&noon, x, y), 245f32.to_radians()) * scale;
+        let p = linear.pixel(x, y);
+        for c in 0..3 {
+            worst = worst.max((p[c] - expected[c]).abs() / expected[c]);
+        }
+    }
+    assert!(
+        worst < 0.04,
+        "the sky's light against the atmosphere's: worst {worst:.3}"
+    );
+
+    // At noon the sky is blue; at sunset the horizon toward the sun glows warm.
+    let high = render(&noon);
+    let low = render(&physical("3"));
+    let top = high.pixel(100, 3);
+    assert!(
+        top[2] as i32 > top[0] as i32 + 40,
+        "the noon sky at the top: {top:?}"
+    );
+    let sun_side = low.pixel(8, 70);
+    let away = low.pixel(192, 70);
+    assert!(
+        sun_side[0] as i32 > sun_side[2] as i32 + 20
+            && sun_side[0] as f64 / sun_side[2] as f64 > away[0] as f64 / away[2].max(1) as f64,
+        "the sunset horizon: toward the sun {sun_side:?}, away {away:?}"
+    );
+    // The sun's disk: the brightest sky pixel lies on the sun's direction and shows white.
+    let sun = noon.light.sun_direction();
+    let low_scene = physical("3");
+    let sun_low = low_scene.light.sun_direction();
+    let (mut best, mut at) = (0.0, (0, 0));
+    for y in 0..H {
+        for x in 0..W {
+            let l = luminance(low.pixel(x, y));
+            if l > best {
+                (best, at) = (l, (x, y));
+            }
+        }
+    }
+    let off = pixel_ray(&low_scene, at.0, at.1)
+        .angle_between(sun_low)
+        .to_degrees();
+    assert!(
+        best > 250.0 && off < 0.6,
+        "the brightest pixel {best:.0} is {off:.2}° from the sun"
+    );
+    assert!(sun != sun_low);
+
+    // The cloud's sunlight reddens as the sun sets with the physical sky, and only with it: the
+    // picked sun colour stays as picked whatever the elevation.
+    let redness = |scene: &Scene| {
+        let c = cloud_colour(
+            &offscreen()
+                .render(scene, W, H, Backdrop::Transparent)
+                .unwrap(),
+        );
+        c[0] / c[2].max(1.0)
+    };
+    let (noon_red, sunset_red) = (redness(&noon), redness(&low_scene));
+    let picked = |e: &str| with(&base, &[&format!("/light/sun_elevation_deg={e}")]);
+    let (picked_noon, picked_low) = (redness(&picked("60")), redness(&picked("3")));
+    assert!(
+        sunset_red > 1.4 * noon_red,
+        "the cloud's red over blue: {noon_red:.2} at noon, {sunset_red:.2} at sunset"
+    );
+    assert!(
+        (picked_low / picked_noon - 1.0).abs() < 0.1,
+        "with picked colours: {picked_noon:.2} and {picked_low:.2}"
     );
 }

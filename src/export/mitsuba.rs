@@ -26,7 +26,7 @@ use glam::Vec3;
 
 use super::formats::grid_box;
 use super::grid::DensityGrid;
-use crate::scene::{Scene, srgb_to_linear};
+use crate::scene::Scene;
 
 /// `text` as an XML attribute value: `&`, `<`, `>`, `"` and `'` escaped, and control characters
 /// (which XML 1.0 cannot hold) as `?`.
@@ -58,9 +58,11 @@ const MAX_DEPTH: u32 = 256;
 /// The app's light in Mitsuba's units (the conversions of docs/export-formats.md, "Units").
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Units {
-    /// The directional emitter's irradiance: 4π × linear sun colour × intensity × 2^exposure.
+    /// The directional emitter's irradiance: 4π × the sun's light (`Lighting::sun_light`: the
+    /// linear sun colour × intensity, or the physical sky's) × 2^exposure.
     pub sun_irradiance: Vec3,
-    /// The constant emitter's radiance: linear sky colour × ambient × 2^exposure.
+    /// The constant emitter's radiance: the sky's light (`Lighting::sky_light`: linear sky colour
+    /// × ambient, or ambient × the physical sky's mean) × 2^exposure.
     pub sky_radiance: Vec3,
     /// The medium's single-scattering albedo (the app absorbs nothing).
     pub albedo: f32,
@@ -81,9 +83,8 @@ impl Units {
         let exposure = light.exposure.exp2();
         let g = light.forward_scattering;
         Self {
-            sun_irradiance: srgb_to_linear(light.sun_color)
-                * (4.0 * std::f32::consts::PI * light.sun_intensity * exposure),
-            sky_radiance: srgb_to_linear(light.sky_color) * (light.ambient * exposure),
+            sun_irradiance: light.sun_light() * (4.0 * std::f32::consts::PI * exposure),
+            sky_radiance: light.sky_light() * exposure,
             albedo: 1.0,
             sigma_t_scale: scene.render.opacity,
             g_forward: g,

@@ -206,11 +206,22 @@ pub struct SkyUniforms {
     /// Where the shafts drawn apart from the clouds' box are not added (texture coordinates,
     /// v down: x0, y0, x1, y1): the box's rectangle; the whole target without shafts.
     pub keep_out: [f32; 4],
+    /// The physical sky (`crate::atmosphere`): x: the light of one unit of its view table
+    /// at this exposure; y: 1 with the physical sky; z: the cosine of the sun's angular
+    /// radius; w: the sun's azimuth (radians, from +x toward +z).
+    pub atmosphere: [f32; 4],
+    /// The sun disk's light at this exposure (rgb), with the physical sky.
+    pub sun_disk: [f32; 4],
+    /// With the physical sky: the sunlight on the ground at this exposure, as a white
+    /// surface's light facing the sun (rgb)...
+    pub ground_sun: [f32; 4],
+    /// ...and the sky's light on it (rgb).
+    pub ground_sky: [f32; 4],
 }
 
 impl SkyUniforms {
     /// Names and byte offsets of the members, in order (checked against the WGSL struct).
-    pub const LAYOUT: [(&'static str, usize); 15] = [
+    pub const LAYOUT: [(&'static str, usize); 19] = [
         ("forward", offset_of!(Self, forward)),
         ("right", offset_of!(Self, right)),
         ("up", offset_of!(Self, up)),
@@ -225,6 +236,10 @@ impl SkyUniforms {
         ("sun_dir", offset_of!(Self, sun_dir)),
         ("ground_lit", offset_of!(Self, ground_lit)),
         ("keep_out", offset_of!(Self, keep_out)),
+        ("atmosphere", offset_of!(Self, atmosphere)),
+        ("sun_disk", offset_of!(Self, sun_disk)),
+        ("ground_sun", offset_of!(Self, ground_sun)),
+        ("ground_sky", offset_of!(Self, ground_sky)),
         ("", std::mem::size_of::<Self>()),
     ];
 
@@ -266,6 +281,36 @@ impl SkyUniforms {
             // A darker, slightly warmer haze below the horizon.
             ground: [hr * 0.62, hg * 0.6, hb * 0.56, 1.0],
             keep_out: SkyUniforms::NO_SHAFTS,
+            ..Self::atmosphere(light)
+        }
+    }
+
+    /// The physical sky's members of `light` (all zero without it).
+    fn atmosphere(light: &Lighting) -> Self {
+        if !light.physical_sky {
+            return Self::default();
+        }
+        let exposure = light.exposure.exp2();
+        let scale = light.physical_scale() * exposure;
+        let sky = crate::atmosphere::sky(light.sun_elevation_deg);
+        // The disk's radiance: the sun's irradiance spread over its solid angle, capped
+        // within half floats (it maps to white whatever its colour's share).
+        let solid_angle = std::f32::consts::TAU * (1.0 - crate::atmosphere::SUN_RADIUS.cos());
+        let disk = (sky.sun_at_eye * (scale / solid_angle)).min(Vec3::splat(3.0e4));
+        Self {
+            atmosphere: [
+                scale,
+                1.0,
+                crate::atmosphere::SUN_RADIUS.cos(),
+                light.sun_azimuth_deg.to_radians(),
+            ],
+            sun_disk: disk.extend(0.0).to_array(),
+            // A white surface facing the sun: 1/π of the sun's irradiance (4π × its light).
+            ground_sun: (sky.sun_at_eye * (4.0 * light.sun_intensity * exposure))
+                .extend(0.0)
+                .to_array(),
+            ground_sky: (sky.sky_mean * scale).extend(0.0).to_array(),
+            ..Self::default()
         }
     }
 }
@@ -446,8 +491,8 @@ impl VolumeUniforms {
         let total = total.max(1);
         let (camera, light, r) = (&view.camera, &view.light, &view.render);
         let exposure = light.exposure.exp2();
-        let sun_color = srgb_to_linear(light.sun_color) * (light.sun_intensity * exposure);
-        let sky_color = srgb_to_linear(light.sky_color) * (light.ambient * exposure);
+        let sun_color = light.sun_light() * exposure;
+        let sky_color = light.sky_light() * exposure;
         let inv_size = Vec3::ONE / volume.size.max(Vec3::splat(1e-6));
         let octaves = r.noise_octaves.min(MAX_OCTAVES as u32);
         // Slices span only the depth the grid's box takes along the view (a flat layer seen

@@ -504,7 +504,15 @@ pub struct SkyPass {
     uniforms: [wgpu::Buffer; 2],
     layout: wgpu::BindGroupLayout,
     bind_groups: [wgpu::BindGroup; 2],
+    /// The physical sky's view table (`atmosphere::SkyTables::view`, half floats).
+    atmosphere: wgpu::Texture,
+    atmosphere_view: wgpu::TextureView,
+    /// The sun elevation's bits the table holds (`NO_ATMOSPHERE`: none yet).
+    atmosphere_key: std::sync::atomic::AtomicU32,
 }
+
+/// `SkyPass::atmosphere_key` before any table is written (a NaN's bits: no elevation's).
+const NO_ATMOSPHERE: u32 = u32::MAX;
 
 impl SkyPass {
     /// Creates the pass writing into `output_format`, shading the ground through `light` (a
@@ -525,8 +533,25 @@ impl SkyPass {
                 texture_3d(1),
                 sampler_entry(2),
                 texture_entry(3, wgpu::TextureViewDimension::D2),
+                texture_entry(4, wgpu::TextureViewDimension::D2),
             ],
         });
+        let [w, h] = crate::atmosphere::VIEW_SIZE;
+        let atmosphere = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("physical sky"),
+            size: wgpu::Extent3d {
+                width: w as u32,
+                height: h as u32,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba16Float,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        let atmosphere_view = atmosphere.create_view(&Default::default());
         let uniforms = [0, 1].map(|_| {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("sky uniforms"),
@@ -535,8 +560,15 @@ impl SkyPass {
                 mapped_at_creation: false,
             })
         });
-        let bind_groups =
-            [0, 1].map(|i| Self::group(device, &layout, &uniforms[i], light, shafts, sampler));
+        let bind_groups = [0, 1].map(|i| {
+            Self::group(
+                device,
+                &layout,
+                &uniforms[i],
+                [light, shafts, &atmosphere_view],
+                sampler,
+            )
+        });
         Self {
             pipeline: targets_pipeline(
                 device,
@@ -550,15 +582,19 @@ impl SkyPass {
             uniforms,
             layout,
             bind_groups,
+            atmosphere,
+            atmosphere_view,
+            atmosphere_key: std::sync::atomic::AtomicU32::new(NO_ATMOSPHERE),
         }
     }
 
+    /// The bind group of one slot: its uniforms, the light volume, the shafts and the
+    /// physical sky's table.
     fn group(
         device: &wgpu::Device,
         layout: &wgpu::BindGroupLayout,
         uniforms: &wgpu::Buffer,
-        light: &wgpu::TextureView,
-        shafts: &wgpu::TextureView,
+        [light, shafts, atmosphere]: [&wgpu::TextureView; 3],
         sampler: &wgpu::Sampler,
     ) -> wgpu::BindGroup {
         device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -581,6 +617,10 @@ impl SkyPass {
                     binding: 3,
                     resource: wgpu::BindingResource::TextureView(shafts),
                 },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: wgpu::BindingResource::TextureView(atmosphere),
+                },
             ],
         })
     }
@@ -598,19 +638,59 @@ impl SkyPass {
                 device,
                 &self.layout,
                 &self.uniforms[i],
-                light,
-                shafts,
+                [light, shafts, &self.atmosphere_view],
                 sampler,
             )
         });
     }
 
-    /// Sets the sky the next [`SkyPass::draw`] in `slot` draws.
-    pub fn write(&self, queue: &wgpu::Queue, slot: SkySlot, uniforms: &SkyUniforms) {
+    /// Sets the sky the next [`SkyPass::draw`] in `slot` draws, with the physical sky of
+    /// `light`'s sun elevation when it has one (its table written when the elevation moved;
+    /// both slots share it, so an image and the viewport drawn in one submission show the
+    /// same sun).
+    pub fn write(
+        &self,
+        queue: &wgpu::Queue,
+        slot: SkySlot,
+        uniforms: &SkyUniforms,
+        light: &crate::scene::Lighting,
+    ) {
+        if light.physical_sky {
+            self.write_atmosphere(queue, light.sun_elevation_deg);
+        }
         queue.write_buffer(
             &self.uniforms[slot as usize],
             0,
             bytemuck::bytes_of(uniforms),
+        );
+    }
+
+    fn write_atmosphere(&self, queue: &wgpu::Queue, elevation_deg: f32) {
+        use std::sync::atomic::Ordering;
+        let key = elevation_deg.to_bits();
+        if self.atmosphere_key.swap(key, Ordering::Relaxed) == key {
+            return;
+        }
+        let tables = crate::atmosphere::sky(elevation_deg);
+        let texels: Vec<u16> = tables
+            .view
+            .iter()
+            .flat_map(|&[r, g, b]| [r, g, b, 1.0].map(|x| half::f16::from_f32(x).to_bits()))
+            .collect();
+        let [w, h] = crate::atmosphere::VIEW_SIZE;
+        queue.write_texture(
+            self.atmosphere.as_image_copy(),
+            bytemuck::cast_slice(&texels),
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(w as u32 * 8),
+                rows_per_image: Some(h as u32),
+            },
+            wgpu::Extent3d {
+                width: w as u32,
+                height: h as u32,
+                depth_or_array_layers: 1,
+            },
         );
     }
 

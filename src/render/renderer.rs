@@ -1057,7 +1057,8 @@ impl VolumeRenderer {
             return ImageBehind::Nothing;
         };
         let light = &view.light;
-        if !light.sky_gradient && !light.ground && shafts_keep_out.is_none() {
+        if !light.physical_sky && !light.sky_gradient && !light.ground && shafts_keep_out.is_none()
+        {
             let shown = super::tone::background_display(background, light.exposure);
             let [r, g, b] = if super::passes::linear_output(self.output_format) {
                 // A float target holds the light itself.
@@ -1186,7 +1187,7 @@ impl VolumeRenderer {
             ..view.clone()
         });
         uniforms.keep_out = keep_out;
-        self.sky.write(queue, slot, &uniforms);
+        self.sky.write(queue, slot, &uniforms, &view.light);
         let mut pass = clear_pass(
             encoder,
             "view behind the cloud",

@@ -99,15 +99,26 @@ mod tests {
     fn the_exposure_caps_and_odd_colours_stay_displayable() {
         let e = &crate::limits::EXPOSURE;
         for exposure in [e.min as f32, e.max as f32, 0.0] {
-            for c in [[0.0; 3], [1.0; 3], [-0.5, 2.0, 0.5], [1e-7, 0.999_999, 0.04]] {
+            for c in [
+                [0.0; 3],
+                [1.0; 3],
+                [-0.5, 2.0, 0.5],
+                [1e-7, 0.999_999, 0.04],
+            ] {
                 let shown = background_display(c, exposure);
                 assert!(
-                    shown.iter().all(|v| v.is_finite() && (0.0..=1.0).contains(v)),
+                    shown
+                        .iter()
+                        .all(|v| v.is_finite() && (0.0..=1.0).contains(v)),
                     "{c:?} at {exposure} EV shows as {shown:?}"
                 );
             }
         }
-        assert!(background_display([1.0; 3], e.max as f32).iter().all(|&v| v > 0.9999));
+        assert!(
+            background_display([1.0; 3], e.max as f32)
+                .iter()
+                .all(|&v| v > 0.9999)
+        );
         assert_eq!(background_display([0.0; 3], e.max as f32), [0.0; 3]);
         assert!(light_of([1.0; 3]).x > 11.0 && light_of([1.0; 3]).x < 13.0);
     }

@@ -65,8 +65,10 @@ pub fn as_linked(v: f32) -> f32 {
 /// Version 2 added billows and stable ids to ellipsoids and drawing planes (a version 1
 /// document has no billows, and its primitives get ids in order when it is read). Version 3
 /// added the clock's frame rate and range (a document without them has the default clock).
-/// Version 4 added key frames (a document without them has none).
-pub const SCENE_VERSION: u32 = 5;
+/// Version 4 added key frames (a document without them has none). Version 5 added moving
+/// ellipsoids and the wind field. Version 6 added the physical sky (a document without it
+/// shows its picked colours).
+pub const SCENE_VERSION: u32 = 6;
 
 /// Errors when reading a scene document.
 #[derive(Debug, thiserror::Error)]
@@ -479,6 +481,10 @@ pub struct Lighting {
     pub sky_gradient: bool,
     /// The sky's colour at the horizon (with `sky_gradient`).
     pub horizon_color: [f32; 3],
+    /// The physical sky (Hillaire 2020, [`crate::atmosphere`]): the sky behind the cloud with
+    /// the sun's disk, the sun's colour and the sky light's, all from the sun's elevation
+    /// through the air. The picked sun, sky, background and horizon colours are not used.
+    pub physical_sky: bool,
     /// Exposure in stops: sun and sky light times 2^EV before tone mapping.
     pub exposure: f32,
     /// A ground plane below the sky, darkened where the clouds shade it from the sun.
@@ -510,6 +516,7 @@ impl Default for Lighting {
             multiple_scattering: limits::MULTIPLE_SCATTERING.default as f32,
             sky_gradient: false,
             horizon_color: [0.78, 0.84, 0.9],
+            physical_sky: false,
             exposure: limits::EXPOSURE.default as f32,
             ground: false,
             ground_height: limits::GROUND_HEIGHT.default as f32,
@@ -534,6 +541,39 @@ pub fn srgb_to_linear(c: [f32; 3]) -> Vec3 {
 }
 
 impl Lighting {
+    /// What one unit of the physical sky's light ([`crate::atmosphere`]: per unit of the
+    /// sun's irradiance) is in the app's light: 4π × the sun's intensity (the app's phase
+    /// function is normalised so that isotropic scattering is 1, see docs/export-formats.md).
+    pub fn physical_scale(&self) -> f32 {
+        4.0 * std::f32::consts::PI * self.sun_intensity
+    }
+
+    /// The sunlight on the clouds (linear, before exposure): the picked colour × intensity,
+    /// or with the physical sky, the intensity × the air's transmittance toward the sun from
+    /// the clouds' height (reddened and dimmed as the sun sets, none below the horizon).
+    pub fn sun_light(&self) -> Vec3 {
+        if self.physical_sky {
+            crate::atmosphere::transmittance(
+                crate::atmosphere::CLOUD_ALTITUDE,
+                self.sun_elevation_deg.to_radians(),
+            ) * self.sun_intensity
+        } else {
+            srgb_to_linear(self.sun_color) * self.sun_intensity
+        }
+    }
+
+    /// The sky light that fills the clouds' shadowed side (linear, before exposure): the
+    /// picked colour × ambient, or with the physical sky, ambient × the mean radiance of the
+    /// sky above the horizon.
+    pub fn sky_light(&self) -> Vec3 {
+        if self.physical_sky {
+            crate::atmosphere::sky(self.sun_elevation_deg).sky_mean
+                * (self.physical_scale() * self.ambient)
+        } else {
+            srgb_to_linear(self.sky_color) * self.ambient
+        }
+    }
+
     /// Unit vector pointing from the scene toward the sun.
     pub fn sun_direction(&self) -> Vec3 {
         let (az, el) = (

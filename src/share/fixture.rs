@@ -99,6 +99,7 @@ pub fn every_part() -> Scene {
     light.shafts = true;
     light.sky_color = [0.5, 0.6, 0.8];
     light.sky_gradient = true;
+    light.physical_sky = true;
     light.sun_elevation_deg = 28.0;
     light.sun_intensity = 1.9;
     let render = &mut scene.render;

@@ -39,8 +39,10 @@ use crate::scene::{
 /// `animation`, written whole and unrounded where a scene has keys) on version 4's base: a build that reads
 /// up to version 4 refuses such a link instead of opening it without its keys. Version 6
 /// carries moving ellipsoids and the wind field that carries them (scene format 5's `motion`
-/// and `wind_field`) on version 5's base.
-pub const LINK_VERSION: u8 = 6;
+/// and `wind_field`) on version 5's base. Version 7 carries the physical sky (scene format 6's
+/// `light.physical_sky`) on a base that has it off: a build that reads up to version 6
+/// refuses such a link instead of opening it with the picked colours.
+pub const LINK_VERSION: u8 = 7;
 
 /// Longest token accepted or written (characters after `#s=`). Browsers take URLs of
 /// megabytes, but mail and chat tools cut them far sooner.
@@ -239,7 +241,8 @@ impl Bases {
 
 /// Each link format version's base: version 1's (the ground at 0), version 2's (at -5),
 /// version 3's (billows and ids), version 4's (the light volume at 96 texels, 4 octaves),
-/// version 5's (the same as 4's: key frames added no default); version 6's the same again.
+/// version 5's (the same as 4's: key frames added no default); version 6's the same again;
+/// version 7's with the physical sky off.
 const BASES: [&str; LINK_VERSION as usize] = [
     include_str!("link/base_v1.json"),
     include_str!("link/base_v2.json"),
@@ -247,6 +250,7 @@ const BASES: [&str; LINK_VERSION as usize] = [
     include_str!("link/base_v4.json"),
     include_str!("link/base_v5.json"),
     include_str!("link/base_v6.json"),
+    include_str!("link/base_v7.json"),
 ];
 
 /// The base of link format `version` (1 to [`LINK_VERSION`]; others take the current one).

@@ -344,7 +344,10 @@ impl Viewport {
             size: px.map(|v| v.div_ceil(OUTSIDE_SHAFTS_DIVISOR * if dragging { 2 } else { 1 })),
         });
         let shells_apart = shafts.is_some();
-        let has_backdrop = scene.light.sky_gradient || scene.light.ground || shafts.is_some();
+        let has_backdrop = scene.light.physical_sky
+            || scene.light.sky_gradient
+            || scene.light.ground
+            || shafts.is_some();
         // Without a backdrop the cloud's composite maps its light with the flat background's
         // (the frame's clear colour, `CloudApp::clear_color`).
         let flat = (!has_backdrop).then(|| {

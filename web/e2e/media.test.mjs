@@ -1,6 +1,6 @@
 // The cloud's media in the browser: a Table 2 filter changes the image, with wind the scene
 // clock (Alt+A plays) moves the noise while the camera stays, and the sky gradient puts the
-// horizon colour at eye level on both backends. Screenshots:
+// horizon colour at eye level on both backends, and the physical sky follows the sun. Screenshots:
 // test-results/screenshots/media-*.png.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
@@ -120,6 +120,55 @@ for (const backend of BOTH_BUILDS) {
       assert.ok(lum(flatDark) + 8 < lum(zenith), `−1 EV darkens the flat background ${zenith}: ${flatDark}`);
       const [flat] = await exposed(0, false, 'flat-0');
       assert.ok(dist(flat, zenith) <= 2, `at 0 EV the flat background ${flat} shows as picked ${zenith}`);
+    });
+  });
+}
+
+for (const backend of BOTH_BUILDS) {
+  test(`the physical sky follows the sun: blue at noon, a warm horizon at sunset, undone in one step (${backend})`, { timeout: 180_000 }, async () => {
+    await withApp({ base: server.url, webgpu: backend === 'webgpu', query: '?preset=empty', viewport: { width: 1280, height: 800 } }, async (page) => {
+      for (const set of ['/camera/pitch_deg=0', '/light/sun_azimuth_deg=245', '/light/sun_elevation_deg=50']) {
+        await page.evaluate((p) => window.cloudsketch.set(p), set);
+      }
+      let s = await until(page, (s) => s.scene.light.sun_elevation_deg === 50, 'the sun high');
+      const [vw, vh] = s.view.viewport;
+      const away = async () => { await page.mouse.move(vw - 5, vh - 5); };
+      const picked = s.scene.light.background.map((v) => Math.round(v * 255));
+      await openGroup(page, 'Light');
+      const box = await revealWidget(page, 'light:physical');
+      const undo = s.view.undo;
+      await page.mouse.click(box[0] + 8, box[1] + box[3] / 2);
+      s = await until(page, (s) => s.scene.light.physical_sky && s.view.undo === undo + 1, 'the physical sky, one undo step');
+      await away();
+      await page.waitForTimeout(500);
+      const shot = async (name) => {
+        const img = await screenshot(page, `media-physical-${name}-${backend}`);
+        return (x, y) => { const i = 4 * (Math.round(y) * img.width + Math.round(x)); return [img.data[i], img.data[i + 1], img.data[i + 2]]; };
+      };
+      const noon = await shot('noon');
+      // The sky's right half: the side panel may cover the left.
+      const [topNoon, horizonNoon] = [noon(vw * 0.75, 4), noon(vw * 0.75, vh / 2 - 6)];
+      console.log(`# ${backend} physical sky at 50°: top ${topNoon}, horizon ${horizonNoon}`);
+      assert.ok(topNoon[2] > topNoon[0] + 40, `the noon sky is blue at the top: ${topNoon}`);
+      const lum = (p) => 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+      assert.ok(lum(horizonNoon) > lum(topNoon), `and paler at the horizon: ${horizonNoon} vs ${topNoon}`);
+      await page.evaluate(() => window.cloudsketch.set('/light/sun_elevation_deg=2'));
+      await until(page, (s) => s.scene.light.sun_elevation_deg === 2, 'the sun low');
+      await page.waitForTimeout(500);
+      const sunset = await shot('sunset');
+      // Toward the sun (ahead, to the left of the centre) the horizon glows warm; the sky dims.
+      const glow = sunset(vw * 0.5 - 0.12 * vh, vh / 2 - 6);
+      const topLow = sunset(vw * 0.75, 4);
+      console.log(`# ${backend} physical sky at 2°: top ${topLow}, horizon toward the sun ${glow}`);
+      assert.ok(glow[0] > glow[2] + 30, `the sunset horizon toward the sun is warm: ${glow}`);
+      assert.ok(lum(topLow) + 20 < lum(topNoon), `the sky dims as the sun sets: ${topNoon} → ${topLow}`);
+      // Undo, twice (the elevation, then the sky): the picked flat background again.
+      await page.keyboard.press('Control+z');
+      await page.keyboard.press('Control+z');
+      s = await until(page, (s) => !s.scene.light.physical_sky, 'the physical sky undone');
+      await page.waitForTimeout(500);
+      const back = (await shot('undone'))(vw * 0.75, 4);
+      assert.ok(back.every((v, i) => Math.abs(v - picked[i]) <= 2), `undone, the background ${back} is as picked ${picked}`);
     });
   });
 }
