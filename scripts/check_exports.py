@@ -144,7 +144,9 @@ def check_units(d):
     "Units"), read back with an XML parser."""
     import math
     import xml.etree.ElementTree as ET
+    import mitsuba as mi
     import numpy as np
+    mi.set_variant("scalar_rgb")
     suns = json.load(open(os.path.join(d, "app_view.json")))["suns"]
     for name, light in suns.items():
         root = ET.parse(os.path.join(d, f"light_{name}.xml")).getroot()
@@ -153,7 +155,13 @@ def check_units(d):
         want_sun = 4 * math.pi * srgb_to_linear(light["sun_color"]) * light["sun_intensity"] * exposure
         want_sky = srgb_to_linear(light["sky_color"]) * light["ambient"] * exposure
         sun = values(root.find("emitter[@type='directional']/rgb[@name='irradiance']"))
-        sky = values(root.find("emitter[@type='constant']/rgb[@name='radiance']"))
+        envmap = root.find("emitter[@type='envmap']")
+        sky_file = envmap.find("string[@name='filename']").get("value")
+        # The map holds the picked sky colour's light everywhere; its scale ambient × 2^exposure.
+        sky_map = np.array(mi.Bitmap(os.path.join(d, sky_file)), dtype=np.float64)[:, :, :3].reshape(-1, 3)
+        uniform = np.ptp(sky_map, axis=0).max() < 1e-6
+        scale = float(envmap.find("float[@name='scale']").get("value"))
+        sky = sky_map[0] * scale if uniform else np.full(3, np.nan)
         medium = root.find("shape/medium")
         phase = medium.find("phase")
         # (Mitsuba hands nested objects over in the order of their names.)
@@ -166,7 +174,7 @@ def check_units(d):
         g = light["forward_scattering"]
         checks = {
             "sun irradiance = 4π × linear sun × intensity × 2^exposure": np.allclose(sun, want_sun, rtol=1e-4),
-            "sky radiance = linear sky × ambient × 2^exposure": np.allclose(sky, want_sky, rtol=1e-4, atol=1e-6),
+            "sky map = linear sky everywhere, scaled by ambient × 2^exposure": np.allclose(sky, want_sky, rtol=1e-4, atol=1e-6),
             "phase = blendphase of hg(g) and hg(-g/3), weight 0.2": phase.get("type") == "blendphase"
             and np.allclose(lobes, [g, -g / 3], atol=1e-4) and abs(weight - 0.2) < 1e-6,
             "albedo 1": np.allclose(albedo, 1.0),
@@ -211,6 +219,49 @@ def check_light(d):
     return figures
 
 
+def check_sky(d):
+    """The physical sky's environment map, as Mitsuba reads it, is the sky the app draws: the
+    export's scene rendered with its emitters visible against the app's linear render of the
+    same view, wherever the cloud leaves the sky clear. A map in another orientation (turned,
+    mirrored, upside down) or in other units misses by far more than the path trace's noise."""
+    import mitsuba as mi
+    import numpy as np
+    mi.set_variant("scalar_rgb")
+    xml = open(os.path.join(d, "sky_physical.xml")).read()
+    shown = xml.replace('name="hide_emitters" value="true"', 'name="hide_emitters" value="false"')
+    if shown == xml:
+        fail("sky_physical.xml: no hidden emitters to show")
+    mi.file_resolver().prepend(d)
+    # The map is scaled by the ambient setting, as the app scales the sky's light on the cloud
+    # (its backdrop shows the sky itself).
+    ambient = json.load(open(os.path.join(d, "app_view.json")))["sky_physical"]["ambient"]
+    trace = np.array(mi.render(mi.load_string(shown), seed=1), dtype=np.float64)[:, :, :3] / ambient
+    app = np.array(mi.Bitmap(os.path.join(d, "sky_physical_app.exr")), dtype=np.float64)[:, :, :3]
+    cloud = np.array(mi.Bitmap(os.path.join(d, "sky_physical_cloud.exr")), dtype=np.float64)[:, :, 3]
+    # Within three pixels of where the sky changes by over a fifth from one pixel to the next
+    # (the horizon's edge) the map's texels (1.4 degrees) are coarser than the pixels (0.5):
+    # left out.
+    lum = app @ np.array([0.2126, 0.7152, 0.0722])
+    step = np.abs(np.diff(lum, axis=0)) > 0.2 * np.minimum(lum[1:], lum[:-1])
+    steep = np.zeros(lum.shape, dtype=bool)
+    for k in range(4):
+        steep[k + 1:] |= step[: step.shape[0] - k]
+        steep[: step.shape[0] - k] |= step[k:]
+    clear = (cloud < 0.002) & ~steep
+    if clear.sum() < 0.3 * clear.size:
+        fail(f"sky_physical: only {clear.sum()} px of clear sky")
+    ratio = trace[clear] / np.maximum(app[clear], 1e-6)
+    mean, worst = np.abs(ratio - 1).mean(), np.percentile(np.abs(ratio - 1), 99)
+    # Left against right: the sun is to the right, so a mirrored map is brighter on the left.
+    half = app.shape[1] // 2
+    side = lambda img: img[:, half:][clear[:, half:]].sum() / max(img[:, :half][clear[:, :half]].sum(), 1e-9)
+    print(f"check_exports: sky_physical: {clear.sum()} clear px; Mitsuba's view of the map against "
+          f"the app's sky: mean |ratio - 1| {mean:.4f}, 99th percentile {worst:.4f}; "
+          f"right/left {side(trace):.3f} (app {side(app):.3f})")
+    if mean > 0.03 or worst > 0.1:
+        fail(f"sky_physical: Mitsuba's sky is not the app's (mean error {mean:.3f}, 99th percentile {worst:.3f})")
+
+
 def check_exr(d):
     import mitsuba as mi
     import numpy as np
@@ -253,6 +304,8 @@ def main():
         check_mitsuba(d)
     if what in ("all", "exr"):
         check_exr(d)
+    if what in ("all", "sky"):
+        check_sky(d)
     if what in ("all", "light"):
         check_units(d)
         check_light(d)

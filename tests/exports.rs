@@ -428,10 +428,44 @@ fn mitsuba_scenes_and_the_apps_render_of_their_view() {
             }),
         );
     }
+    // The physical sky: the export's environment map as Mitsuba sees it against the app's own
+    // sky in linear light (the sun to the right and behind the viewer, so the sky differs left
+    // to right and the sun's disk, which the map leaves to the directional emitter, is out of
+    // view), and the cloud alone for where the sky shows.
+    let mut physical = scene.clone();
+    physical.light.physical_sky = true;
+    physical.light.sun_azimuth_deg = 40.0;
+    physical.light.sun_elevation_deg = 15.0;
+    physical.light.exposure = -0.5;
+    physical.light.ambient = 0.7;
+    physical.camera.pitch_deg = -8.0;
+    let options = Options {
+        resolution: 64,
+        image: size,
+        samples: 4,
+        ..Options::default()
+    };
+    for f in export(&physical, Format::Mitsuba, &options, "sky_physical").unwrap() {
+        std::fs::write(out_dir().join(&f.name), &f.bytes).unwrap();
+    }
+    for (name, backdrop) in [
+        ("sky_physical_app.exr", Backdrop::Sky),
+        ("sky_physical_cloud.exr", Backdrop::Transparent),
+    ] {
+        let image = linear
+            .render_linear(&physical, size, backdrop, 1, None)
+            .unwrap();
+        std::fs::write(out_dir().join(name), image.to_exr().unwrap()).unwrap();
+    }
     let background = scene.light.background.map(|c| (c * 255.0).round() as u8);
     std::fs::write(
         out_dir().join("app_view.json"),
-        serde_json::json!({ "background": background, "suns": suns }).to_string(),
+        serde_json::json!({
+            "background": background,
+            "suns": suns,
+            "sky_physical": { "ambient": physical.light.ambient },
+        })
+        .to_string(),
     )
     .unwrap();
 }

@@ -1,5 +1,7 @@
 //! A Mitsuba 3 scene (XML) around the cloud's `.vol` grid: the app's camera, the sun as a
-//! directional emitter, the sky's light as a constant emitter, and the grid as the extinction
+//! directional emitter, the sky's light as an environment map (`STEM.sky.pfm`: the physical
+//! sky's radiance over every direction, or the picked sky colour everywhere), and the grid as
+//! the extinction
 //! of a non-emissive heterogeneous medium inside a null-surfaced box. Mitsuba renders it with
 //! `mitsuba scene.xml` (any variant; `scalar_rgb` on a CPU).
 //!
@@ -7,10 +9,11 @@
 //! nothing else:
 //! - the app's phase function is normalised so isotropic scattering is 1, Mitsuba's so it is
 //!   1/4π: the sun's irradiance is 4π × its linear colour × intensity;
-//! - the sky's light reaches the cloud from every direction, so the constant emitter's radiance
-//!   is the sky colour × ambient (no phase factor: a normalised phase integrates to 1). The
-//!   app takes it from above only (its transmittance toward the zenith); the constant emitter
-//!   lights the base from below too;
+//! - the sky's light reaches the cloud from every direction, so the environment map's radiance
+//!   is the sky's light × ambient (no phase factor: a normalised phase integrates to 1): the
+//!   linear sky colour, or the physical sky's radiance × 4π × the sun's intensity. The app
+//!   takes it from above only (its transmittance toward the zenith), as the sky's mean; the
+//!   map lights the base from below too, and from each direction with its own colour;
 //! - both are scaled by 2^exposure, as the app scales all the cloud's light (its EXR holds the
 //!   same exposed light);
 //! - the phase is the app's two lobes, Mitsuba's `blendphase` of hg(g) and hg(−g/3), 4:1;
@@ -61,9 +64,8 @@ pub struct Units {
     /// The directional emitter's irradiance: 4π × the sun's light (`Lighting::sun_light`: the
     /// linear sun colour × intensity, or the physical sky's) × 2^exposure.
     pub sun_irradiance: Vec3,
-    /// The constant emitter's radiance: the sky's light (`Lighting::sky_light`: linear sky colour
-    /// × ambient, or ambient × the physical sky's mean) × 2^exposure.
-    pub sky_radiance: Vec3,
+    /// The environment map's scale: ambient × 2^exposure (the map holds the sky's light).
+    pub sky_scale: f32,
     /// The medium's single-scattering albedo (the app absorbs nothing).
     pub albedo: f32,
     /// σt per world unit at density 1: the scene's opacity.
@@ -84,7 +86,7 @@ impl Units {
         let g = light.forward_scattering;
         Self {
             sun_irradiance: light.sun_light() * (4.0 * std::f32::consts::PI * exposure),
-            sky_radiance: light.sky_light() * exposure,
+            sky_scale: light.ambient * exposure,
             albedo: 1.0,
             sigma_t_scale: scene.render.opacity,
             g_forward: g,
@@ -94,12 +96,66 @@ impl Units {
     }
 }
 
-/// The scene XML for `scene`, referring to its grid as `vol_name`, rendering `size` pixels
-/// with `samples` per pixel.
+/// The sky environment map's size (latitude-longitude) with the physical sky.
+pub const SKY_MAP_SIZE: [usize; 2] = [256, 128];
+
+/// The direction of texel (u, v) of a latitude-longitude map as Mitsuba's `envmap` reads it
+/// (y up; u = atan2(x, −z) / 2π, v = θ / π from the zenith).
+pub fn sky_map_direction(u: f32, v: f32) -> Vec3 {
+    let (phi, theta) = (std::f32::consts::TAU * u, std::f32::consts::PI * v);
+    Vec3::new(
+        theta.sin() * phi.sin(),
+        theta.cos(),
+        -theta.sin() * phi.cos(),
+    )
+}
+
+/// The sky's light over every direction (before ambient and exposure, which the XML's scale
+/// applies) as a PFM latitude-longitude map for Mitsuba's `envmap`: the physical sky's
+/// radiance in the app's units ([`SKY_MAP_SIZE`]), or the picked sky colour's light
+/// everywhere (a few texels).
+pub fn write_sky(scene: &Scene) -> Vec<u8> {
+    let light = &scene.light;
+    let ([w, h], texels): ([usize; 2], Vec<Vec3>) = if light.physical_sky {
+        let tables = crate::atmosphere::sky(light.sun_elevation_deg);
+        let (scale, azimuth) = (light.physical_scale(), light.sun_azimuth_deg.to_radians());
+        let [w, h] = SKY_MAP_SIZE;
+        let texels = (0..h)
+            .flat_map(|j| (0..w).map(move |i| (i, j)))
+            .map(|(i, j)| {
+                let d = sky_map_direction((i as f32 + 0.5) / w as f32, (j as f32 + 0.5) / h as f32);
+                tables.radiance(d, azimuth) * scale
+            })
+            .collect();
+        (SKY_MAP_SIZE, texels)
+    } else {
+        let sky = crate::scene::srgb_to_linear(light.sky_color);
+        ([4, 2], vec![sky; 8])
+    };
+    write_pfm(w, h, &texels)
+}
+
+/// `texels` (`w` × `h`, row-major, the top row first) as a little-endian colour PFM (which
+/// stores the bottom row first).
+fn write_pfm(w: usize, h: usize, texels: &[Vec3]) -> Vec<u8> {
+    let mut out = format!("PF\n{w} {h}\n-1.0\n").into_bytes();
+    out.reserve(w * h * 12);
+    for row in texels.chunks(w).rev() {
+        for t in row {
+            for c in t.to_array() {
+                out.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+    }
+    out
+}
+
+/// The scene XML for `scene`, referring to its grid and its sky's map by `vol_name` and
+/// `sky_name`, rendering `size` pixels with `samples` per pixel.
 pub fn write_xml(
     scene: &Scene,
     grid: &DensityGrid,
-    vol_name: &str,
+    [vol_name, sky_name]: [&str; 2],
     size: [u32; 2],
     samples: u32,
 ) -> String {
@@ -169,8 +225,9 @@ pub fn write_xml(
     );
     let _ = writeln!(
         x,
-        "  <emitter type=\"constant\"><rgb name=\"radiance\" value=\"{}\"/></emitter>",
-        v3(units.sky_radiance)
+        "  <emitter type=\"envmap\"><string name=\"filename\" value=\"{}\"/><float name=\"scale\" value=\"{:.6}\"/></emitter>",
+        xml_attribute(sky_name),
+        units.sky_scale
     );
     let _ = writeln!(x, "  <shape type=\"cube\">");
     let _ = writeln!(
@@ -228,5 +285,72 @@ mod tests {
         );
         assert!(!xml.contains("a<&"), "the raw name leaked into the XML");
         assert_eq!(xml_attribute("x\ny\u{1}"), "x&#10;y?");
+    }
+
+    /// A PFM's size and texels, the top row first.
+    fn read_pfm(bytes: &[u8]) -> (usize, usize, Vec<Vec3>) {
+        let text = |k: usize| bytes.split(|&b| b == b'\n').nth(k).unwrap();
+        assert_eq!(text(0), b"PF");
+        let size = String::from_utf8(text(1).to_vec()).unwrap();
+        let mut it = size.split(' ').map(|v| v.parse::<usize>().unwrap());
+        let (w, h) = (it.next().unwrap(), it.next().unwrap());
+        assert_eq!(text(2), b"-1.0", "little-endian");
+        let start = bytes.len() - w * h * 12;
+        let f = |k: usize| {
+            f32::from_le_bytes(bytes[start + 4 * k..start + 4 * k + 4].try_into().unwrap())
+        };
+        let mut rows: Vec<Vec<Vec3>> = (0..h)
+            .map(|j| {
+                (0..w)
+                    .map(|i| {
+                        let k = 3 * (j * w + i);
+                        Vec3::new(f(k), f(k + 1), f(k + 2))
+                    })
+                    .collect()
+            })
+            .collect();
+        rows.reverse();
+        (w, h, rows.concat())
+    }
+
+    #[test]
+    fn the_sky_map_is_the_physical_skys_light_with_the_sun_where_the_app_has_it() {
+        let mut scene = Scene::default();
+        scene.light.physical_sky = true;
+        scene.light.sun_elevation_deg = 8.0;
+        scene.light.sun_azimuth_deg = 130.0;
+        let (w, h, texels) = read_pfm(&write_sky(&scene));
+        assert_eq!([w, h], SKY_MAP_SIZE);
+        let tables = crate::atmosphere::sky(8.0);
+        let scale = scene.light.physical_scale();
+        // The top row is the zenith's light.
+        let zenith = tables.radiance(Vec3::Y, 0.0) * scale;
+        assert!(((texels[w / 2] - zenith) / zenith).abs().max_element() < 0.03);
+        // The brightest texel lies toward the sun, in the app's frame: a map mirrored or turned
+        // would put it elsewhere.
+        let (k, _) = texels
+            .iter()
+            .enumerate()
+            .max_by(|a, b| a.1.element_sum().total_cmp(&b.1.element_sum()))
+            .unwrap();
+        let d = sky_map_direction(
+            ((k % w) as f32 + 0.5) / w as f32,
+            ((k / w) as f32 + 0.5) / h as f32,
+        );
+        // (Its azimuth: the sky is brightest toward the sun, at the horizon below it.)
+        let across = |v: Vec3| Vec3::new(v.x, 0.0, v.z);
+        let off = across(d)
+            .angle_between(across(scene.light.sun_direction()))
+            .to_degrees();
+        assert!(
+            off < 3.0,
+            "the brightest texel is {off:.1}° round from the sun"
+        );
+        assert!(d.y < scene.light.sun_direction().y + 0.05);
+        // Picked colours: the sky colour's light everywhere.
+        scene.light.physical_sky = false;
+        let (_, _, texels) = read_pfm(&write_sky(&scene));
+        let sky = crate::scene::srgb_to_linear(scene.light.sky_color);
+        assert!(texels.iter().all(|t| (*t - sky).abs().max_element() < 1e-6));
     }
 }

@@ -75,10 +75,11 @@ impl Format {
             .map_or("?", |(_, n)| n)
     }
 
-    /// The names of the files written beside the main one, `STEM.EXT` (Mitsuba's volume).
+    /// The names of the files written beside the main one, `STEM.EXT` (Mitsuba's volume and
+    /// its sky's environment map), in the order [`export`] returns them after the main one.
     pub fn companions(self, stem: &str) -> Vec<String> {
         match self {
-            Format::Mitsuba => vec![format!("{stem}.vol")],
+            Format::Mitsuba => mitsuba_companions(stem).to_vec(),
             _ => Vec::new(),
         }
     }
@@ -95,6 +96,11 @@ impl Format {
     pub fn is_mesh(self) -> bool {
         matches!(self, Format::Glb | Format::Obj | Format::Ply)
     }
+}
+
+/// Mitsuba's volume and its sky's environment map, named after `stem`.
+fn mitsuba_companions(stem: &str) -> [String; 2] {
+    [format!("{stem}.vol"), format!("{stem}.sky.pfm")]
 }
 
 /// How to export.
@@ -244,9 +250,19 @@ pub fn write(
             write_vdb(grid, axes, "density", scene.seed ^ 0x5644_4220),
         )],
         Format::Mitsuba => {
-            let vol = format.companions(stem).remove(0);
-            let xml = write_xml(scene, grid, &vol, options.image, options.samples.max(1));
-            vec![file("xml", xml.into_bytes()), file("vol", write_vol(grid))]
+            let [vol, sky] = mitsuba_companions(stem);
+            let xml = write_xml(
+                scene,
+                grid,
+                [&vol, &sky],
+                options.image,
+                options.samples.max(1),
+            );
+            vec![
+                file("xml", xml.into_bytes()),
+                file("vol", write_vol(grid)),
+                file("sky.pfm", mitsuba::write_sky(scene)),
+            ]
         }
         Format::Glb => vec![file(
             "glb",
