@@ -388,8 +388,7 @@ for (const backend of BOTH_BUILDS) {
 
 // Where the browser cannot encode the video (its VP9 encoder refuses the size, stood in for
 // here), Record says so and writes PNGs at the size it began with (even, for the video), one
-// zip download; without WebCodecs at all, or with ?record=png, it starts with PNGs at the
-// natural size and the same frames (not tested apart: one check of the address). 12 frames, each covering the pixels the CLI's frame covers (IoU ≥ 0.9) and
+// zip download. 12 frames, each covering the pixels the CLI's frame covers (IoU ≥ 0.9) and
 // closer to its own frame than to its neighbours'. On the WebGL2 build, which browsers without
 // WebGPU (the likeliest to lack WebCodecs) load. The document's light grid (32 texels, 3
 // octaves) is finer than the view's preview of it on this CPU adapter (24, 2): the frames must
@@ -400,40 +399,67 @@ test('Record where the video encoder refuses: the range as PNGs in a zip, each t
   await withApp({ base: server.url, webgpu: false, query: '?preset=developing', viewport: { width: 1280, height: 800 }, init: refuse }, async (page) => {
     const { file, scene, last, notices } = await recordRange(page, [32, 3], 'timeline');
     assert.ok([...notices].some((n) => /cannot encode VP9 at \d+×\d+: recording PNGs instead/.test(n)), `said so: ${[...notices].join(' | ')}`);
-    assert.equal(file.suggestedFilename(), 'untitled-frames.zip');
-    assert.deepEqual(last.files, ['untitled-frames.zip (a download)']);
-    const files = unzipStored(new Uint8Array(fs.readFileSync(await file.path())));
-    assert.deepEqual(files.map((f) => f.name), Array.from({ length: 12 }, (_, k) => `untitled_${String(k).padStart(4, '0')}.png`));
     const [vw, vh] = (await state(page)).view.viewport;
     // The size the recording began with, even for the video, kept when the encoder refused.
     const natural = Math.round(320 * vh / vw);
-    const h = natural - (natural % 2);
-    const frames = files.map((f) => PNG.sync.read(Buffer.from(f.bytes)));
-    for (const f of frames) assert.deepEqual([f.width, f.height], [320, h]);
-    const cli = cliFrames(scene, 320, h);
-    // The sky in the corner is the document's background.
-    const bg = scene.light.background.map((v) => Math.round(v * 255));
-    assert.ok(frames[0].data.subarray(0, 3).every((v, i) => Math.abs(v - bg[i]) <= 3), 'sky in the corner');
-    const covered = frames.map((f, k) => {
-      const { iou, n } = coverageIoU(f, cli[k]);
-      assert.ok(iou >= 0.9, `frame ${k}: page and CLI cover the same pixels: IoU ${iou.toFixed(3)}`);
-      for (const j of [k - 1, k + 1].filter((j) => j >= 0 && j < 12)) {
-        assert.ok(coverageIoU(f, cli[j]).iou < iou, `frame ${k} is closer to the CLI's frame ${j} than to its own`);
-      }
-      return n;
-    });
+    const { frames, files, cli } = await zippedFrames(file, last, scene, 320, natural - (natural % 2));
     // Lit with the document's light: nearer the CLI's frame 11 than the same frame drawn with
     // the view's preview light (the baseline a recording of the view's light would match).
     const preview = structuredClone(scene);
     preview.render.light_resolution = 24;
     preview.render.light_octaves = 2;
-    const [previewed] = cliFrames(preview, 320, h, 11, 11);
+    const [previewed] = cliFrames(preview, 320, frames[0].height, 11, 11);
     const meanDiff = (a, b) => { let d = 0; for (let i = 0; i < a.data.length; i++) d += Math.abs(a.data[i] - b.data[i]); return d / a.data.length; };
     const [toDocument, toPreview] = [meanDiff(frames[11], cli[11]), meanDiff(frames[11], previewed)];
     console.log(`# webgl2: frame 11 differs from the CLI's by ${toDocument.toFixed(3)} a byte with the document's light, ${toPreview.toFixed(3)} with the preview's`);
     assert.ok(toDocument < 0.5 * toPreview, `drawn with the document's light: ${toDocument.toFixed(3)} against ${toPreview.toFixed(3)}`);
     fs.writeFileSync('test-results/screenshots/record-png-11-webgl2.png', Buffer.from(files[11].bytes));
-    console.log(`# webgl2: cloud pixels by frame ${covered.join(' ')}`);
-    assert.ok(covered[11] > 1.3 * covered[0] && covered[0] > 200, `the tower grows over the range: ${covered[0]} → ${covered[11]} px`);
   });
 });
+
+// `?record=png` asks for PNGs from the start (a browser without WebCodecs gets them the same
+// way): no video is tried, so nothing is said of an encoder, and the frames keep the view's
+// natural height (a video's must be even). The same 12 frames, each the CLI's. On the WebGPU
+// build, with its encoder present: the address alone chooses.
+test('Record with ?record=png: PNGs in a zip from the start, each the CLI\'s frame (webgpu)', { timeout: 600_000 }, async () => {
+  assert.ok(fs.existsSync(NATIVE), `${NATIVE} missing: run cargo test (it builds the CLI) first`);
+  await withApp({ base: server.url, webgpu: true, query: '?preset=developing&record=png', viewport: { width: 1280, height: 720 } }, async (page) => {
+    const hasEncoder = await page.evaluate(() => typeof VideoEncoder === 'function');
+    const { file, scene, last, notices } = await recordRange(page, [24, 2], 'timeline');
+    assert.ok(![...notices].some((n) => /cannot encode/.test(n)), `no encoder tried: ${[...notices].join(' | ')}`);
+    const [vw, vh] = (await state(page)).view.viewport;
+    const natural = Math.round(320 * vh / vw);
+    const { files } = await zippedFrames(file, last, scene, 320, natural);
+    console.log(`# webgpu ?record=png: ${files.length} PNGs at 320×${natural} (WebCodecs ${hasEncoder ? 'present' : 'missing'})`);
+    fs.writeFileSync('test-results/screenshots/record-png-0-webgpu.png', Buffer.from(files[0].bytes));
+  });
+});
+
+/**
+ * The recording's zip download: 12 PNGs named by frame, each `w`×`h`, the sky in the corner
+ * the document's background, each covering the pixels the CLI's render of its frame covers
+ * (IoU ≥ 0.9) and closer to it than to its neighbours', the tower growing over the range.
+ * Returns the decoded frames, the zip's files and the CLI's frames.
+ */
+async function zippedFrames(file, last, scene, w, h) {
+  assert.equal(file.suggestedFilename(), 'untitled-frames.zip');
+  assert.deepEqual(last.files, ['untitled-frames.zip (a download)']);
+  const files = unzipStored(new Uint8Array(fs.readFileSync(await file.path())));
+  assert.deepEqual(files.map((f) => f.name), Array.from({ length: 12 }, (_, k) => `untitled_${String(k).padStart(4, '0')}.png`));
+  const frames = files.map((f) => PNG.sync.read(Buffer.from(f.bytes)));
+  for (const f of frames) assert.deepEqual([f.width, f.height], [w, h]);
+  const cli = cliFrames(scene, w, h);
+  const bg = scene.light.background.map((v) => Math.round(v * 255));
+  assert.ok(frames[0].data.subarray(0, 3).every((v, i) => Math.abs(v - bg[i]) <= 3), 'sky in the corner');
+  const covered = frames.map((f, k) => {
+    const { iou, n } = coverageIoU(f, cli[k]);
+    assert.ok(iou >= 0.9, `frame ${k}: page and CLI cover the same pixels: IoU ${iou.toFixed(3)}`);
+    for (const j of [k - 1, k + 1].filter((j) => j >= 0 && j < 12)) {
+      assert.ok(coverageIoU(f, cli[j]).iou < iou, `frame ${k} is closer to the CLI's frame ${j} than to its own`);
+    }
+    return n;
+  });
+  console.log(`# cloud pixels by frame ${covered.join(' ')}`);
+  assert.ok(covered[11] > 1.3 * covered[0] && covered[0] > 200, `the tower grows over the range: ${covered[0]} → ${covered[11]} px`);
+  return { frames, files, cli };
+}
