@@ -210,7 +210,13 @@ fn cloud_at(world: vec3<f32>) -> vec4<f32> {
     // hollows get less of it than tops and open sides.
     let lv = textureSampleLevel(light_tex, clamp_smp, uvw, 0.0);
     let sun = sun_light(lv.r, dot(view_dir, u.sun_dir.xyz));
-    let light = u.sun_color.rgb * sun + u.sky_color.rgb * lv.g;
+    var light = u.sun_color.rgb * sun + u.sky_color.rgb * lv.g;
+    if u.haze.w > 0.5 {
+        // Aerial perspective: the air between the eye and this sample takes its share of the
+        // light out and adds the sky's in its place (far clouds fade into the sky's colour).
+        let through = exp(-u.haze.xyz * distance(world, u.eye.xyz));
+        light = light * through + u.haze_light.rgb * (1.0 - through);
+    }
     return vec4<f32>(light * alpha, alpha);
 }
 

@@ -56,6 +56,10 @@ struct Volume {
     // x: the ground's height (the air below it is hidden), y: the air's phase asymmetry g,
     // z: the shells drawn apart (Shells::apart), whose light also goes to the first target.
     air: vec4<f32>,
+    // Aerial perspective with the physical sky: the air's extinction per world unit (xyz);
+    // w: 1 when on. haze_light: the light the air adds in its place (rgb).
+    haze: vec4<f32>,
+    haze_light: vec4<f32>,
 };
 
 @group(0) @binding(0) var<uniform> u: Volume;

@@ -45,8 +45,18 @@ pub const CLOUD_ALTITUDE: f32 = 1.5;
 /// The sun's angular radius (radians).
 pub const SUN_RADIUS: f32 = 0.004_65;
 
+/// Kilometres per world unit (a world unit is 100 m: the default cumulus is about a kilometre
+/// across): the aerial perspective's scale.
+pub const KM_PER_UNIT: f32 = 0.1;
+
+/// The air's extinction per kilometre at the eye's height (what aerial perspective takes out of
+/// a far cloud's light).
+pub fn air_extinction() -> Vec3 {
+    medium(EYE_ALTITUDE).extinction
+}
+
 /// The view table's size: azimuth from the sun (0 to π) × elevation (−π/2 to π/2).
-pub const VIEW_SIZE: [usize; 2] = [64, 128];
+pub const VIEW_SIZE: [usize; 2] = [64, 256];
 
 const TRANSMITTANCE_SIZE: [usize; 2] = [128, 48];
 const MULTIPLE_SIZE: [usize; 2] = [32, 32];

@@ -2180,3 +2180,60 @@ fn the_physical_sky_is_the_atmospheres_light_and_a_low_sun_reddens_the_sky_and_t
         "with picked colours: {picked_noon:.2} and {picked_low:.2}"
     );
 }
+
+#[test]
+fn a_far_cloud_fades_into_the_physical_skys_colour_and_a_near_one_barely() {
+    // Orthographic views of one size from 30 and 280 world units (3 and 28 km): the cloud
+    // covers the same pixels, only the air between differs. With the physical sky the far
+    // cloud's light moves toward the sky's colour (bluer, and its contrast with the sky drops);
+    // with picked colours the distance changes nothing (the baseline).
+    let half = 30.0 * (22.5f32).to_radians().tan();
+    let at = |scene: &Scene, distance: f32| {
+        let fov = 2.0 * (half / distance).atan().to_degrees();
+        let s = with(
+            scene,
+            &[
+                "/camera/orthographic=true",
+                &format!("/camera/distance={distance}"),
+                &format!("/camera/fov_y_deg={fov}"),
+            ],
+        );
+        let image = render_linear(&s, Backdrop::Transparent);
+        let (mut sum, mut n) = (glam::DVec3::ZERO, 0.0);
+        for p in image.rgba.chunks(4).filter(|p| p[3] > 0.9) {
+            sum += glam::DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64) / p[3] as f64;
+            n += 1.0;
+        }
+        (sum / f64::max(n, 1.0), n)
+    };
+    let blueness = |c: glam::DVec3| c.z / c.x;
+    let picked = smooth_cumulus();
+    let physical = with(&picked, &["/light/physical_sky=true"]);
+    let ((near, n_near), (far, n_far)) = (at(&physical, 30.0), at(&physical, 280.0));
+    assert!(
+        n_near > 500.0 && (n_far / n_near - 1.0).abs() < 0.05,
+        "{n_near} vs {n_far} px"
+    );
+    let ((p_near, _), (p_far, _)) = (at(&picked, 30.0), at(&picked, 280.0));
+    let (shift, baseline) = (
+        blueness(far) / blueness(near),
+        blueness(p_far) / blueness(p_near),
+    );
+    eprintln!(
+        "blue over red, far against near: {shift:.3} (picked colours {baseline:.3}); near {near:?}, far {far:?}"
+    );
+    assert!(
+        shift > 1.1 && (baseline - 1.0).abs() < 0.01,
+        "blue over red, far against near: {shift:.3} with the physical sky, {baseline:.3} without"
+    );
+    // The far cloud's light lies between the near cloud's and the sky's toward it: the air
+    // took out what it added back, about 1 − e^(−σ·25 km) of it.
+    let through = (-cloudsketch::atmosphere::air_extinction().as_dvec3() * 25.0).exp();
+    let expected = near * through;
+    for c in 0..3 {
+        assert!(
+            far[c] > expected[c] && far[c] < near[c].max(expected[c]) + 0.5,
+            "channel {c}: far {far:?}, near {near:?}, near × transmittance {expected:?}"
+        );
+    }
+}

@@ -76,6 +76,12 @@ pub struct VolumeUniforms {
     /// y: the air's phase asymmetry g, z: the shells drawn apart ([`Shells::apart`]), whose
     /// light also goes to the first target.
     pub air: [f32; 4],
+    /// Aerial perspective with the physical sky: the air's extinction per world unit (xyz:
+    /// what the air between the eye and a sample takes out of its light); w: 1 when on.
+    pub haze: [f32; 4],
+    /// The light the air adds in its place (rgb): the physical sky's toward the cloud, at this
+    /// exposure.
+    pub haze_light: [f32; 4],
 }
 
 /// The phase asymmetry of the air's scattering in the shafts: mildly forward, so shafts are
@@ -451,7 +457,7 @@ pub fn crop_matrix(crop: [f32; 4]) -> Mat4 {
 
 impl VolumeUniforms {
     /// Names and byte offsets of the members, in order (checked against the WGSL struct).
-    pub const LAYOUT: [(&'static str, usize); 23] = [
+    pub const LAYOUT: [(&'static str, usize); 25] = [
         ("view_proj", offset_of!(Self, view_proj)),
         ("eye", offset_of!(Self, eye)),
         ("forward", offset_of!(Self, forward)),
@@ -474,6 +480,8 @@ impl VolumeUniforms {
         ("shells", offset_of!(Self, shells)),
         ("shafts", offset_of!(Self, shafts)),
         ("air", offset_of!(Self, air)),
+        ("haze", offset_of!(Self, haze)),
+        ("haze_light", offset_of!(Self, haze_light)),
         ("", std::mem::size_of::<Self>()),
     ];
 
@@ -595,6 +603,31 @@ impl VolumeUniforms {
                 shells.map_or(0.0, |s| s.apart as f32),
                 0.0,
             ],
+            ..Self::haze(light, center - eye, exposure)
+        }
+    }
+
+    /// The aerial perspective of `light`'s physical sky (none without it), the cloud's centre
+    /// `toward` from the eye.
+    fn haze(light: &Lighting, toward: Vec3, exposure: f32) -> Self {
+        if !light.physical_sky {
+            return Self::zeroed();
+        }
+        let sky = crate::atmosphere::sky(light.sun_elevation_deg);
+        // The air's own light over a few kilometres is near the sky's at the horizon (a long
+        // path through the same low air), looking down as well: the table below the horizon
+        // holds the ground beyond, not the air.
+        let level = Vec3::new(toward.x, toward.y.max(0.0), toward.z);
+        let seen = sky.radiance(
+            level.normalize_or(Vec3::NEG_Z),
+            light.sun_azimuth_deg.to_radians(),
+        ) * (light.physical_scale() * exposure);
+        Self {
+            haze: (crate::atmosphere::air_extinction() * crate::atmosphere::KM_PER_UNIT)
+                .extend(1.0)
+                .to_array(),
+            haze_light: seen.extend(0.0).to_array(),
+            ..Self::zeroed()
         }
     }
 }
