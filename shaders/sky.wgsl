@@ -115,23 +115,31 @@ fn sky_colour(in: Fullscreen) -> vec3<f32> {
         // No gradient: the flat background, the ground alone drawn over it.
         colour = sky.zenith.rgb;
     }
-    if sky.eye.w > 0.5 {
-        // The ground: where this pixel's ray meets the plane y = height.
-        let ortho = dot(sky.origin_right.xyz, sky.origin_right.xyz) > 0.0;
-        let dir = select(d, sky.forward.xyz, ortho);
-        let origin = sky.eye.xyz + in.ndc.x * sky.origin_right.xyz + in.ndc.y * sky.origin_up.xyz;
-        let t = (sky.grid_min.w - origin.y) / dir.y;
-        if dir.y < 0.0 && t > 0.0 {
-            let p = origin + dir * t;
-            // Sunlight on the ground (by the sun's height) through the clouds, plus the sky's.
-            let sun = max(sky.sun_dir.y, 0.0) * ground_sun(p);
-            let lit = sky.ground_lit.rgb * (0.35 + 0.65 * sun);
-            // Far ground fades into the horizon's haze.
-            let haze = smoothstep(0.0, 0.25, -dir.y);
-            colour = mix(colour, lit, haze);
-        }
+    let ground = ground_at(in, d);
+    if ground.w > 0.0 {
+        // Sunlight on the ground (by the sun's height) through the clouds, plus the sky's.
+        let sun = max(sky.sun_dir.y, 0.0) * ground_sun(ground.xyz);
+        let lit = sky.ground_lit.rgb * (0.35 + 0.65 * sun);
+        colour = mix(colour, lit, ground.w);
     }
     return colour;
+}
+
+// Where this pixel's ray (`d` in perspective) meets the ground plane y = height (xyz), and how
+// much the ground shows there (w: 0 where there is no ground or the ray misses it, rising as
+// the ray looks down: far ground fades into the horizon's haze).
+fn ground_at(in: Fullscreen, d: vec3<f32>) -> vec4<f32> {
+    if sky.eye.w < 0.5 {
+        return vec4<f32>(0.0);
+    }
+    let ortho = dot(sky.origin_right.xyz, sky.origin_right.xyz) > 0.0;
+    let dir = select(d, sky.forward.xyz, ortho);
+    let origin = sky.eye.xyz + in.ndc.x * sky.origin_right.xyz + in.ndc.y * sky.origin_up.xyz;
+    let t = (sky.grid_min.w - origin.y) / dir.y;
+    if dir.y >= 0.0 || t <= 0.0 {
+        return vec4<f32>(0.0);
+    }
+    return vec4<f32>(origin + dir * t, smoothstep(0.0, 0.25, -dir.y));
 }
 
 // The physical sky along this pixel's ray (the view table's light, the sun's disk), and the
@@ -156,20 +164,14 @@ fn physical_sky(in: Fullscreen) -> vec3<f32> {
     let edge = 1.0 - sky.atmosphere.z;
     let disk = smoothstep(sky.atmosphere.z - 0.1 * edge, sky.atmosphere.z + 0.1 * edge, c);
     light = light + sky.sun_disk.rgb * disk;
-    if sky.eye.w > 0.5 {
-        let ortho = dot(sky.origin_right.xyz, sky.origin_right.xyz) > 0.0;
-        let dir = select(d, sky.forward.xyz, ortho);
-        let origin = sky.eye.xyz + in.ndc.x * sky.origin_right.xyz + in.ndc.y * sky.origin_up.xyz;
-        let t = (sky.grid_min.w - origin.y) / dir.y;
-        if dir.y < 0.0 && t > 0.0 {
-            let p = origin + dir * t;
-            // A Lambertian ground of the picked colour (its albedo), lit by the sun through
-            // the clouds and by the sky.
-            let sun = max(sky.sun_dir.y, 0.0) * ground_sun(p);
-            let albedo = srgb_to_linear(sky.ground_lit.rgb);
-            let lit = albedo * (sky.ground_sun.rgb * sun + sky.ground_sky.rgb);
-            light = mix(light, lit, smoothstep(0.0, 0.25, -dir.y));
-        }
+    let ground = ground_at(in, d);
+    if ground.w > 0.0 {
+        // A Lambertian ground of the picked colour (its albedo), lit by the sun through the
+        // clouds and by the sky.
+        let sun = max(sky.sun_dir.y, 0.0) * ground_sun(ground.xyz);
+        let albedo = srgb_to_linear(sky.ground_lit.rgb);
+        let lit = albedo * (sky.ground_sun.rgb * sun + sky.ground_sky.rgb);
+        light = mix(light, lit, ground.w);
     }
     return light;
 }
