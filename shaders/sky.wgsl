@@ -36,8 +36,9 @@ struct Sky {
     // Where the shafts' light is not added (texture coordinates, v down: x0, y0, x1, y1): the
     // clouds' box, whose composite adds its own; the whole target when there are no shafts.
     keep_out: vec4<f32>,
-    // The physical sky: x: the light of one unit of the view table; y: 1 with the physical
-    // sky; z: the cosine of the sun's angular radius; w: the sun's azimuth (radians).
+    // The physical sky: x: the light of one unit of the view table as stored (× SKY_TABLE_SCALE
+    // in src/render/gpu_types.rs); y: 1 with the physical sky; z: the cosine of the sun's
+    // angular radius; w: the sun's azimuth (radians).
     atmosphere: vec4<f32>,
     // The sun disk's light (rgb).
     sun_disk: vec4<f32>,

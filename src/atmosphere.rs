@@ -325,6 +325,9 @@ pub struct SkyTables {
     pub sun_at_clouds: Vec3,
     /// The mean radiance of the sky above the horizon (the clouds' sky light).
     pub sky_mean: Vec3,
+    /// The sky's light on level ground, as the one radiance from the whole sky that would
+    /// light it as much (its irradiance / π: the mean weighted by each direction's cosine).
+    pub sky_on_ground: Vec3,
 }
 
 impl SkyTables {
@@ -334,15 +337,20 @@ impl SkyTables {
         let table = Table::make(VIEW_SIZE, |u, v| {
             march_view(view_direction(u * PI, v_to_elevation(v)), sun, 32, true)
         });
-        // The upper hemisphere's mean, each direction weighted by its solid angle.
+        // The upper hemisphere's mean, each direction weighted by its solid angle; and as it
+        // lights the ground, weighted by its cosine from the zenith too.
         let (mut sum, mut weight) = (Vec3::ZERO, 0.0);
+        let (mut on_ground, mut ground_weight) = (Vec3::ZERO, 0.0);
         for j in 0..24 {
             let elevation = (j as f32 + 0.5) / 24.0 * FRAC_PI_2;
             for i in 0..32 {
                 let azimuth = (i as f32 + 0.5) / 32.0 * PI;
                 let w = elevation.cos();
-                sum += table.sample(azimuth / PI, elevation_to_v(elevation)) * w;
+                let l = table.sample(azimuth / PI, elevation_to_v(elevation));
+                sum += l * w;
                 weight += w;
+                on_ground += l * (w * elevation.sin());
+                ground_weight += w * elevation.sin();
             }
         }
         Self {
@@ -351,6 +359,7 @@ impl SkyTables {
             sun_at_eye: transmittance(EYE_ALTITUDE, sun_elevation),
             sun_at_clouds: transmittance(CLOUD_ALTITUDE, sun_elevation),
             sky_mean: sum / weight,
+            sky_on_ground: on_ground / ground_weight,
         }
     }
 
@@ -370,18 +379,50 @@ impl SkyTables {
     }
 }
 
-/// The sky for the sun `elevation_deg` degrees up: made once per elevation (the last one asked
-/// is kept, so a scene drawn frame after frame makes it once).
-pub fn sky(elevation_deg: f32) -> Arc<SkyTables> {
-    static LAST: Mutex<Option<(u32, Arc<SkyTables>)>> = Mutex::new(None);
-    let key = elevation_deg.to_bits();
-    let mut last = LAST.lock().unwrap_or_else(|e| e.into_inner());
-    if let Some((_, tables)) = last.as_ref().filter(|(k, _)| *k == key) {
-        return tables.clone();
+/// The skies made last, by sun elevation (its bits), the most recently asked first.
+pub struct SkyCache {
+    kept: Mutex<Vec<(u32, Arc<SkyTables>)>>,
+}
+
+impl SkyCache {
+    /// How many skies are kept: a slider's few last positions, or an image and the viewport
+    /// posed at two elevations, each made once.
+    pub const KEPT: usize = 4;
+
+    /// An empty cache.
+    pub const fn new() -> Self {
+        Self {
+            kept: Mutex::new(Vec::new()),
+        }
     }
-    let tables = Arc::new(SkyTables::new(elevation_deg.to_radians()));
-    *last = Some((key, tables.clone()));
-    tables
+
+    /// The sky for the sun `elevation_deg` degrees up, made if it is not kept.
+    pub fn get(&self, elevation_deg: f32) -> Arc<SkyTables> {
+        let key = elevation_deg.to_bits();
+        let mut kept = self.kept.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(i) = kept.iter().position(|(k, _)| *k == key) {
+            let hit = kept.remove(i);
+            kept.insert(0, hit.clone());
+            return hit.1;
+        }
+        let tables = Arc::new(SkyTables::new(elevation_deg.to_radians()));
+        kept.insert(0, (key, tables.clone()));
+        kept.truncate(Self::KEPT);
+        tables
+    }
+}
+
+impl Default for SkyCache {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// The sky for the sun `elevation_deg` degrees up, from the one cache every caller shares (a
+/// scene drawn frame after frame makes it once).
+pub fn sky(elevation_deg: f32) -> Arc<SkyTables> {
+    static CACHE: SkyCache = SkyCache::new();
+    CACHE.get(elevation_deg)
 }
 
 #[cfg(test)]
@@ -471,10 +512,18 @@ mod tests {
     }
 
     #[test]
-    fn the_last_sky_asked_is_kept() {
-        let a = sky(12.5);
-        let b = sky(12.5);
-        assert!(Arc::ptr_eq(&a, &b));
-        assert!(!Arc::ptr_eq(&a, &sky(13.0)));
+    fn the_skies_asked_last_are_kept() {
+        // A cache of the test's own: others' tests ask the shared one meanwhile.
+        let cache = SkyCache::new();
+        let a = cache.get(12.5);
+        assert!(Arc::ptr_eq(&a, &cache.get(12.5)));
+        let b = cache.get(13.0);
+        assert!(!Arc::ptr_eq(&a, &b) && a.sun_elevation != b.sun_elevation);
+        // Up to KEPT elevations stay; the one asked longest ago goes first.
+        for e in [14.0, 15.0, 16.0] {
+            cache.get(e);
+        }
+        assert!(Arc::ptr_eq(&b, &cache.get(13.0)));
+        assert!(!Arc::ptr_eq(&a, &cache.get(12.5)));
     }
 }

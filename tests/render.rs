@@ -2137,7 +2137,6 @@ fn the_physical_sky_is_the_atmospheres_light_and_a_low_sun_reddens_the_sky_and_t
         "the sunset horizon: toward the sun {sun_side:?}, away {away:?}"
     );
     // The sun's disk: the brightest sky pixel lies on the sun's direction and shows white.
-    let sun = noon.light.sun_direction();
     let low_scene = physical("3");
     let sun_low = low_scene.light.sun_direction();
     let (mut best, mut at) = (0.0, (0, 0));
@@ -2156,7 +2155,6 @@ fn the_physical_sky_is_the_atmospheres_light_and_a_low_sun_reddens_the_sky_and_t
         best > 250.0 && off < 0.6,
         "the brightest pixel {best:.0} is {off:.2}° from the sun"
     );
-    assert!(sun != sun_low);
 
     // The cloud's sunlight reddens as the sun sets with the physical sky, and only with it: the
     // picked sun colour stays as picked whatever the elevation.
@@ -2226,14 +2224,25 @@ fn a_far_cloud_fades_into_the_physical_skys_colour_and_a_near_one_barely() {
         shift > 1.1 && (baseline - 1.0).abs() < 0.01,
         "blue over red, far against near: {shift:.3} with the physical sky, {baseline:.3} without"
     );
-    // The far cloud's light lies between the near cloud's and the sky's toward it: the air
-    // took out what it added back, about 1 − e^(−σ·25 km) of it.
-    let through = (-cloudsketch::atmosphere::air_extinction().as_dvec3() * 25.0).exp();
-    let expected = near * through;
-    for c in 0..3 {
-        assert!(
-            far[c] > expected[c] && far[c] < near[c].max(expected[c]) + 0.5,
-            "channel {c}: far {far:?}, near {near:?}, near × transmittance {expected:?}"
-        );
-    }
+    // The far cloud's light is the near one's through 25 km more air, plus the air's own light
+    // (the physical sky's, looking level toward the cloud): from the near image, the cloud's
+    // own light C = (near − L·(1 − T₃)) / T₃, then far = C·T₂₈ + L·(1 − T₂₈), each T the air's
+    // transmittance over 3 and 28 km. Within 2% (0.1% measured on lavapipe; each sample's own
+    // distance is used, not the centre's).
+    let light = &physical.light;
+    let toward = physical.camera.forward();
+    let level = glam::Vec3::new(toward.x, toward.y.max(0.0), toward.z).normalize();
+    let air = cloudsketch::atmosphere::sky(light.sun_elevation_deg)
+        .radiance(level, light.sun_azimuth_deg.to_radians())
+        .as_dvec3()
+        * f64::from(light.physical_scale() * light.exposure.exp2());
+    let sigma = cloudsketch::atmosphere::air_extinction().as_dvec3();
+    let through = |km: f64| (-sigma * km).exp();
+    let own = (near - air * (glam::DVec3::ONE - through(3.0))) / through(3.0);
+    let predicted = own * through(28.0) + air * (glam::DVec3::ONE - through(28.0));
+    let error = ((far - predicted) / predicted).abs().max_element();
+    assert!(
+        error < 0.02,
+        "far {far:?}, predicted {predicted:?} from near {near:?} (error {error:.3})"
+    );
 }

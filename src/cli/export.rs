@@ -17,7 +17,7 @@ pub struct Request<'a> {
     pub scene: Option<&'a str>,
     /// Format name.
     pub format: &'a str,
-    /// Output path (the main file; Mitsuba's `.vol` goes beside it).
+    /// Output path (the main file; Mitsuba's `.vol` and `.sky.pfm` go beside it).
     pub output: &'a Path,
     /// Grid texels along the longest side.
     pub resolution: u32,
@@ -145,7 +145,7 @@ fn stem_of(output: &Path) -> String {
 }
 
 /// The files an export to `output` writes: the main file where asked, the others (Mitsuba's
-/// volume) beside it under their own names.
+/// volume and sky map) beside it under their own names.
 fn files_of(format: Format, output: &Path) -> Vec<PathBuf> {
     let dir = output.parent().unwrap_or(Path::new(""));
     let mut paths = vec![output.to_path_buf()];

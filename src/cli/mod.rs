@@ -157,7 +157,7 @@ enum Command {
         #[arg(long, default_value = crate::share::DEFAULT_BASE)]
         base: String,
     },
-    /// Export the cloud for other tools: vdb (OpenVDB fog volume), mitsuba (scene XML + .vol),
+    /// Export the cloud for other tools: vdb (OpenVDB fog volume), mitsuba (scene XML + .vol + .sky.pfm),
     /// glb, obj, ply (its surface), png (the rendered view).
     Export {
         /// Scene JSON or share link; the default scene when left out.
@@ -165,7 +165,7 @@ enum Command {
         /// vdb, mitsuba, glb, obj, ply or png.
         #[arg(long)]
         format: String,
-        /// Output file (Mitsuba's .vol is written beside its XML).
+        /// Output file (Mitsuba's .vol and .sky.pfm are written beside its XML).
         #[arg(short, long)]
         output: PathBuf,
         /// Grid texels along the cloud's longest side (8 to 256).

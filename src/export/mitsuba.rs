@@ -100,7 +100,9 @@ impl Units {
 pub const SKY_MAP_SIZE: [usize; 2] = [256, 128];
 
 /// The direction of texel (u, v) of a latitude-longitude map as Mitsuba's `envmap` reads it
-/// (y up; u = atan2(x, −z) / 2π, v = θ / π from the zenith).
+/// (y up; u = atan2(x, −z) / 2π, v = θ / π from the zenith). Mitsuba takes a map's columns as
+/// cells (texel i at u = (i + ½) / w) and its rows as grid points, the first at the zenith
+/// and the last at the nadir (row j at v = j / (h − 1)).
 pub fn sky_map_direction(u: f32, v: f32) -> Vec3 {
     let (phi, theta) = (std::f32::consts::TAU * u, std::f32::consts::PI * v);
     Vec3::new(
@@ -113,7 +115,7 @@ pub fn sky_map_direction(u: f32, v: f32) -> Vec3 {
 /// The sky's light over every direction (before ambient and exposure, which the XML's scale
 /// applies) as a PFM latitude-longitude map for Mitsuba's `envmap`: the physical sky's
 /// radiance in the app's units ([`SKY_MAP_SIZE`]), or the picked sky colour's light
-/// everywhere (a few texels).
+/// everywhere (8 × 4 texels).
 pub fn write_sky(scene: &Scene) -> Vec<u8> {
     let light = &scene.light;
     let ([w, h], texels): ([usize; 2], Vec<Vec3>) = if light.physical_sky {
@@ -123,14 +125,15 @@ pub fn write_sky(scene: &Scene) -> Vec<u8> {
         let texels = (0..h)
             .flat_map(|j| (0..w).map(move |i| (i, j)))
             .map(|(i, j)| {
-                let d = sky_map_direction((i as f32 + 0.5) / w as f32, (j as f32 + 0.5) / h as f32);
+                let d = sky_map_direction((i as f32 + 0.5) / w as f32, j as f32 / (h - 1) as f32);
                 tables.radiance(d, azimuth) * scale
             })
             .collect();
         (SKY_MAP_SIZE, texels)
     } else {
         let sky = crate::scene::srgb_to_linear(light.sky_color);
-        ([4, 2], vec![sky; 8])
+        // (Mitsuba takes no map under 2 × 3 texels.)
+        ([8, 4], vec![sky; 32])
     };
     write_pfm(w, h, &texels)
 }
@@ -323,9 +326,12 @@ mod tests {
         assert_eq!([w, h], SKY_MAP_SIZE);
         let tables = crate::atmosphere::sky(8.0);
         let scale = scene.light.physical_scale();
-        // The top row is the zenith's light.
+        // The top row is the zenith's light, the bottom row the nadir's.
         let zenith = tables.radiance(Vec3::Y, 0.0) * scale;
-        assert!(((texels[w / 2] - zenith) / zenith).abs().max_element() < 0.03);
+        assert!(((texels[w / 2] - zenith) / zenith).abs().max_element() < 0.01);
+        let nadir = tables.radiance(Vec3::NEG_Y, 0.0) * scale;
+        let last = texels[(h - 1) * w + w / 2];
+        assert!(((last - nadir) / nadir).abs().max_element() < 0.01);
         // The brightest texel lies toward the sun, in the app's frame: a map mirrored or turned
         // would put it elsewhere.
         let (k, _) = texels
@@ -335,7 +341,7 @@ mod tests {
             .unwrap();
         let d = sky_map_direction(
             ((k % w) as f32 + 0.5) / w as f32,
-            ((k / w) as f32 + 0.5) / h as f32,
+            (k / w) as f32 / (h - 1) as f32,
         );
         // (Its azimuth: the sky is brightest toward the sun, at the horizon below it.)
         let across = |v: Vec3| Vec3::new(v.x, 0.0, v.z);
@@ -347,9 +353,11 @@ mod tests {
             "the brightest texel is {off:.1}° round from the sun"
         );
         assert!(d.y < scene.light.sun_direction().y + 0.05);
-        // Picked colours: the sky colour's light everywhere.
+        // Picked colours: the sky colour's light everywhere, in a map Mitsuba takes (at least
+        // 2 × 3 texels).
         scene.light.physical_sky = false;
-        let (_, _, texels) = read_pfm(&write_sky(&scene));
+        let (w, h, texels) = read_pfm(&write_sky(&scene));
+        assert!(w >= 2 && h >= 3, "{w} × {h}");
         let sky = crate::scene::srgb_to_linear(scene.light.sky_color);
         assert!(texels.iter().all(|t| (*t - sky).abs().max_element() < 1e-6));
     }

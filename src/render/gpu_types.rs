@@ -177,7 +177,8 @@ impl Shells {
     }
 }
 
-/// Uniforms of the sky gradient (`struct Sky` in `shaders/sky.wgsl`).
+/// Uniforms of the sky pass: the physical sky, the gradient or the flat colour, and the ground
+/// (`struct Sky` in `shaders/sky.wgsl`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct SkyUniforms {
@@ -305,7 +306,7 @@ impl SkyUniforms {
         let disk = (sky.sun_at_eye * (scale / solid_angle)).min(Vec3::splat(3.0e4));
         Self {
             atmosphere: [
-                scale,
+                scale / SKY_TABLE_SCALE,
                 1.0,
                 crate::atmosphere::SUN_RADIUS.cos(),
                 light.sun_azimuth_deg.to_radians(),
@@ -315,11 +316,16 @@ impl SkyUniforms {
             ground_sun: (sky.sun_at_eye * (4.0 * light.sun_intensity * exposure))
                 .extend(0.0)
                 .to_array(),
-            ground_sky: (sky.sky_mean * scale).extend(0.0).to_array(),
+            ground_sky: (sky.sky_on_ground * scale).extend(0.0).to_array(),
             ..Self::default()
         }
     }
 }
+
+/// The physical sky's table is stored times this (half floats: a twilight sky's radiance per
+/// unit of the sun's, a millionth, would fall among their coarse subnormals); the sky pass's
+/// scale (`SkyUniforms::atmosphere`'s x) divides it out.
+pub const SKY_TABLE_SCALE: f32 = 1024.0;
 
 impl SkyUniforms {
     /// A `keep_out` over the whole target: no shafts' light added anywhere.

@@ -6,7 +6,9 @@
 
 use std::num::NonZeroU64;
 
-use super::gpu_types::{BehindUniforms, LightSliceUniforms, SkyUniforms, VolumeUniforms};
+use super::gpu_types::{
+    BehindUniforms, LightSliceUniforms, SKY_TABLE_SCALE, SkyUniforms, VolumeUniforms,
+};
 use super::shaders;
 
 /// Slice draws one frame (one submit) may record.
@@ -504,14 +506,16 @@ pub struct SkyPass {
     uniforms: [wgpu::Buffer; 2],
     layout: wgpu::BindGroupLayout,
     bind_groups: [wgpu::BindGroup; 2],
-    /// The physical sky's view table (`atmosphere::SkyTables::view`, half floats).
-    atmosphere: wgpu::Texture,
-    atmosphere_view: wgpu::TextureView,
+    /// Each slot's physical sky view table (`atmosphere::SkyTables::view` × `SKY_TABLE_SCALE`,
+    /// half floats): an image and the viewport drawn in one submission may have their suns
+    /// at two elevations.
+    atmosphere: [wgpu::Texture; 2],
+    atmosphere_views: [wgpu::TextureView; 2],
     /// The sun elevation's bits the table holds (`NO_ATMOSPHERE`: none yet).
-    atmosphere_key: std::sync::atomic::AtomicU32,
+    atmosphere_keys: [std::sync::atomic::AtomicU32; 2],
 }
 
-/// `SkyPass::atmosphere_key` before any table is written (a NaN's bits: no elevation's).
+/// `SkyPass::atmosphere_keys` before any table is written (a NaN's bits: no elevation's).
 const NO_ATMOSPHERE: u32 = u32::MAX;
 
 impl SkyPass {
@@ -537,21 +541,23 @@ impl SkyPass {
             ],
         });
         let [w, h] = crate::atmosphere::VIEW_SIZE;
-        let atmosphere = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("physical sky"),
-            size: wgpu::Extent3d {
-                width: w as u32,
-                height: h as u32,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Rgba16Float,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-            view_formats: &[],
+        let atmosphere = [0, 1].map(|_| {
+            device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("physical sky"),
+                size: wgpu::Extent3d {
+                    width: w as u32,
+                    height: h as u32,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: wgpu::TextureFormat::Rgba16Float,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+                view_formats: &[],
+            })
         });
-        let atmosphere_view = atmosphere.create_view(&Default::default());
+        let atmosphere_views = [0, 1].map(|i| atmosphere[i].create_view(&Default::default()));
         let uniforms = [0, 1].map(|_| {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("sky uniforms"),
@@ -565,7 +571,7 @@ impl SkyPass {
                 device,
                 &layout,
                 &uniforms[i],
-                [light, shafts, &atmosphere_view],
+                [light, shafts, &atmosphere_views[i]],
                 sampler,
             )
         });
@@ -583,8 +589,8 @@ impl SkyPass {
             layout,
             bind_groups,
             atmosphere,
-            atmosphere_view,
-            atmosphere_key: std::sync::atomic::AtomicU32::new(NO_ATMOSPHERE),
+            atmosphere_views,
+            atmosphere_keys: [0, 1].map(|_| std::sync::atomic::AtomicU32::new(NO_ATMOSPHERE)),
         }
     }
 
@@ -638,16 +644,15 @@ impl SkyPass {
                 device,
                 &self.layout,
                 &self.uniforms[i],
-                [light, shafts, &self.atmosphere_view],
+                [light, shafts, &self.atmosphere_views[i]],
                 sampler,
             )
         });
     }
 
     /// Sets the sky the next [`SkyPass::draw`] in `slot` draws, with the physical sky of
-    /// `light`'s sun elevation when it has one (its table written when the elevation moved;
-    /// both slots share it, so an image and the viewport drawn in one submission show the
-    /// same sun).
+    /// `light`'s sun elevation when it has one (the slot's table written when its elevation
+    /// moved).
     pub fn write(
         &self,
         queue: &wgpu::Queue,
@@ -656,7 +661,7 @@ impl SkyPass {
         light: &crate::scene::Lighting,
     ) {
         if light.physical_sky {
-            self.write_atmosphere(queue, light.sun_elevation_deg);
+            self.write_atmosphere(queue, slot, light.sun_elevation_deg);
         }
         queue.write_buffer(
             &self.uniforms[slot as usize],
@@ -665,21 +670,23 @@ impl SkyPass {
         );
     }
 
-    fn write_atmosphere(&self, queue: &wgpu::Queue, elevation_deg: f32) {
+    fn write_atmosphere(&self, queue: &wgpu::Queue, slot: SkySlot, elevation_deg: f32) {
         use std::sync::atomic::Ordering;
         let key = elevation_deg.to_bits();
-        if self.atmosphere_key.swap(key, Ordering::Relaxed) == key {
+        if self.atmosphere_keys[slot as usize].swap(key, Ordering::Relaxed) == key {
             return;
         }
         let tables = crate::atmosphere::sky(elevation_deg);
         let texels: Vec<u16> = tables
             .view
             .iter()
-            .flat_map(|&[r, g, b]| [r, g, b, 1.0].map(|x| half::f16::from_f32(x).to_bits()))
+            .flat_map(|&[r, g, b]| {
+                [r, g, b, 1.0].map(|x| half::f16::from_f32(x * SKY_TABLE_SCALE).to_bits())
+            })
             .collect();
         let [w, h] = crate::atmosphere::VIEW_SIZE;
         queue.write_texture(
-            self.atmosphere.as_image_copy(),
+            self.atmosphere[slot as usize].as_image_copy(),
             bytemuck::cast_slice(&texels),
             wgpu::TexelCopyBufferLayout {
                 offset: 0,

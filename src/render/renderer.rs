@@ -1038,7 +1038,7 @@ impl VolumeRenderer {
     }
 
     /// Readies what lies behind an image's cloud: nothing (no `background`: transparent), the
-    /// flat background as the output's clear colour (no sky gradient, no ground, no shafts
+    /// flat background as the output's clear colour (no physical sky or gradient, no ground, no shafts
     /// laid apart: `shafts_keep_out` none), or the image backdrop, its sky drawn with the
     /// shafts outside `shafts_keep_out`. `place` is where the composited image lies in it.
     #[allow(clippy::too_many_arguments)]
@@ -1226,7 +1226,7 @@ impl VolumeRenderer {
 
     /// Draws the view behind the cloud into a texture `size` pixels (the viewport's), which
     /// [`VolumeRenderer::lay_backdrop`] then lays on every frame until it changes: `background`
-    /// (sRGB-encoded, as picked) with `view`'s sky gradient or ground, and the shafts of light
+    /// (sRGB-encoded, as picked) with `view`'s physical sky, sky gradient or ground, and the shafts of light
     /// [`VolumeRenderer::draw_outside_shafts`] drew (call it first) when `shafts`, added
     /// outside `crop` (the cloud's box in its pixels; none when out of view), all mapped by the
     /// one tone map; `key` is what it is drawn for ([`VolumeRenderer::backdrop_key`]). On CPU

@@ -67,8 +67,8 @@ pub const FIELD_EVAL: &str = concat!(
     include_str!("../../shaders/field_eval.wgsl")
 );
 
-/// The sky gradient behind the cloud: `sun_shadow.wgsl` + `fullscreen.wgsl` + `tone.wgsl` +
-/// `sky.wgsl`.
+/// The sky behind the cloud (physical, a gradient or flat, and the ground): `sun_shadow.wgsl` +
+/// `fullscreen.wgsl` + `tone.wgsl` + `sky.wgsl`.
 pub const SKY: &str = concat!(
     include_str!("../../shaders/sun_shadow.wgsl"),
     include_str!("../../shaders/fullscreen.wgsl"),

@@ -222,8 +222,8 @@ impl RendererPaint for ViewportPaint {
     }
 }
 
-/// What lies behind the cloud in the viewport: the background colour, the sky gradient or the
-/// ground, and the shafts of light around the cloud's box, where no cloud lies in front of
+/// What lies behind the cloud in the viewport: the background colour, the physical sky or the
+/// sky gradient, the ground, and the shafts of light around the cloud's box, where no cloud lies in front of
 /// them. Drawn into a texture of its own when any of it changes (`redraw`), and laid from it
 /// on every frame, under everything else: on a CPU adapter the ground's shading and the
 /// shafts' lay, redone on every frame, took over half of each frame of a refinement.

@@ -122,7 +122,22 @@ fn paint(ui: &egui::Ui, center: Pos2, scene: &crate::scene::Scene, active: bool)
     ));
     let p = orb_position(camera, &scene.light);
     let at = center + Vec2::new(p.x, -p.y) * RADIUS;
-    let [r, g, b] = scene.light.sun_color.map(|c| (c * 255.0) as u8);
+    // The sun's colour: as picked, or the physical sky's (its hue, at full brightness; a sun
+    // below the horizon, which lights nothing, grey).
+    let colour = if scene.light.physical_sky {
+        let light = scene.light.sun_light();
+        let top = light.max_element();
+        if top > 0.0 {
+            (light / top)
+                .to_array()
+                .map(crate::render::tone::linear_to_srgb)
+        } else {
+            [0.4; 3]
+        }
+    } else {
+        scene.light.sun_color
+    };
+    let [r, g, b] = colour.map(|c| (c.clamp(0.0, 1.0) * 255.0) as u8);
     let sun = Color32::from_rgb(r, g, b);
     if p.z < 0.0 {
         painter.circle_filled(at, 7.0, sun);

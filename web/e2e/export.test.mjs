@@ -427,8 +427,10 @@ test('Record with ?record=png: PNGs in a zip from the start, each the CLI\'s fra
     const hasEncoder = await page.evaluate(() => typeof VideoEncoder === 'function');
     const { file, scene, last, notices } = await recordRange(page, [24, 2], 'timeline');
     assert.ok(![...notices].some((n) => /cannot encode/.test(n)), `no encoder tried: ${[...notices].join(' | ')}`);
+    assert.ok(hasEncoder, 'the browser has WebCodecs: the address alone chose PNGs');
     const [vw, vh] = (await state(page)).view.viewport;
     const natural = Math.round(320 * vh / vw);
+    assert.equal(natural % 2, 1, `an odd natural height (${natural}), which a video's would round to even`);
     const { files } = await zippedFrames(file, last, scene, 320, natural);
     console.log(`# webgpu ?record=png: ${files.length} PNGs at 320×${natural} (WebCodecs ${hasEncoder ? 'present' : 'missing'})`);
     fs.writeFileSync('test-results/screenshots/record-png-0-webgpu.png', Buffer.from(files[0].bytes));
