@@ -4,6 +4,8 @@
 #![no_main]
 #![allow(dead_code, unused_imports)]
 
+#[path = "../../src/atmosphere.rs"]
+mod atmosphere;
 #[path = "../../src/density.rs"]
 mod density;
 #[path = "../../src/derive/mod.rs"]
