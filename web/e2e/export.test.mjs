@@ -352,17 +352,29 @@ for (const backend of BOTH_BUILDS) {
         canvas.height = video.videoHeight;
         const ctx = canvas.getContext('2d', { willReadFrequently: true });
         const frames = [];
+        const grab = () => {
+          ctx.clearRect(0, 0, canvas.width, canvas.height);
+          ctx.drawImage(video, 0, 0);
+          return ctx.getImageData(0, 0, canvas.width, canvas.height).data;
+        };
+        const same = (a, b) => a.every((v, i) => v === b[i]);
+        let before = grab();
         // (Frame 0 last: a seek within the frame shown decodes none.)
         for (const t of [5.5, 11.5, 0.5]) {
           await new Promise((ok) => { video.onseeked = ok; video.currentTime = t; });
-          // A busy page may draw nothing for a moment after the seek: drawn until opaque.
-          for (let i = 0; i < 200; i++) {
-            ctx.clearRect(0, 0, canvas.width, canvas.height);
-            ctx.drawImage(video, 0, 0);
-            if (ctx.getImageData(0, 0, 1, 1).data[3] === 255) break;
+          // A busy page may draw nothing for a moment after the seek, or still a frame shown
+          // before it (once the check read frame 11 as another, IoU 0.59): drawn until opaque,
+          // another frame than the last sampled (each differs from the one before), and the
+          // same twice in a row (5 s at most).
+          let img = grab();
+          let last = null;
+          for (let i = 0; i < 200 && (img[3] !== 255 || same(img, before) || !last || !same(img, last)); i++) {
             await new Promise((ok) => setTimeout(ok, 25));
+            last = img;
+            img = grab();
           }
-          frames.push(Array.from(ctx.getImageData(0, 0, canvas.width, canvas.height).data));
+          frames.push(Array.from(img));
+          before = img;
         }
         return { width: video.videoWidth, height: video.videoHeight, duration: video.duration, frames };
       }, bytes.toString('base64'));
