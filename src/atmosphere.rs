@@ -512,6 +512,36 @@ mod tests {
     }
 
     #[test]
+    fn the_sun_at_the_sliders_ends_gives_a_finite_sky() {
+        // The elevation slider's ends (±89°) and the horizon: every texel finite and not
+        // negative, no light from a sun under the ground, and a sky that still glows from
+        // above a sun just below the horizon's edge.
+        for e in [-89.0f32, -0.5, 0.0, 89.0] {
+            let sky = SkyTables::new(e.to_radians());
+            assert!(
+                sky.view
+                    .iter()
+                    .flatten()
+                    .all(|v| v.is_finite() && *v >= 0.0),
+                "{e}°"
+            );
+            for v in [
+                sky.sun_at_eye,
+                sky.sun_at_clouds,
+                sky.sky_mean,
+                sky.sky_on_ground,
+            ] {
+                assert!(v.is_finite() && v.min_element() >= 0.0, "{e}°: {v}");
+            }
+        }
+        assert_eq!(
+            SkyTables::new(-89f32.to_radians()).sun_at_clouds,
+            Vec3::ZERO
+        );
+        assert!(luminance(SkyTables::new(89f32.to_radians()).sky_mean) > 0.0);
+    }
+
+    #[test]
     fn the_skies_asked_last_are_kept() {
         // A cache of the test's own: others' tests ask the shared one meanwhile.
         let cache = SkyCache::new();
