@@ -45,6 +45,20 @@ fn fs_main(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
         tau = tau + density_at(p, octaves) * h;
         p = p + dir * h;
     }
+    // The cloud beyond, away from the sun: how deep the light that reached here can diffuse
+    // on (volume.wgsl's diffusion of the multiple scattering).
+    // Steps of two: the term is smooth (it changes the light by a few percent per optical
+    // depth), so half the march's cost buys it.
+    var tau_away = 0.0;
+    var b = start - dir * (fract(52.9829189 * fract(grain)) * 2.0 * h);
+    for (var i = 0u; i < ls.slice.y; i = i + 2u) {
+        let uvw = (b - u.grid_min.xyz) * u.grid_inv_size.xyz;
+        if any(uvw < vec3<f32>(0.0)) || any(uvw > vec3<f32>(1.0)) {
+            break;
+        }
+        tau_away = tau_away + density_at(b, octaves) * 2.0 * h;
+        b = b - dir * (2.0 * h);
+    }
     // The sky's light, from straight above: through the texels above this one, a step of two
     // texels each (the same heights in every column of a parity: no jitter, and no bands
     // between neighbouring columns either; soft light needs no finer steps), and this texel's
@@ -60,15 +74,27 @@ fn fs_main(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
         tau_up = tau_up + density_at(q, octaves) * step;
         q.y = q.y + step;
     }
+    // Diffusion through the cloud's thickness, for volume.wgsl's multiple scattering: a
+    // two-stream slab lit on one side sends the light scattered many times back out near its
+    // lit face (much cloud beyond to return it) and less near its far face, by
+    // 2(τ_away + c) / (τ_sun + τ_away + 2c); 1 where the cloud is thin, in [0, 2]. Stored as
+    // the ratio itself (halved), which is smooth: 8 bits of it, not of the depths.
+    let t_sun = u.media.x * tau;
+    let t_away = u.media.x * tau_away;
+    let diffusion = (t_away + DIFFUSION) / (t_sun + t_away + 2.0 * DIFFUSION);
     // Stored as T^(1/8) = exp(−τ/8): 8 bits keep deep shadow (T far below 1/255) that
     // multiple scattering brings back (volume.wgsl raises it to 8·k for T^k).
     return vec4<f32>(
-        exp(-u.media.x * tau / 8.0),
+        exp(-t_sun / 8.0),
         exp(-SKY_EXTINCTION * u.media.x * tau_up),
-        0.0,
+        diffusion,
         1.0,
     );
 }
+
+// The diffusion length of the multiple scattering's thickness term, in optical depths: the
+// depth over which light scattered many times forgets which face it entered by.
+const DIFFUSION: f32 = 4.0;
 
 // The share of the extinction the sky's diffuse light sees on its way down: it comes from the
 // whole upper hemisphere and much of it is scattered forward on through, so it reaches deeper

@@ -143,10 +143,17 @@ fn phase(cos_theta: f32, g: f32) -> f32 {
     return mix(hg(cos_theta, -g / 3.0), hg(cos_theta, g), 0.8);
 }
 
+// The multiple scattering's weight per unit of the Multiple scattering control: its default,
+// 0.5, gives the weight that brings the slices closest to a path trace of the same cloud
+// (scripts/check_exports.py light; docs/export-formats.md).
+const MS_GAIN: f32 = 2.5;
+
 // Light reaching the sample from the sun: `s` is the light volume's T^(1/8) (transmittance
 // toward the sun, stored so deep shadow keeps its precision), raised to Dirtiness, through
-// the phase function for the angle between the sun's light and the view ray.
-fn sun_light(s: f32, cos_theta: f32) -> f32 {
+// the phase function for the angle between the sun's light and the view ray. `diffusion` (the
+// light volume's blue, doubled) scales the light scattered many times by where the sample lies
+// in the cloud's thickness along the sun's rays (light_march.wgsl).
+fn sun_light(s: f32, diffusion: f32, cos_theta: f32) -> f32 {
     let dirt = u.sun_color.w;
     let g = u.sun_dir.w;
     // T^k = exp2(k · log2 T): one logarithm for all the octaves.
@@ -155,13 +162,13 @@ fn sun_light(s: f32, cos_theta: f32) -> f32 {
     // Multiple scattering (after Wrenninge 2013): octaves that see less extinction (×0.3
     // each), carry less energy (×0.6) and scatter less forward (×0.5), so light diffuses
     // into thick clouds instead of stopping at their sunny face.
-    let ms = u.sky_color.w;
+    let ms = MS_GAIN * u.sky_color.w;
     if ms > 0.0 {
         var a = 0.6;
         var b = 0.3;
         var c = 0.5;
         for (var i = 0; i < 3; i = i + 1) {
-            light = light + ms * a * exp2(log_t * b) * phase(cos_theta, g * c);
+            light = light + ms * a * exp2(log_t * b) * phase(cos_theta, g * c) * diffusion;
             a = a * 0.6;
             b = b * 0.3;
             c = c * 0.5;
@@ -209,7 +216,7 @@ fn cloud_at(world: vec3<f32>) -> vec4<f32> {
     // The sky's light comes through the cloud above (the light volume's green): bases and
     // hollows get less of it than tops and open sides.
     let lv = textureSampleLevel(light_tex, clamp_smp, uvw, 0.0);
-    let sun = sun_light(lv.r, dot(view_dir, u.sun_dir.xyz));
+    let sun = sun_light(lv.r, 2.0 * lv.b, dot(view_dir, u.sun_dir.xyz));
     var light = u.sun_color.rgb * sun + u.sky_color.rgb * lv.g;
     if u.haze.w > 0.5 {
         // Aerial perspective: the air between the eye and this sample takes its share of the

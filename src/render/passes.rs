@@ -803,13 +803,28 @@ pub struct LightPass {
     bank: u64,
 }
 
-/// The light volume's format: transmittance toward the sun (stored as T^(1/8)) and the sky's light
-/// let through from above, in [0, 1]; renderable and filterable everywhere.
-pub const LIGHT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg8Unorm;
+/// The light volume's format where the adapter renders and filters half floats (as it must to
+/// accumulate in them): transmittance toward the sun (stored as T^(1/8)), the sky's light let
+/// through from above, and the multiple scattering's diffusion through the cloud's thickness
+/// (halved), in [0, 1]. Half floats keep the multiple scattering smooth: its octaves raise the
+/// stored transmittance to small powers, so 8 bits of it step by a level of the image.
+pub const LIGHT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+/// The light volume's format where half floats are not renderable (plain WebGL2).
+pub const LIGHT_FORMAT_8BIT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+
+/// The light volume's format for slices accumulated in `accum_format`: half floats where the
+/// adapter accumulates in them, 8 bits otherwise.
+pub fn light_format(accum_format: wgpu::TextureFormat) -> wgpu::TextureFormat {
+    if accum_format == wgpu::TextureFormat::Rgba16Float {
+        LIGHT_FORMAT
+    } else {
+        LIGHT_FORMAT_8BIT
+    }
+}
 
 impl LightPass {
-    /// Creates the pass.
-    pub fn new(device: &wgpu::Device) -> Self {
+    /// Creates the pass, rendering the light volume's slices in `format` (`light_format`).
+    pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat) -> Self {
         let volume_size = std::mem::size_of::<VolumeUniforms>() as u64;
         let volume_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("light volume: volume"),
@@ -851,7 +866,7 @@ impl LightPass {
             "light volume",
             shaders::LIGHT_MARCH,
             &[&volume_layout, &slice_layout],
-            LIGHT_FORMAT,
+            format,
             None,
         );
         Self {

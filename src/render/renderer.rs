@@ -6,7 +6,7 @@ use super::gpu_types::{
 };
 use super::passes::{
     BackdropPass, CompositePass, FillPass, LIGHT_FORMAT, LightPass, MARCH_WORKGROUP,
-    MAX_LIGHT_SLICES, MarchPass, SkyPass, SkySlot, SlicePass,
+    MAX_LIGHT_SLICES, MarchPass, SkyPass, SkySlot, SlicePass, light_format,
 };
 use super::progressive::JobPlan;
 use super::resources::{
@@ -30,6 +30,8 @@ pub struct SliceJob {
 /// Pipelines, samplers, textures and the accumulation targets.
 pub struct VolumeRenderer {
     accum_format: wgpu::TextureFormat,
+    /// The light volume's format (`passes::light_format`).
+    light_format: wgpu::TextureFormat,
     output_format: wgpu::TextureFormat,
     slices: SlicePass,
     composite: CompositePass,
@@ -223,13 +225,24 @@ impl VolumeRenderer {
         output_format: wgpu::TextureFormat,
         accum_format: wgpu::TextureFormat,
     ) -> Self {
+        let light_format = light_format(accum_format);
+        // Full light from the sun and the sky, and no diffusion (its ratio 1, stored halved).
+        let texel = [1.0f32, 1.0, 0.5, 1.0];
+        let bytes: Vec<u8> = if light_format == LIGHT_FORMAT {
+            texel
+                .iter()
+                .flat_map(|&v| half::f16::from_f32(v).to_le_bytes())
+                .collect()
+        } else {
+            texel.iter().map(|&v| (v * 255.0).round() as u8).collect()
+        };
         let placeholder = upload_3d(
             device,
             queue,
             "light placeholder",
             [1, 1, 1],
-            LIGHT_FORMAT,
-            &[255, 255],
+            light_format,
+            &bytes,
         );
         let clamp_sampler = sampler(device, wgpu::AddressMode::ClampToEdge);
         let composite = CompositePass::new(device, output_format);
@@ -287,7 +300,8 @@ impl VolumeRenderer {
                 mapped_at_creation: false,
             }),
             beyond: None,
-            light_pass: LightPass::new(device),
+            light_pass: LightPass::new(device, light_format),
+            light_format,
             light: None,
             spare_light: None,
             light_placeholder: placeholder,
@@ -533,7 +547,7 @@ impl VolumeRenderer {
                 mip_level_count: 1,
                 sample_count: 1,
                 dimension: wgpu::TextureDimension::D3,
-                format: LIGHT_FORMAT,
+                format: self.light_format,
                 usage: wgpu::TextureUsages::COPY_DST
                     | wgpu::TextureUsages::TEXTURE_BINDING
                     | wgpu::TextureUsages::COPY_SRC,
@@ -550,7 +564,7 @@ impl VolumeRenderer {
                 mip_level_count: 1,
                 sample_count: 1,
                 dimension: wgpu::TextureDimension::D2,
-                format: LIGHT_FORMAT,
+                format: self.light_format,
                 usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
                 view_formats: &[],
             });

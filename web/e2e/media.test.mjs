@@ -245,10 +245,12 @@ for (const backend of BOTH_BUILDS) {
       const opaque = await screenshot(page, `widgets-opacity-${backend}`);
       // Under the one tone map a thin sunlit veil already shows (its light adds to the sky's),
       // so more opacity covers only a little more (1.7% more pixels at 18 levels) and changes
-      // the body's shading instead: its self-shadowing deepens.
+      // the body's shading instead: its self-shadowing deepens, the sides and base away from
+      // the sun darkening (43% of the cloud's pixels changed; the sunlit body, lit through by
+      // the multiple scattering, stays near white).
       const changed = countChanged(last, opaque, body);
       console.log(`# ${backend} opacity: coverage ${coverage(last)} → ${coverage(opaque)} px, ${changed} px changed`);
-      assert.ok(coverage(opaque) >= coverage(last) && changed > 0.1 * body.w * body.h,
+      assert.ok(coverage(opaque) >= coverage(last) && changed > 0.3 * coverage(last),
         `opacity ${opacity} → ${s.scene.render.opacity.toFixed(2)}: coverage ${coverage(last)} → ${coverage(opaque)} px, ${changed} px changed`);
 
       // The sun: drag on the orb to its right, then to its left (a drag at pointer-move rate,
