@@ -872,3 +872,48 @@ fn a_planes_keyed_inflation_blend_and_billows_pose_its_outline_as_a_fresh_one_wo
         (0.8, 0.5, 0.9)
     );
 }
+
+#[test]
+fn a_new_time_on_a_scene_with_nothing_animated_derives_nothing() {
+    // Time has its own revision: moving it on a still scene changes only the time (the noise's
+    // motion follows it in the renderer), so the derived volumes stay as they are, no work
+    // done. The baseline: the same move on a scene whose ellipsoids move re-poses them, and
+    // their part and its volume change.
+    let mut doc = Document::new(Scene::default());
+    assert!(!doc.scene().is_animated());
+    let mut derived = Derived::default();
+    let first = derived.update(doc.scene(), doc.revisions()).density;
+    let (work, before) = (derived.work(), doc.revisions());
+    for t in [0.5, 3.0, 7.25] {
+        doc.set_time(t);
+        let now = doc.revisions();
+        assert!(now.time > before.time, "the time's revision moves");
+        assert_eq!(
+            (now.geometry, now.light, now.render, now.camera, now.clock),
+            (
+                before.geometry,
+                before.light,
+                before.render,
+                before.camera,
+                before.clock
+            ),
+            "and no other part's"
+        );
+        let v = derived.update(doc.scene(), now).density;
+        assert_eq!(v.generation, first.generation);
+        assert_eq!(derived.work(), work, "nothing derived at {t} s");
+    }
+
+    let mut moving = Document::new(Scene::preset(Preset::Developing));
+    assert!(moving.scene().is_animated());
+    let mut derived = Derived::default();
+    let first = derived.update(moving.scene(), moving.revisions()).density;
+    let (bakes, geometry) = (derived.work().bakes, moving.revisions().geometry);
+    moving.set_time(0.5);
+    assert!(
+        moving.revisions().geometry > geometry,
+        "the pose moved the ellipsoids"
+    );
+    let later = derived.update(moving.scene(), moving.revisions()).density;
+    assert!(later.generation > first.generation && derived.work().bakes > bakes);
+}

@@ -45,10 +45,14 @@ pub struct Revisions {
     /// the torque change the render part too, and the view looking through the shot moves the
     /// camera).
     pub clock: u64,
+    /// The scene's time: the noise's motion and a simulation's step follow it. Moving it on a
+    /// scene with nothing animated changes no other part; where keys or motion pose values
+    /// there, the parts they moved change too.
+    pub time: u64,
 }
 
 impl Revisions {
-    /// Changes whenever any part of the document does (camera included).
+    /// Changes whenever any part of the document does (camera and time included).
     pub fn any(&self) -> u64 {
         self.geometry
             .max(self.light)
@@ -56,6 +60,7 @@ impl Revisions {
             .max(self.camera)
             .max(self.reference)
             .max(self.clock)
+            .max(self.time)
     }
 }
 
@@ -68,11 +73,18 @@ struct Changed {
     camera: bool,
     reference: bool,
     clock: bool,
+    time: bool,
 }
 
 impl Changed {
     fn any(&self) -> bool {
-        self.geometry || self.light || self.render || self.camera || self.reference || self.clock
+        self.geometry
+            || self.light
+            || self.render
+            || self.camera
+            || self.reference
+            || self.clock
+            || self.time
     }
 }
 
@@ -116,7 +128,8 @@ fn diff(a: &Scene, b: &Scene) -> Changed {
             || a.wind_field != b.wind_field,
         light: a.light != b.light,
         // A keyed wind or torque moves the noise by its integral: new keys there redraw.
-        render: a.render != b.render || a.time != b.time || drift_keys(a) != drift_keys(b),
+        render: a.render != b.render || drift_keys(a) != drift_keys(b),
+        time: a.time != b.time,
         camera: a.camera != b.camera,
         reference: a.reference != b.reference,
         clock: a.clock != b.clock || !a.animation.same_as(&b.animation) || a.shot != b.shot,
@@ -162,6 +175,7 @@ impl Document {
                 camera: n,
                 reference: n,
                 clock: n,
+                time: n,
             },
             auto_key: false,
         }
@@ -200,6 +214,7 @@ impl Document {
             (changed.camera, &mut r.camera),
             (changed.reference, &mut r.reference),
             (changed.clock, &mut r.clock),
+            (changed.time, &mut r.time),
         ] {
             if flag {
                 *rev = n;
@@ -347,7 +362,7 @@ impl Document {
 
     /// Sets the scene clock (playing, scrubbing) and poses every keyed value there, which
     /// drops an edit of a keyed value not keyed (as Blender does). Not an undo step; bumps the
-    /// render revision and those of the parts the pose moved.
+    /// time revision and those of the parts the pose moved (none where nothing is animated).
     pub fn set_time(&mut self, time: f32) {
         let time = if time.is_finite() {
             time.clamp(0.0, crate::limits::MAX_TIME)
@@ -359,7 +374,7 @@ impl Document {
             // changes.
             self.scene.time = time;
             self.bump(Changed {
-                render: true,
+                time: true,
                 ..Default::default()
             });
         } else if time != self.scene.time {
@@ -367,7 +382,7 @@ impl Document {
             let changed = diff(&self.scene, &posed);
             self.scene = posed;
             self.bump(Changed {
-                render: true,
+                time: true,
                 ..changed
             });
         }

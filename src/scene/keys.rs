@@ -1604,7 +1604,7 @@ mod tests {
             (before.geometry, before.light),
             (after.geometry, after.light)
         );
-        assert_ne!(before.render, after.render);
+        assert_ne!(before.time, after.time);
     }
 
     #[test]

@@ -24,7 +24,7 @@ pub struct SceneFiles {
 }
 
 /// A revision of everything a file holds except the view (camera moves do not make a scene
-/// unsaved, as in Blender).
+/// unsaved, as in Blender; the time, which the file holds, does).
 fn content_revision(doc: &Document) -> u64 {
     let r = doc.revisions();
     r.geometry
@@ -32,6 +32,7 @@ fn content_revision(doc: &Document) -> u64 {
         .max(r.render)
         .max(r.reference)
         .max(r.clock)
+        .max(r.time)
 }
 
 impl SceneFiles {

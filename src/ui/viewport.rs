@@ -717,7 +717,7 @@ fn view_key(doc: &Document, density: u64, px: [u32; 2], crop: Option<[u32; 4]>) 
     // from frame to frame while the document stays as it is (its image kept the first
     // frame's cloud, or chunks of several).
     let r = doc.revisions();
-    (r.geometry, r.light, r.render, r.camera, density).hash(&mut h);
+    (r.geometry, r.light, r.render, r.camera, r.time, density).hash(&mut h);
     px.hash(&mut h);
     crop.hash(&mut h);
     h.finish()
