@@ -867,6 +867,10 @@ impl Animation {
         let Some(value) = channel.repaired(&value) else {
             return false;
         };
+        // A time that is no number keys nothing (not a key thrown to 0 s).
+        if !t.is_finite() {
+            return false;
+        }
         let t = clamp_time(t);
         let at = match index {
             Some(ix) => ix.get(&channel).copied(),
@@ -980,6 +984,9 @@ impl Animation {
     /// Moves the keys of `channels` at time `from` to time `to` (a key already at `to` is
     /// replaced). Returns whether any moved.
     pub fn retime(&mut self, channels: &[Channel], from: f32, to: f32) -> bool {
+        if !to.is_finite() {
+            return false;
+        }
         let to = clamp_time(to);
         if from == to {
             return false;
@@ -1211,14 +1218,16 @@ impl Scene {
     /// unkeyed values and every item whose keyed values are already there stay as they are
     /// (shared). Returns whether anything changed.
     pub fn pose(&mut self, t: f32) -> bool {
-        // Keys first, then the motion, which sets a moving ellipsoid's centre and radii.
+        // Keys first, then the motion, which sets a moving ellipsoid's centre and radii. A time
+        // that is no number poses as 0 s, as the clock takes it.
+        let t = clamp_time(t);
         self.pose_where(t, |_| true) | self.pose_motion(t)
     }
 
     /// [`Scene::pose`] of `channels` alone (a key edit poses what it changed and leaves an
     /// unkeyed edit of another value as it is). Returns whether anything changed.
     pub fn pose_channels(&mut self, t: f32, channels: &HashSet<Channel>) -> bool {
-        !channels.is_empty() && self.pose_where(t, |c| channels.contains(&c))
+        !channels.is_empty() && self.pose_where(clamp_time(t), |c| channels.contains(&c))
     }
 
     /// Poses the tracks whose channel `which` takes.
@@ -1418,6 +1427,67 @@ mod tests {
         assert!(channels.contains(&Channel::Light {
             property: LightProperty::SunElevation
         }));
+    }
+
+    #[test]
+    fn times_that_are_not_numbers_key_nothing_move_nothing_and_pose_as_zero() {
+        let mut scene = one_ellipsoid();
+        let id = scene.ellipsoids[0].id;
+        let strength = Channel::Ellipsoid {
+            id,
+            property: EllipsoidProperty::Strength,
+        };
+        let mut anim = Animation::default();
+        assert!(anim.key(strength, 1.0, vec![0.25]));
+        assert!(anim.key(strength, 3.0, vec![0.75]));
+        for bad in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+            // No key at 0 s (nor at the cap) from a time that is no number...
+            assert!(!anim.key(strength, bad, vec![0.5]), "{bad}");
+            // ...nor a key dragged there.
+            assert!(!anim.retime(&[strength], 3.0, bad), "{bad}");
+            assert_eq!(anim.remove_at(&[strength], bad), 0, "{bad}");
+        }
+        assert_eq!(
+            anim.tracks[0]
+                .keys
+                .iter()
+                .map(|k| (k.t, k.value[0]))
+                .collect::<Vec<_>>(),
+            vec![(1.0, 0.25), (3.0, 0.75)]
+        );
+        // A document's keys at such times (a damaged file or link) are dropped, with a message.
+        let mut damaged = anim.clone();
+        let track = Arc::make_mut(&mut damaged.tracks[0]);
+        track.keys.insert(
+            0,
+            Key {
+                t: f32::NEG_INFINITY,
+                value: vec![1.0],
+                ease: Ease::default(),
+            },
+        );
+        track.keys.push(Key {
+            t: f32::NAN,
+            value: vec![1.0],
+            ease: Ease::default(),
+        });
+        let said = damaged.repair(&scene).join("\n");
+        assert!(
+            said.contains("2 keys") && said.contains("not finite"),
+            "{said}"
+        );
+        assert_eq!(damaged, anim);
+        // Posed at such a time, the scene is as at 0 s, every value a number.
+        scene.animation = anim;
+        let at_zero = scene.posed_at(0.0);
+        for bad in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+            let posed = scene.posed_at(bad);
+            assert_eq!(posed.time, 0.0);
+            assert_eq!(posed.ellipsoids[0].strength, at_zero.ellipsoids[0].strength);
+            let mut in_place = scene.clone();
+            in_place.pose(bad);
+            assert_eq!(in_place.ellipsoids[0].strength, 0.25, "{bad}");
+        }
     }
 
     #[test]
