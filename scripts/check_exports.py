@@ -193,10 +193,10 @@ def check_light(d):
     cloud (the app's alpha over one half), for suns in front, to the side and behind: luminance
     rank correlation, mean ratio, and the ratio of their 90th/10th-percentile contrasts. The
     mean ratio is held within 0.75-1.33 for every sun: the multiple scattering's calibrated
-    weight and diffusion (volume.wgsl) give 1.02 / 1.19 / 0.81 (behind / front / side) at this
-    trace's 64 samples; the light before them, 1.59 / 2.68 / 1.90. The correlation and contrast
+    weight and diffusion (volume.wgsl, light_march.wgsl) give 1.18 / 1.23 / 0.80 (behind / front /
+    side) at this trace's 64 samples; the light before them, 1.59 / 2.68 / 1.90. The correlation and contrast
     are printed, not held, but for one guard: with the sun in front the rank correlation must
-    reach 0.45 (0.53 here; 0.30 at 1024 samples without the diffusion, which is what moves the
+    reach 0.5 (0.63 here; 0.30 at 1024 samples without the diffusion, which is what moves the
     light to the thick centre). #37's target for them (>= 0.9, 0.8-1.25) is met to the side and
     behind at 1024 samples, not in front, and 64 samples' noise alone lowers the correlation."""
     import mitsuba as mi
@@ -223,8 +223,8 @@ def check_light(d):
     for name, (_, mean, _) in figures.items():
         if not 0.75 <= mean <= 1.33:
             fail(f"light_{name}: the path trace's mean light is {mean:.3f}x the app's (0.75-1.33)")
-    if "front" in figures and figures["front"][0] < 0.45:
-        fail(f"light_front: rank correlation {figures['front'][0]:.3f} < 0.45 (no diffusion?)")
+    if "front" in figures and figures["front"][0] < 0.5:
+        fail(f"light_front: rank correlation {figures['front'][0]:.3f} < 0.5 (no diffusion?)")
     return figures
 
 

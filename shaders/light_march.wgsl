@@ -77,11 +77,13 @@ fn fs_main(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
     // Diffusion through the cloud's thickness, for volume.wgsl's multiple scattering: a
     // two-stream slab lit on one side sends the light scattered many times back out near its
     // lit face (much cloud beyond to return it) and less near its far face, by
-    // 2(τ_away + c) / (τ_sun + τ_away + 2c); 1 where the cloud is thin, in [0, 2]. Stored as
-    // the ratio itself (halved), which is smooth: 8 bits of it, not of the depths.
+    // 2(τ_away + c) / (τ_sun + τ_away + 2c); and a cloud thin along the sun's rays scatters
+    // little of its light more than once, by 1 − exp(−(τ_sun + τ_away)/THIN). In [0, 2],
+    // stored halved: the ratio itself, which is smooth (8 bits of it, not of the depths).
     let t_sun = u.media.x * tau;
     let t_away = u.media.x * tau_away;
-    let diffusion = (t_away + DIFFUSION) / (t_sun + t_away + 2.0 * DIFFUSION);
+    let diffusion = (t_away + DIFFUSION) / (t_sun + t_away + 2.0 * DIFFUSION)
+        * (1.0 - exp(-(t_sun + t_away) / THIN));
     // Stored as T^(1/8) = exp(−τ/8): 8 bits keep deep shadow (T far below 1/255) that
     // multiple scattering brings back (volume.wgsl raises it to 8·k for T^k).
     return vec4<f32>(
@@ -95,6 +97,9 @@ fn fs_main(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
 // The diffusion length of the multiple scattering's thickness term, in optical depths: the
 // depth over which light scattered many times forgets which face it entered by.
 const DIFFUSION: f32 = 4.0;
+// The optical depth along the sun's rays over which a cloud goes from scattering its light once
+// to scattering it many times.
+const THIN: f32 = 4.0;
 
 // The share of the extinction the sky's diffuse light sees on its way down: it comes from the
 // whole upper hemisphere and much of it is scattered forward on through, so it reaches deeper

@@ -190,7 +190,12 @@ fn table_2_filters_and_the_worley_basis_each_change_the_media() {
     // difference comes from the media).
     let base = with(
         &Scene::default(),
-        &["/render/slices=64", "/render/noise_amount=0.6"],
+        &[
+            "/render/slices=64",
+            "/render/noise_amount=0.6",
+            // Half the sun: the cloud in the tone map's middle, not its shoulder near white.
+            "/light/sun_intensity=0.8",
+        ],
     );
     let images: Vec<_> = ["stratus", "cumulus", "wispy", "veined"]
         .iter()

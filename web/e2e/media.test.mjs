@@ -246,7 +246,7 @@ for (const backend of BOTH_BUILDS) {
       // Under the one tone map a thin sunlit veil already shows (its light adds to the sky's),
       // so more opacity covers only a little more (1.7% more pixels at 18 levels) and changes
       // the body's shading instead: its self-shadowing deepens, the sides and base away from
-      // the sun darkening (43% of the cloud's pixels changed; the sunlit body, lit through by
+      // the sun darkening (48% of the cloud's pixels changed; the sunlit body, lit through by
       // the multiple scattering, stays near white).
       const changed = countChanged(last, opaque, body);
       console.log(`# ${backend} opacity: coverage ${coverage(last)} → ${coverage(opaque)} px, ${changed} px changed`);
