@@ -917,3 +917,46 @@ fn a_new_time_on_a_scene_with_nothing_animated_derives_nothing() {
     let later = derived.update(moving.scene(), moving.revisions()).density;
     assert!(later.generation > first.generation && derived.work().bakes > bakes);
 }
+
+#[test]
+fn a_scrub_re_bakes_only_the_bricks_the_moving_ellipsoid_reaches() {
+    // Two ellipsoids far apart, one rising by its motion: a new time re-poses it and the bake
+    // re-evaluates the bricks of its old and new place alone (the grid stays as it was), and
+    // the result is a fresh derivation's. The wrong
+    // version, a whole bake on every scrub, evaluates every texel.
+    use crate::scene::{Ellipsoid, Motion};
+    let mut scene = Scene::preset(Preset::Empty);
+    // The still one is the taller, so the rising one stays inside the box.
+    let still = Ellipsoid::new(Vec3::new(-6.0, 0.0, 0.0), Vec3::new(1.5, 4.0, 1.5));
+    let mut rising = Ellipsoid::new(Vec3::new(6.0, 0.0, 0.0), Vec3::new(1.5, 1.0, 1.5));
+    rising.motion = Some(Motion {
+        carried: false,
+        rise: 0.4,
+        from: rising.center,
+        size: rising.radii,
+        ..Motion::default()
+    });
+    scene.ellipsoids = vec![Arc::new(still), Arc::new(rising)];
+    scene.settle();
+    let mut doc = Document::new(scene);
+    let mut derived = Derived::default();
+    let first = derived.update(doc.scene(), doc.revisions()).density;
+    let total = first.data.values.len() as u64;
+    assert!(total > 10_000, "{total} texels");
+    for t in [0.25, 0.5, 1.0] {
+        let before = derived.work().baked_texels;
+        doc.set_time(t);
+        let v = derived.update(doc.scene(), doc.revisions()).density;
+        let texels = derived.work().baked_texels - before;
+        assert_eq!(v.data.values.len() as u64, total, "the same grid at {t} s");
+        assert!(
+            texels > 0 && texels * 2 < total,
+            "{texels} of {total} texels re-evaluated at {t} s"
+        );
+        assert_eq!(
+            *v.data,
+            *density_of(doc.scene()),
+            "a fresh derivation at {t} s"
+        );
+    }
+}
