@@ -126,6 +126,13 @@ pub enum LightProperty {
     Ambient,
     /// Exposure in stops.
     Exposure,
+    /// The sky's colour (sRGB): its light on the cloud, and the sky at the zenith with the
+    /// gradient.
+    SkyColor,
+    /// The horizon's colour (sRGB) of the sky gradient.
+    HorizonColor,
+    /// The background colour (sRGB): the flat sky, or the gradient's zenith.
+    Background,
 }
 
 /// A keyed property of the cloud's media (Schpok's Table 2 controls).
@@ -269,7 +276,10 @@ impl Channel {
                 PlaneProperty::Billows => 2,
             },
             Channel::Light { property } => match property {
-                LightProperty::SunColor => 3,
+                LightProperty::SunColor
+                | LightProperty::SkyColor
+                | LightProperty::HorizonColor
+                | LightProperty::Background => 3,
                 _ => 1,
             },
             Channel::Media {
@@ -378,6 +388,9 @@ impl Channel {
                     LightProperty::SunColor => l.sun_color.to_vec(),
                     LightProperty::Ambient => vec![l.ambient],
                     LightProperty::Exposure => vec![l.exposure],
+                    LightProperty::SkyColor => l.sky_color.to_vec(),
+                    LightProperty::HorizonColor => l.horizon_color.to_vec(),
+                    LightProperty::Background => l.background.to_vec(),
                 }
             }
             Channel::Media { property } => {
@@ -469,6 +482,9 @@ impl Channel {
                     LightProperty::SunColor => l.sun_color = [value[0], value[1], value[2]],
                     LightProperty::Ambient => l.ambient = value[0],
                     LightProperty::Exposure => l.exposure = value[0],
+                    LightProperty::SkyColor => l.sky_color = [value[0], value[1], value[2]],
+                    LightProperty::HorizonColor => l.horizon_color = [value[0], value[1], value[2]],
+                    LightProperty::Background => l.background = [value[0], value[1], value[2]],
                 }
             }
             Channel::Media { property } => {
@@ -545,7 +561,10 @@ impl Channel {
                 LightProperty::SunAzimuth => param(value[0], limits::SUN_AZIMUTH),
                 LightProperty::SunElevation => param(value[0], limits::SUN_ELEVATION),
                 LightProperty::SunIntensity => param(value[0], limits::SUN_INTENSITY),
-                LightProperty::SunColor => value.iter().map(|c| c.clamp(0.0, 1.0)).collect(),
+                LightProperty::SunColor
+                | LightProperty::SkyColor
+                | LightProperty::HorizonColor
+                | LightProperty::Background => value.iter().map(|c| c.clamp(0.0, 1.0)).collect(),
                 LightProperty::Ambient => param(value[0], limits::AMBIENT),
                 LightProperty::Exposure => param(value[0], limits::EXPOSURE),
             },
@@ -669,13 +688,16 @@ impl Index {
 }
 
 /// The light's keyable properties.
-pub const LIGHT: [LightProperty; 6] = [
+pub const LIGHT: [LightProperty; 9] = [
     LightProperty::SunAzimuth,
     LightProperty::SunElevation,
     LightProperty::SunIntensity,
     LightProperty::SunColor,
     LightProperty::Ambient,
     LightProperty::Exposure,
+    LightProperty::SkyColor,
+    LightProperty::HorizonColor,
+    LightProperty::Background,
 ];
 
 /// The media's keyable properties.
@@ -1430,6 +1452,55 @@ mod tests {
     }
 
     #[test]
+    fn the_skys_horizons_and_backgrounds_colours_key_pose_and_record_like_the_suns() {
+        use crate::scene::{Document, Edit};
+        let mut doc = Document::new(one_ellipsoid());
+        let mut anim = Animation::default();
+        for (property, at_0, at_2) in [
+            (LightProperty::SkyColor, [0.2, 0.4, 0.8], [0.8, 0.4, 0.2]),
+            (
+                LightProperty::HorizonColor,
+                [1.0, 1.0, 1.0],
+                [0.0, 0.5, 1.0],
+            ),
+            (LightProperty::Background, [0.0, 0.0, 0.0], [0.5, 1.0, 0.25]),
+        ] {
+            let channel = Channel::Light { property };
+            assert_eq!(channel.width(), 3);
+            assert!(anim.key(channel, 0.0, at_0.to_vec()));
+            assert!(anim.key(channel, 2.0, at_2.to_vec()));
+            // Out of range, a colour is brought within [0, 1], as the picker's.
+            assert!(anim.key(channel, 4.0, vec![2.0, -1.0, 0.5]));
+            assert_eq!(
+                anim.track(channel).unwrap().keys[2].value,
+                vec![1.0, 0.0, 0.5]
+            );
+        }
+        doc.apply(Edit::SetAnimation(anim, "insert keys"), None);
+        let light = doc.revisions().light;
+        doc.set_time(1.0);
+        assert!(doc.revisions().light > light, "the pose changed the light");
+        let l = &doc.scene().light;
+        assert_eq!(l.sky_color, [0.5, 0.4, 0.5]);
+        assert_eq!(l.horizon_color, [0.5, 0.75, 1.0]);
+        assert_eq!(l.background, [0.25, 0.5, 0.125]);
+        // Auto-key records an edit of one: a picked background at 3 s is a key there, and
+        // the other two colours are left as they are.
+        let mut edited = doc.scene().clone();
+        edited.light.background = [0.9, 0.1, 0.1];
+        let mut anim = doc.scene().animation.clone();
+        assert_eq!(anim.record_changes(doc.scene(), &edited, 3.0), 1);
+        let background = Channel::Light {
+            property: LightProperty::Background,
+        };
+        assert_eq!(
+            anim.track(background).unwrap().key_at(3.0).unwrap().value,
+            vec![0.9, 0.1, 0.1]
+        );
+        assert_eq!(anim.tracks.iter().map(|t| t.keys.len()).sum::<usize>(), 10);
+    }
+
+    #[test]
     fn times_that_are_not_numbers_key_nothing_move_nothing_and_pose_as_zero() {
         let mut scene = one_ellipsoid();
         let id = scene.ellipsoids[0].id;
@@ -1664,7 +1735,7 @@ mod tests {
     }
 
     #[test]
-    fn a_new_time_on_a_scene_without_keys_moves_only_the_render_revision() {
+    fn a_new_time_on_a_scene_without_keys_moves_only_the_time_revision() {
         use crate::scene::Document;
         let mut doc = Document::new(one_ellipsoid());
         let before = doc.revisions();
