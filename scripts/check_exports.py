@@ -196,8 +196,8 @@ def check_light(d):
     weight and diffusion (volume.wgsl, light_march.wgsl) give 1.18 / 1.23 / 0.80 (behind / front /
     side) at this trace's 64 samples; the light before them, 1.59 / 2.68 / 1.90. The correlation and contrast
     are printed, not held, but for one guard: with the sun in front the rank correlation must
-    reach 0.5 (0.63 here; 0.30 at 1024 samples without the diffusion, which is what moves the
-    light to the thick centre). #37's target for them (>= 0.9, 0.8-1.25) is met to the side and
+    reach 0.58 (0.63 here, the trace seeded; 0.53 without the thin cloud's term, 0.30 at 1024
+    samples without the diffusion, which is what moves the light to the thick centre). #37's target for them (>= 0.9, 0.8-1.25) is met to the side and
     behind at 1024 samples, not in front, and 64 samples' noise alone lowers the correlation."""
     import mitsuba as mi
     import numpy as np
@@ -223,8 +223,10 @@ def check_light(d):
     for name, (_, mean, _) in figures.items():
         if not 0.75 <= mean <= 1.33:
             fail(f"light_{name}: the path trace's mean light is {mean:.3f}x the app's (0.75-1.33)")
-    if "front" in figures and figures["front"][0] < 0.5:
-        fail(f"light_front: rank correlation {figures['front'][0]:.3f} < 0.5 (no diffusion?)")
+    if "front" not in figures:
+        fail("app_view.json has no front-lit sun to hold the diffusion by")
+    if figures["front"][0] < 0.58:
+        fail(f"light_front: rank correlation {figures['front'][0]:.3f} < 0.58 (no diffusion?)")
     return figures
 
 

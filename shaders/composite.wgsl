@@ -24,9 +24,18 @@ struct Behind {
     place: vec4<f32>,
     // rgb: the flat background's display colour; w: 1 when it is that colour, not the texture.
     flat: vec4<f32>,
-    // rgb: the flat background's light (`light_of(flat.rgb)`, worked out once on the CPU).
+    // rgb: the flat background's light (`light_of(flat.rgb)`, worked out once on the CPU);
+    // w: what the accumulated light is multiplied by (0: as it is; the 8-bit scale undone).
     flat_light: vec4<f32>,
 };
+
+// The cloud's accumulated pixel at `uv`, its light as the slices drew it: an 8-bit target holds
+// it scaled down (VolumeUniforms' haze_light.w), which `behind.flat_light.w` undoes.
+fn accumulated(uv: vec2<f32>) -> vec4<f32> {
+    let p = textureSampleLevel(src, src_smp, uv, 0.0);
+    let k = select(1.0, behind.flat_light.w, behind.flat_light.w > 0.0);
+    return vec4<f32>(p.rgb * k, p.a);
+}
 
 // What lies behind one pixel: its display colour and its light.
 struct Seen {
@@ -72,7 +81,7 @@ fn cloud(p: vec4<f32>) -> vec4<f32> {
 
 @fragment
 fn fs_main(in: Fullscreen) -> @location(0) vec4<f32> {
-    let p = textureSampleLevel(src, src_smp, in.uv, 0.0);
+    let p = accumulated(in.uv);
     if p.a <= 1e-4 {
         discard;
     }
@@ -81,7 +90,7 @@ fn fs_main(in: Fullscreen) -> @location(0) vec4<f32> {
 
 @fragment
 fn fs_transparent(in: Fullscreen) -> @location(0) vec4<f32> {
-    let p = textureSampleLevel(src, src_smp, in.uv, 0.0);
+    let p = accumulated(in.uv);
     if p.a <= 1e-4 {
         discard;
     }
@@ -90,7 +99,7 @@ fn fs_transparent(in: Fullscreen) -> @location(0) vec4<f32> {
 
 // The cloud with the shafts' `light` added, over what lies behind.
 fn with_light(uv: vec2<f32>, light: vec3<f32>) -> vec4<f32> {
-    let p = textureSampleLevel(src, src_smp, uv, 0.0);
+    let p = accumulated(uv);
     let some = p.a > 1e-4;
     return over_behind(behind_at(uv), select(0.0, p.a, some), select(vec3<f32>(0.0), p.rgb, some), light);
 }
@@ -98,7 +107,7 @@ fn with_light(uv: vec2<f32>, light: vec3<f32>) -> vec4<f32> {
 // The same over no background: the cloud alone, with the display of the shafts' light added
 // (what that light shows over black: mapped alone, sRGB-encoded).
 fn with_light_transparent(uv: vec2<f32>, light: vec3<f32>) -> vec4<f32> {
-    let p = textureSampleLevel(src, src_smp, uv, 0.0);
+    let p = accumulated(uv);
     var out = vec4<f32>(0.0);
     if p.a > 1e-4 {
         out = cloud(p);
@@ -115,7 +124,7 @@ fn fs_shafts(in: Fullscreen) -> @location(0) vec4<f32> {
 // beyond the box, drawn apart, seen through the whole cloud, as the slices would have hidden
 // them had they been drawn among them.
 fn beyond_light(uv: vec2<f32>) -> vec3<f32> {
-    let alpha = textureSampleLevel(src, src_smp, uv, 0.0).a;
+    let alpha = accumulated(uv).a;
     let beyond = textureSampleLevel(beyond_tex, src_smp, beyond_uv.xy + uv * beyond_uv.zw, 0.0).rgb;
     let own = textureSampleLevel(shafts_tex, src_smp, uv, 0.0).rgb;
     return own + (1.0 - alpha) * beyond;
@@ -149,7 +158,7 @@ fn fs_shafts_transparent(in: Fullscreen) -> @location(0) vec4<f32> {
 // the linear light behind it. Premultiplied light over nothing stays light with no alpha (it
 // adds to whatever lies under it), so over a transparent background it needs no glow.
 fn linear_with_light(uv: vec2<f32>, shafts: vec3<f32>) -> vec4<f32> {
-    let p = textureSampleLevel(src, src_smp, uv, 0.0);
+    let p = accumulated(uv);
     var out = vec4<f32>(0.0);
     if p.a > 1e-4 {
         out = p;
@@ -159,7 +168,7 @@ fn linear_with_light(uv: vec2<f32>, shafts: vec3<f32>) -> vec4<f32> {
 
 @fragment
 fn fs_linear(in: Fullscreen) -> @location(0) vec4<f32> {
-    let p = textureSampleLevel(src, src_smp, in.uv, 0.0);
+    let p = accumulated(in.uv);
     if p.a <= 1e-4 {
         discard;
     }

@@ -3,8 +3,10 @@
 // slices draw — the field *with its noise* (fewer octaves: `LightSlice.slice.z`) — marched in
 // steps toward the sun (red), and how much of the sky's light the cloud above lets through
 // (green: the transmittance toward the zenith, diffuse light seeing SKY_EXTINCTION of the
-// extinction), so the sky lights tops and open sides, not bases and hollows. One render pass per z-slice of the 3D texture (WebGL2 can render into
-// 3D texture slices; it has no compute). Composed after volume_common.wgsl and
+// extinction), so the sky lights tops and open sides, not bases and hollows, and (blue) the
+// multiple scattering's diffusion, from the depths toward the sun and away from it through
+// the cloud beyond (a second march). One render pass per z-slice of the 3D texture (WebGL2 can
+// render into 3D texture slices; it has no compute). Composed after volume_common.wgsl and
 // volume_noise.wgsl; `LightSlice` mirrors `LightSliceUniforms` in src/render/gpu_types.rs.
 
 struct LightSlice {

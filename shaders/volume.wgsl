@@ -227,13 +227,20 @@ fn cloud_at(world: vec3<f32>) -> vec4<f32> {
     return vec4<f32>(light * alpha, alpha);
 }
 
+// The scale of the light accumulated in the slices' target: 1 in floats, less in 8 bits
+// (plain WebGL2), which would clip a sunlit cloud's light at 1; the composite scales it back.
+fn accumulated(c: vec4<f32>) -> vec4<f32> {
+    let k = select(1.0, u.haze_light.w, u.haze_light.w > 0.0);
+    return vec4<f32>(c.rgb * k, c.a);
+}
+
 @fragment
 fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
     let c = cloud_at(in.world);
     if c.a <= 0.0 {
         discard;
     }
-    return c;
+    return accumulated(c);
 }
 
 // Sunlight the air scatters toward the eye over one shell's stretch of the pixel's ray
@@ -284,14 +291,15 @@ fn fs_shafts(in: VsOut) -> ShaftsOut {
         out.shafts = light;
         // The shells drawn apart (beyond the clouds' box, only ever drawn with no slice) also
         // into the first target, which the viewport lays under its cloud's box.
-        out.cloud = select(vec4<f32>(0.0), light, f32(in.shell) < u.air.z);
+        out.cloud = accumulated(select(vec4<f32>(0.0), light, f32(in.shell) < u.air.z));
         return out;
     }
-    out.cloud = cloud_at(in.world);
-    if out.cloud.a <= 0.0 {
+    let c = cloud_at(in.world);
+    if c.a <= 0.0 {
         discard;
     }
-    out.shafts = vec4<f32>(0.0, 0.0, 0.0, out.cloud.a);
+    out.cloud = accumulated(c);
+    out.shafts = vec4<f32>(0.0, 0.0, 0.0, c.a);
     return out;
 }
 
@@ -337,7 +345,7 @@ fn fs_outside_shafts(in: VsOut) -> ShaftsOut {
     let scale = u.sun_color.rgb
         * (u.shafts.w * (1.0 - exp(-sigma * spacing)) * hg(dot(dir, u.sun_dir.xyz), u.air.y));
     var out: ShaftsOut;
-    out.cloud = vec4<f32>(scale * beyond, 0.0);
+    out.cloud = accumulated(vec4<f32>(scale * beyond, 0.0));
     out.shafts = vec4<f32>(scale * all, 0.0);
     return out;
 }

@@ -80,7 +80,8 @@ pub struct VolumeUniforms {
     /// what the air between the eye and a sample takes out of its light); w: 1 when on.
     pub haze: [f32; 4],
     /// The light the air adds in its place (rgb): the physical sky's toward the cloud, at this
-    /// exposure.
+    /// exposure; w: the scale of the light the slices accumulate (0 or 1: as it is;
+    /// [`EIGHT_BIT_LIGHT_SCALE`] in an 8-bit target).
     pub haze_light: [f32; 4],
 }
 
@@ -341,9 +342,16 @@ pub struct BehindUniforms {
     pub place: [f32; 4],
     /// The flat background's display colour (rgb); w: 1 when there is no texture behind.
     pub flat: [f32; 4],
-    /// The flat background's light (rgb): `tone::light_of` of its display colour.
+    /// The flat background's light (rgb): `tone::light_of` of its display colour; w: what the
+    /// cloud's accumulated light is multiplied by before the tone map (0 or 1: as it is; 8-bit
+    /// accumulation stores it scaled by [`EIGHT_BIT_LIGHT_SCALE`]).
     pub flat_light: [f32; 4],
 }
+
+/// The scale of the light the slices accumulate in an 8-bit target (plain WebGL2, no float
+/// targets): a sunlit cloud's light is over 1, which 8 bits would clip; scaled, it fits up to
+/// 1 / this. The composite scales it back.
+pub const EIGHT_BIT_LIGHT_SCALE: f32 = 0.25;
 
 impl BehindUniforms {
     /// Names and byte offsets of the members, in order (checked against the WGSL struct).
@@ -370,6 +378,13 @@ impl BehindUniforms {
             place,
             ..Self::default()
         }
+    }
+
+    /// The same, for a cloud accumulated with its light scaled by `scale`
+    /// (`resources::accumulation_light_scale`).
+    pub fn accumulated_at(mut self, scale: f32) -> Self {
+        self.flat_light[3] = 1.0 / scale;
+        self
     }
 }
 

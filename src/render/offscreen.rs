@@ -177,6 +177,8 @@ pub struct Offscreen {
     can_march: bool,
     /// What its images hold.
     output: Output,
+    /// The accumulation format the adapter allows (`resources::accumulation_format`).
+    accumulation: wgpu::TextureFormat,
 }
 
 /// How a timed frame is drawn.
@@ -302,12 +304,8 @@ impl Offscreen {
             .await
             .map_err(|e| OffscreenError::Device(e.to_string()))?;
         let stamps = (features == Stamps::FEATURES).then(|| Stamps::new(&device, &queue));
-        let mut renderer = VolumeRenderer::new(
-            &device,
-            &queue,
-            output.format(),
-            accumulation_format(&adapter),
-        );
+        let accumulation = accumulation_format(&adapter);
+        let mut renderer = VolumeRenderer::new(&device, &queue, output.format(), accumulation);
         renderer.set_marching(&device, marches_by_default(&adapter, &device));
         let can_march = can_march(&adapter, &device);
         Ok(Self {
@@ -320,7 +318,30 @@ impl Offscreen {
             stamps,
             can_march,
             output,
+            accumulation,
         })
+    }
+
+    /// Draws as a browser without float targets (plain WebGL2) must: the slices accumulated
+    /// and the light volume kept in 8 bits, the slices rasterised; or, `false`, back in the
+    /// adapter's own formats (still rasterised after the 8 bits: [`Offscreen::set_marching`]
+    /// marches again). So any adapter tests the 8-bit path. Display images only.
+    pub fn set_eight_bit(&mut self, on: bool) -> Result<(), OffscreenError> {
+        self.expect(Output::Display)?;
+        let accumulation = if on {
+            wgpu::TextureFormat::Rgba8Unorm
+        } else {
+            self.accumulation
+        };
+        let marching = !on && self.renderer.marching();
+        self.renderer = VolumeRenderer::new(
+            &self.device,
+            &self.queue,
+            self.output.format(),
+            accumulation,
+        );
+        self.renderer.set_marching(&self.device, marching);
+        Ok(())
     }
 
     /// Marches the slices in a compute pass (the default on GPUs that can) or rasterises them

@@ -10,7 +10,8 @@ use super::passes::{
 };
 use super::progressive::JobPlan;
 use super::resources::{
-    MarchImages, TARGETS, Target, VolumeTextures, accumulation_texture, sampler, upload_3d,
+    MarchImages, TARGETS, Target, VolumeTextures, accumulation_light_scale, accumulation_texture,
+    sampler, upload_3d,
 };
 use crate::derive::Volumes;
 
@@ -712,6 +713,7 @@ impl VolumeRenderer {
         // No slice and one instance, a shell's triangle over the whole view, in which
         // fs_outside_shafts sums every shell's light.
         let mut uniforms = VolumeUniforms::new(view, &volume, total, 0..total, Some(&shells));
+        uniforms.haze_light[3] = accumulation_light_scale(self.accum_format);
         uniforms.shells[0] = 0.0;
         uniforms.shells[1] = 1.0;
         uniforms.shells[2] = 0.0;
@@ -801,13 +803,14 @@ impl VolumeRenderer {
             target.has_shafts = shells.is_some();
         }
         let with_shafts = target.has_shafts && shells.is_some();
-        let uniforms = VolumeUniforms::new(
+        let mut uniforms = VolumeUniforms::new(
             &job.view,
             &volume,
             plan.total,
             plan.range.clone(),
             shells.as_ref().filter(|_| with_shafts),
         );
+        uniforms.haze_light[3] = accumulation_light_scale(self.accum_format);
         let offset = self.slices.write(queue, &uniforms);
         let load = if plan.clear {
             wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT)
@@ -1083,7 +1086,10 @@ impl VolumeRenderer {
             queue.write_buffer(
                 &self.flat_image.0,
                 0,
-                bytemuck::bytes_of(&BehindUniforms::flat(place, shown)),
+                bytemuck::bytes_of(
+                    &BehindUniforms::flat(place, shown)
+                        .accumulated_at(accumulation_light_scale(self.accum_format)),
+                ),
             );
             return ImageBehind::Flat(wgpu::Color {
                 r: r.into(),
@@ -1108,7 +1114,10 @@ impl VolumeRenderer {
         queue.write_buffer(
             &self.behind_uniforms[SkySlot::Image as usize],
             0,
-            bytemuck::bytes_of(&BehindUniforms::backdrop(place)),
+            bytemuck::bytes_of(
+                &BehindUniforms::backdrop(place)
+                    .accumulated_at(accumulation_light_scale(self.accum_format)),
+            ),
         );
         ImageBehind::Backdrop
     }
@@ -1303,14 +1312,15 @@ impl VolumeRenderer {
     /// with [`VolumeRenderer::viewport_behind`].
     pub fn prepare_behind(&mut self, queue: &wgpu::Queue, crop: [f32; 4], flat: Option<[f32; 3]>) {
         self.viewport_flat = flat.is_some() || self.backdrop.is_none();
+        let scale = accumulation_light_scale(self.accum_format);
         let (buffer, uniforms) = match flat {
             Some(shown) => (
                 &self.flat_behind.0,
-                BehindUniforms::flat(place_of(crop), shown),
+                BehindUniforms::flat(place_of(crop), shown).accumulated_at(scale),
             ),
             None => (
                 &self.behind_uniforms[SkySlot::Viewport as usize],
-                BehindUniforms::backdrop(place_of(crop)),
+                BehindUniforms::backdrop(place_of(crop)).accumulated_at(scale),
             ),
         };
         queue.write_buffer(buffer, 0, bytemuck::bytes_of(&uniforms));

@@ -260,6 +260,16 @@ pub fn accumulation_format(adapter: &wgpu::Adapter) -> wgpu::TextureFormat {
     }
 }
 
+/// The scale the slices apply to the light they accumulate in `format`: 1 in floats,
+/// [`super::gpu_types::EIGHT_BIT_LIGHT_SCALE`] in 8 bits (the composite scales it back).
+pub fn accumulation_light_scale(format: wgpu::TextureFormat) -> f32 {
+    if format == wgpu::TextureFormat::Rgba16Float {
+        1.0
+    } else {
+        super::gpu_types::EIGHT_BIT_LIGHT_SCALE
+    }
+}
+
 /// Whether `device` (of `adapter`) can march the slices (`shaders/volume_march.wgsl`):
 /// compute shaders, storage images of the marched slices' format, and limits that allow the
 /// pass (a device asked for WebGL2's limits, as egui-wgpu asks on every GL backend, has none).
