@@ -2292,9 +2292,21 @@ fn the_eight_bit_path_draws_the_float_paths_image_within_rounding() {
             &["/render/slices=64"],
         );
         let float = o.render(&scene, W, H, Backdrop::Sky).expect("render");
+        let float_alone = o
+            .render(&scene, W, H, Backdrop::Transparent)
+            .expect("render");
         o.set_eight_bit(true).unwrap();
         let eight = o.render(&scene, W, H, Backdrop::Sky).expect("render");
+        let eight_alone = o
+            .render(&scene, W, H, Backdrop::Transparent)
+            .expect("render");
         o.set_eight_bit(false).unwrap();
+        // The cloud alone (a transparent PNG) too: nothing behind it to carry the scale back.
+        let (mean_alone, _) = image_difference(&float_alone, &eight_alone);
+        assert!(
+            mean_alone < 0.5,
+            "{name} alone: 8 bits against half floats: mean {mean_alone:.2}"
+        );
         let (mean, worst) = image_difference(&float, &eight);
         let bg = background(&scene);
         let brightness = |image: &Image| {

@@ -267,6 +267,13 @@ impl VolumeRenderer {
         let flat_image_buffer = behind_buffer();
         let flat_image_group =
             composite.behind_group(device, &shafts_placeholder, &flat_image_buffer);
+        // What a transparent image's composite reads (nothing behind): the accumulation's
+        // light scale, which 8 bits need undone.
+        let nothing =
+            BehindUniforms::default().accumulated_at(accumulation_light_scale(accum_format));
+        for buffer in [&flat_buffer, &flat_image_buffer] {
+            queue.write_buffer(buffer, 0, bytemuck::bytes_of(&nothing));
+        }
         Self {
             accum_format,
             output_format,
