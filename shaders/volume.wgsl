@@ -291,7 +291,9 @@ fn fs_shafts(in: VsOut) -> ShaftsOut {
         out.shafts = light;
         // The shells drawn apart (beyond the clouds' box, only ever drawn with no slice) also
         // into the first target, which the viewport lays under its cloud's box.
-        out.cloud = accumulated(select(vec4<f32>(0.0), light, f32(in.shell) < u.air.z));
+        // (Drawn into the target of the shafts apart, which the composite reads as light as
+        // it is, not the accumulation: unscaled.)
+        out.cloud = select(vec4<f32>(0.0), light, f32(in.shell) < u.air.z);
         return out;
     }
     let c = cloud_at(in.world);
@@ -345,7 +347,8 @@ fn fs_outside_shafts(in: VsOut) -> ShaftsOut {
     let scale = u.sun_color.rgb
         * (u.shafts.w * (1.0 - exp(-sigma * spacing)) * hg(dot(dir, u.sun_dir.xyz), u.air.y));
     var out: ShaftsOut;
-    out.cloud = accumulated(vec4<f32>(scale * beyond, 0.0));
+    // The composite reads this target as light as it is (`beyond_tex`): unscaled.
+    out.cloud = vec4<f32>(scale * beyond, 0.0);
     out.shafts = vec4<f32>(scale * all, 0.0);
     return out;
 }

@@ -98,6 +98,7 @@ fn cs_main(@builtin(global_invocation_id) id: vec3<u32>) {
             shafts = shafts + through * shaft(a, b, pixel, k);
         }
     }
-    textureStore(cloud_out, id.xy, vec4<f32>(light, 1.0 - through));
+    // Laid into the accumulation as the slices draw into it: at its light scale.
+    textureStore(cloud_out, id.xy, accumulated(vec4<f32>(light, 1.0 - through)));
     textureStore(shafts_out, id.xy, vec4<f32>(shafts, 1.0 - through));
 }

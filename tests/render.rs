@@ -2319,6 +2319,31 @@ fn the_eight_bit_path_draws_the_float_paths_image_within_rounding() {
                 .collect();
             v.iter().sum::<f64>() / v.len().max(1) as f64
         };
+        // As the viewport draws it (the cloud's box sliced, the shafts around it apart), with
+        // shafts of light.
+        let shafts = with(&scene, &["/light/shafts=true"]);
+        let float_cropped = o.render_cropped(&shafts, W, H).expect("render");
+        o.set_eight_bit(true).unwrap();
+        let eight_cropped = o.render_cropped(&shafts, W, H).expect("render");
+        o.set_eight_bit(false).unwrap();
+        let (mean_cropped, _) = image_difference(&float_cropped, &eight_cropped);
+        assert!(
+            mean_cropped < 0.5,
+            "{name} cropped, with shafts: 8 bits against half floats: mean {mean_cropped:.2}"
+        );
+        // Marched slices (where an adapter marches yet cannot accumulate in floats) are laid
+        // into the 8-bit accumulation at its scale too.
+        if name == "cumulus" {
+            o.set_eight_bit(true).unwrap();
+            o.set_marching(true).expect("lavapipe marches the slices");
+            let marched = o.render(&scene, W, H, Backdrop::Sky).expect("render");
+            o.set_eight_bit(false).unwrap();
+            let (mean_marched, _) = image_difference(&float, &marched);
+            assert!(
+                mean_marched < 1.0,
+                "{name} marched: 8 bits against half floats: mean {mean_marched:.2}"
+            );
+        }
         let (b_float, b_eight) = (brightness(&float), brightness(&eight));
         eprintln!(
             "{name}: 8 bits against half floats: mean {mean:.2}, worst {worst}; cloud brightness {b_float:.1} → {b_eight:.1}"
