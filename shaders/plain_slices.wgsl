@@ -37,7 +37,6 @@ fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
     let d = clamp(f + 0.3 * (n / 1.75 - 0.5) - 0.4, 0.0, 1.0);
     let alpha = 1.0 - exp(-u.media.x * d * u.slicing.z);
     let light = u.sun_color.rgb * sun + u.sky_color.rgb;
-    // At the accumulation's light scale, as the slices draw (volume.wgsl's `accumulated`).
-    let k = select(1.0, u.haze_light.w, u.haze_light.w > 0.0);
-    return vec4<f32>(light * alpha * k, alpha);
+    // At the accumulation's light scale, as the slices draw.
+    return accumulated(vec4<f32>(light * alpha, alpha));
 }

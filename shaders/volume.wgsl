@@ -227,13 +227,6 @@ fn cloud_at(world: vec3<f32>) -> vec4<f32> {
     return vec4<f32>(light * alpha, alpha);
 }
 
-// The scale of the light accumulated in the slices' target: 1 in floats, less in 8 bits
-// (plain WebGL2), which would clip a sunlit cloud's light at 1; the composite scales it back.
-fn accumulated(c: vec4<f32>) -> vec4<f32> {
-    let k = select(1.0, u.haze_light.w, u.haze_light.w > 0.0);
-    return vec4<f32>(c.rgb * k, c.a);
-}
-
 @fragment
 fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
     let c = cloud_at(in.world);

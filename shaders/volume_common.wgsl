@@ -71,3 +71,11 @@ struct Volume {
 // Transmittance toward the sun (red), computed on the GPU with the noise (light_march.wgsl);
 // the slices read it, the light pass writes it (and so binds no texture 5).
 @group(0) @binding(5) var light_tex: texture_3d<f32>;
+
+// `c` (premultiplied light and alpha) at the scale of the light accumulated in the slices'
+// target: 1 in floats, less in 8 bits (plain WebGL2), which would clip a sunlit cloud's light
+// at 1 (`VolumeUniforms::haze_light.w`; 0 means 1); the composite scales it back.
+fn accumulated(c: vec4<f32>) -> vec4<f32> {
+    let k = select(1.0, u.haze_light.w, u.haze_light.w > 0.0);
+    return vec4<f32>(c.rgb * k, c.a);
+}
