@@ -11,6 +11,7 @@
 use std::collections::HashMap;
 use std::path::PathBuf;
 
+use cloudsketch::derive::frame_of;
 use cloudsketch::export::{Axes, Format, Options, Up, export};
 use cloudsketch::field::media::Media;
 use cloudsketch::field::{ISO, bake_fine, density};
@@ -359,13 +360,13 @@ fn mitsuba_scenes_and_the_apps_render_of_their_view() {
     }
     let mut offscreen = Offscreen::new().expect("an offscreen adapter");
     let image = offscreen
-        .render(&scene, size[0], size[1], Backdrop::Sky)
+        .render(&frame_of(&scene, None), size[0], size[1], Backdrop::Sky)
         .unwrap();
     std::fs::write(out_dir().join("app_view.png"), image.to_png().unwrap()).unwrap();
     // The same view as linear light, for the check's own EXR reader (OpenEXR, in Mitsuba).
     let linear = Offscreen::with_output(Output::Linear)
         .expect("an offscreen adapter")
-        .render_linear(&scene, size, Backdrop::Sky, 1, None)
+        .render_linear(&frame_of(&scene, None), size, Backdrop::Sky, 1, None)
         .unwrap();
     std::fs::write(out_dir().join("app_view.exr"), linear.to_exr().unwrap()).unwrap();
     // The same cloud seen through an orthographic camera (Mitsuba's orthographic sensor).
@@ -381,7 +382,7 @@ fn mitsuba_scenes_and_the_apps_render_of_their_view() {
         std::fs::write(out_dir().join(&f.name), &f.bytes).unwrap();
     }
     let image = offscreen
-        .render(&ortho, size[0], size[1], Backdrop::Sky)
+        .render(&frame_of(&ortho, None), size[0], size[1], Backdrop::Sky)
         .unwrap();
     std::fs::write(
         out_dir().join("app_view_ortho.png"),
@@ -411,7 +412,13 @@ fn mitsuba_scenes_and_the_apps_render_of_their_view() {
             std::fs::write(out_dir().join(&f.name), &f.bytes).unwrap();
         }
         let cloud = linear
-            .render_linear(&lit, LIGHT_SIZE, Backdrop::Transparent, 1, None)
+            .render_linear(
+                &frame_of(&lit, None),
+                LIGHT_SIZE,
+                Backdrop::Transparent,
+                1,
+                None,
+            )
             .unwrap();
         std::fs::write(
             out_dir().join(format!("{stem}.exr")),
@@ -453,7 +460,7 @@ fn mitsuba_scenes_and_the_apps_render_of_their_view() {
         ("sky_physical_cloud.exr", Backdrop::Transparent),
     ] {
         let image = linear
-            .render_linear(&physical, size, backdrop, 1, None)
+            .render_linear(&frame_of(&physical, None), size, backdrop, 1, None)
             .unwrap();
         std::fs::write(out_dir().join(name), image.to_exr().unwrap()).unwrap();
     }
@@ -487,9 +494,11 @@ fn a_transparent_png_has_the_clouds_alpha_and_no_sky() {
     let scene = Scene::default();
     let mut offscreen = Offscreen::new().expect("an offscreen adapter");
     let clear = offscreen
-        .render(&scene, 160, 90, Backdrop::Transparent)
+        .render(&frame_of(&scene, None), 160, 90, Backdrop::Transparent)
         .unwrap();
-    let opaque = offscreen.render(&scene, 160, 90, Backdrop::Sky).unwrap();
+    let opaque = offscreen
+        .render(&frame_of(&scene, None), 160, 90, Backdrop::Sky)
+        .unwrap();
     let alpha: Vec<u8> = clear.rgba.chunks(4).map(|p| p[3]).collect();
     assert_eq!(alpha[0], 0, "the corner is sky: transparent");
     let covered = alpha.iter().filter(|&&a| a > 250).count();
@@ -544,7 +553,9 @@ fn the_cpu_media_the_exports_bake_agree_with_the_shaders_tiers_and_all() {
         })
         .collect();
     let mut offscreen = Offscreen::new().expect("an offscreen adapter");
-    let gpu = offscreen.media_at(&scene, &probes).unwrap();
+    let gpu = offscreen
+        .media_at(&frame_of(&scene, None), &probes)
+        .unwrap();
     assert_eq!(gpu.len(), probes.len());
     let media = Media::new(&scene);
     let cpu: Vec<f32> = probes.iter().map(|&(p, f)| media.density(f, p)).collect();

@@ -7,6 +7,8 @@
 //!   document does not know (it took 5–6 GB when the text was first built into a JSON tree):
 //!   read and opened within the file's size and 16 MiB.
 //! - A link that inflates to just over its cap: refused within twice the cap and 1 MiB.
+//! - A recording's PNG frames (64 MiB of them) made a zip download: its pieces take under
+//!   1 MiB beside the frames (an archive built whole took the frames' size again).
 //!
 //! One test, so nothing else in this binary allocates while it measures.
 
@@ -184,5 +186,25 @@ fn peak_memory_follows_the_caps_not_the_input() {
         cap / MIB,
         peak / MIB
     );
+
+    // A recording's frames as one zip: its pieces borrow the frames.
+    let frames: Vec<cloudsketch::export::File> = (0..64u8)
+        .map(|k| cloudsketch::export::File {
+            name: format!("cloud_{k:04}.png"),
+            bytes: vec![k; MIB],
+        })
+        .collect();
+    let (pieces, peak) = peak_of(|| cloudsketch::export::zip_pieces(&frames));
+    eprintln!(
+        "a zip of 64 MiB of frames, in pieces: peak {:.3} MiB",
+        peak as f64 / MIB as f64
+    );
+    assert!(
+        peak < MIB,
+        "a zip of 64 MiB of frames: peak {peak} bytes beside them"
+    );
+    let whole = pieces.concat();
+    assert_eq!(whole, cloudsketch::export::zip(&frames));
+    assert!(whole.len() > 64 * MIB);
     std::fs::remove_dir_all(&dir).unwrap();
 }

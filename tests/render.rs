@@ -4,6 +4,7 @@
 
 use std::sync::{Mutex, OnceLock};
 
+use cloudsketch::derive::frame_of;
 use cloudsketch::render::offscreen::{Backdrop, Image, LinearImage, Offscreen, Output};
 use cloudsketch::scene::{Channel, Preset, Scene, set_by_pointer};
 
@@ -21,7 +22,7 @@ fn offscreen() -> std::sync::MutexGuard<'static, Offscreen> {
 
 fn render(scene: &Scene) -> Image {
     offscreen()
-        .render(scene, W, H, Backdrop::Sky)
+        .render(&frame_of(scene, None), W, H, Backdrop::Sky)
         .expect("render")
 }
 
@@ -1070,7 +1071,7 @@ fn a_transparent_image_keeps_the_shafts_light() {
     );
     let transparent = |s: &Scene| {
         offscreen()
-            .render(s, W, H, Backdrop::Transparent)
+            .render(&frame_of(s, None), W, H, Backdrop::Transparent)
             .expect("render")
     };
     let clear = transparent(&layer);
@@ -1314,7 +1315,7 @@ fn marched_and_rasterised(scene: &Scene, chunks: u32) -> [Image; 2] {
     let was = o.marching();
     let images = [true, false].map(|on| {
         o.set_marching(on).expect("lavapipe marches the slices");
-        o.render_in_chunks(scene, [W, H], Backdrop::Sky, chunks)
+        o.render_in_chunks(&frame_of(scene, None), [W, H], Backdrop::Sky, chunks)
             .expect("render")
     });
     o.set_marching(was).unwrap();
@@ -1426,7 +1427,9 @@ fn the_viewport_draws_shafts_around_the_clouds_box_as_the_whole_view_draws_them(
             ],
         );
         let whole = render(&on);
-        let split = offscreen().render_cropped(&on, W, H).expect("render");
+        let split = offscreen()
+            .render_cropped(&frame_of(&on, None), W, H)
+            .expect("render");
         let off = render(&with(&on, &["/light/shafts=false"]));
         if let Ok(dir) = std::env::var("CLOUDSKETCH_TEST_IMAGES") {
             std::fs::write(
@@ -1489,7 +1492,7 @@ fn the_sky_lights_the_clouds_top_and_the_cloud_hides_it_from_its_base() {
     // this renderer had) lights both the same. With the sun too, the base stays the darker.
     let transparent = |s: &Scene| {
         offscreen()
-            .render(s, W, H, Backdrop::Transparent)
+            .render(&frame_of(s, None), W, H, Backdrop::Transparent)
             .expect("render")
     };
     let scene = smooth_cumulus();
@@ -1571,7 +1574,7 @@ fn billows_make_the_outline_rough_at_every_scale() {
         }
         let dimension = |scene: &Scene| {
             let image = offscreen()
-                .render(scene, 1920, 1080, Backdrop::Transparent)
+                .render(&frame_of(scene, None), 1920, 1080, Backdrop::Transparent)
                 .expect("render");
             outline_dimension(&image)
         };
@@ -1622,7 +1625,10 @@ fn the_previewed_light_and_the_documents_each_draw_their_own_shadows() {
     assert_eq!([capped.light_resolution, capped.light_octaves], [16, 1]);
 
     let mut o = offscreen();
-    let mut draw = |s: &Scene| o.render(s, W, H, Backdrop::Transparent).expect("render");
+    let mut draw = |s: &Scene| {
+        o.render(&frame_of(s, None), W, H, Backdrop::Transparent)
+            .expect("render")
+    };
     let (first, previewed, again) = (draw(&scene), draw(&preview), draw(&scene));
     let differing = first
         .rgba
@@ -1871,7 +1877,7 @@ fn the_developing_anvil_grows_out_of_the_column_in_one_piece() {
     let size = [400, 300];
     let shot = |s: &Scene, t: f32| {
         offscreen()
-            .render(&s.posed_at(t), size[0], size[1], Backdrop::Sky)
+            .render(&frame_of(&s, Some(t)), size[0], size[1], Backdrop::Sky)
             .expect("render")
     };
     let anvil = scene
@@ -1926,7 +1932,7 @@ fn linear_offscreen() -> std::sync::MutexGuard<'static, Offscreen> {
 
 fn render_linear(scene: &Scene, backdrop: Backdrop) -> LinearImage {
     linear_offscreen()
-        .render_linear(scene, [W, H], backdrop, 1, None)
+        .render_linear(&frame_of(scene, None), [W, H], backdrop, 1, None)
         .expect("linear render")
 }
 
@@ -1947,7 +1953,7 @@ fn the_linear_image_is_the_display_image_before_its_tone_map() {
     scene.light.ground = false;
     scene.light.shafts = false;
     let display = offscreen()
-        .render(&scene, W, H, Backdrop::Transparent)
+        .render(&frame_of(&scene, None), W, H, Backdrop::Transparent)
         .expect("render");
     let linear = render_linear(&scene, Backdrop::Transparent);
     assert_eq!((linear.width, linear.height), (W, H));
@@ -2188,7 +2194,7 @@ fn the_physical_sky_is_the_atmospheres_light_and_a_low_sun_reddens_the_sky_and_t
     let redness = |scene: &Scene| {
         let c = cloud_colour(
             &offscreen()
-                .render(scene, W, H, Backdrop::Transparent)
+                .render(&frame_of(scene, None), W, H, Backdrop::Transparent)
                 .unwrap(),
         );
         c[0] / c[2].max(1.0)
@@ -2291,14 +2297,18 @@ fn the_eight_bit_path_draws_the_float_paths_image_within_rounding() {
             &Scene::preset(Preset::from_name(name).unwrap()),
             &["/render/slices=64"],
         );
-        let float = o.render(&scene, W, H, Backdrop::Sky).expect("render");
+        let float = o
+            .render(&frame_of(&scene, None), W, H, Backdrop::Sky)
+            .expect("render");
         let float_alone = o
-            .render(&scene, W, H, Backdrop::Transparent)
+            .render(&frame_of(&scene, None), W, H, Backdrop::Transparent)
             .expect("render");
         o.set_eight_bit(true).unwrap();
-        let eight = o.render(&scene, W, H, Backdrop::Sky).expect("render");
+        let eight = o
+            .render(&frame_of(&scene, None), W, H, Backdrop::Sky)
+            .expect("render");
         let eight_alone = o
-            .render(&scene, W, H, Backdrop::Transparent)
+            .render(&frame_of(&scene, None), W, H, Backdrop::Transparent)
             .expect("render");
         o.set_eight_bit(false).unwrap();
         // The cloud alone (a transparent PNG) too: nothing behind it to carry the scale back.
@@ -2322,9 +2332,13 @@ fn the_eight_bit_path_draws_the_float_paths_image_within_rounding() {
         // As the viewport draws it (the cloud's box sliced, the shafts around it apart), with
         // shafts of light.
         let shafts = with(&scene, &["/light/shafts=true"]);
-        let float_cropped = o.render_cropped(&shafts, W, H).expect("render");
+        let float_cropped = o
+            .render_cropped(&frame_of(&shafts, None), W, H)
+            .expect("render");
         o.set_eight_bit(true).unwrap();
-        let eight_cropped = o.render_cropped(&shafts, W, H).expect("render");
+        let eight_cropped = o
+            .render_cropped(&frame_of(&shafts, None), W, H)
+            .expect("render");
         o.set_eight_bit(false).unwrap();
         let (mean_cropped, _) = image_difference(&float_cropped, &eight_cropped);
         assert!(
@@ -2336,7 +2350,9 @@ fn the_eight_bit_path_draws_the_float_paths_image_within_rounding() {
         if name == "cumulus" {
             o.set_eight_bit(true).unwrap();
             o.set_marching(true).expect("lavapipe marches the slices");
-            let marched = o.render(&scene, W, H, Backdrop::Sky).expect("render");
+            let marched = o
+                .render(&frame_of(&scene, None), W, H, Backdrop::Sky)
+                .expect("render");
             o.set_eight_bit(false).unwrap();
             let (mean_marched, _) = image_difference(&float, &marched);
             assert!(

@@ -30,20 +30,20 @@ impl FrameCheckpoints {
         })
     }
 
-    /// Before a frame of `posed`: on the first, reads the furthest checkpoint into `derived`;
-    /// what the run starts from, for the frame's progress.
-    pub fn before(&mut self, derived: &mut Derived, posed: &Scene) -> Option<String> {
+    /// Before the frame of `scene` at `time` seconds: on the first, reads the furthest
+    /// checkpoint into `derived`; what the run starts from, for the frame's progress.
+    pub fn before(&mut self, derived: &mut Derived, scene: &Scene, time: f32) -> Option<String> {
         let checkpoints = self.checkpoints.as_mut()?;
         if !std::mem::take(&mut self.first) {
             return None;
         }
-        checkpoints.resume(derived, posed, posed.time)
+        checkpoints.resume(derived, scene, time)
     }
 
-    /// After a frame of `posed`: writes the snapshot its run in `derived` passed.
-    pub fn after(&mut self, derived: &mut Derived, posed: &Scene) {
+    /// After a frame of `scene`: writes the snapshot its run in `derived` passed.
+    pub fn after(&mut self, derived: &mut Derived, scene: &Scene) {
         if let Some(checkpoints) = self.checkpoints.as_mut() {
-            checkpoints.save(derived, posed);
+            checkpoints.save(derived, scene);
         }
     }
 }

@@ -84,23 +84,28 @@ pub fn run(r: &Request) -> Result<(), String> {
     let mut scene = read(r)?;
     // --fps applied; --frames with a name without # refused (no sequence without #).
     r.sequence.plan(r.output, &mut scene, r.at)?;
-    if let Some(at) = r.at {
-        scene = scene.posed_at(at.seconds(&scene.clock)?);
-    }
+    let at =
+        r.at.map(|moment| moment.seconds(&scene.clock))
+            .transpose()?;
     let start = std::time::Instant::now();
     if format == Format::Png {
         let mut offscreen = Offscreen::new().map_err(|e| e.to_string())?;
         let png = super::render_shown(
             &mut offscreen,
-            &scene,
+            &crate::derive::frame_of(&scene, at),
             [width, height],
             backdrop,
             super::ImageFile::Png,
         )?;
         write(r.output, &png)?;
     } else {
+        // The exporters sample the posed scene's field at their own resolution.
+        let posed = match at {
+            Some(t) => scene.posed_at(t),
+            None => scene,
+        };
         let files =
-            export(&scene, format, &options, &stem_of(r.output)).map_err(|e| e.to_string())?;
+            export(&posed, format, &options, &stem_of(r.output)).map_err(|e| e.to_string())?;
         // The companions first and the main file last, so a main file never refers to a
         // volume that is not there; on a failure, what this run wrote is removed.
         let mut written: Vec<&Path> = Vec::new();
@@ -182,7 +187,8 @@ fn sequence(
         .as_bytes(),
     );
     let mut offscreen: Option<Offscreen> = None;
-    let mut own = crate::derive::Derived::default();
+    // The derivation cache whose simulation run steps on from frame to frame.
+    let mut derived = crate::derive::Derived::default();
     let mut checkpoints = FrameCheckpoints::open(r.sequence.checkpoints.as_deref())?;
     Sequence {
         frames: plan.frames,
@@ -194,18 +200,16 @@ fn sequence(
         inputs: &r.scene.into_iter().collect::<Vec<_>>(),
     }
     .run(|frame, main: &Path| -> Result<Made, String> {
-        let posed = scene.posed_at(scene.clock.seconds(frame));
+        let t = scene.clock.seconds(frame);
         if format == Format::Png && offscreen.is_none() {
             offscreen = Some(Offscreen::new().map_err(|e| e.to_string())?);
         }
-        // The renderer's derivation cache for a PNG, this sequence's own for the others: the
-        // one whose simulation run steps on from frame to frame.
-        let note = checkpoints.before(derived_of(&mut offscreen, &mut own), &posed);
+        let note = checkpoints.before(&mut derived, &scene, t);
         let files: FrameFiles = match offscreen.as_mut() {
             Some(offscreen) => {
                 let png = super::render_file(
                     offscreen,
-                    &posed,
+                    &derived.frame(&scene, Some(t)),
                     options.image,
                     backdrop,
                     super::ImageFile::Png,
@@ -213,28 +217,22 @@ fn sequence(
                 )?;
                 vec![(main.to_path_buf(), png)]
             }
-            None => crate::export::export_frame(&mut own, &posed, format, options, &stem_of(main))
-                .map_err(|e| e.to_string())?
-                .into_iter()
-                .zip(files_of(format, main))
-                // The companions first, the main file last.
-                .rev()
-                .map(|(f, path)| (path, f.bytes))
-                .collect(),
+            None => crate::export::export_frame(
+                &mut derived,
+                &scene.posed_at(t),
+                format,
+                options,
+                &stem_of(main),
+            )
+            .map_err(|e| e.to_string())?
+            .into_iter()
+            .zip(files_of(format, main))
+            // The companions first, the main file last.
+            .rev()
+            .map(|(f, path)| (path, f.bytes))
+            .collect(),
         };
-        checkpoints.after(derived_of(&mut offscreen, &mut own), &posed);
+        checkpoints.after(&mut derived, &scene);
         Ok(Made { files, note })
     })
-}
-
-/// The derivation cache a sequence's frames step on: the renderer's where there is one (a PNG
-/// sequence), else the sequence's own.
-fn derived_of<'a>(
-    offscreen: &'a mut Option<Offscreen>,
-    own: &'a mut crate::derive::Derived,
-) -> &'a mut crate::derive::Derived {
-    match offscreen {
-        Some(o) => o.derived(),
-        None => own,
-    }
 }

@@ -491,11 +491,11 @@ impl ImageFile {
     }
 }
 
-/// Renders `scene` at full quality and encodes it as `file`, with a progress line where the
+/// Renders `frame` at full quality and encodes it as `file`, with a progress line where the
 /// terminal shows one (the renderer must make `file.output()`'s images).
 pub fn render_shown(
     offscreen: &mut crate::render::offscreen::Offscreen,
-    scene: &Scene,
+    frame: &crate::derive::Frame,
     size: [u32; 2],
     backdrop: crate::render::offscreen::Backdrop,
     file: ImageFile,
@@ -504,22 +504,22 @@ pub fn render_shown(
     if progress.shown() {
         render_file(
             offscreen,
-            scene,
+            frame,
             size,
             backdrop,
             file,
             Some(&mut |done| progress.set(done)),
         )
     } else {
-        render_file(offscreen, scene, size, backdrop, file, None)
+        render_file(offscreen, frame, size, backdrop, file, None)
     }
 }
 
-/// Renders `scene` at full quality and encodes it as `file`; with `progress`, the slices in
+/// Renders `frame` at full quality and encodes it as `file`; with `progress`, the slices in
 /// chunks, each reported (the same image).
 pub fn render_file(
     offscreen: &mut crate::render::offscreen::Offscreen,
-    scene: &Scene,
+    frame: &crate::derive::Frame,
     [width, height]: [u32; 2],
     backdrop: crate::render::offscreen::Backdrop,
     file: ImageFile,
@@ -530,9 +530,9 @@ pub fn render_file(
         ImageFile::Png => {
             let image = match progress {
                 Some(report) => {
-                    offscreen.render_with_progress(scene, [width, height], backdrop, chunks, report)
+                    offscreen.render_with_progress(frame, [width, height], backdrop, chunks, report)
                 }
-                None => offscreen.render(scene, width, height, backdrop),
+                None => offscreen.render(frame, width, height, backdrop),
             }
             .map_err(|e| e.to_string())?;
             image
@@ -540,7 +540,7 @@ pub fn render_file(
                 .map_err(|e| format!("PNG encoding failed: {e}"))
         }
         ImageFile::Exr => offscreen
-            .render_linear(scene, [width, height], backdrop, chunks, progress)
+            .render_linear(frame, [width, height], backdrop, chunks, progress)
             .map_err(|e| e.to_string())?
             .to_exr(),
     }

@@ -5,6 +5,7 @@ use std::path::Path;
 use super::checkpoints::FrameCheckpoints;
 use super::sequence::{Made, Pattern, Sequence, SequenceArgs, stable_hash};
 use super::{ImageFile, read_scene_or_link, write};
+use crate::derive::{Derived, Frame};
 use crate::render::offscreen::{Backdrop, MAX_SIDE, Offscreen};
 use crate::scene::{Scene, set_by_pointer};
 
@@ -77,14 +78,15 @@ pub fn run(r: &Request) -> Result<(), String> {
         );
     }
     // Through the shot camera where asked.
-    let framed = |mut posed: Scene| {
+    let framed = |mut frame: Frame| {
         if r.shot
-            && let Some(shot) = posed.shot.clone()
+            && let Some(shot) = frame.scene.shot.clone()
         {
-            posed.camera = shot;
+            frame.scene.camera = shot;
         }
-        posed
+        frame
     };
+    let mut derived = Derived::default();
     let mut offscreen = Offscreen::with_output(file.output()).map_err(|e| e.to_string())?;
     if let Some(plan) = plan {
         let key = stable_hash(
@@ -109,17 +111,12 @@ pub fn run(r: &Request) -> Result<(), String> {
             inputs: &inputs,
         }
         .run(|frame, main| {
-            let posed = framed(scene.posed_at(scene.clock.seconds(frame)));
-            let note = checkpoints.before(offscreen.derived(), &posed);
-            let bytes = super::render_file(
-                &mut offscreen,
-                &posed,
-                [width, height],
-                backdrop,
-                file,
-                None,
-            )?;
-            checkpoints.after(offscreen.derived(), &posed);
+            let t = scene.clock.seconds(frame);
+            let note = checkpoints.before(&mut derived, &scene, t);
+            let made = framed(derived.frame(&scene, Some(t)));
+            let bytes =
+                super::render_file(&mut offscreen, &made, [width, height], backdrop, file, None)?;
+            checkpoints.after(&mut derived, &scene);
             Ok(Made {
                 files: vec![(main.to_path_buf(), bytes)],
                 note,
@@ -127,12 +124,13 @@ pub fn run(r: &Request) -> Result<(), String> {
         });
     }
     // Without a moment, the scene as read (a --set of a keyed value shows, as an edit does).
-    let scene = framed(match r.at {
-        Some(moment) => scene.posed_at(moment.seconds(&scene.clock)?),
-        None => scene,
-    });
+    let at =
+        r.at.map(|moment| moment.seconds(&scene.clock))
+            .transpose()?;
     let start = std::time::Instant::now();
-    let bytes = super::render_shown(&mut offscreen, &scene, [width, height], backdrop, file)?;
+    let frame = framed(derived.frame(&scene, at));
+    let scene = &frame.scene;
+    let bytes = super::render_shown(&mut offscreen, &frame, [width, height], backdrop, file)?;
     write(r.output, &bytes)?;
     eprintln!(
         "rendered {width}x{height} {}, {} slices on {} in {:.2} s → {}",

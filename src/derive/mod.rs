@@ -22,10 +22,25 @@ use crate::scene::{DrawingPlane, Revisions, Scene};
 /// A derived value with a generation that changes whenever the value does.
 #[derive(Debug)]
 pub struct Versioned<T> {
-    /// Bumped on every change; consumers (GPU uploads) compare it instead of the data.
+    /// New on every change, and never repeated by any cache in the process (two caches feeding
+    /// one renderer cannot confuse their volumes); consumers (GPU uploads) compare it instead
+    /// of the data.
     pub generation: u64,
     /// The value.
     pub data: Arc<T>,
+}
+
+/// The source of [`Versioned::generation`]s: shared by every cache, so none repeats.
+static NEXT_GENERATION: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
+
+impl<T> Versioned<T> {
+    /// `data` as a new generation.
+    pub fn new(data: Arc<T>) -> Self {
+        Self {
+            generation: NEXT_GENERATION.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
+            data,
+        }
+    }
 }
 
 impl<T> Clone for Versioned<T> {
@@ -35,6 +50,21 @@ impl<T> Clone for Versioned<T> {
             data: self.data.clone(),
         }
     }
+}
+
+/// One moment of a document as [`Derived::frame`] makes it: what every image and export of
+/// that moment is drawn from.
+#[derive(Clone, Debug)]
+pub struct Frame {
+    /// The scene, every animated value posed at the moment.
+    pub scene: Scene,
+    /// Its volumes.
+    pub volumes: Volumes,
+}
+
+/// [`Derived::frame`] with a cache of its own: `scene` at `at` seconds (`None`: as it stands).
+pub fn frame_of(scene: &Scene, at: Option<f32>) -> Frame {
+    Derived::default().frame(scene, at)
 }
 
 /// What the renderer draws: the density volume and the noise seed.
@@ -251,7 +281,6 @@ pub struct Derived {
     left_out: usize,
     /// The run has not yet reached the scene's time (a far jump catches up over frames).
     pub catching_up: bool,
-    generation: u64,
     work: Work,
 }
 
@@ -356,12 +385,8 @@ impl Derived {
         };
         let (volume, behind) = player.density(scene.time);
         self.catching_up = behind;
-        self.generation += 1;
         self.work.bakes += 1;
-        let v = Versioned {
-            generation: self.generation,
-            data: Arc::new(volume),
-        };
+        let v = Versioned::new(Arc::new(volume));
         self.simulated = Some((key, v.clone()));
         v
     }
@@ -410,7 +435,6 @@ impl Derived {
         {
             return v.clone();
         }
-        self.generation += 1;
         let (ours, theirs) = (&simulated.data, &strokes.data);
         let united = if ours.is_empty() || theirs.is_empty() {
             ours.union(theirs, crate::limits::MAX_GRID_RESOLUTION)
@@ -433,24 +457,17 @@ impl Derived {
             };
             ours.union_with(&grid, &resampled)
         };
-        let v = Versioned {
-            generation: self.generation,
-            data: Arc::new(united),
-        };
+        let v = Versioned::new(Arc::new(united));
         self.united = Some((key, v.clone()));
         v
     }
 
     /// A bake as a new generation of a density volume, its work counted.
     fn counted(&mut self, baked: crate::field::Baked) -> Versioned<DensityVolume> {
-        self.generation += 1;
         self.work.bakes += 1;
         self.work.bake_work += baked.work;
         self.work.baked_texels += baked.texels;
-        Versioned {
-            generation: self.generation,
-            data: baked.volume,
-        }
+        Versioned::new(baked.volume)
     }
 
     /// The volumes of `scene` whose parts are at `revisions`; derives only what changed.
@@ -487,18 +504,40 @@ impl Derived {
         self.outlines_on_grid = None;
     }
 
-    /// The density volume `scene` describes at its time, as [`density_of`] derives it from
-    /// scratch (on the grid a fresh load would choose), reusing this cache's plane shapes and
-    /// simulation run: frame after frame of a sequence steps a simulation on from the last
-    /// instead of replaying it (a frame reached so equals the frame played from step 0).
-    pub fn density_afresh(&mut self, scene: &Scene) -> Arc<DensityVolume> {
-        let doc = crate::scene::Document::new(scene.clone());
-        self.forget_grid();
-        let mut volume = self.density(doc.scene(), doc.revisions());
+    /// The volumes of `scene` at `revisions` as [`Derived::update`] derives them, a simulation
+    /// far from its start played all the way to the scene's time (the app spreads that over
+    /// frames; a render or an export waits for it).
+    pub fn caught_up(&mut self, scene: &Scene, revisions: Revisions) -> Volumes {
+        let mut volumes = self.update(scene, revisions);
         while self.catching_up {
-            volume = self.density(doc.scene(), doc.revisions());
+            volumes = self.update(scene, revisions);
         }
-        volume.data
+        volumes
+    }
+
+    /// The document at one moment, ready to draw or export: `scene` with every animated value
+    /// (keys, motion, growth) posed at `at` seconds (`None`: the scene as it stands, so a value
+    /// set over its keys shows), and its volumes derived as a fresh load derives them, on the
+    /// grid the document chooses and not the one an earlier frame left, so a frame is the same
+    /// wherever and in whatever order it is made. The plane shapes and a simulation run carry
+    /// over from earlier frames: frame after frame of a sequence steps a simulation on from the
+    /// last instead of replaying it (a frame reached so equals the frame played from step 0).
+    ///
+    /// This is the one place a standalone image or export interprets time; the app's viewport
+    /// derives incrementally with [`Derived::update`] from the document its clock posed.
+    pub fn frame(&mut self, scene: &Scene, at: Option<f32>) -> Frame {
+        let scene = match at {
+            Some(t) => scene.posed_at(t),
+            None => scene.clone(),
+        };
+        self.forget_grid();
+        let volumes = self.caught_up(&scene, Revisions::fresh());
+        Frame { scene, volumes }
+    }
+
+    /// The density volume `scene` describes at its time: [`Derived::frame`]'s, unposed.
+    pub fn density_afresh(&mut self, scene: &Scene) -> Arc<DensityVolume> {
+        self.frame(scene, None).volumes.density.data
     }
 
     /// The work done so far.

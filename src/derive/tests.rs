@@ -1029,3 +1029,38 @@ fn the_simulated_presets_clouds_form_grow_and_dissipate() {
         "the steady parcel keeps its cloud: {steady:?}"
     );
 }
+
+#[test]
+fn a_frame_is_the_same_whichever_frames_its_cache_made_before() {
+    // The developing cumulus's puffs rise and grow: each time has its own grid extent.
+    let scene = Scene::preset(Preset::Developing);
+    let mut shared = Derived::default();
+    for t in [10.0, 0.0, 20.0, 10.0] {
+        let made = shared.frame(&scene, Some(t));
+        let fresh = frame_of(&scene, Some(t));
+        assert_eq!(
+            made.scene,
+            scene.posed_at(t),
+            "the frame at {t} s is not posed there"
+        );
+        assert_eq!(made.scene, fresh.scene);
+        assert!(
+            *made.volumes.density.data == *fresh.volumes.density.data,
+            "at {t} s the frame made after others differs from one made alone"
+        );
+        // Two caches feeding one renderer never hand it one generation for two volumes.
+        assert_ne!(
+            made.volumes.density.generation,
+            fresh.volumes.density.generation
+        );
+    }
+    assert!(
+        *frame_of(&scene, Some(0.0)).volumes.density.data
+            != *frame_of(&scene, Some(20.0)).volumes.density.data,
+        "the preset does not develop"
+    );
+    // Without a time, the scene as it stands: a value set over its keys shows.
+    let mut edited = scene.posed_at(10.0);
+    Arc::make_mut(&mut edited.ellipsoids[0]).center.x += 3.0;
+    assert_eq!(frame_of(&edited, None).scene, edited);
+}

@@ -25,7 +25,7 @@ pub use mesh::{Mesh, mesh};
 pub use mitsuba::write_xml;
 pub use png::encode_rgba as encode_png;
 pub use vdb::write_vdb;
-pub use zip::zip;
+pub use zip::{zip, zip_pieces};
 
 use crate::field::ISO;
 use crate::scene::Scene;

@@ -1,6 +1,8 @@
 //! A minimal ZIP archive (entries stored, not compressed): how the browser hands over an
 //! export of several files (Mitsuba's XML and its grid) as one download.
 
+use std::borrow::Cow;
+
 use super::File;
 
 /// CRC-32 (IEEE 802.3, reflected), as ZIP stores it.
@@ -17,10 +19,18 @@ pub(super) fn crc32(bytes: &[u8]) -> u32 {
 
 /// The files as one ZIP archive (at most 4 GiB in all; exports are far below).
 pub fn zip(files: &[File]) -> Vec<u8> {
-    let mut out = Vec::new();
+    zip_pieces(files).concat()
+}
+
+/// [`zip`]'s archive in pieces, in order: each entry's local header and its bytes (borrowed,
+/// not copied), then the central directory with its end. The page hands the pieces to one
+/// download, so a recording's frames are never copied into an archive beside themselves in
+/// the wasm's memory (768 MiB of frames would take 1.5 GiB).
+pub fn zip_pieces(files: &[File]) -> Vec<Cow<'_, [u8]>> {
+    let mut pieces = Vec::with_capacity(2 * files.len() + 1);
+    let mut offset = 0usize;
     let mut central = Vec::new();
     for f in files {
-        let offset = out.len() as u32;
         let crc = crc32(&f.bytes);
         let (size, name) = (f.bytes.len() as u32, f.name.as_bytes());
         // Local header: signature, version 2.0, flags (UTF-8 names), stored, time, date.
@@ -36,29 +46,31 @@ pub fn zip(files: &[File]) -> Vec<u8> {
             v.extend((name.len() as u16).to_le_bytes());
             v.extend(0u16.to_le_bytes());
         };
-        out.extend(0x0403_4b50u32.to_le_bytes());
-        common(&mut out);
-        out.extend(name);
-        out.extend(&f.bytes);
+        let mut local = Vec::with_capacity(30 + name.len());
+        local.extend(0x0403_4b50u32.to_le_bytes());
+        common(&mut local);
+        local.extend(name);
         central.extend(0x0201_4b50u32.to_le_bytes());
         central.extend(20u16.to_le_bytes()); // made by
         common(&mut central);
         central.extend([0u8; 8]); // comment length, disk, internal and external attributes
         central.extend([0u8; 2]);
-        central.extend(offset.to_le_bytes());
+        central.extend((offset as u32).to_le_bytes());
         central.extend(name);
+        offset += local.len() + f.bytes.len();
+        pieces.push(Cow::Owned(local));
+        pieces.push(Cow::Borrowed(f.bytes.as_slice()));
     }
-    let start = out.len() as u32;
-    let count = files.len() as u16;
-    out.extend(&central);
-    out.extend(0x0605_4b50u32.to_le_bytes());
-    out.extend([0u8; 4]);
-    out.extend(count.to_le_bytes());
-    out.extend(count.to_le_bytes());
-    out.extend((central.len() as u32).to_le_bytes());
-    out.extend(start.to_le_bytes());
-    out.extend(0u16.to_le_bytes());
-    out
+    let (start, size, count) = (offset as u32, central.len() as u32, files.len() as u16);
+    central.extend(0x0605_4b50u32.to_le_bytes());
+    central.extend([0u8; 4]);
+    central.extend(count.to_le_bytes());
+    central.extend(count.to_le_bytes());
+    central.extend(size.to_le_bytes());
+    central.extend(start.to_le_bytes());
+    central.extend(0u16.to_le_bytes());
+    pieces.push(Cow::Owned(central));
+    pieces
 }
 
 #[cfg(test)]

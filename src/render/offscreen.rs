@@ -9,9 +9,9 @@ use super::renderer::{SliceJob, VolumeRenderer};
 use super::resources::{
     accumulation_format, can_march, copy_for_readback, marches_by_default, read_rows, unpremultiply,
 };
-use crate::derive::Derived;
+use crate::derive::{Frame, Volumes};
 use crate::field::{DensityVolume, Field};
-use crate::scene::{Document, Scene};
+use crate::scene::Scene;
 
 pub use crate::limits::MAX_RENDER_SIDE as MAX_SIDE;
 
@@ -168,7 +168,6 @@ pub struct Offscreen {
     queue: wgpu::Queue,
     info: wgpu::AdapterInfo,
     renderer: VolumeRenderer,
-    derived: Derived,
     /// The GPU field evaluation (the bench's baseline), made on first use.
     field_evaluator: Option<FieldEvaluator>,
     /// Timestamp queries around recorded work, where the adapter has them.
@@ -313,7 +312,6 @@ impl Offscreen {
             queue,
             info,
             renderer,
-            derived: Derived::default(),
             field_evaluator: None,
             stamps,
             can_march,
@@ -369,56 +367,51 @@ impl Offscreen {
         self.info.device_type == wgpu::DeviceType::Cpu
     }
 
-    /// Its derivation cache, whose simulation run carries from render to render (a
-    /// sequence's checkpoints are written from it and read into it).
-    pub fn derived(&mut self) -> &mut Derived {
-        &mut self.derived
-    }
-
-    /// Renders `scene` from its camera at full quality, over its sky or over nothing.
+    /// Renders `frame` (derived by [`crate::derive::Derived::frame`]) from its camera at full
+    /// quality, over its sky or over nothing.
     pub fn render(
         &mut self,
-        scene: &Scene,
+        frame: &Frame,
         width: u32,
         height: u32,
         backdrop: Backdrop,
     ) -> Result<Image, OffscreenError> {
-        self.render_in_chunks(scene, [width, height], backdrop, 1)
+        self.render_in_chunks(frame, [width, height], backdrop, 1)
     }
 
-    /// Renders `scene` as [`Offscreen::render`] does, its slices drawn in `chunks` draws of
+    /// Renders `frame` as [`Offscreen::render`] does, its slices drawn in `chunks` draws of
     /// consecutive slices, far to near, as the app's refinement spreads an image over frames:
     /// the same image as one draw. At most [`MAX_SLICE_DRAWS_PER_FRAME`] chunks (one
     /// submission's uniform slots).
     pub fn render_in_chunks(
         &mut self,
-        scene: &Scene,
+        frame: &Frame,
         size: [u32; 2],
         backdrop: Backdrop,
         chunks: u32,
     ) -> Result<Image, OffscreenError> {
-        self.render_chunked(scene, size, backdrop, chunks, None)
+        self.render_chunked(frame, size, backdrop, chunks, None)
     }
 
-    /// Renders `scene` as [`Offscreen::render`] does (the same image), its slices drawn in
+    /// Renders `frame` as [`Offscreen::render`] does (the same image), its slices drawn in
     /// `chunks` submissions, each waited for, calling `progress` with the share done after each:
     /// a long render (8192² on a CPU adapter) shows how far it is.
     pub fn render_with_progress(
         &mut self,
-        scene: &Scene,
+        frame: &Frame,
         size: [u32; 2],
         backdrop: Backdrop,
         chunks: u32,
         progress: &mut dyn FnMut(f32),
     ) -> Result<Image, OffscreenError> {
-        self.render_chunked(scene, size, backdrop, chunks, Some(progress))
+        self.render_chunked(frame, size, backdrop, chunks, Some(progress))
     }
 
     /// The chunked render: all chunks in one submission, or with `progress` each chunk in its
     /// own, waited for and reported.
     fn render_chunked(
         &mut self,
-        scene: &Scene,
+        frame: &Frame,
         [width, height]: [u32; 2],
         backdrop: Backdrop,
         chunks: u32,
@@ -426,7 +419,7 @@ impl Offscreen {
     ) -> Result<Image, OffscreenError> {
         let (encoder, output) = self.chunked(
             Output::Display,
-            scene,
+            frame,
             [width, height],
             backdrop,
             chunks,
@@ -439,13 +432,13 @@ impl Offscreen {
         Ok(image)
     }
 
-    /// Renders `scene` as [`Offscreen::render_with_progress`] does, as linear light before
+    /// Renders `frame` as [`Offscreen::render_with_progress`] does, as linear light before
     /// any tone map (exposure applied; the sky's colours as the light the tone map shows as
     /// them, `tone::light_of`), premultiplied:
     /// what an EXR holds. Needs an offscreen made with [`Output::Linear`].
     pub fn render_linear(
         &mut self,
-        scene: &Scene,
+        frame: &Frame,
         [width, height]: [u32; 2],
         backdrop: Backdrop,
         chunks: u32,
@@ -453,7 +446,7 @@ impl Offscreen {
     ) -> Result<LinearImage, OffscreenError> {
         let size = [width, height];
         let (encoder, output) =
-            self.chunked(Output::Linear, scene, size, backdrop, chunks, progress)?;
+            self.chunked(Output::Linear, frame, size, backdrop, chunks, progress)?;
         let bytes = self.read_pixels(encoder, &output, size, 8)?;
         let rgba = bytes
             .chunks_exact(2)
@@ -482,7 +475,7 @@ impl Offscreen {
     fn chunked(
         &mut self,
         kind: Output,
-        scene: &Scene,
+        frame: &Frame,
         [width, height]: [u32; 2],
         backdrop: Backdrop,
         chunks: u32,
@@ -490,8 +483,8 @@ impl Offscreen {
     ) -> Result<(wgpu::CommandEncoder, wgpu::Texture), OffscreenError> {
         self.expect(kind)?;
         check_size(width, height)?;
-        let background = (backdrop == Backdrop::Sky).then_some(scene.light.background);
-        let mut job = self.full_job(scene, width, height);
+        let background = (backdrop == Backdrop::Sky).then_some(frame.scene.light.background);
+        let mut job = self.job(frame, width, height);
         let total = job.plan.total;
         // One submission holds at most MAX_SLICE_DRAWS_PER_FRAME draws' uniforms; chunks
         // submitted and waited for one by one may be as many as there are slices.
@@ -533,18 +526,19 @@ impl Offscreen {
         Ok(self.encode(&job, background, None))
     }
 
-    /// Renders `scene` over its sky as the app's viewport draws it: the volume over the
+    /// Renders `frame` over its sky as the app's viewport draws it: the volume over the
     /// cloud's box on screen alone, the shafts of light around it drawn apart at a fraction of
     /// the size ([`super::VolumeRenderer::render_image_cropped`]).
     pub fn render_cropped(
         &mut self,
-        scene: &Scene,
+        frame: &Frame,
         width: u32,
         height: u32,
     ) -> Result<Image, OffscreenError> {
         self.expect(Output::Display)?;
         check_size(width, height)?;
-        let job = self.full_job(scene, width, height);
+        let scene = &frame.scene;
+        let job = self.job(frame, width, height);
         let Some(crop) = self.viewport_crop(scene, [width, height]) else {
             return self.draw(&job, Some(scene.light.background));
         };
@@ -565,15 +559,15 @@ impl Offscreen {
         self.read_back(encoder, &output, [width, height])
     }
 
-    /// The density the slices' shader gives `scene`'s media at each probe, a world point and
+    /// The density the slices' shader gives `frame`'s media at each probe, a world point and
     /// the field's value there ([`super::probe`]): what the CPU's media (`field::media`, which
     /// the exports bake) must agree with.
     pub fn media_at(
         &mut self,
-        scene: &Scene,
+        frame: &Frame,
         probes: &[(glam::Vec3, f32)],
     ) -> Result<Vec<f32>, OffscreenError> {
-        let job = self.full_job(scene, 16, 16);
+        let job = self.job(frame, 16, 16);
         let data: Vec<[f32; 4]> = probes.iter().map(|(p, f)| [p.x, p.y, p.z, *f]).collect();
         let mut encoder = self
             .device
@@ -602,19 +596,20 @@ impl Offscreen {
         Ok(densities)
     }
 
-    /// Times `frames` full-quality frames of `scene` (slices and composite, no readback) drawn
+    /// Times `frames` full-quality draws of `frame` (slices and composite, no readback) drawn
     /// as `drawing` says, each waited for on the device, by `clock`; `None` for the device's
     /// clock where the adapter has no timestamp queries.
     pub fn time_frames(
         &mut self,
-        scene: &Scene,
+        frame: &Frame,
         [width, height]: [u32; 2],
         frames: usize,
         drawing: Drawing,
         clock: Clock,
     ) -> Result<Option<Vec<f64>>, OffscreenError> {
         check_size(width, height)?;
-        let job = self.full_job(scene, width, height);
+        let scene = &frame.scene;
+        let job = self.job(frame, width, height);
         let pipeline =
             (drawing == Drawing::Plain).then(|| self.renderer.baseline_pipeline(&self.device));
         let crop = (drawing == Drawing::Cropped)
@@ -659,40 +654,32 @@ impl Offscreen {
         Some(super::crop::PixelCrop::snap(ndc, size))
     }
 
-    /// Plays `doc` as the app plays it live: for each of `times`, the document moved to that
-    /// time (posed), derived through the cache (only what moved), uploaded, and drawn whole at
-    /// full quality into a `size` image (no read-back). Returns each frame's wall-clock seconds,
-    /// from setting the time to the device being done.
-    pub fn time_playback(
+    /// Uploads `volumes` (only where their generation changed) and draws them with `scene`'s
+    /// view, light and quality whole into a `size` image, waiting for the device (no
+    /// read-back): one frame of live playback, whose cost the bench times from the new time
+    /// on (the derivation included).
+    pub fn draw_and_wait(
         &mut self,
-        doc: &mut Document,
+        scene: &Scene,
+        volumes: &Volumes,
         [width, height]: [u32; 2],
-        times: &[f32],
-    ) -> Result<Vec<f64>, OffscreenError> {
+    ) -> Result<(), OffscreenError> {
         check_size(width, height)?;
-        let mut out = Vec::with_capacity(times.len());
-        for &t in times {
-            let start = std::time::Instant::now();
-            doc.set_time(t);
-            let job = self.job_of(doc, width, height);
-            let background = Some(doc.scene().light.background);
-            let (encoder, _output) = self.encode(&job, background, None);
-            self.submit_and_wait(encoder)?;
-            out.push(start.elapsed().as_secs_f64());
-        }
-        Ok(out)
+        let job = self.job_of(scene, volumes, width, height);
+        let (encoder, _output) = self.encode(&job, Some(scene.light.background), None);
+        self.submit_and_wait(encoder)
     }
 
-    /// Times `runs` computations of `scene`'s light volume on the GPU (every slice marched
+    /// Times `runs` computations of `frame`'s light volume on the GPU (every slice marched
     /// toward the sun through the field and its noise), each waited for on the device, by
     /// `clock`; `None` for the device's clock where the adapter has no timestamp queries.
     pub fn time_light_volume(
         &mut self,
-        scene: &Scene,
+        frame: &Frame,
         runs: usize,
         clock: Clock,
     ) -> Result<Option<Vec<f64>>, OffscreenError> {
-        let job = self.full_job(scene, 64, 64);
+        let job = self.job(frame, 64, 64);
         (0..runs)
             .map(|_| {
                 self.renderer.invalidate_light();
@@ -824,32 +811,16 @@ impl Offscreen {
             .map_err(|e| OffscreenError::Readback(e.to_string()))
     }
 
-    /// Derives `scene`'s volumes (through the per-plane cache) and uploads them; returns the
-    /// full-quality job for an image of `width`×`height`.
-    fn full_job(&mut self, scene: &Scene, width: u32, height: u32) -> SliceJob {
-        // A fresh document has fresh revisions: everything is derived again, except strokes
-        // the plane cache has already interpreted, on the grid a fresh load would choose (not
-        // the one the last render's history left), so the image depends on `scene` alone.
-        let doc = Document::new(scene.clone());
-        self.derived.forget_grid();
-        self.job_of(&doc, width, height)
+    /// Uploads `frame`'s volumes and returns the full-quality job for a `width`×`height` image.
+    fn job(&mut self, frame: &Frame, width: u32, height: u32) -> SliceJob {
+        self.job_of(&frame.scene, &frame.volumes, width, height)
     }
 
-    /// Derives `doc`'s scene through the cache as it stands (only what its revisions say
-    /// changed), uploads it and returns the full-quality job for a `width`×`height` image.
-    fn job_of(&mut self, doc: &Document, width: u32, height: u32) -> SliceJob {
-        let scene = doc.scene();
-        let mut volumes = self.derived.update(scene, doc.revisions());
-        // A simulation far from its start catches up over several calls (the app spreads
-        // them over frames); a render waits for it.
-        for _ in 0..1000 {
-            if !self.derived.catching_up {
-                break;
-            }
-            volumes = self.derived.update(scene, doc.revisions());
-        }
+    /// Uploads `volumes` (only where their generation changed) and returns the full-quality
+    /// job drawing them with `scene`'s view for a `width`×`height` image.
+    fn job_of(&mut self, scene: &Scene, volumes: &Volumes, width: u32, height: u32) -> SliceJob {
         self.renderer.begin_frame();
-        self.renderer.upload(&self.device, &self.queue, &volumes);
+        self.renderer.upload(&self.device, &self.queue, volumes);
         SliceJob {
             plan: JobPlan {
                 target: 0,

@@ -52,6 +52,20 @@ pub struct Revisions {
 }
 
 impl Revisions {
+    /// Revisions no earlier value had: whatever is derived at them is derived afresh.
+    pub fn fresh() -> Self {
+        let n = next_revision();
+        Self {
+            geometry: n,
+            light: n,
+            render: n,
+            camera: n,
+            reference: n,
+            clock: n,
+            time: n,
+        }
+    }
+
     /// Changes whenever any part of the document does (camera and time included).
     pub fn any(&self) -> u64 {
         self.geometry
@@ -162,21 +176,12 @@ impl Default for Document {
 impl Document {
     /// A document holding `scene`, with an empty history.
     pub fn new(scene: Scene) -> Self {
-        let n = next_revision();
         Self {
             scene,
             undo: VecDeque::new(),
             redo: Vec::new(),
             last_key: None,
-            revisions: Revisions {
-                geometry: n,
-                light: n,
-                render: n,
-                camera: n,
-                reference: n,
-                clock: n,
-                time: n,
-            },
+            revisions: Revisions::fresh(),
             auto_key: false,
         }
     }

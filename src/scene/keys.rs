@@ -1269,6 +1269,33 @@ impl Scene {
         changed
     }
 
+    /// Whether `channel` holds what its keys pose at the scene's time, so a key there would
+    /// change nothing (Blender's "only insert needed"); false for a value without keys, which
+    /// nothing poses.
+    pub fn as_keyed(&self, channel: Channel) -> bool {
+        let Some(value) = self
+            .animation
+            .track(channel)
+            .and_then(|track| track.sample(clamp_time(self.time)))
+        else {
+            return false;
+        };
+        // Through the value's own setter, so a value it wraps (a yaw) or normalises (a
+        // rotation) compares as it is held.
+        let mut posed = self.clone();
+        let index = Index::of(&posed);
+        channel.set(&mut posed, &index, &value);
+        match (channel.get(&posed), channel.get(self)) {
+            (Some(a), Some(b)) => {
+                a.len() == b.len()
+                    && a.iter()
+                        .zip(&b)
+                        .all(|(x, y)| (x - y).abs() <= 1e-6 * x.abs().max(y.abs()).max(1.0))
+            }
+            _ => false,
+        }
+    }
+
     /// The scene at time `t`: its clock set to `t` and every keyed value posed there. The one
     /// pure call the app, the renderer, the exporters and the command line take a time
     /// through.

@@ -29,8 +29,8 @@ const MIN_SCALE: f32 = 0.25;
 /// Most frames cached (a range of a day at 120 frames a second has ten million).
 const MAX_FRAMES: usize = 10_000;
 
-/// Bytes of PNG files a recording holds (the browser's download copies them once more into
-/// its zip, within wasm32's 4 GiB).
+/// Bytes of PNG files a recording holds (the browser's zip download is made from them in
+/// pieces, outside the wasm's memory: `export::zip_pieces`).
 pub const RECORD_CAP: usize = 768 << 20;
 
 /// Whether a video sink takes a frame now.

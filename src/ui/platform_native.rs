@@ -162,6 +162,11 @@ pub fn save_bytes(path: &str, bytes: &[u8], _mime: &str) -> Result<String, Strin
     Ok(path.to_owned())
 }
 
+/// Writes the concatenation of `pieces` as the file at `path`.
+pub fn save_pieces(path: &str, pieces: &[&[u8]], mime: &str) -> Result<String, String> {
+    save_bytes(path, &pieces.concat(), mime)
+}
+
 /// Writes an RGBA image as a PNG file at `path`.
 pub fn save_png(path: &str, width: u32, height: u32, rgba: Vec<u8>) -> Result<String, String> {
     let image = crate::render::offscreen::Image {

@@ -256,6 +256,20 @@ pub fn save_bytes(name: &str, bytes: &[u8], mime: &str) -> Result<String, String
     download_blob(name, &blob)
 }
 
+/// Saves the concatenation of `pieces` as a download named `name` of media type `mime`: one
+/// blob made from them, so the whole is never built in the wasm's memory (a recording's zip).
+pub fn save_pieces(name: &str, pieces: &[&[u8]], mime: &str) -> Result<String, String> {
+    let parts = js_sys::Array::new();
+    for piece in pieces {
+        parts.push(&js_sys::Uint8Array::from(*piece));
+    }
+    let options = web_sys::BlobPropertyBag::new();
+    options.set_type(mime);
+    let blob =
+        web_sys::Blob::new_with_u8_array_sequence_and_options(&parts, &options).map_err(refused)?;
+    download_blob(name, &blob)
+}
+
 /// Hands a blob to the browser as a download named `name`.
 fn download_blob(name: &str, blob: &web_sys::Blob) -> Result<String, String> {
     let fail = refused;

@@ -50,7 +50,9 @@ for (const backend of BOTH_BUILDS) {
       s = await until(page, (s) => s.scene.ellipsoids[0].center[0] > x0 + 1, 'moved right');
       const x48 = s.scene.ellipsoids[0].center[0];
       await page.keyboard.press('i');
-      s = await until(page, (s) => s.view.timeline.key_count === 8, 'keys at frame 48');
+      // Only what changed is keyed again: the centre, not the radii, rotation or strength.
+      s = await until(page, (s) => s.view.timeline.key_count === 5, 'the centre keyed at frame 48');
+      assert.match(s.view.notice.text, /Keyed the selection at frame 48 \(1 value\)/);
       assert.equal(s.view.timeline.keys.length, 2);
       await waitForFullQuality(page);
       const at48 = await screenshot(page, `timeline-2-frame48-${backend}`);
@@ -86,7 +88,7 @@ for (const backend of BOTH_BUILDS) {
       s = await scrubTo(page, 24);
       assert.ok(Math.abs(s.scene.ellipsoids[0].center[0] - x0) < 1e-4, 'one key: no motion');
       await page.keyboard.press('Control+Shift+z');
-      s = await until(page, (s) => s.view.timeline.key_count === 8, 'redone');
+      s = await until(page, (s) => s.view.timeline.key_count === 5, 'redone');
 
       // Drag the diamond at frame 48 to frame 96: frame 48 is then half way.
       s = await state(page);
@@ -119,7 +121,7 @@ for (const backend of BOTH_BUILDS) {
       await page.keyboard.press('Delete');
       s = await until(page, (s) => s.view.timeline.key_count === 0, 'the boxed keys deleted');
       await page.keyboard.press('Control+z');
-      s = await until(page, (s) => s.view.timeline.key_count === 8, 'the deletion undone');
+      s = await until(page, (s) => s.view.timeline.key_count === 5, 'the deletion undone');
     });
   });
 }
@@ -164,7 +166,9 @@ for (const backend of BOTH_BUILDS) {
       await page.mouse.move(vw / 2, vh / 2);
       await page.keyboard.press('0');
       await page.keyboard.press('i');
-      s = await until(page, (s) => s.view.timeline.key_count === 10 && s.view.through_shot, 'the shot keyed at frame 48');
+      // The orbit's changed values alone are keyed again (the yaw at least; the target, the
+      // distance and the field of view were not moved).
+      s = await until(page, (s) => s.view.timeline.key_count > 5 && s.view.timeline.key_count < 10 && s.view.through_shot, 'the shot keyed at frame 48');
       const yaw48 = s.scene.shot.yaw_deg;
       const d = ((yaw48 - yaw0 + 540) % 360) - 180;
       assert.ok(Math.abs(d) > 10, `the two keys differ in yaw: ${yaw0} → ${yaw48}`);
@@ -187,8 +191,8 @@ for (const backend of BOTH_BUILDS) {
 
   // A tier's floor keyed by auto-key as an artist keys it: a tier added, Auto-key on, the floor
   // slider pressed at frame 0 and again at frame 48; the floor is half way at frame 24 and back at
-  // each key; with nothing selected the timeline shows the two keys, I keys the floor with the
-  // sun (and says so), and undo takes back the key edits one by one.
+  // each key; with nothing selected the timeline shows the two keys, I keys the sun and not the
+  // floor its keys pose (and says so), and undo takes back the key edits one by one.
   test(`auto-key records a tier's floor, which the scrub bar poses between its keys (${backend})`, { timeout: 240_000 }, async () => {
     await withApp({ base: server.url, webgpu: backend === 'webgpu', viewport: { width: 1280, height: 800 } }, async (page) => {
       await openGroup(page, 'Render');
@@ -223,13 +227,14 @@ for (const backend of BOTH_BUILDS) {
       assert.ok(Math.abs(s.scene.render.tiers[0].floor - (a + b) / 2) < 1e-3, `frame 24: ${s.scene.render.tiers[0].floor}, want ${(a + b) / 2}`);
       s = await scrubTo(page, 0);
       assert.ok(Math.abs(s.scene.render.tiers[0].floor - a) < 1e-4, 'back at the first key');
-      // I with nothing selected, at frame 12: the sun's three values and the floor.
+      // I with nothing selected, at frame 12: the sun's three values, not yet keyed; the
+      // floor is as its keys pose it there, so it gets no key.
       s = await scrubTo(page, 12);
       const between = s.scene.render.tiers[0].floor;
       await page.mouse.move(s.view.viewport[0] / 2, s.view.viewport[1] / 2);
       await page.keyboard.press('i');
-      s = await until(page, (s) => s.view.timeline.key_count === 6, 'keyed at frame 12');
-      assert.match(s.view.notice.text, /Keyed the sun and 1 other keyed value at frame 12/);
+      s = await until(page, (s) => s.view.timeline.key_count === 5, 'keyed at frame 12');
+      assert.match(s.view.notice.text, /Keyed the sun at frame 12 \(3 values\)/);
       assert.ok(Math.abs(s.scene.render.tiers[0].floor - between) < 1e-4, 'keying keeps the value');
       // Undo: the I keys, then the frame-48 key with its value.
       await page.keyboard.press('Control+z');

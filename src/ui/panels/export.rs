@@ -5,7 +5,7 @@
 
 use egui::Ui;
 
-use crate::export::{Format, Options, Sampling, Up, write, zip};
+use crate::export::{File, Format, Options, Sampling, Up, write, zip_pieces};
 use crate::scene::{Document, Scene};
 use crate::ui::flipbook::Frames;
 use crate::ui::notice::Notices;
@@ -365,7 +365,7 @@ impl ExportPanel {
         // The browser gets one download (several files as a ZIP); natively every file.
         let saved: Result<Vec<String>, String> = if platform::HAS_PICKER && files.len() > 1 {
             let name = format!("{}-{}.zip", place.stem, format.name());
-            platform::save_bytes(&name, &zip(&files), "application/zip").map(|w| vec![w])
+            save_zip(&name, &files)
         } else {
             files
                 .iter()
@@ -431,7 +431,7 @@ impl ExportPanel {
         let saved = frames.and_then(|files| {
             if platform::HAS_PICKER {
                 let name = format!("{}-frames.zip", place.stem);
-                platform::save_bytes(&name, &zip(&files), "application/zip").map(|w| vec![w])
+                save_zip(&name, &files)
             } else {
                 files
                     .iter()
@@ -522,4 +522,12 @@ mod tests {
         assert!(ask.record.is_none() && panel.running());
         assert_eq!(panel.recording(), None);
     }
+}
+
+/// Saves `files` as one zip download named `name`, handed over in pieces (the archive is never
+/// built beside the files).
+fn save_zip(name: &str, files: &[File]) -> Result<Vec<String>, String> {
+    let pieces = zip_pieces(files);
+    let pieces: Vec<&[u8]> = pieces.iter().map(|p| &**p).collect();
+    platform::save_pieces(name, &pieces, "application/zip").map(|w| vec![w])
 }

@@ -1,8 +1,8 @@
 //! The timeline strip under the view: play, pause and loop, the frame, a scrub bar whose one
 //! drag covers the whole frame range, the range and the rate, and the keys of what is selected
 //! as diamonds (drag to retime, Shift+click to select several, right-click for the ease,
-//! Delete over the strip removes them). I keys the selection (the sun with nothing selected);
-//! auto-key records every edit. The time lives in the document (renders and links reproduce
+//! Delete over the strip removes them). I keys the selection's changed values (the sun with
+//! nothing selected); auto-key records every edit. The time lives in the document (renders and links reproduce
 //! it) but, like the camera, changing it is not an undo step; playing is view state.
 
 use egui::{Color32, Pos2, Sense, Stroke, Ui, vec2};
@@ -219,11 +219,18 @@ impl Timeline {
         true
     }
 
-    /// I: keys the selection's values at the document's time (one undo step). Returns what
-    /// to tell the user.
+    /// I: keys the selection's changed values at the document's time (one undo step): of what
+    /// [`keyed_by_i`] offers, a keyed value only where it differs from what its keys pose there
+    /// (it was edited since), and a value without keys always (Blender's key with "only insert
+    /// needed"). Returns what to tell the user.
     pub fn insert_keys(&mut self, doc: &mut Document, selection: &Selection) -> String {
         let scene = doc.scene();
-        let channels = keyed_by_i(scene, selection, self.shot_view);
+        let offered = keyed_by_i(scene, selection, self.shot_view);
+        let channels: Vec<Channel> = offered
+            .iter()
+            .copied()
+            .filter(|c| !scene.as_keyed(*c))
+            .collect();
         let mut animation = scene.animation.clone();
         let t = scene.time;
         let n = animation.key_all(scene, channels.iter().copied(), t);
@@ -231,25 +238,27 @@ impl Timeline {
         let what = if selection.is_empty() && self.shot_view {
             "the shot camera".to_owned()
         } else if selection.is_empty() {
-            // The sun's place and strength, and whatever else of the scene is keyed already
-            // (the light's other values, the media's, the tiers').
-            let others = channels
-                .iter()
-                .filter(|c| {
-                    !matches!(
-                        c,
-                        Channel::Light {
-                            property: LightProperty::SunAzimuth
-                                | LightProperty::SunElevation
-                                | LightProperty::SunIntensity
-                        }
-                    )
-                })
-                .count();
-            match others {
-                0 => "the sun".to_owned(),
-                1 => "the sun and 1 other keyed value".to_owned(),
-                k => format!("the sun and {k} other keyed values"),
+            // The sun's place and strength, and the light, media and tier values keyed before
+            // that were changed since.
+            let sun = |c: &&Channel| {
+                matches!(
+                    c,
+                    Channel::Light {
+                        property: LightProperty::SunAzimuth
+                            | LightProperty::SunElevation
+                            | LightProperty::SunIntensity
+                    }
+                )
+            };
+            let others = channels.iter().filter(|c| !sun(c)).count();
+            let values = |k| match k {
+                1 => "1 other keyed value".to_owned(),
+                k => format!("{k} other keyed values"),
+            };
+            match (channels.iter().any(|c| sun(&c)), others) {
+                (_, 0) => "the sun".to_owned(),
+                (true, k) => format!("the sun and {}", values(k)),
+                (false, k) => values(k).replacen(" other", "", 1),
             }
         } else {
             match selection.items().len() {
@@ -258,6 +267,11 @@ impl Timeline {
             }
         };
         if n == 0 {
+            if channels.is_empty() && !offered.is_empty() {
+                return format!(
+                    "Nothing changed: {what} is as its keys pose it at frame {frame:.0}"
+                );
+            }
             return if channels.is_empty() {
                 "Nothing to key".into()
             } else if channels.iter().any(|c| {
@@ -282,7 +296,8 @@ impl Timeline {
         }
         doc.apply(Edit::SetAnimation(animation, "insert keys"), None);
         self.selected = vec![t];
-        format!("Keyed {what} at frame {frame:.0} ({n} values)")
+        let values = if n == 1 { "value" } else { "values" };
+        format!("Keyed {what} at frame {frame:.0} ({n} {values})")
     }
 
     /// Alt+I, or Delete over the strip: removes the shown channels' selected keys, or those at
@@ -974,8 +989,8 @@ mod tests {
         let said = timeline.delete_keys(&mut doc, &selection);
         assert_eq!(said, "Deleted 4 keys");
         assert_eq!(doc.scene().animation.key_count(), 3);
-        // With a media value keyed, I with nothing selected keys it again with the sun, and
-        // says so (it used to say "the sun" alone).
+        // With a media value keyed, I with nothing selected keys what changed of it and of
+        // the sun, and says so (it used to say "the sun" alone).
         let opacity = Channel::Media {
             property: crate::scene::MediaProperty::Opacity,
         };
@@ -983,10 +998,35 @@ mod tests {
         animation.key(opacity, 0.0, opacity.get(doc.scene()).unwrap());
         doc.apply(Edit::SetAnimation(animation, "key"), None);
         doc.set_time(doc.scene().clock.seconds(24));
+        // Nothing changed since the keys: nothing to key, no undo step.
+        let steps = doc.undo_len();
+        let said = timeline.insert_keys(&mut doc, &Selection::default());
+        assert!(said.starts_with("Nothing changed: the sun"), "{said}");
+        assert_eq!(doc.undo_len(), steps);
+        // The opacity and the sun's azimuth changed at frame 24: those two are keyed.
+        let mut render = doc.scene().render.clone();
+        render.opacity *= 0.5;
+        doc.apply(Edit::SetRender(render), None);
+        let mut light = doc.scene().light.clone();
+        light.sun_azimuth_deg += 30.0;
+        doc.apply(Edit::SetLight(light), None);
+        let before = doc.scene().animation.key_count();
         let said = timeline.insert_keys(&mut doc, &Selection::default());
         assert!(
-            said.starts_with("Keyed the sun and 1 other keyed value at frame 24 (4 values)"),
+            said.starts_with("Keyed the sun and 1 other keyed value at frame 24 (2 values)"),
             "{said}"
         );
+        assert_eq!(doc.scene().animation.key_count(), before + 2);
+        // The ellipsoid, its keys deleted above, is keyed whole again; then moved, only its
+        // centre is keyed.
+        doc.set_time(doc.scene().clock.seconds(48));
+        let said = timeline.insert_keys(&mut doc, &selection);
+        assert!(said.ends_with("(4 values)"), "{said}");
+        doc.set_time(doc.scene().clock.seconds(72));
+        let mut moved = doc.scene().ellipsoids.clone();
+        Arc::make_mut(&mut moved[0]).center.x += 2.0;
+        doc.apply(Edit::SetEllipsoids(moved), None);
+        let said = timeline.insert_keys(&mut doc, &selection);
+        assert!(said.ends_with("(1 value)"), "{said}");
     }
 }
