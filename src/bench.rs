@@ -515,6 +515,52 @@ fn time_moves() -> Vec<BenchResult> {
     out
 }
 
+/// The next full-quality image after a new time on the default scene, nothing keyed (the
+/// time's own revision derives nothing; the light is swept again as the noise moves), against
+/// the image after a full derivation of the same scene: each derived, uploaded and drawn whole
+/// at 640×360, the device waited for (wall clock; the first draw, which compiles, left out).
+fn time_to_image(offscreen: &mut Offscreen) -> Result<BenchResult, String> {
+    const SIZE: [u32; 2] = [640, 360];
+    let mut doc = Document::new(Scene::default());
+    let mut derived = Derived::default();
+    let volumes = derived.caught_up(doc.scene(), doc.revisions());
+    offscreen
+        .draw_and_wait(doc.scene(), &volumes, SIZE)
+        .map_err(|e| e.to_string())?;
+    let work = derived.work();
+    let mut t = 0.0;
+    let mut new_time = Vec::new();
+    for _ in 0..5 {
+        t += 0.5;
+        let start = Instant::now();
+        doc.set_time(t);
+        let volumes = derived.caught_up(doc.scene(), doc.revisions());
+        offscreen
+            .draw_and_wait(doc.scene(), &volumes, SIZE)
+            .map_err(|e| e.to_string())?;
+        new_time.push(start.elapsed().as_secs_f64());
+    }
+    if derived.work() != work {
+        eprintln!("warning: a new time derived work on a scene with nothing keyed");
+    }
+    let mut afresh = Vec::new();
+    for _ in 0..3 {
+        let start = Instant::now();
+        let frame = Derived::default().frame(doc.scene(), None);
+        offscreen
+            .draw_and_wait(&frame.scene, &frame.volumes, SIZE)
+            .map_err(|e| e.to_string())?;
+        afresh.push(start.elapsed().as_secs_f64());
+    }
+    Ok(result(
+        "time_next_image_new_t_nothing_keyed_640x360",
+        median(new_time) * 1e3,
+        "ms",
+        "time_next_image_full_derive_640x360",
+        median(afresh) * 1e3,
+    ))
+}
+
 /// The `simulated` preset (its parcels moving with the wind) at step 2,000: scrubbed back 100
 /// steps (a snapshot and at most 32 steps) against replayed from step 0 by a fresh
 /// derivation, each to the frame's density.
@@ -1051,6 +1097,7 @@ pub fn run(json: bool, only: Option<&str>) -> Result<(), String> {
     }
     if wanted("time") {
         results.extend(time_moves());
+        results.push(time_to_image(&mut offscreen)?);
     }
     if wanted("sequence") {
         results.extend(sequences());
