@@ -11,7 +11,7 @@ use std::sync::atomic::{AtomicU8, AtomicU32, Ordering};
 use std::sync::{Arc, Mutex};
 
 use super::crop::{OUTSIDE_SHAFTS_DIVISOR, PixelCrop};
-use super::progressive::JobPlan;
+use super::progressive::{JobPlan, slice_weight};
 use super::renderer::{SliceJob, VolumeRenderer};
 use super::resources::{CAPTURE_TARGET, copy_for_readback, read_rows, unpremultiply};
 use super::{FULL_VIEW, View};
@@ -62,6 +62,30 @@ pub fn capture_chunks(pixels: u64, slices: u32, cost: f64, budget: f64) -> u32 {
     let seconds = pixels as f64 * slices as f64 * cost.max(0.0);
     let chunks = (seconds / budget.max(1e-6)).ceil();
     (chunks.clamp(1.0, slices.max(1) as f64)) as u32
+}
+
+/// How many frames' chunks a capture of `view` at `size` takes over `density` (the uploaded
+/// clouds), when a plain pixel·slice costs `cost` seconds (the planner's) and a frame may spend
+/// `budget` seconds: its slices are drawn over the cloud's box on screen alone, and with the
+/// shafts of light among them each weighs [`slice_weight`]'s more.
+pub fn chunks_for(
+    view: &View,
+    density: &crate::field::DensityVolume,
+    size: [u32; 2],
+    cost: f64,
+    budget: f64,
+) -> u32 {
+    let aspect = size[0] as f32 / size[1].max(1) as f32;
+    let pixels = (!density.is_empty())
+        .then(|| {
+            view.camera
+                .ndc_bounds(density.min, density.min + density.size, aspect)
+        })
+        .flatten()
+        .map_or(size, |ndc| PixelCrop::snap(ndc, size).size());
+    let pixels = pixels[0] as u64 * pixels[1] as u64;
+    let weight = slice_weight(view.light.shafts && !density.is_empty());
+    capture_chunks(pixels, view.render.slices, cost * weight, budget)
 }
 
 impl Capture {
@@ -297,5 +321,36 @@ mod tests {
         assert_eq!(capture_chunks(1920 * 1080, 128, 1e-12, 0.05), 1);
         assert_eq!(capture_chunks(8192 * 8192, 64, 1e-6, 0.05), 64);
         assert_eq!(capture_chunks(0, 0, 1.0, 0.05), 1);
+    }
+
+    #[test]
+    fn a_capture_with_shafts_takes_twice_the_frames_and_counts_the_clouds_box_alone() {
+        let scene = crate::scene::Scene::default();
+        let density = crate::field::bake(&crate::derive::field_of(&scene), 32);
+        let view = |shafts: bool| {
+            let mut light = scene.light.clone();
+            light.shafts = shafts;
+            View {
+                camera: scene.camera.clone(),
+                light,
+                render: scene.render.clone(),
+                drift: crate::render::gpu_types::Drifts::of(&scene),
+                aspect: 16.0 / 9.0,
+                crop: FULL_VIEW,
+            }
+        };
+        let (size, cost, budget) = ([1920, 1080], 1e-8, 0.05);
+        let plain = chunks_for(&view(false), &density, size, cost, budget);
+        let shafts = chunks_for(&view(true), &density, size, cost, budget);
+        // The cloud's box on screen, not the whole view: fewer chunks than the whole view's.
+        let whole = capture_chunks(1920 * 1080, scene.render.slices, cost, budget);
+        assert!(plain > 1 && plain < whole, "{plain} of {whole}");
+        assert!(
+            (2 * plain).abs_diff(shafts) <= 1,
+            "with shafts {shafts} chunks, without {plain}"
+        );
+        // Nothing uploaded yet: the whole view, and no shafts to weigh.
+        let empty = crate::field::DensityVolume::default();
+        assert_eq!(chunks_for(&view(true), &empty, size, cost, budget), whole);
     }
 }

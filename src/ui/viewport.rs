@@ -11,7 +11,7 @@ use super::tools::{ToolContext, Toolbox, ViewInput};
 use crate::derive::Derived;
 use crate::render::SliceJob;
 use crate::render::View;
-use crate::render::capture::{Capture, capture_chunks};
+use crate::render::capture::{Capture, chunks_for};
 use crate::render::crop::{OUTSIDE_SHAFTS_DIVISOR, PixelCrop};
 
 /// Seconds of a frame an export's capture may take (the rest is the view's: a drag during an
@@ -504,26 +504,8 @@ impl Viewport {
         let density = &density.data;
         let now = ui.input(|i| i.time);
         if let Some((size, transparent)) = self.capture_request.take() {
-            // Its slices spread over frames within a frame's budget, as refinement's are,
-            // counting the pixels of the cloud's box the capture draws them over.
-            let aspect = size[0] as f32 / size[1].max(1) as f32;
-            let pixels = (!density.is_empty())
-                .then(|| {
-                    exported
-                        .camera
-                        .ndc_bounds(density.min, density.min + density.size, aspect)
-                })
-                .flatten()
-                .map_or(size, |ndc| PixelCrop::snap(ndc, size).size());
-            let pixels = pixels[0] as u64 * pixels[1] as u64;
-            let chunks = capture_chunks(
-                pixels,
-                exported.render.slices,
-                // The planner's cost is a plain slice's: a capture with shafts costs more.
-                self.progressive.cost()
-                    * slice_weight(exported.light.shafts && !density.is_empty()),
-                budget,
-            );
+            // Its slices spread over frames within a frame's budget, as refinement's are.
+            let chunks = chunks_for(exported, density, size, self.progressive.cost(), budget);
             self.capture = Some(Capture::new(exported, size, transparent, chunks));
             self.capture_geometry = cx.doc.revisions().geometry;
         }
