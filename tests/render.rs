@@ -378,8 +378,48 @@ fn presets_are_each_recognisable() {
     }
     let (w, h) = cloud_box(&images[1], background(&scenes[1]));
     assert!(w as f64 >= 4.0 * h as f64, "stratus is a layer: {w}×{h} px");
-    let (w, h) = cloud_box(&images[3], background(&scenes[3]));
-    assert!(h > w, "cumulonimbus towers: {w}×{h} px");
+    // The cumulonimbus towers, and its anvil spreads on top: the widest row of its top fifth
+    // is far wider than the tower at half its height (a column, or a dome, is not).
+    let bg = background(&scenes[3]);
+    let (w, h) = cloud_box(&images[3], bg);
+    assert!(h as f64 >= 0.9 * w as f64, "cumulonimbus towers: {w}×{h} px");
+    let widths = row_widths(&images[3], bg);
+    let rows: Vec<usize> = (0..widths.len()).filter(|&y| widths[y] > 0).collect();
+    let (top, bottom) = (rows[0], rows[rows.len() - 1]);
+    let anvil = widths[top..=top + (bottom - top) / 5].iter().max().copied().unwrap_or(0);
+    let waist = widths[(top + bottom) / 2];
+    assert!(
+        anvil as f64 >= 1.8 * waist as f64,
+        "cumulonimbus anvil: {anvil} px wide, the tower at half height {waist} px"
+    );
+    // It spreads downwind (+x, to the right from the preset's camera): past the tower's middle
+    // it reaches at least twice as far right as left (the symmetric mushroom it was: 1.4×).
+    let image = &images[3];
+    let xs = |y: u32| (0..image.width).filter(move |&x| differs(image.pixel(x, y), bg));
+    let middle = {
+        let row: Vec<u32> = xs(((top + bottom) / 2) as u32).collect();
+        row.iter().sum::<u32>() as f64 / row.len().max(1) as f64
+    };
+    let (left, right) = (top..=top + (bottom - top) / 5)
+        .flat_map(|y| xs(y as u32))
+        .fold((f64::MAX, 0f64), |(l, r), x| (l.min(x as f64), r.max(x as f64)));
+    assert!(
+        right - middle >= 2.0 * (middle - left),
+        "cumulonimbus anvil downwind: {:.0} px right of the tower, {:.0} px left",
+        right - middle,
+        middle - left
+    );
+}
+
+/// Each row's count of pixels that differ from the sky.
+fn row_widths(image: &cloudsketch::render::offscreen::Image, bg: [u8; 3]) -> Vec<u32> {
+    (0..image.height)
+        .map(|y| {
+            (0..image.width)
+                .filter(|&x| differs(image.pixel(x, y), bg))
+                .count() as u32
+        })
+        .collect()
 }
 
 #[test]

@@ -96,33 +96,34 @@ fn layer(n: usize, w: f32, d: f32, y: f32, radii: Vec3, seed: u64) -> Vec<Ellips
 }
 
 fn cumulonimbus() -> Vec<Ellipsoid> {
-    // The tower: rings of puffs rising and bulging out of one another, then the anvil spreading
-    // flat on top, overhanging toward the wind.
+    // The tower: rings of puffs rising and bulging out of one another, leaning downwind (+x)
+    // as the wind aloft shears them; then the anvil, spreading flat on top far downwind,
+    // thinning toward its edge, with a little overhang upwind (its staging's wind blows +x).
     let mut rng = SplitMix::new(51);
     let mut u = move || rng.next_f64() as f32;
     let mut v = Vec::new();
     for level in 0..7 {
         let y = 1.5 + level as f32 * 2.0;
+        // The tower leans downwind, more the higher it is.
+        let lean = 0.03 * (level * level) as f32;
         for k in 0..3 {
             let a = k as f32 * 2.1 + level as f32 * 0.9;
             let off = 1.3 + 0.5 * u();
-            let c = Vec3::new(a.cos() * off, y + u(), a.sin() * off * 0.8);
+            let c = Vec3::new(lean + a.cos() * off, y + u(), a.sin() * off * 0.8);
             let r = 2.0 + 0.8 * u() - level as f32 * 0.08;
             v.push(Ellipsoid::new(c, Vec3::new(r, r * 0.85, r)));
         }
     }
-    v.push(Ellipsoid::new(
-        Vec3::new(1.5, 15.6, 0.0),
-        Vec3::new(6.5, 1.2, 4.0),
-    ));
-    v.push(Ellipsoid::new(
-        Vec3::new(-1.0, 15.2, 0.6),
-        Vec3::new(4.5, 1.0, 3.2),
-    ));
-    v.push(Ellipsoid::new(
-        Vec3::new(4.5, 15.9, -0.4),
-        Vec3::new(3.0, 0.8, 2.4),
-    ));
+    // The anvil: thick over the crown, a wedge thinning far downwind, overhanging a little
+    // upwind.
+    for (c, r) in [
+        (Vec3::new(2.0, 15.4, 0.0), Vec3::new(5.0, 1.6, 4.2)),
+        (Vec3::new(-1.8, 15.2, 0.5), Vec3::new(3.2, 1.1, 3.2)),
+        (Vec3::new(6.5, 16.0, -0.3), Vec3::new(4.2, 1.0, 3.6)),
+        (Vec3::new(10.0, 16.4, 0.4), Vec3::new(3.0, 0.55, 2.8)),
+    ] {
+        v.push(Ellipsoid::new(c, r));
+    }
     v
 }
 
