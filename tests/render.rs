@@ -382,11 +382,18 @@ fn presets_are_each_recognisable() {
     // is far wider than the tower at half its height (a column, or a dome, is not).
     let bg = background(&scenes[3]);
     let (w, h) = cloud_box(&images[3], bg);
-    assert!(h as f64 >= 0.9 * w as f64, "cumulonimbus towers: {w}×{h} px");
+    assert!(
+        h as f64 >= 0.9 * w as f64,
+        "cumulonimbus towers: {w}×{h} px"
+    );
     let widths = row_widths(&images[3], bg);
     let rows: Vec<usize> = (0..widths.len()).filter(|&y| widths[y] > 0).collect();
     let (top, bottom) = (rows[0], rows[rows.len() - 1]);
-    let anvil = widths[top..=top + (bottom - top) / 5].iter().max().copied().unwrap_or(0);
+    let anvil = widths[top..=top + (bottom - top) / 5]
+        .iter()
+        .max()
+        .copied()
+        .unwrap_or(0);
     let waist = widths[(top + bottom) / 2];
     assert!(
         anvil as f64 >= 1.8 * waist as f64,
@@ -402,7 +409,9 @@ fn presets_are_each_recognisable() {
     };
     let (left, right) = (top..=top + (bottom - top) / 5)
         .flat_map(|y| xs(y as u32))
-        .fold((f64::MAX, 0f64), |(l, r), x| (l.min(x as f64), r.max(x as f64)));
+        .fold((f64::MAX, 0f64), |(l, r), x| {
+            (l.min(x as f64), r.max(x as f64))
+        });
     assert!(
         right - middle >= 2.0 * (middle - left),
         "cumulonimbus anvil downwind: {:.0} px right of the tower, {:.0} px left",

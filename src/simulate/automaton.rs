@@ -221,10 +221,13 @@ pub fn level_of(p: f32) -> u8 {
     if p.is_nan() || p <= LEVELS[1] * 0.5 {
         return 0;
     }
-    // The nearest level in log space: above the geometric mean of two neighbours, the
-    // higher (no logarithm per cell: a simulation's parcels set these at every interval).
+    // The nearest level in log space: above the geometric mean of two neighbours, the higher
+    // (no logarithm or root per cell: a simulation's parcels set these at every interval).
+    static BETWEEN: std::sync::OnceLock<[f32; LEVELS.len() - 2]> = std::sync::OnceLock::new();
+    let between =
+        BETWEEN.get_or_init(|| std::array::from_fn(|i| (LEVELS[i + 1] * LEVELS[i + 2]).sqrt()));
     let mut k = 1;
-    while k + 1 < LEVELS.len() && p > (LEVELS[k] * LEVELS[k + 1]).sqrt() {
+    while k + 1 < LEVELS.len() && p > between[k - 1] {
         k += 1;
     }
     k as u8
@@ -436,25 +439,57 @@ impl Automaton {
     /// Sets the probability levels of `kind` per cell (x fastest, then z, then y: the rows'
     /// order), from `level(x, y, z)`.
     pub fn set_levels(&mut self, kind: Kind, level: impl Fn(usize, usize, usize) -> u8) {
+        let nx = self.dims[0];
+        self.set_levels_in_spans(kind, 0, |_, _| Some((0, nx)), level);
+    }
+
+    /// [`Automaton::set_levels`] where only the cells `span(y, z)` (a range of x, or none) of
+    /// each row ask `level`, and every other cell is at `outside`: the same levels, in a time
+    /// that grows with the spans' cells (a parcel's steering reaches only the cells its box
+    /// holds).
+    pub fn set_levels_in_spans(
+        &mut self,
+        kind: Kind,
+        outside: u8,
+        span: impl Fn(usize, usize) -> Option<(usize, usize)>,
+        level: impl Fn(usize, usize, usize) -> u8,
+    ) {
         let [nx, ny, nz] = self.dims;
         let words = self.words;
+        let top = LEVELS.len() as u8 - 1;
+        let outside = outside.min(top) as usize;
         let mut m = Membership::default();
         let mut row = vec![[0u64; LEVELS.len()]; words];
+        // Every bit of a row's word that holds a cell.
+        let full = |w: usize| {
+            let bits = (nx - 64 * w).min(64);
+            if bits == 64 {
+                u64::MAX
+            } else {
+                (1u64 << bits) - 1
+            }
+        };
         for y in 0..ny {
             for l in &mut m {
                 l.layers.push(l.at.len());
             }
             for z in 0..nz {
-                row.iter_mut().for_each(|w| *w = [0; LEVELS.len()]);
-                for x in 0..nx {
-                    let l = level(x, y, z).min(LEVELS.len() as u8 - 1) as usize;
-                    if l > 0 {
-                        row[x / 64][l] |= 1 << (x % 64);
+                row.iter_mut().enumerate().for_each(|(w, bits)| {
+                    *bits = [0; LEVELS.len()];
+                    bits[outside] = full(w);
+                });
+                if let Some((from, to)) = span(y, z) {
+                    for x in from..to.min(nx) {
+                        let bit = 1u64 << (x % 64);
+                        let bits = &mut row[x / 64];
+                        bits[outside] &= !bit;
+                        bits[level(x, y, z).min(top) as usize] |= bit;
                     }
                 }
                 let first = (y * nz + z) * words;
                 for (w, bits) in row.iter().enumerate() {
-                    for (l, &b) in m.iter_mut().zip(bits).filter(|(_, b)| **b != 0) {
+                    // (Level 0 is never drawn: its cells are in no list.)
+                    for (l, &b) in m.iter_mut().zip(bits).skip(1).filter(|(_, b)| **b != 0) {
                         l.at.push((first + w) as u32);
                         l.members.push(b);
                     }

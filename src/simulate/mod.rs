@@ -36,6 +36,21 @@ pub struct Parcel {
 }
 
 impl Parcel {
+    /// Half the sides of the smallest box along the world's axes that holds it (a little
+    /// more, for rounding): where its weight can be above 0.
+    pub fn reach(&self) -> Vec3 {
+        let m = glam::Mat3::from_quat(self.rotation);
+        let axes = [m.x_axis, m.y_axis, m.z_axis];
+        let r = self.radii.max(Vec3::splat(1e-4));
+        let side = |i: usize| {
+            (0..3)
+                .map(|j| (axes[j][i] * r[j]).powi(2))
+                .sum::<f32>()
+                .sqrt()
+        };
+        Vec3::new(side(0), side(1), side(2)) * 1.001 + Vec3::splat(1e-4)
+    }
+
     /// 1 at the centre, 0 at and beyond the surface (smoothly).
     pub fn weight(&self, p: Vec3) -> f32 {
         let local = self.rotation.inverse() * (p - self.center) / self.radii.max(Vec3::splat(1e-4));
@@ -271,13 +286,15 @@ impl Simulation {
 /// 2000: vapour and activation re-supplied inside them, cloud dissolving outside).
 fn steer(automaton: &mut Automaton, settings: &Settings, parcels: &[Parcel]) {
     let dims = automaton.dims;
-    // Each parcel's weight over the cells of its bounding box alone (0 elsewhere), the
-    // largest where they overlap; in (y, z, x) order.
+    // Each parcel's weight over the cells of its box alone (0 elsewhere), the largest where
+    // they overlap; in (y, z, x) order. Each row's span of cells some parcel weighs: every
+    // cell outside it is outside every parcel.
     let mut weights = vec![0.0f32; dims[0] * dims[1] * dims[2]];
+    let mut spans: Vec<Option<(usize, usize)>> = vec![None; dims[1] * dims[2]];
     let origin = Vec3::from(settings.origin);
     let h = settings.cell_size.max(1e-3);
     for q in parcels {
-        let reach = Vec3::splat(q.radii.max_element());
+        let reach = q.reach();
         let cell = |v: Vec3, up: bool| {
             let c = (v - origin) / h - 0.5;
             let c = if up { c.ceil() } else { c.floor() };
@@ -286,19 +303,29 @@ fn steer(automaton: &mut Automaton, settings: &Settings, parcels: &[Parcel]) {
         let (lo, hi) = (cell(q.center - reach, false), cell(q.center + reach, true));
         for y in lo[1]..(hi[1] + 1).min(dims[1]) {
             for z in lo[2]..(hi[2] + 1).min(dims[2]) {
+                let row = y * dims[2] + z;
                 for x in lo[0]..(hi[0] + 1).min(dims[0]) {
                     let w = q.weight(settings.center(x, y, z));
-                    let slot = &mut weights[(y * dims[2] + z) * dims[0] + x];
-                    *slot = slot.max(w);
+                    if w > 0.0 {
+                        let slot = &mut weights[row * dims[0] + x];
+                        *slot = slot.max(w);
+                        let span = spans[row].get_or_insert((x, x + 1));
+                        *span = (span.0.min(x), span.1.max(x + 1));
+                    }
                 }
             }
         }
     }
     let at = |x: usize, y: usize, z: usize| weights[(y * dims[2] + z) * dims[0] + x];
+    let span = |y: usize, z: usize| spans[y * dims[2] + z];
     let s = settings;
-    automaton.set_levels(Kind::Hum, |x, y, z| level_of(s.p_hum * at(x, y, z)));
-    automaton.set_levels(Kind::Act, |x, y, z| level_of(s.p_act * at(x, y, z)));
-    automaton.set_levels(Kind::Ext, |x, y, z| {
+    automaton.set_levels_in_spans(Kind::Hum, level_of(0.0), span, |x, y, z| {
+        level_of(s.p_hum * at(x, y, z))
+    });
+    automaton.set_levels_in_spans(Kind::Act, level_of(0.0), span, |x, y, z| {
+        level_of(s.p_act * at(x, y, z))
+    });
+    automaton.set_levels_in_spans(Kind::Ext, level_of(s.p_ext_outside), span, |x, y, z| {
         let w = at(x, y, z);
         level_of(s.p_ext_inside * w + s.p_ext_outside * (1.0 - w))
     });

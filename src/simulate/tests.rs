@@ -632,3 +632,31 @@ fn a_checkpoint_resumes_the_run_in_a_fresh_player_and_refuses_another_runs() {
     assert!(err.contains("bytes"), "{err}");
     assert!(fresh.resume(b"not a checkpoint", 130).is_err());
 }
+
+#[test]
+fn levels_set_in_spans_are_the_levels_set_cell_by_cell() {
+    // A row of 70 cells (a whole word and a part of one); inside each row's span the levels
+    // vary, outside it they are one level: both ways of setting them run the same steps.
+    let dims = [70, 5, 6];
+    let span = |y: usize, z: usize| ((y + z) % 3 != 0).then_some((3 * z + y, 40 + 5 * z));
+    let inside = |x: usize, y: usize, z: usize| ((x * 7 + y * 3 + z) % LEVELS.len()) as u8;
+    let level = |x: usize, y: usize, z: usize| match span(y, z) {
+        Some((from, to)) if (from..to).contains(&x) => inside(x, y, z),
+        _ => 5,
+    };
+    let mut cell_by_cell = Automaton::new(dims, 9);
+    let mut spans = Automaton::new(dims, 9);
+    for kind in [Kind::Hum, Kind::Act, Kind::Ext] {
+        cell_by_cell.set_levels(kind, level);
+        spans.set_levels_in_spans(kind, 5, span, inside);
+    }
+    for _ in 0..12 {
+        cell_by_cell.advance();
+        spans.advance();
+    }
+    assert_eq!(cell_by_cell.state(), spans.state());
+    assert!(
+        cell_by_cell.state() != Automaton::new(dims, 9).state(),
+        "the steps changed nothing"
+    );
+}
