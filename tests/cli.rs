@@ -1069,6 +1069,9 @@ fn a_sequence_writes_each_frame_once_and_any_split_of_it_gives_the_same_bytes() 
     for (frames, pattern, says) in [
         ("5..2", path("bad/f_##.png"), "reversed"),
         ("0..x", path("bad/f_##.png"), "whole frame numbers"),
+        ("..", path("bad/f_##.png"), "whole frame numbers"),
+        ("5..", path("bad/f_##.png"), "whole frame numbers"),
+        ("..5", path("bad/f_##.png"), "whole frame numbers"),
         ("0..20000", path("bad/f_##.png"), "at most 10000"),
         ("0..3", path("plain.png"), "no run of #"),
         ("0..3", format!("{blocker}/f_##.png"), "cannot"),
@@ -1159,6 +1162,73 @@ fn a_simulated_vdb_sequence_steps_on_and_equals_each_frame_exported_alone() {
         std::fs::read(&alone).unwrap() == seq(4),
         "frame 4 differs from its sequence's"
     );
+}
+
+/// The mesh and Mitsuba exporters make sequences too: one file (and its companions) per
+/// frame under the pattern's names, each the file that frame exported alone makes.
+#[test]
+fn mesh_and_mitsuba_sequences_write_a_file_a_frame_as_each_frame_alone_does() {
+    let dir = folder("format-sequences");
+    let path = |name: &str| dir.join(name).to_str().unwrap().to_owned();
+    let scene = path("developing.json");
+    let o = cloudsketch(&["new", "--preset", "developing", "-o", &scene]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let export = |format: &str, extra: &[&str]| {
+        let mut args = vec![
+            "export",
+            &scene,
+            "--format",
+            format,
+            "--resolution",
+            "24",
+            "--fps",
+            "1",
+        ];
+        args.extend(extra);
+        cloudsketch(&args)
+    };
+    for (format, extension) in [
+        ("glb", "glb"),
+        ("obj", "obj"),
+        ("ply", "ply"),
+        ("mitsuba", "xml"),
+    ] {
+        let pattern = path(&format!("{format}/cloud.####.{extension}"));
+        let o = export(format, &["--frames", "0..2", "-o", &pattern]);
+        assert!(o.status.success(), "{format}: {}", stderr(&o));
+        let main: Vec<String> = listing(&dir.join(format))
+            .into_iter()
+            .filter(|n| n.ends_with(&format!(".{extension}")))
+            .collect();
+        assert_eq!(
+            main,
+            (0..3)
+                .map(|k| format!("cloud.{k:04}.{extension}"))
+                .collect::<Vec<_>>(),
+            "{format}"
+        );
+        let frame =
+            |k: u32| std::fs::read(dir.join(format!("{format}/cloud.{k:04}.{extension}"))).unwrap();
+        // The developing cumulus rises and grows between frames 0 and 2 (2 s apart).
+        assert_ne!(frame(0), frame(2), "{format}: the frames are one");
+        // Frame 2 alone: the same main file, and the same companions (Mitsuba's grid and sky).
+        let alone_dir = dir.join(format!("{format}-alone"));
+        std::fs::create_dir_all(&alone_dir).unwrap();
+        let alone = alone_dir.join(format!("cloud.0002.{extension}"));
+        let o = export(format, &["--frame", "2", "-o", alone.to_str().unwrap()]);
+        assert!(o.status.success(), "{format}: {}", stderr(&o));
+        assert!(
+            std::fs::read(&alone).unwrap() == frame(2),
+            "{format}: frame 2 alone differs from its sequence's"
+        );
+        for name in listing(&alone_dir) {
+            assert!(
+                std::fs::read(alone_dir.join(&name)).unwrap()
+                    == std::fs::read(dir.join(format).join(&name)).unwrap(),
+                "{format}: {name} alone differs from its sequence's"
+            );
+        }
+    }
 }
 
 #[test]
