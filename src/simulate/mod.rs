@@ -51,6 +51,38 @@ impl Parcel {
         Vec3::new(side(0), side(1), side(2)) * 1.001 + Vec3::splat(1e-4)
     }
 
+    /// The cells of row `(y, z)` of `settings`' grid, within `within` (a range of x), that it
+    /// may weigh above 0: where the row's line crosses it, a cell wider each way for rounding
+    /// (each cell is still weighed); `None` where the line misses it.
+    fn cells_along_x(
+        &self,
+        settings: &Settings,
+        y: usize,
+        z: usize,
+        within: (usize, usize),
+    ) -> Option<(usize, usize)> {
+        let h = settings.cell_size.max(1e-3);
+        let inverse = self.rotation.inverse();
+        let r = self.radii.max(Vec3::splat(1e-4));
+        // local(t) = a + t b along the row, t the world x: inside where |local|² < 1.
+        let on_row = settings.center(0, y, z);
+        let a = inverse * (Vec3::new(0.0, on_row.y, on_row.z) - self.center) / r;
+        let b = inverse * Vec3::X / r;
+        let (bb, ab, aa) = (b.dot(b), a.dot(b), a.dot(a));
+        let disc = ab * ab - bb * (aa - 1.0);
+        if disc < 0.0 || bb <= 0.0 {
+            return None;
+        }
+        let root = disc.sqrt();
+        let (t0, t1) = ((-ab - root) / bb, (-ab + root) / bb);
+        let x0 = settings.origin[0];
+        let from = ((t0 - x0) / h - 0.5).floor() - 1.0;
+        let to = ((t1 - x0) / h - 0.5).ceil() + 2.0;
+        let from = (from.max(0.0) as usize).max(within.0);
+        let to = (to.max(0.0) as usize).min(within.1);
+        (from < to).then_some((from, to))
+    }
+
     /// 1 at the centre, 0 at and beyond the surface (smoothly).
     pub fn weight(&self, p: Vec3) -> f32 {
         let local = self.rotation.inverse() * (p - self.center) / self.radii.max(Vec3::splat(1e-4));
@@ -286,37 +318,69 @@ impl Simulation {
 /// 2000: vapour and activation re-supplied inside them, cloud dissolving outside).
 fn steer(automaton: &mut Automaton, settings: &Settings, parcels: &[Parcel]) {
     let dims = automaton.dims;
-    // Each parcel's weight over the cells of its box alone (0 elsewhere), the largest where
-    // they overlap; in (y, z, x) order. Each row's span of cells some parcel weighs: every
-    // cell outside it is outside every parcel.
-    let mut weights = vec![0.0f32; dims[0] * dims[1] * dims[2]];
-    let mut spans: Vec<Option<(usize, usize)>> = vec![None; dims[1] * dims[2]];
     let origin = Vec3::from(settings.origin);
     let h = settings.cell_size.max(1e-3);
-    for q in parcels {
-        let reach = q.reach();
-        let cell = |v: Vec3, up: bool| {
-            let c = (v - origin) / h - 0.5;
-            let c = if up { c.ceil() } else { c.floor() };
-            [0, 1, 2].map(|i| (c[i].max(0.0) as usize).min(dims[i]))
-        };
-        let (lo, hi) = (cell(q.center - reach, false), cell(q.center + reach, true));
-        for y in lo[1]..(hi[1] + 1).min(dims[1]) {
-            for z in lo[2]..(hi[2] + 1).min(dims[2]) {
-                let row = y * dims[2] + z;
-                for x in lo[0]..(hi[0] + 1).min(dims[0]) {
-                    let w = q.weight(settings.center(x, y, z));
-                    if w > 0.0 {
-                        let slot = &mut weights[row * dims[0] + x];
-                        *slot = slot.max(w);
-                        let span = spans[row].get_or_insert((x, x + 1));
-                        *span = (span.0.min(x), span.1.max(x + 1));
-                    }
+    // Each parcel's box of cells (the rows it may cross).
+    let boxes: Vec<([usize; 3], [usize; 3])> = parcels
+        .iter()
+        .map(|q| {
+            let reach = q.reach();
+            let cell = |v: Vec3, up: bool| {
+                let c = (v - origin) / h - 0.5;
+                let c = if up { c.ceil() } else { c.floor() };
+                [0, 1, 2].map(|i| (c[i].max(0.0) as usize).min(dims[i]))
+            };
+            (cell(q.center - reach, false), cell(q.center + reach, true))
+        })
+        .collect();
+    // Per row (y, z), the span of cells some parcel weighs above 0 and their weights (the
+    // largest where parcels overlap); every cell outside the spans is outside every parcel.
+    let rows = dims[1] * dims[2];
+    let mut spans: Vec<Option<(usize, usize)>> = vec![None; rows];
+    let mut starts = vec![0usize; rows];
+    let mut weights: Vec<f32> = Vec::new();
+    let mut row_weights = vec![0.0f32; dims[0]];
+    let mut crossing: Vec<(usize, (usize, usize))> = Vec::with_capacity(parcels.len());
+    for y in 0..dims[1] {
+        for z in 0..dims[2] {
+            // The parcels whose surface this row's line crosses, and where.
+            crossing.clear();
+            for (i, (q, (lo, hi))) in parcels.iter().zip(&boxes).enumerate() {
+                let inside = |k: usize, v: usize| lo[k] <= v && v <= hi[k];
+                if inside(1, y)
+                    && inside(2, z)
+                    && let Some(cells) =
+                        q.cells_along_x(settings, y, z, (lo[0], (hi[0] + 1).min(dims[0])))
+                {
+                    crossing.push((i, cells));
                 }
             }
+            let row = y * dims[2] + z;
+            let Some(span) = crossing
+                .iter()
+                .map(|&(_, c)| c)
+                .reduce(|a, b| (a.0.min(b.0), a.1.max(b.1)))
+            else {
+                continue;
+            };
+            row_weights[span.0..span.1].fill(0.0);
+            for &(i, (from, to)) in &crossing {
+                let q = &parcels[i];
+                for x in from..to {
+                    let w = q.weight(settings.center(x, y, z));
+                    row_weights[x] = row_weights[x].max(w);
+                }
+            }
+            starts[row] = weights.len();
+            weights.extend_from_slice(&row_weights[span.0..span.1]);
+            spans[row] = Some(span);
         }
     }
-    let at = |x: usize, y: usize, z: usize| weights[(y * dims[2] + z) * dims[0] + x];
+    let at = |x: usize, y: usize, z: usize| {
+        let row = y * dims[2] + z;
+        let from = spans[row].map_or(0, |s| s.0);
+        weights[starts[row] + x - from]
+    };
     let span = |y: usize, z: usize| spans[y * dims[2] + z];
     let s = settings;
     automaton.set_levels_in_spans(Kind::Hum, level_of(0.0), span, |x, y, z| {
