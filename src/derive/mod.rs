@@ -254,7 +254,7 @@ impl OutlinesKey {
     }
 }
 
-/// The derivation cache of one document (keep one per viewport or offscreen device).
+/// The derivation cache of one document (keep one per viewport, or per sequence of frames).
 #[derive(Default)]
 pub struct Derived {
     planes: PlaneCache,
@@ -523,8 +523,10 @@ impl Derived {
     /// over from earlier frames: frame after frame of a sequence steps a simulation on from the
     /// last instead of replaying it (a frame reached so equals the frame played from step 0).
     ///
-    /// This is the one place a standalone image or export interprets time; the app's viewport
-    /// derives incrementally with [`Derived::update`] from the document its clock posed.
+    /// Every standalone image (offscreen renders, the CLI's images and PNG frames) is drawn
+    /// from one; the exporters, which sample the field at their own resolution, take the scene
+    /// posed at the same time (`Scene::posed_at`), and the app's viewport derives incrementally
+    /// with [`Derived::update`] from the document its clock posed.
     pub fn frame(&mut self, scene: &Scene, at: Option<f32>) -> Frame {
         let scene = match at {
             Some(t) => scene.posed_at(t),

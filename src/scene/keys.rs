@@ -1269,31 +1269,37 @@ impl Scene {
         changed
     }
 
-    /// Whether `channel` holds what its keys pose at the scene's time, so a key there would
-    /// change nothing (Blender's "only insert needed"); false for a value without keys, which
-    /// nothing poses.
-    pub fn as_keyed(&self, channel: Channel) -> bool {
-        let Some(value) = self
-            .animation
-            .track(channel)
-            .and_then(|track| track.sample(clamp_time(self.time)))
-        else {
-            return false;
-        };
-        // Through the value's own setter, so a value it wraps (a yaw) or normalises (a
-        // rotation) compares as it is held.
+    /// Those of `channels` a key at the scene's time would change: a keyed value that differs
+    /// from what its keys pose there (Blender's "only insert needed"), and every value without
+    /// keys, which nothing poses. The keyed ones are posed once, through their own setters, so
+    /// a value they wrap (a yaw) or normalise (a rotation) compares as it is held.
+    pub fn changed_from_keys(&self, channels: &[Channel]) -> Vec<Channel> {
+        let keyed: HashSet<Channel> = channels
+            .iter()
+            .copied()
+            .filter(|c| self.animation.track(*c).is_some())
+            .collect();
         let mut posed = self.clone();
-        let index = Index::of(&posed);
-        channel.set(&mut posed, &index, &value);
-        match (channel.get(&posed), channel.get(self)) {
-            (Some(a), Some(b)) => {
-                a.len() == b.len()
-                    && a.iter()
-                        .zip(&b)
-                        .all(|(x, y)| (x - y).abs() <= 1e-6 * x.abs().max(y.abs()).max(1.0))
-            }
-            _ => false,
-        }
+        posed.pose_channels(self.time, &keyed);
+        let (ours, theirs) = (Index::of(self), Index::of(&posed));
+        channels
+            .iter()
+            .copied()
+            .filter(|c| {
+                if !keyed.contains(c) {
+                    return true;
+                }
+                match (c.get_in(&posed, Some(&theirs)), c.get_in(self, Some(&ours))) {
+                    (Some(a), Some(b)) => {
+                        a.len() != b.len()
+                            || a.iter()
+                                .zip(&b)
+                                .any(|(x, y)| (x - y).abs() > 1e-6 * x.abs().max(y.abs()).max(1.0))
+                    }
+                    _ => true,
+                }
+            })
+            .collect()
     }
 
     /// The scene at time `t`: its clock set to `t` and every keyed value posed there. The one

@@ -2,8 +2,9 @@
 //! drag covers the whole frame range, the range and the rate, and the keys of what is selected
 //! as diamonds (drag to retime, Shift+click to select several, right-click for the ease,
 //! Delete over the strip removes them). I keys the selection's changed values (the sun with
-//! nothing selected); auto-key records every edit. The time lives in the document (renders and links reproduce
-//! it) but, like the camera, changing it is not an undo step; playing is view state.
+//! nothing selected); auto-key records every edit. The time lives in the document (renders
+//! and links reproduce it) but, like the camera, changing it is not an undo step; playing is
+//! view state.
 
 use egui::{Color32, Pos2, Sense, Stroke, Ui, vec2};
 
@@ -226,11 +227,7 @@ impl Timeline {
     pub fn insert_keys(&mut self, doc: &mut Document, selection: &Selection) -> String {
         let scene = doc.scene();
         let offered = keyed_by_i(scene, selection, self.shot_view);
-        let channels: Vec<Channel> = offered
-            .iter()
-            .copied()
-            .filter(|c| !scene.as_keyed(*c))
-            .collect();
+        let channels = scene.changed_from_keys(&offered);
         let mut animation = scene.animation.clone();
         let t = scene.time;
         let n = animation.key_all(scene, channels.iter().copied(), t);
@@ -269,7 +266,7 @@ impl Timeline {
         if n == 0 {
             if channels.is_empty() && !offered.is_empty() {
                 return format!(
-                    "Nothing changed: {what} is as its keys pose it at frame {frame:.0}"
+                    "Nothing keyed: {what} unchanged from the keys at frame {frame:.0}"
                 );
             }
             return if channels.is_empty() {
@@ -1001,7 +998,10 @@ mod tests {
         // Nothing changed since the keys: nothing to key, no undo step.
         let steps = doc.undo_len();
         let said = timeline.insert_keys(&mut doc, &Selection::default());
-        assert!(said.starts_with("Nothing changed: the sun"), "{said}");
+        assert!(
+            said.starts_with("Nothing keyed: the sun unchanged"),
+            "{said}"
+        );
         assert_eq!(doc.undo_len(), steps);
         // The opacity and the sun's azimuth changed at frame 24: those two are keyed.
         let mut render = doc.scene().render.clone();
