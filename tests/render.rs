@@ -2346,18 +2346,16 @@ fn the_eight_bit_path_draws_the_float_paths_image_within_rounding() {
             &Scene::preset(Preset::from_name(name).unwrap()),
             &["/render/slices=64"],
         );
-        let float = o
-            .render(&frame_of(&scene, None), W, H, Backdrop::Sky)
-            .expect("render");
+        // Derived once: every drawing below is of the same volumes.
+        let frame = frame_of(&scene, None);
+        let float = o.render(&frame, W, H, Backdrop::Sky).expect("render");
         let float_alone = o
-            .render(&frame_of(&scene, None), W, H, Backdrop::Transparent)
+            .render(&frame, W, H, Backdrop::Transparent)
             .expect("render");
         o.set_eight_bit(true).unwrap();
-        let eight = o
-            .render(&frame_of(&scene, None), W, H, Backdrop::Sky)
-            .expect("render");
+        let eight = o.render(&frame, W, H, Backdrop::Sky).expect("render");
         let eight_alone = o
-            .render(&frame_of(&scene, None), W, H, Backdrop::Transparent)
+            .render(&frame, W, H, Backdrop::Transparent)
             .expect("render");
         o.set_eight_bit(false).unwrap();
         // The cloud alone (a transparent PNG) too: nothing behind it to carry the scale back.
@@ -2380,14 +2378,10 @@ fn the_eight_bit_path_draws_the_float_paths_image_within_rounding() {
         };
         // As the viewport draws it (the cloud's box sliced, the shafts around it apart), with
         // shafts of light.
-        let shafts = with(&scene, &["/light/shafts=true"]);
-        let float_cropped = o
-            .render_cropped(&frame_of(&shafts, None), W, H)
-            .expect("render");
+        let shafts = frame_of(&with(&scene, &["/light/shafts=true"]), None);
+        let float_cropped = o.render_cropped(&shafts, W, H).expect("render");
         o.set_eight_bit(true).unwrap();
-        let eight_cropped = o
-            .render_cropped(&frame_of(&shafts, None), W, H)
-            .expect("render");
+        let eight_cropped = o.render_cropped(&shafts, W, H).expect("render");
         o.set_eight_bit(false).unwrap();
         let (mean_cropped, _) = image_difference(&float_cropped, &eight_cropped);
         assert!(
@@ -2399,9 +2393,7 @@ fn the_eight_bit_path_draws_the_float_paths_image_within_rounding() {
         if name == "cumulus" {
             o.set_eight_bit(true).unwrap();
             o.set_marching(true).expect("lavapipe marches the slices");
-            let marched = o
-                .render(&frame_of(&scene, None), W, H, Backdrop::Sky)
-                .expect("render");
+            let marched = o.render(&frame, W, H, Backdrop::Sky).expect("render");
             o.set_eight_bit(false).unwrap();
             let (mean_marched, _) = image_difference(&float, &marched);
             assert!(
