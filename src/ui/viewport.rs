@@ -721,4 +721,35 @@ mod tests {
         assert_eq!(full.px, [0, 0, 800, 600]);
         assert_eq!(full.ndc(view), [-1.0, -1.0, 1.0, 1.0]);
     }
+
+    #[test]
+    fn each_frame_a_simulation_catches_up_keys_a_new_image() {
+        // A far jump in time: the simulation catches up over frames while the document stays
+        // as it is. The view's image key must change with each frame's cloud, or the view
+        // keeps a refinement begun on a cloud passed on the way (the page test of the jump
+        // cannot tell: which clouds a refinement draws on is a matter of timing there).
+        use crate::scene::{Preset, Scene};
+        let mut doc = Document::new(Scene::preset(Preset::Simulated));
+        let mut derived = Derived::default();
+        doc.set_time(60.0);
+        let revisions = doc.revisions();
+        let mut keys = Vec::new();
+        loop {
+            let volumes = derived.update(doc.scene(), doc.revisions());
+            keys.push(view_key(&doc, volumes.density.generation, [900, 560], None));
+            if !derived.catching_up {
+                break;
+            }
+        }
+        assert_eq!(doc.revisions(), revisions, "the document stayed as it was");
+        assert!(keys.len() >= 3, "caught up over {} frames", keys.len());
+        let mut distinct = keys.clone();
+        distinct.sort_unstable();
+        distinct.dedup();
+        assert_eq!(distinct.len(), keys.len(), "a key repeated: {keys:?}");
+        // Caught up, the same cloud keeps its image.
+        let volumes = derived.update(doc.scene(), doc.revisions());
+        let again = view_key(&doc, volumes.density.generation, [900, 560], None);
+        assert_eq!(again, *keys.last().unwrap());
+    }
 }

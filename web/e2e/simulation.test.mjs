@@ -128,12 +128,15 @@ test('the page times the automaton as the native bench does (?bench=ca)', { time
   });
 });
 
-// A far jump in time: the simulation catches up over frames while the document stays as it
-// is, and the image must show where it arrives (it kept the first frame's cloud, or chunks of
-// several, until something else changed). The jump goes to step 10,000 (1,000 s at the
-// preset's 10 steps a second): catching up 6,000 steps took 24–30 s here, against 16–24 s for a
-// refinement of the view at its whole resolution, too close for the premise the test asserts;
-// 10,000 take about 45 s. (The automaton's last step, 20,000, took 70 s here and 115 s in CI.)
+// A far jump in time: the simulation catches up over frames (200 steps a frame) while the
+// document stays as it is, and the image must show where it arrives, as a fresh image of the
+// same view does. Which passed clouds a refinement begun during the catching up draws on is a
+// matter of timing here (late in a long jump they look like the arrival), so the view's image
+// key, which must change with each frame's cloud, is tested apart
+// (`ui::viewport::tests::each_frame_a_simulation_catches_up_keys_a_new_image`); this test
+// asserts no timing, only that the arrival looks unlike the start (an image kept from before
+// the jump cannot pass for it) and that the shown image is the arrival's. The jump goes to the
+// automaton's last step, 20,000 (2,000 s at the preset's 10 steps a second).
 test('after a far jump in time the image shows the cloud the simulation caught up with', { timeout: 420_000 }, async () => {
   await withApp({ base: server.url, webgpu: true, query: '?preset=simulated&refine=whole', viewport: { width: 900, height: 560 } }, async (page) => {
     await page.evaluate(() => window.cloudsketch.set('/light/ground=false'));
@@ -141,15 +144,14 @@ test('after a far jump in time the image shows the cloud the simulation caught u
     const settled = await waitForFullQuality(page);
     const [vw, vh] = s.view.viewport;
     const body = { x: 0, y: 130, w: vw - 320, h: vh - 160 };
-    await page.evaluate(() => window.cloudsketch.set('/time=1000'));
-    s = await until(page, (s) => s.scene.time === 1000 && s.view.catching_up, 'catching up');
+    const start = await screenshot(page, 'simulation-jump-start');
+    await page.evaluate(() => window.cloudsketch.set('/time=2000'));
+    s = await until(page, (s) => s.scene.time === 2000 && s.view.catching_up, 'catching up');
     const t0 = Date.now();
     await until(page, (s) => !s.view.catching_up, 'caught up', 240_000);
     const caught = (Date.now() - t0) / 1000;
     const after = await waitForFullQuality(page);
     console.log(`# caught up in ${caught} s, then full quality in ${after.seconds} s (the view refined in ${settled.seconds} s)`);
-    // The premise: the view had time to finish a refinement while the simulation caught up.
-    assert.ok(caught > settled.seconds, `caught up in ${caught} s, faster than a refinement (${settled.seconds} s)`);
     const shown = await screenshot(page, 'simulation-jump-shown');
     // The same view drawn afresh: a slice count there and back (two edits) redraws it.
     await page.evaluate(() => window.cloudsketch.set('/render/slices=127'));
@@ -160,6 +162,9 @@ test('after a far jump in time the image shows the cloud the simulation caught u
     const fresh = await screenshot(page, 'simulation-jump-fresh');
     const changed = countChanged(shown, fresh, body);
     assert.ok(changed <= 50, `${changed} px differ from a fresh image of the same view`);
+    const moved = countChanged(start, fresh, body);
+    console.log(`# ${changed} px off a fresh image; ${moved} px off the start`);
+    assert.ok(moved > 20 * 50, `the arrival looks like the start: ${moved} px differ`);
 
     // The clock's frame rate is the document's (an undo step that redraws nothing).
     const undo = (await state(page)).view.undo;
