@@ -477,3 +477,61 @@ async function zippedFrames(file, last, scene, w, h) {
   assert.ok(covered[11] > 1.3 * covered[0] && covered[0] > 200, `the tower grows over the range: ${covered[0]} → ${covered[11]} px`);
   return { frames, files, cli };
 }
+
+// Record stopped midway (#39), on both builds, as a user stops it: the timeline's button reads
+// "Stop N%" while frames are drawn, and the view answers input meanwhile (a drag orbits the
+// camera). Clicking the button again stops the recording: nothing downloads, the notice says
+// so, the document is back at the time it began from, the button reads Record again, and the
+// view draws at full quality (it is not left capturing). A second Record then runs to its end
+// and downloads (nothing of the stopped one is left in its way).
+for (const backend of BOTH_BUILDS) {
+  test(`Record stopped midway saves nothing; the view answers a drag while recording (${backend})`, { timeout: 600_000 }, async () => {
+    await withApp({ base: server.url, webgpu: backend === 'webgpu', query: '?preset=developing', viewport: { width: 1280, height: 800 } }, async (page) => {
+      await page.evaluate(() => {
+        for (const p of ['/clock/end=11', '/clock/fps=1', '/render/slices=16', '/render/light_resolution=24', '/render/light_octaves=2',
+          '/light/ground=false', '/light/sky_gradient=false', '/light/shafts=false', '/time=7.5']) window.cloudsketch.set(p);
+      });
+      let s = await until(page, (s) => s.scene.clock.end === 11 && s.scene.time === 7.5 && !s.scene.light.shafts, 'a 12-frame range at 7.5 s (between frames)');
+      await waitForFullQuality(page);
+      const [vw, vh] = s.view.viewport;
+      const yaw0 = s.scene.camera.yaw_deg;
+      const downloads = [];
+      page.on('download', (d) => downloads.push(d.suggestedFilename()));
+      const pressRecord = async () => {
+        const [x, y, w, h] = (await state(page)).view.widgets['timeline:record'];
+        await page.mouse.click(x + w / 2, y + h / 2);
+      };
+      await pressRecord();
+      // A frame or more drawn: the button shows the share done.
+      const stopAt = (s) => Number(/^Stop (\d+)%$/.exec(s.view.timeline.record ?? '')?.[1] ?? -1);
+      s = await until(page, (s) => stopAt(s) >= 8, 'recording, a frame or more drawn', 240_000);
+      // A drag across the view at the pointer's own rate (not a frame per move) orbits it.
+      await page.mouse.move(vw * 0.3, vh * 0.5);
+      await page.mouse.down();
+      await page.mouse.move(vw * 0.3 + 120, vh * 0.5, { steps: 24 });
+      await page.mouse.up();
+      s = await until(page, (s) => s.scene.camera.yaw_deg !== yaw0, 'the drag orbited the view');
+      assert.ok(stopAt(s) >= 0, `still recording after the drag: ${s.view.timeline.record}`);
+      const notices = new Set();
+      await pressRecord();
+      s = await until(page, (s) => {
+        if (s.view.notice?.text) notices.add(s.view.notice.text);
+        return s.view.export.progress == null && s.view.timeline.record === 'Record';
+      }, 'stopped');
+      assert.ok([...notices].some((n) => /cancelled/i.test(n)), `said so: ${[...notices].join(' | ')}`);
+      assert.equal(s.scene.time, 7.5, 'back at the time it began from (no frame\'s time)');
+      await waitForFullQuality(page);
+      // Anything still on its way would have come by now (a frame takes well under this).
+      await page.waitForTimeout(3000);
+      assert.deepEqual(downloads, [], 'nothing downloaded');
+      await screenshot(page, `record-stopped-${backend}`);
+      // Recorded again, to its end.
+      await pressRecord();
+      await until(page, (s) => stopAt(s) >= 0, 'recording again');
+      s = await until(page, (s) => s.view.export.progress == null && s.view.timeline.record === 'Record', 'recorded', 480_000);
+      assert.equal(s.view.export.last?.error, undefined, 'the second recording did not fail');
+      await until(page, () => downloads.length === 1, 'the second recording downloaded', 30_000);
+      console.log(`# ${backend}: stopped at ${[...notices].join(' | ')}; then ${downloads[0]}`);
+    });
+  });
+}
