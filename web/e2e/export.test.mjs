@@ -431,23 +431,25 @@ test('Record where the video encoder refuses: the range as PNGs in a zip, each t
 
 // `?record=png` asks for PNGs from the start (a browser without WebCodecs gets them the same
 // way): no video is tried, so nothing is said of an encoder, and the frames keep the view's
-// natural height (a video's must be even). The same 12 frames, each the CLI's. On the WebGPU
-// build, with its encoder present: the address alone chooses.
-test('Record with ?record=png: PNGs in a zip from the start, each the CLI\'s frame (webgpu)', { timeout: 600_000 }, async () => {
-  assert.ok(fs.existsSync(NATIVE), `${NATIVE} missing: run cargo test (it builds the CLI) first`);
-  await withApp({ base: server.url, webgpu: true, query: '?preset=developing&record=png', viewport: { width: 1280, height: 720 } }, async (page) => {
-    const hasEncoder = await page.evaluate(() => typeof VideoEncoder === 'function');
-    const { file, scene, last, notices } = await recordRange(page, [24, 2], 'timeline');
-    assert.ok(![...notices].some((n) => /cannot encode/.test(n)), `no encoder tried: ${[...notices].join(' | ')}`);
-    assert.ok(hasEncoder, 'the browser has WebCodecs: the address alone chose PNGs');
-    const [vw, vh] = (await state(page)).view.viewport;
-    const natural = Math.round(320 * vh / vw);
-    assert.equal(natural % 2, 1, `an odd natural height (${natural}), which a video's would round to even`);
-    const { files } = await zippedFrames(file, last, scene, 320, natural);
-    console.log(`# webgpu ?record=png: ${files.length} PNGs at 320×${natural} (WebCodecs ${hasEncoder ? 'present' : 'missing'})`);
-    fs.writeFileSync('test-results/screenshots/record-png-0-webgpu.png', Buffer.from(files[0].bytes));
+// natural height (a video's must be even). The same 12 frames, each the CLI's. On both
+// builds, with the encoder present: the address alone chooses.
+for (const backend of BOTH_BUILDS) {
+  test(`Record with ?record=png: PNGs in a zip from the start, each the CLI's frame (${backend})`, { timeout: 600_000 }, async () => {
+    assert.ok(fs.existsSync(NATIVE), `${NATIVE} missing: run cargo test (it builds the CLI) first`);
+    await withApp({ base: server.url, webgpu: backend === 'webgpu', query: '?preset=developing&record=png', viewport: { width: 1280, height: 720 } }, async (page) => {
+      const hasEncoder = await page.evaluate(() => typeof VideoEncoder === 'function');
+      const { file, scene, last, notices } = await recordRange(page, [24, 2], 'timeline');
+      assert.ok(![...notices].some((n) => /cannot encode/.test(n)), `no encoder tried: ${[...notices].join(' | ')}`);
+      assert.ok(hasEncoder, 'the browser has WebCodecs: the address alone chose PNGs');
+      const [vw, vh] = (await state(page)).view.viewport;
+      const natural = Math.round(320 * vh / vw);
+      assert.equal(natural % 2, 1, `an odd natural height (${natural}), which a video's would round to even`);
+      const { files } = await zippedFrames(file, last, scene, 320, natural);
+      console.log(`# ${backend} ?record=png: ${files.length} PNGs at 320×${natural} (WebCodecs ${hasEncoder ? 'present' : 'missing'})`);
+      fs.writeFileSync(`test-results/screenshots/record-png-0-${backend}.png`, Buffer.from(files[0].bytes));
+    });
   });
-});
+}
 
 /**
  * The recording's zip download: 12 PNGs named by frame, each `w`×`h`, the sky in the corner
