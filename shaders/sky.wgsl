@@ -76,7 +76,16 @@ fn vs_main(@builtin(vertex_index) vi: u32) -> Fullscreen {
 
 @fragment
 fn fs_main(in: Fullscreen) -> @location(0) vec4<f32> {
-    return vec4<f32>(display(sky_light(in)), 1.0);
+    return vec4<f32>(display(sky_light(in)) + dither(in.clip.xy), 1.0);
+}
+
+// An offset below half a level of 8 bits, the same for each channel, spread over the pixels
+// (Jimenez's interleaved gradient noise of the pixel's place on the target): a slow gradient
+// rounds to one level here and the next there instead of to bands of each with a contour line
+// between them, and a colour on a level (a picked one) stays on it.
+fn dither(pixel: vec2<f32>) -> f32 {
+    let n = fract(52.9829189 * fract(dot(floor(pixel), vec2<f32>(0.06711056, 0.00583715))));
+    return (n - 0.5) * (0.9 / 255.0);
 }
 
 // Into a float target (the offscreen linear image an EXR holds): the same light before the

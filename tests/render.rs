@@ -2411,3 +2411,64 @@ fn the_eight_bit_path_draws_the_float_paths_image_within_rounding() {
         );
     }
 }
+
+/// An 8-bit sky is dithered, not banded: a slow gradient (the picked gradient, the physical
+/// sky) rounded to 8 bits leaves bands of one level with a contour line between them (seen
+/// at 1920×1080). Against the exact display levels of the same sky (the linear image through
+/// the one tone map): no pixel is more than a level off, and along each row the error averaged
+/// over 16 pixels (what the eye sees from a step back) is under 0.4× plain rounding's, which
+/// keeps each band's error whole (0.25 levels on average, the undithered sky's 1.0×).
+#[test]
+fn an_eight_bit_sky_is_dithered_not_banded() {
+    let (w, h) = (640u32, 360u32);
+    for (what, sets) in [
+        ("gradient", ["/light/sky_gradient=true", "/light/physical_sky=false"]),
+        ("physical sky", ["/light/sky_gradient=false", "/light/physical_sky=true"]),
+    ] {
+        let mut all = vec!["/light/ground=false", "/light/shafts=false"];
+        all.extend(sets);
+        let scene = with(&Scene::preset(Preset::Empty), &all);
+        let frame = frame_of(&scene, None);
+        let eight = offscreen()
+            .render(&frame, w, h, Backdrop::Sky)
+            .expect("render");
+        let linear = linear_offscreen()
+            .render_linear(&frame, [w, h], Backdrop::Sky, 1, None)
+            .expect("linear render");
+        let at = |x: u32, y: u32, c: usize| ((y * w + x) * 4) as usize + c;
+        let exact = |x: u32, y: u32, c: usize| shown(linear.rgba[at(x, y, c)] as f64);
+        let (mut worst, mut dithered, mut rounded, mut runs) = (0.0f64, 0.0f64, 0.0f64, 0usize);
+        for y in 0..h {
+            for x0 in (0..w - 15).step_by(16) {
+                for c in 0..3 {
+                    let (mut d, mut r) = (0.0, 0.0);
+                    for x in x0..x0 + 16 {
+                        let e = exact(x, y, c);
+                        let got = eight.rgba[at(x, y, c)] as f64;
+                        worst = worst.max((got - e).abs());
+                        d += got - e;
+                        r += e.round() - e;
+                    }
+                    dithered += (d / 16.0).abs();
+                    rounded += (r / 16.0).abs();
+                    runs += 1;
+                }
+            }
+        }
+        let (dithered, rounded) = (dithered / runs as f64, rounded / runs as f64);
+        let mut levels: Vec<u8> = (0..h).map(|y| eight.rgba[at(w / 2, y, 2)]).collect();
+        levels.sort_unstable();
+        levels.dedup();
+        eprintln!(
+            "{what}: {} levels of blue down the middle; error over 16 px {dithered:.3} levels, \
+             plain rounding's {rounded:.3}; worst pixel {worst:.2} levels off",
+            levels.len()
+        );
+        assert!(levels.len() >= 8, "{what}: a gradient of {} levels", levels.len());
+        assert!(worst <= 1.1, "{what}: a pixel {worst:.2} levels off");
+        assert!(
+            dithered < 0.4 * rounded,
+            "{what}: banded: {dithered:.3} levels off over 16 px, plain rounding {rounded:.3}"
+        );
+    }
+}
