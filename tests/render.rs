@@ -2422,8 +2422,14 @@ fn the_eight_bit_path_draws_the_float_paths_image_within_rounding() {
 fn an_eight_bit_sky_is_dithered_not_banded() {
     let (w, h) = (640u32, 360u32);
     for (what, sets) in [
-        ("gradient", ["/light/sky_gradient=true", "/light/physical_sky=false"]),
-        ("physical sky", ["/light/sky_gradient=false", "/light/physical_sky=true"]),
+        (
+            "gradient",
+            ["/light/sky_gradient=true", "/light/physical_sky=false"],
+        ),
+        (
+            "physical sky",
+            ["/light/sky_gradient=false", "/light/physical_sky=true"],
+        ),
     ] {
         let mut all = vec!["/light/ground=false", "/light/shafts=false"];
         all.extend(sets);
@@ -2464,7 +2470,11 @@ fn an_eight_bit_sky_is_dithered_not_banded() {
              plain rounding's {rounded:.3}; worst pixel {worst:.2} levels off",
             levels.len()
         );
-        assert!(levels.len() >= 8, "{what}: a gradient of {} levels", levels.len());
+        assert!(
+            levels.len() >= 8,
+            "{what}: a gradient of {} levels",
+            levels.len()
+        );
         assert!(worst <= 1.1, "{what}: a pixel {worst:.2} levels off");
         assert!(
             dithered < 0.4 * rounded,

@@ -129,6 +129,8 @@ pub struct CloudApp {
     flipbook: super::flipbook::Flipbook,
     /// When the last frame played (the app's clock), while playing.
     last_tick: Option<f64>,
+    /// The stalls a press is held through (a click across a slow frame still clicks).
+    held: super::click_timing::HeldClock,
     /// The cache's next capture, asked for once the view has drawn the frame's time (and a
     /// simulation has caught up with it): its size, and frames waited.
     flipbook_capture: Option<([u32; 2], u32)>,
@@ -187,6 +189,7 @@ impl CloudApp {
             published: None,
             flipbook: Default::default(),
             last_tick: None,
+            held: Default::default(),
             flipbook_capture: None,
         }
     }
@@ -778,8 +781,11 @@ impl eframe::App for CloudApp {
     /// Keys that would press a button the user is not looking at: Tab means nothing here (as
     /// in Blender it is no focus key), and while the pointer is over the view no widget keeps
     /// the keyboard, so Space and Enter press nothing and the view's shortcuts always work.
+    ///
+    /// A click held across a slow frame still clicks ([`super::click_timing`]).
     fn raw_input_hook(&mut self, ctx: &egui::Context, raw: &mut egui::RawInput) {
         use egui::{Event, Key};
+        super::click_timing::apply(&mut self.held, ctx, raw);
         raw.events
             .retain(|e| !matches!(e, Event::Key { key: Key::Tab, .. }));
         let over_view = ctx

@@ -20,12 +20,14 @@
 //! - `panels`: one struct per side-panel group, each with its own `ui()`;
 //! - `shortcuts`: a frame's key presses as shortcuts, in the order they were pressed;
 //! - `press_record`: every pointer sample of a press, however few frames it spans;
+//! - `click_timing`: a click held across a slow frame still clicks;
 //! - `selection`, `notice`, `widgets`: small shared pieces;
 //! - `platform_native` / `platform_web`: the one platform seam (chosen by `cfg` on the module).
 
 mod app;
 mod autosave;
 mod camera_input;
+mod click_timing;
 mod ellipsoids;
 mod flipbook;
 mod gizmo;

@@ -164,3 +164,28 @@ for (const backend of BOTH_BUILDS) {
     });
   });
 }
+
+// A click held across a slow frame still clicks. egui times a press by the frame that sees it
+// and, by default, takes a release over 0.8 s later for a long press, not a click: a frame
+// over 0.8 s between the two (a heavy edit, a busy machine: the page's main thread held here
+// for 1.2 s after a frame has seen the press) lost the click on Play, as it would lose one on
+// any button. A browser's own buttons click however long they are held.
+for (const backend of BOTH_BUILDS) {
+  test(`a click held across a slow frame still clicks (${backend})`, { timeout: 120_000 }, async () => {
+    await withApp({ base: server.url, webgpu: backend === 'webgpu', query: '?preset=developing', viewport: { width: 1280, height: 800 } }, async (page) => {
+      let s = await state(page);
+      assert.equal(s.view.timeline.playing, false, 'paused at first');
+      const [x, y, w, h] = s.view.widgets['timeline:play'];
+      await page.mouse.move(x + w / 2, y + h / 2);
+      await page.mouse.down();
+      // A frame sees the press; then the page is busy for 1.2 s before the release comes.
+      await page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+      await page.evaluate(() => { const t = performance.now(); while (performance.now() - t < 1200); });
+      await page.mouse.up();
+      s = await until(page, (s) => s.view.timeline.playing, 'the held click pressed Play', 10_000);
+      // And a quick click pauses again.
+      await page.mouse.click(x + w / 2, y + h / 2);
+      await until(page, (s) => !s.view.timeline.playing, 'a click paused it', 10_000);
+    });
+  });
+}
