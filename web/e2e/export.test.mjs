@@ -490,10 +490,11 @@ for (const backend of BOTH_BUILDS) {
   test(`Record stopped midway saves nothing; the view answers a drag while recording (${backend})`, { timeout: 600_000 }, async () => {
     await withApp({ base: server.url, webgpu: backend === 'webgpu', query: '?preset=developing', viewport: { width: 1280, height: 800 } }, async (page) => {
       await page.evaluate(() => {
-        for (const p of ['/clock/end=11', '/clock/fps=1', '/render/slices=16', '/render/light_resolution=24', '/render/light_octaves=2',
-          '/light/ground=false', '/light/sky_gradient=false', '/light/shafts=false', '/time=7.5']) window.cloudsketch.set(p);
+        for (const p of ['/clock/end=47', '/clock/fps=4', '/render/slices=16', '/render/light_resolution=24', '/render/light_octaves=2',
+          '/light/ground=false', '/light/sky_gradient=false', '/light/shafts=false', '/time=7.6']) window.cloudsketch.set(p);
       });
-      let s = await until(page, (s) => s.scene.clock.end === 11 && s.scene.time === 7.5 && !s.scene.light.shafts, 'a 12-frame range at 7.5 s (between frames)');
+      // 48 frames: long enough that the drag below comes well before the end, however fast.
+      let s = await until(page, (s) => s.scene.clock.end === 47 && s.scene.time === 7.6 && !s.scene.light.shafts, 'a 48-frame range at 7.6 s (between frames)');
       await waitForFullQuality(page);
       const [vw, vh] = s.view.viewport;
       const yaw0 = s.scene.camera.yaw_deg;
@@ -506,7 +507,7 @@ for (const backend of BOTH_BUILDS) {
       await pressRecord();
       // A frame or more drawn: the button shows the share done.
       const stopAt = (s) => Number(/^Stop (\d+)%$/.exec(s.view.timeline.record ?? '')?.[1] ?? -1);
-      s = await until(page, (s) => stopAt(s) >= 8, 'recording, a frame or more drawn', 240_000);
+      s = await until(page, (s) => stopAt(s) >= 3, 'recording, a frame or more drawn', 240_000);
       // A drag across the view at the pointer's own rate (not a frame per move) orbits it.
       await page.mouse.move(vw * 0.3, vh * 0.5);
       await page.mouse.down();
@@ -521,13 +522,15 @@ for (const backend of BOTH_BUILDS) {
         return s.view.export.progress == null && s.view.timeline.record === 'Record';
       }, 'stopped');
       assert.ok([...notices].some((n) => /cancelled/i.test(n)), `said so: ${[...notices].join(' | ')}`);
-      assert.equal(s.scene.time, 7.5, 'back at the time it began from (no frame\'s time)');
+      assert.equal(s.scene.time, 7.6, 'back at the time it began from (no frame\'s time)');
       await waitForFullQuality(page);
       // Anything still on its way would have come by now (a frame takes well under this).
       await page.waitForTimeout(3000);
       assert.deepEqual(downloads, [], 'nothing downloaded');
       await screenshot(page, `record-stopped-${backend}`);
-      // Recorded again, to its end.
+      // Recorded again, to its end (six frames).
+      await page.evaluate(() => window.cloudsketch.set('/clock/end=5'));
+      await until(page, (s) => s.scene.clock.end === 5, 'a 6-frame range');
       await pressRecord();
       await until(page, (s) => stopAt(s) >= 0, 'recording again');
       s = await until(page, (s) => s.view.export.progress == null && s.view.timeline.record === 'Record', 'recorded', 480_000);
