@@ -258,25 +258,34 @@ pub fn save_bytes(name: &str, bytes: &[u8], mime: &str) -> Result<String, String
 
 /// Saves the concatenation of `pieces` as a download named `name` of media type `mime`: one
 /// blob made from them, so the whole is never built in the wasm's memory (a recording's zip),
-/// nor copied into the page's JavaScript heap on its way (the blob reads the pieces where
-/// they lie).
+/// nor, as a rule, copied into the page's JavaScript heap on its way (the blob reads the
+/// pieces where they lie).
 pub fn save_pieces(name: &str, pieces: &[&[u8]], mime: &str) -> Result<String, String> {
     let options = web_sys::BlobPropertyBag::new();
     options.set_type(mime);
+    let total: usize = pieces.iter().map(|p| p.len()).sum();
     let parts = js_sys::Array::new();
-    let blob = {
-        for piece in pieces {
-            // SAFETY: a view of the wasm's memory stays valid until that memory grows, which
-            // only an allocation here could make it do; nothing between these views and the
-            // blob, which copies what they show, allocates in the wasm's memory.
-            let view = unsafe { js_sys::Uint8Array::view(piece) };
-            parts.push(&view);
-        }
-        web_sys::Blob::new_with_u8_array_sequence_and_options(&parts, &options)
-    };
-    // The views are let go before anything else runs.
+    for piece in pieces {
+        // SAFETY: a view of the wasm's memory is valid until that memory grows. Nothing here
+        // allocates in it but, rarely, wasm-bindgen's table of JavaScript values, when it
+        // takes a slot for a view it has to grow; a view made before that growth reads as
+        // empty. The blob's size shows it, and the pieces are then copied instead.
+        let view = unsafe { js_sys::Uint8Array::view(piece) };
+        parts.push(&view);
+    }
+    let blob = web_sys::Blob::new_with_u8_array_sequence_and_options(&parts, &options);
     parts.set_length(0);
-    download_blob(name, &blob.map_err(refused)?)
+    let blob = match blob {
+        Ok(blob) if blob.size() as usize == total => blob,
+        _ => {
+            for piece in pieces {
+                parts.push(&js_sys::Uint8Array::from(*piece));
+            }
+            web_sys::Blob::new_with_u8_array_sequence_and_options(&parts, &options)
+                .map_err(refused)?
+        }
+    };
+    download_blob(name, &blob)
 }
 
 /// Hands a blob to the browser as a download named `name`.
