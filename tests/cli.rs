@@ -1027,9 +1027,7 @@ fn json_lines(o: &Output) -> Vec<serde_json::Value> {
 fn a_sequence_writes_each_frame_once_and_any_split_of_it_gives_the_same_bytes() {
     let dir = folder("sequence");
     let path = |name: &str| dir.join(name).to_str().unwrap().to_owned();
-    let scene = path("developing.json");
-    let o = cloudsketch(&["new", "--preset", "developing", "-o", &scene]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let scene = preset_scene(&dir, "developing");
     let render = |frames: &str, pattern: &str, extra: &[&str]| {
         let mut args = vec![
             "render",
@@ -1175,9 +1173,7 @@ fn a_sequence_writes_each_frame_once_and_any_split_of_it_gives_the_same_bytes() 
 fn a_simulated_vdb_sequence_steps_on_and_equals_each_frame_exported_alone() {
     let dir = folder("vdb-sequence");
     let path = |name: &str| dir.join(name).to_str().unwrap().to_owned();
-    let scene = path("simulated.json");
-    let o = cloudsketch(&["new", "--preset", "simulated", "-o", &scene]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let scene = preset_scene(&dir, "simulated");
     let export = |extra: &[&str]| {
         let mut args = vec![
             "export",
@@ -1227,9 +1223,7 @@ fn a_simulated_vdb_sequence_steps_on_and_equals_each_frame_exported_alone() {
 fn mesh_and_mitsuba_sequences_write_a_file_a_frame_as_each_frame_alone_does() {
     let dir = folder("format-sequences");
     let path = |name: &str| dir.join(name).to_str().unwrap().to_owned();
-    let scene = path("developing.json");
-    let o = cloudsketch(&["new", "--preset", "developing", "-o", &scene]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let scene = preset_scene(&dir, "developing");
     let export = |format: &str, extra: &[&str]| {
         let mut args = vec![
             "export",
@@ -1292,9 +1286,7 @@ fn mesh_and_mitsuba_sequences_write_a_file_a_frame_as_each_frame_alone_does() {
 fn a_chunk_starts_from_the_furthest_checkpoint_and_refuses_another_runs() {
     let dir = folder("checkpoints");
     let path = |name: &str| dir.join(name).to_str().unwrap().to_owned();
-    let scene = path("simulated.json");
-    let o = cloudsketch(&["new", "--preset", "simulated", "-o", &scene]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let scene = preset_scene(&dir, "simulated");
     let checkpoints = path("ck");
     let export = |frames: &str, out: &str| {
         cloudsketch(&[
@@ -1358,8 +1350,17 @@ fn a_chunk_starts_from_the_furthest_checkpoint_and_refuses_another_runs() {
 
 /// The `developing` preset saved as `developing.json` in `dir`; its path.
 fn developing_scene(dir: &std::path::Path) -> String {
-    let scene = dir.join("developing.json").to_str().unwrap().to_owned();
-    let o = cloudsketch(&["new", "--preset", "developing", "-o", &scene]);
+    preset_scene(dir, "developing")
+}
+
+/// Preset `name` saved as `NAME.json` in `dir`; its path.
+fn preset_scene(dir: &std::path::Path, name: &str) -> String {
+    let scene = dir
+        .join(format!("{name}.json"))
+        .to_str()
+        .unwrap()
+        .to_owned();
+    let o = cloudsketch(&["new", "--preset", name, "-o", &scene]);
     assert!(o.status.success(), "{}", stderr(&o));
     scene
 }
