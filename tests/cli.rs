@@ -634,10 +634,6 @@ fn outputs_that_collide_or_cannot_be_written_are_refused_before_any_work() {
             "taken.vol: a folder",
         ),
         (
-            vec!["render", &scene, "-o", at("nowhere/x.png")],
-            "no such folder",
-        ),
-        (
             vec!["render", &scene, "-o", dir.to_str().unwrap()],
             "a folder",
         ),
@@ -647,6 +643,11 @@ fn outputs_that_collide_or_cannot_be_written_are_refused_before_any_work() {
     // of permission, or mounted read-only in a container; the reason is the OS's either way).
     let sysfs = std::path::Path::new("/sys").is_dir();
     let unwritable: Vec<(Vec<&str>, &str)> = vec![
+        // A folder that cannot be made.
+        (
+            vec!["render", &scene, "-o", "/sys/cloudsketch-new/x.png"],
+            "cannot make the folder /sys/cloudsketch-new",
+        ),
         (
             vec![
                 "render",
@@ -710,6 +711,18 @@ fn outputs_that_collide_or_cannot_be_written_are_refused_before_any_work() {
         );
         assert_eq!(std::fs::read(&scene).unwrap(), scene_text, "{args:?}");
     }
+    // An output's folder that does not exist yet is made, as a sequence's is.
+    let nested = dir.join("new/folder/x.png");
+    let o = cloudsketch(&[
+        "render",
+        &scene,
+        "--size",
+        "64x36",
+        "-o",
+        nested.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(&std::fs::read(&nested).unwrap()[1..4], b"PNG");
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -840,13 +853,36 @@ fn long_work_shows_its_progress_on_a_terminal_and_nowhere_else() {
         .expect("util-linux's script");
     let shown = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success(), "{shown}");
+    // indicatif's line: the label, a share, and a redraw that returns to the margin and clears.
     assert!(
-        shown.contains("\rsimulating 3000 steps:") && shown.contains('%'),
+        shown.contains("simulating 3000 steps:") && shown.contains('%'),
         "{shown:?}"
     );
+    assert!(shown.contains("\r\x1b[2K"), "redrawn in place: {shown:?}");
     let o = cloudsketch(&["simulate", "--steps", "3000", "-o", vol.to_str().unwrap()]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(!stderr(&o).contains('%'), "{}", stderr(&o));
+
+    // A sequence counts its frames on the line.
+    let out = temp("progress_seq");
+    let _ = std::fs::remove_dir_all(&out);
+    let pattern = out.join("f_##.png");
+    let command = format!(
+        "'{}' render --frames 0..11 --size 320x180 -o '{}'",
+        env!("CARGO_BIN_EXE_cloudsketch"),
+        pattern.display()
+    );
+    let o = Command::new("script")
+        .args(["-qec", &command, "/dev/null"])
+        .output()
+        .expect("util-linux's script");
+    let shown = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{shown}");
+    assert!(
+        shown.contains("frames 0..11:") && shown.contains("/12,"),
+        "{shown:?}"
+    );
+    let _ = std::fs::remove_dir_all(&out);
 }
 
 /// `--time` and `--frame` name the same moments on the scene's clock, in `render`, `export`

@@ -383,10 +383,23 @@ pub fn read_scene_or_link(arg: &str) -> Result<Scene, String> {
     Ok(scene)
 }
 
-/// Refuses, before any work, outputs that cannot be written or that collide with each other or
-/// with an input (compared as canonical paths: `./a.json` and `a.json` are one file, and so are
-/// a link and its target). `inputs` that are links or missing files take no part.
+/// Makes each output's folder where it does not exist yet (as a sequence does), then refuses,
+/// before any work, outputs that cannot be written or that collide with each other or with an
+/// input (compared as canonical paths: `./a.json` and `a.json` are one file, and so are a link
+/// and its target). `inputs` that are links or missing files take no part.
 pub fn check_outputs(inputs: &[&str], outputs: &[&Path]) -> Result<(), String> {
+    for out in outputs {
+        if let Some(folder) = out.parent().filter(|f| !f.as_os_str().is_empty()) {
+            if !folder.exists() {
+                std::fs::create_dir_all(folder).map_err(|e| {
+                    format!(
+                        "cannot make the folder {}: {e} (nothing was written)",
+                        folder.display()
+                    )
+                })?;
+            }
+        }
+    }
     let mut taken: Vec<(PathBuf, String)> = inputs
         .iter()
         .filter(|arg| !is_link(arg))
@@ -500,7 +513,7 @@ pub fn render_shown(
     backdrop: crate::render::offscreen::Backdrop,
     file: ImageFile,
 ) -> Result<Vec<u8>, String> {
-    let mut progress = progress::Progress::new(format!("rendering {}x{}", size[0], size[1]));
+    let mut progress = progress::Progress::share(format!("rendering {}x{}", size[0], size[1]));
     if progress.shown() {
         render_file(
             offscreen,

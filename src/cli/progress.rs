@@ -1,30 +1,49 @@
-//! A progress line for long work (a large render on a CPU adapter, a long simulation), on
-//! standard error when it is a terminal: nothing is printed into a pipe or a log.
+//! A progress line for long work (a large render on a CPU adapter, a long simulation, a
+//! sequence's frames), drawn by `indicatif` on standard error when it is a terminal: nothing
+//! is printed into a pipe or a log.
 
-use std::io::{IsTerminal, Write};
+use std::io::IsTerminal;
 use std::time::{Duration, Instant};
+
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 /// How long work runs before its progress line appears (short work shows none).
 const DELAY: Duration = Duration::from_millis(500);
-/// How often the line is redrawn.
-const EVERY: Duration = Duration::from_millis(100);
+/// How often the line is redrawn, at most.
+const REDRAWS_PER_SECOND: u8 = 10;
+/// The steps a share of the work (`Progress::share`) is counted in.
+const SHARE_STEPS: u64 = 1000;
 
-/// One progress line: `rendering 8192x8192: 42%`, redrawn in place.
+/// One progress line, redrawn in place: `rendering 8192x8192:  42% [=====>    ] 3s left`,
+/// or, counting things, `frames 0..119:  35% [===>      ] 42/120, 1m left`.
 pub struct Progress {
     label: String,
+    total: u64,
+    counting: bool,
     on: bool,
     start: Instant,
-    drawn: Option<Instant>,
+    bar: Option<ProgressBar>,
 }
 
 impl Progress {
-    /// A line for `label`, drawn only when standard error is a terminal.
-    pub fn new(label: impl Into<String>) -> Self {
+    /// A line for `label` whose work is a share from 0 to 1 (`set`).
+    pub fn share(label: impl Into<String>) -> Self {
+        Self::with(label.into(), SHARE_STEPS, false)
+    }
+
+    /// A line for `label` whose work is `total` things (`done`): frames, say.
+    pub fn counting(label: impl Into<String>, total: u64) -> Self {
+        Self::with(label.into(), total.max(1), true)
+    }
+
+    fn with(label: String, total: u64, counting: bool) -> Self {
         Self {
-            label: label.into(),
+            label,
+            total,
+            counting,
             on: std::io::stderr().is_terminal(),
             start: Instant::now(),
-            drawn: None,
+            bar: None,
         }
     }
 
@@ -34,26 +53,41 @@ impl Progress {
     }
 
     /// The share of the work done, 0–1.
-    pub fn set(&mut self, done: f32) {
-        let now = Instant::now();
-        if !self.on || now - self.start < DELAY || self.drawn.is_some_and(|at| now - at < EVERY) {
+    pub fn set(&mut self, share: f32) {
+        let steps = (share.clamp(0.0, 1.0) as f64 * self.total as f64).floor() as u64;
+        self.done(steps);
+    }
+
+    /// How many of the things are done.
+    pub fn done(&mut self, done: u64) {
+        if !self.on || (self.bar.is_none() && self.start.elapsed() < DELAY) {
             return;
         }
-        self.drawn = Some(now);
-        let percent = (done.clamp(0.0, 1.0) * 100.0).floor();
-        let mut err = std::io::stderr().lock();
-        let _ = write!(err, "\r{}: {percent:>3}%", self.label);
-        let _ = err.flush();
+        let bar = self.bar.get_or_insert_with(|| {
+            let what = if self.counting { " {pos}/{len}," } else { "" };
+            let template = format!("{{msg}}: {{percent:>3}}% [{{bar:30}}]{what} {{eta}} left");
+            let style = ProgressStyle::with_template(&template)
+                .unwrap_or_else(|_| ProgressStyle::default_bar())
+                .progress_chars("=> ");
+            let bar = ProgressBar::with_draw_target(
+                Some(self.total),
+                ProgressDrawTarget::stderr_with_hz(REDRAWS_PER_SECOND),
+            )
+            .with_style(style)
+            .with_message(self.label.clone())
+            .with_elapsed(self.start.elapsed());
+            bar.reset_eta();
+            bar
+        });
+        bar.set_position(done.min(self.total));
     }
 }
 
 impl Drop for Progress {
     /// Clears the line, so what is printed next starts at the margin.
     fn drop(&mut self) {
-        if self.drawn.is_some() {
-            let mut err = std::io::stderr().lock();
-            let _ = write!(err, "\r\x1b[K");
-            let _ = err.flush();
+        if let Some(bar) = self.bar.take() {
+            bar.finish_and_clear();
         }
     }
 }

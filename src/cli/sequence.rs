@@ -349,10 +349,10 @@ impl Sequence<'_> {
         let key = format!("{:016x}", self.key);
         let total = self.frames.len();
         let start = Instant::now();
-        let mut line = super::progress::Progress::new(format!(
-            "frames {}..{}",
-            self.frames.first, self.frames.last
-        ));
+        let mut line = super::progress::Progress::counting(
+            format!("frames {}..{}", self.frames.first, self.frames.last),
+            total as u64,
+        );
         let (mut made, mut skipped) = (0u32, 0u32);
         for (i, frame) in self.frames.iter().enumerate() {
             let main = self.pattern.path(frame);
@@ -389,7 +389,7 @@ impl Sequence<'_> {
                     if let Some(note) = note {
                         eprintln!("frame {frame}: the simulation runs from {note}");
                     }
-                    line.set(done as f32 / total as f32)
+                    line.done(u64::from(done))
                 }
             }
         }

@@ -57,7 +57,7 @@ pub fn run(
     }
     let start = std::time::Instant::now();
     let mut sim = Simulation::steered(&settings, Sources::of(&scene));
-    let mut progress = super::progress::Progress::new(format!("simulating {steps} steps"));
+    let mut progress = super::progress::Progress::share(format!("simulating {steps} steps"));
     let mut done = 0;
     while done < steps {
         let batch = (steps - done).min(256);
