@@ -104,13 +104,23 @@ pub struct Simulation {
     steered_at: u64,
 }
 
-/// Steps between two posings of moving parcels: the automaton's probabilities follow keyed or
-/// moving parcels in intervals of this many steps (0.8 s at the default rate), each from
-/// where they stand at its first step, so a step's probabilities depend on its number alone.
+/// Most steps between two posings of moving parcels: the automaton's probabilities follow
+/// keyed or moving parcels in intervals of [`Simulation::posing_every`] steps, at most this many (0.8 s at
+/// the default rate), each from where they stand at its first step, so a step's probabilities
+/// depend on its number alone. (A power of two: intervals tile the player's snapshots.)
 pub const SOURCE_EVERY: u64 = 8;
 
+/// How far, in cells, a parcel may move within one interval: parcels faster than this are
+/// posed more often, down to every step. (The `simulated` preset's turbulent breeze moves its
+/// parcels about 1.2 cells in 8 steps; a bound of a quarter cell would pose them every step,
+/// which with today's whole-box re-steering costs about 6× the run.)
+pub const SOURCE_DRIFT_CELLS: f32 = 2.0;
+
+/// Points in time the parcels' speed is sampled at, over the scene's frame range.
+const SPEED_SAMPLES: usize = 128;
+
 /// The parcels of a run over time: fixed, or posed from the scene's keys and motion at the
-/// first step of each [`SOURCE_EVERY`] steps.
+/// first step of each interval of [`Simulation::posing_every`] steps.
 #[derive(Clone, Debug)]
 pub struct Sources {
     /// Where they stand at time 0.
@@ -118,11 +128,17 @@ pub struct Sources {
     /// What poses them (the scene's ellipsoids posed at 0, their keys, the wind field and the
     /// seed), when any of them is keyed or moves.
     moving: Option<Box<crate::scene::Scene>>,
+    /// The end of the scene's frame range in seconds: what the parcels' speed is sampled over.
+    end: f32,
+    /// Steps per interval (a power of two, 1 to [`SOURCE_EVERY`]), set by the run that follows
+    /// them ([`Simulation::steered`]) from its settings.
+    every: u64,
 }
 
 impl PartialEq for Sources {
     fn eq(&self, other: &Self) -> bool {
         self.start == other.start
+            && self.end == other.end
             && match (&self.moving, &other.moving) {
                 (None, None) => true,
                 (Some(a), Some(b)) => {
@@ -142,6 +158,8 @@ impl Sources {
         Self {
             start: parcels,
             moving: None,
+            end: 1.0,
+            every: SOURCE_EVERY,
         }
     }
 
@@ -189,6 +207,8 @@ impl Sources {
         Self {
             start: parcels(&start),
             moving: Some(Box::new(moving)),
+            end: scene.clock.seconds(scene.clock.end).max(1.0),
+            every: SOURCE_EVERY,
         }
     }
 
@@ -214,8 +234,11 @@ impl Simulation {
     }
 
     /// A fresh run of `settings` steered by `sources`: the parcels as they stand at each
-    /// interval of [`SOURCE_EVERY`] steps (at the settings' rate).
-    pub fn steered(settings: &Settings, sources: Sources) -> Self {
+    /// interval of [`Simulation::posing_every`] steps (at the settings' rate).
+    pub fn steered(settings: &Settings, mut sources: Sources) -> Self {
+        if sources.moves() {
+            sources.every = interval(settings, sources.end, |t| sources.at(t));
+        }
         let dims = settings.dims();
         let mut automaton = Automaton::new(dims, settings.seed);
         steer(&mut automaton, settings, &sources.start);
@@ -261,6 +284,12 @@ impl Simulation {
         &self.automaton
     }
 
+    /// Steps per posing of its moving parcels: [`SOURCE_EVERY`], or fewer where a parcel moves
+    /// more than [`SOURCE_DRIFT_CELLS`] in that many steps somewhere in the scene's range.
+    pub fn posing_every(&self) -> u64 {
+        self.sources.every
+    }
+
     /// Steps taken.
     pub fn step(&self) -> u64 {
         self.automaton.step
@@ -271,7 +300,7 @@ impl Simulation {
         for _ in 0..n {
             if self.sources.moves() {
                 let step = self.automaton.step;
-                let first = step - step % SOURCE_EVERY;
+                let first = step - step % self.sources.every;
                 if self.steered_at != first {
                     let seconds = first as f32 / self.settings.rate.max(1e-3);
                     steer(
@@ -312,6 +341,32 @@ impl Simulation {
         };
         volume(&self.settings, self.automaton.dims, values)
     }
+}
+
+/// Steps per posing of parcels that `pose` places at a time in seconds, for a run of
+/// `settings` over `[0, end]` s: the largest power of two up to [`SOURCE_EVERY`] in which no
+/// parcel's box (its centre, and its reach as it grows or turns) moves more than
+/// [`SOURCE_DRIFT_CELLS`], by the fastest motion sampled over the range.
+fn interval(settings: &Settings, end: f32, pose: impl Fn(f32) -> Vec<Parcel>) -> u64 {
+    let dt = end / SPEED_SAMPLES as f32;
+    let steps_per_sample = (dt * settings.rate.max(1e-3)).max(1e-6);
+    let mut fastest = 0.0f32; // world units per step
+    let mut before = pose(0.0);
+    for k in 1..=SPEED_SAMPLES {
+        let now = pose(dt * k as f32);
+        for (a, b) in before.iter().zip(&now) {
+            let moved = (b.center - a.center).abs().max_element()
+                + (b.reach() - a.reach()).abs().max_element();
+            fastest = fastest.max(moved / steps_per_sample);
+        }
+        before = now;
+    }
+    let drift = SOURCE_DRIFT_CELLS * settings.cell_size.max(1e-3);
+    let mut every = SOURCE_EVERY;
+    while every > 1 && fastest * every as f32 > drift {
+        every /= 2;
+    }
+    every
 }
 
 /// Sets the automaton's re-supply and extinction probabilities from `parcels` (Dobashi et al.

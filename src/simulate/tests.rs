@@ -600,6 +600,55 @@ fn moving_parcels_steer_the_run_and_a_scrubbed_frame_equals_it_played_from_step_
 }
 
 #[test]
+fn fast_parcels_are_posed_every_step_and_slow_ones_every_interval() {
+    use crate::scene::{Preset, Scene};
+    let settings = Settings {
+        cells: [64, 16, 64],
+        cell_size: 0.5,
+        origin: [-16.0, -1.0, -16.0],
+        ..Settings::default()
+    };
+    // The preset's own breeze and turbulence move its parcels about 1.2 cells of its own
+    // grid in 8 steps, under the bound: posed every 8 steps, as before.
+    let slow = Scene::preset(Preset::Simulated);
+    for grid in [&settings, &Settings::default()] {
+        let run = Simulation::steered(grid, Sources::of(&slow));
+        assert_eq!(run.posing_every(), SOURCE_EVERY);
+    }
+    let gale = |speed: f32| {
+        let mut fast = slow.clone();
+        fast.wind_field.velocity = [speed, 0.0];
+        fast.wind_field.turbulence = 0.0;
+        Sources::of(&fast)
+    };
+    // 4 units a second is 0.8 cells a step at 10 steps a second: posed every 2 steps, so a
+    // parcel moves 1.6 cells between posings, not 6.4.
+    assert_eq!(Simulation::steered(&settings, gale(4.0)).posing_every(), 2);
+    // 12 units a second (2.4 cells a step): posed every step.
+    let sources = gale(12.0);
+    let mut run = Simulation::steered(&settings, sources.clone());
+    assert_eq!(run.posing_every(), 1);
+    // The brute-force reference: the parcels posed where they stand before every step.
+    let mut reference = Simulation::steered(&settings, Sources::fixed(sources.at(0.0)));
+    for step in 0..48u64 {
+        steer(
+            &mut reference.automaton,
+            &settings,
+            &sources.at(step as f32 / settings.rate),
+        );
+        reference.automaton.advance();
+    }
+    run.advance(48);
+    assert_eq!(run.smoothed(), reference.smoothed(), "posed at every step");
+    // The baseline: posed every 8 steps, the gale's parcels jump 19 cells at a time, and the
+    // cloud differs.
+    let mut coarse = Simulation::steered(&settings, sources);
+    coarse.sources.every = SOURCE_EVERY;
+    coarse.advance(48);
+    assert_ne!(coarse.smoothed(), reference.smoothed());
+}
+
+#[test]
 fn a_checkpoint_resumes_the_run_in_a_fresh_player_and_refuses_another_runs() {
     let (settings, parcels) = parcel_settings();
     let mut played = Player::new(&settings, Sources::fixed(parcels.clone()));
