@@ -641,6 +641,8 @@ impl Player {
                 "animation": s.animation,
                 "wind_field": s.wind_field,
                 "seed": s.seed,
+                // The range the parcels' speed is sampled over (how often they are posed).
+                "end": sources.end,
             })
         });
         let text = serde_json::json!({
