@@ -318,7 +318,7 @@ pub const SUN_INTENSITY: Param = Param::linear(
     "Brightness of direct sunlight",
     0.0,
     10.0,
-    1.6,
+    0.8,
 );
 /// Ambient sky light multiplier.
 pub const AMBIENT: Param = Param::linear(
@@ -326,7 +326,7 @@ pub const AMBIENT: Param = Param::linear(
     "Brightness of the sky light that fills the shadowed side",
     0.0,
     3.0,
-    0.45,
+    0.25,
 );
 /// Forward scattering: the Henyey–Greenstein asymmetry g of the cloud's phase function.
 pub const FORWARD_SCATTERING: Param = Param::linear(

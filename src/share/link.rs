@@ -41,8 +41,11 @@ use crate::scene::{
 /// carries moving ellipsoids and the wind field that carries them (scene format 5's `motion`
 /// and `wind_field`) on version 5's base. Version 7 carries the physical sky (scene format 6's
 /// `light.physical_sky`) on a base that has it off: a build that reads up to version 6
-/// refuses such a link instead of opening it with the picked colours.
-pub const LINK_VERSION: u8 = 7;
+/// refuses such a link instead of opening it with the picked colours. Version 8 is version 7
+/// on a base whose sun and sky light are half as bright (sun intensity 0.8, ambient 0.25, so
+/// the lit cloud's light sits below the tone curve's shoulder): the payload's layout is the
+/// same.
+pub const LINK_VERSION: u8 = 8;
 
 /// Longest token accepted or written (characters after `#s=`). Browsers take URLs of
 /// megabytes, but mail and chat tools cut them far sooner.
@@ -242,7 +245,8 @@ impl Bases {
 /// Each link format version's base: version 1's (the ground at 0), version 2's (at -5),
 /// version 3's (billows and ids), version 4's (the light volume at 96 texels, 4 octaves),
 /// version 5's (the same as 4's: key frames added no default); version 6's the same again;
-/// version 7's with the physical sky off.
+/// version 7's with the physical sky off; version 8's with the sun at 0.8 and the ambient at
+/// 0.25.
 const BASES: [&str; LINK_VERSION as usize] = [
     include_str!("link/base_v1.json"),
     include_str!("link/base_v2.json"),
@@ -251,6 +255,7 @@ const BASES: [&str; LINK_VERSION as usize] = [
     include_str!("link/base_v5.json"),
     include_str!("link/base_v6.json"),
     include_str!("link/base_v7.json"),
+    include_str!("link/base_v8.json"),
 ];
 
 /// The base of link format `version` (1 to [`LINK_VERSION`]; others take the current one).
