@@ -2334,9 +2334,9 @@ fn a_far_cloud_fades_into_the_physical_skys_colour_and_a_near_one_barely() {
 /// A browser without float targets (plain WebGL2) accumulates the slices and keeps the light
 /// volume in 8 bits: its image is the float path's within the 8 bits' rounding (mean 0.08
 /// levels, the cloud's brightness within 0.5), for a thick cloud, a layer and wisps. The
-/// accumulated light is scaled by 0.4 to fit: unscaled, 8 bits clip the calibrated sunlit
-/// cloud's light at 1 (at the earlier sun of 1.6, the cumulus 225 → 208 levels); a diffusion
-/// read back unhalved brightens it as far.
+/// accumulated light is scaled by a quarter to fit: unscaled, 8 bits clip the calibrated
+/// sunlit cloud's light at 1 (at the earlier sun of 1.6, the cumulus 225 → 208 levels); a
+/// diffusion read back unhalved brightens it as far.
 #[test]
 fn the_eight_bit_path_draws_the_float_paths_image_within_rounding() {
     let mut o = offscreen();
