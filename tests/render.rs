@@ -376,8 +376,30 @@ fn presets_are_each_recognisable() {
             );
         }
     }
-    let (w, h) = cloud_box(&images[1], background(&scenes[1]));
-    assert!(w as f64 >= 4.0 * h as f64, "stratus is a layer: {w}×{h} px");
+    // The stratus is a layer seen from below: a sheet wider than the view, over open sky, its
+    // underside greyer where it comes nearest the eye (the bottom fifth of its rows) than far
+    // off (the top fifth), where the view grazes it. (A cloud seen whole, as the sausage it
+    // was, fits inside the frame.)
+    let bg = background(&scenes[1]);
+    let (w, h) = cloud_box(&images[1], bg);
+    assert!(
+        w == W && (h as f64) <= 0.8 * H as f64,
+        "stratus is a layer overhead: {w}×{h} px of {W}×{H}"
+    );
+    let rows_mean = |rows: std::ops::Range<u32>| {
+        let v: Vec<f64> = rows
+            .flat_map(|y| (0..W).map(move |x| (x, y)))
+            .map(|(x, y)| images[1].pixel(x, y))
+            .filter(|&p| differs(p, bg))
+            .map(luminance)
+            .collect();
+        v.iter().sum::<f64>() / v.len().max(1) as f64
+    };
+    let (far, near) = (rows_mean(0..h / 5), rows_mean(h - h / 5..h));
+    assert!(
+        near < 0.85 * far,
+        "stratus underside: {near:.1} near the eye, {far:.1} far off"
+    );
     // The cumulonimbus towers, and its anvil spreads on top: the widest row of its top fifth
     // is far wider than the tower at half its height (a column, or a dome, is not).
     let bg = background(&scenes[3]);
@@ -2332,16 +2354,18 @@ fn a_far_cloud_fades_into_the_physical_skys_colour_and_a_near_one_barely() {
 }
 
 /// A browser without float targets (plain WebGL2) accumulates the slices and keeps the light
-/// volume in 8 bits: its image is the float path's within the 8 bits' rounding (mean 0.08
-/// levels, the cloud's brightness within 0.5), for a thick cloud, a layer and wisps. The
-/// accumulated light is scaled by a quarter to fit: unscaled, 8 bits clip the calibrated
-/// sunlit cloud's light at 1 (at the earlier sun of 1.6, the cumulus 225 → 208 levels); a
-/// diffusion read back unhalved brightens it as far.
+/// volume in 8 bits: its image is the float path's within the 8 bits' rounding (mean 0.04–0.38
+/// levels, the cloud's brightness within 0.4), for every preset: a thick cloud, a layer seen
+/// from below, wisps, a tower and a low sun. The accumulated light is scaled by a half to fit:
+/// unscaled, 8 bits clip the calibrated sunlit cloud's light at 1 (at the earlier sun of 1.6,
+/// the cumulus 225 → 208 levels); a diffusion read back unhalved brightens it as far. The
+/// cloud alone (straight alpha, its faint fringe's colour divided by its alpha) is within 0.6
+/// levels, the stratus's wide fringe the most.
 #[test]
 fn the_eight_bit_path_draws_the_float_paths_image_within_rounding() {
     let mut o = offscreen();
     o.set_marching(false).unwrap();
-    for name in ["cumulus", "stratus", "cirrus"] {
+    for name in ["cumulus", "stratus", "cirrus", "sunset", "cumulonimbus"] {
         let scene = with(
             &Scene::preset(Preset::from_name(name).unwrap()),
             &["/render/slices=64"],
@@ -2361,7 +2385,7 @@ fn the_eight_bit_path_draws_the_float_paths_image_within_rounding() {
         // The cloud alone (a transparent PNG) too: nothing behind it to carry the scale back.
         let (mean_alone, _) = image_difference(&float_alone, &eight_alone);
         assert!(
-            mean_alone < 0.5,
+            mean_alone < 0.75,
             "{name} alone: 8 bits against half floats: mean {mean_alone:.2}"
         );
         let (mean, worst) = image_difference(&float, &eight);
@@ -2386,9 +2410,9 @@ fn the_eight_bit_path_draws_the_float_paths_image_within_rounding() {
         let (mean_cropped, _) = image_difference(&float_cropped, &eight_cropped);
         // The shafts' light is added shell by shell, each rounded to 8 bits unscaled: the
         // fainter the sun, the more of each shell's light rounds away (the cumulus 0.32 levels
-        // at a sun of 1.6, 0.55 at today's default 0.8).
+        // at a sun of 1.6, 0.53 at today's default 0.8; the sunset 0.71).
         assert!(
-            mean_cropped < 0.75,
+            mean_cropped < 0.85,
             "{name} cropped, with shafts: 8 bits against half floats: mean {mean_cropped:.2}"
         );
         // Marched slices (where an adapter marches yet cannot accumulate in floats) are laid

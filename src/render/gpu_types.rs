@@ -350,8 +350,10 @@ pub struct BehindUniforms {
 
 /// The scale of the light the slices accumulate in an 8-bit target (plain WebGL2, no float
 /// targets): a sunlit cloud's light is over 1, which 8 bits would clip; scaled, it fits up to
-/// 1 / this. The composite scales it back.
-pub const EIGHT_BIT_LIGHT_SCALE: f32 = 0.25;
+/// 1 / this, 2.5 times the default sun (0.8); the presets' light fits, the sunset's included.
+/// The composite scales it back. (A quarter, chosen for a sun of 1.6, spent a bit on light no
+/// preset reaches: the stratus seen from below was a level off the float path's.)
+pub const EIGHT_BIT_LIGHT_SCALE: f32 = 0.5;
 
 impl BehindUniforms {
     /// Names and byte offsets of the members, in order (checked against the WGSL struct).

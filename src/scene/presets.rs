@@ -303,7 +303,7 @@ impl Scene {
         let mut wind_field = super::WindField::default();
         let ellipsoids = match preset {
             Preset::Cumulus => billowed(cumulus()),
-            Preset::Stratus => layer(28, 30.0, 10.0, 3.0, Vec3::new(3.2, 0.7, 2.6), 11),
+            Preset::Stratus => layer(64, 56.0, 40.0, 4.0, Vec3::new(6.0, 1.0, 5.0), 11),
             Preset::Cirrus => layer(9, 22.0, 12.0, 9.0, Vec3::new(6.0, 0.35, 0.9), 23),
             Preset::Cumulonimbus => billowed(cumulonimbus()),
             Preset::Sunset => billowed(layer(14, 20.0, 8.0, 3.5, Vec3::new(2.6, 1.3, 2.2), 37)),
