@@ -111,10 +111,11 @@ pub struct Simulation {
 pub const SOURCE_EVERY: u64 = 8;
 
 /// How far, in cells, a parcel may move within one interval: parcels faster than this are
-/// posed more often, down to every step. (The `simulated` preset's turbulent breeze moves its
-/// parcels about 1.2 cells in 8 steps; a bound of a quarter cell would pose them every step,
+/// posed more often, down to every step, so a step's parcels stand within a cell of where they
+/// are at that step. (The `simulated` preset's turbulent breeze moves its parcels about 1.2 of
+/// its cells in 8 steps: posed every 4. A bound of a quarter cell would pose them every step,
 /// which with today's whole-box re-steering costs about 6× the run.)
-pub const SOURCE_DRIFT_CELLS: f32 = 2.0;
+pub const SOURCE_DRIFT_CELLS: f32 = 1.0;
 
 /// Points in time the parcels' speed is sampled at, over the scene's frame range.
 const SPEED_SAMPLES: usize = 128;

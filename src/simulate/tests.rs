@@ -609,21 +609,22 @@ fn fast_parcels_are_posed_every_step_and_slow_ones_every_interval() {
         ..Settings::default()
     };
     // The preset's own breeze and turbulence move its parcels about 1.2 cells of its own
-    // grid in 8 steps, under the bound: posed every 8 steps, as before.
+    // grid in 8 steps: posed every 4; on this grid of cells twice as large, 0.6 cells in 8
+    // steps: every 8.
     let slow = Scene::preset(Preset::Simulated);
-    for grid in [&settings, &Settings::default()] {
-        let run = Simulation::steered(grid, Sources::of(&slow));
-        assert_eq!(run.posing_every(), SOURCE_EVERY);
-    }
+    let every =
+        |grid: &Settings, sources: Sources| Simulation::steered(grid, sources).posing_every();
+    assert_eq!(every(&Settings::default(), Sources::of(&slow)), 4);
+    assert_eq!(every(&settings, Sources::of(&slow)), SOURCE_EVERY);
     let gale = |speed: f32| {
         let mut fast = slow.clone();
         fast.wind_field.velocity = [speed, 0.0];
         fast.wind_field.turbulence = 0.0;
         Sources::of(&fast)
     };
-    // 4 units a second is 0.8 cells a step at 10 steps a second: posed every 2 steps, so a
-    // parcel moves 1.6 cells between posings, not 6.4.
-    assert_eq!(Simulation::steered(&settings, gale(4.0)).posing_every(), 2);
+    // 2 units a second is 0.4 cells a step at 10 steps a second: posed every 2 steps, so a
+    // parcel moves 0.8 cells between posings, not 3.2.
+    assert_eq!(every(&settings, gale(2.0)), 2);
     // 12 units a second (2.4 cells a step): posed every step.
     let sources = gale(12.0);
     let mut run = Simulation::steered(&settings, sources.clone());
