@@ -14,10 +14,15 @@ use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 
-/// Writes `bytes` at `path` through a temporary file beside it: on success the file holds
-/// exactly `bytes`; on failure it is as it was (absent, or its old content) and no temporary
-/// file is left.
+/// Writes `bytes` at `path` through a temporary file beside it, making its folder first where
+/// it does not exist: on success the file holds exactly `bytes`; on failure it is as it was
+/// (absent, or its old content) and no temporary file is left.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    if let Some(folder) = path.parent().filter(|f| !f.as_os_str().is_empty())
+        && !folder.exists()
+    {
+        std::fs::create_dir_all(folder)?;
+    }
     let tmp = temporary_beside(path);
     let written = (|| {
         let mut file = std::fs::File::create(&tmp)?;

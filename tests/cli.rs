@@ -711,7 +711,20 @@ fn outputs_that_collide_or_cannot_be_written_are_refused_before_any_work() {
         );
         assert_eq!(std::fs::read(&scene).unwrap(), scene_text, "{args:?}");
     }
-    // An output's folder that does not exist yet is made, as a sequence's is.
+    // An output's folder that does not exist yet is made, as a sequence's is, but only by the
+    // write: a command refused or failed before it leaves no empty folder.
+    let never = dir.join("never/x.png");
+    let o = cloudsketch(&[
+        "render",
+        "no-such-scene.json",
+        "-o",
+        never.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    assert!(
+        !dir.join("never").exists(),
+        "a failed render made its folder"
+    );
     let nested = dir.join("new/folder/x.png");
     let o = cloudsketch(&[
         "render",
@@ -847,10 +860,17 @@ fn long_work_shows_its_progress_on_a_terminal_and_nowhere_else() {
         env!("CARGO_BIN_EXE_cloudsketch"),
         vol.display()
     );
-    let o = Command::new("script")
-        .args(["-qec", &command, "/dev/null"])
-        .output()
-        .expect("util-linux's script");
+    // The line at once (not after half a second, which a fast machine might beat), on a
+    // terminal indicatif draws on (not a dumb one).
+    let on_terminal = |command: &str| {
+        Command::new("script")
+            .args(["-qec", command, "/dev/null"])
+            .env("CLOUDSKETCH_PROGRESS_AT_ONCE", "1")
+            .env("TERM", "xterm")
+            .output()
+            .expect("util-linux's script")
+    };
+    let o = on_terminal(&command);
     let shown = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success(), "{shown}");
     // indicatif's line: the label, a share, and a redraw that returns to the margin and clears.
@@ -859,7 +879,12 @@ fn long_work_shows_its_progress_on_a_terminal_and_nowhere_else() {
         "{shown:?}"
     );
     assert!(shown.contains("\r\x1b[2K"), "redrawn in place: {shown:?}");
-    let o = cloudsketch(&["simulate", "--steps", "3000", "-o", vol.to_str().unwrap()]);
+    // Piped, nothing of it, even at once.
+    let o = Command::new(env!("CARGO_BIN_EXE_cloudsketch"))
+        .args(["simulate", "--steps", "3000", "-o", vol.to_str().unwrap()])
+        .env("CLOUDSKETCH_PROGRESS_AT_ONCE", "1")
+        .output()
+        .unwrap();
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(!stderr(&o).contains('%'), "{}", stderr(&o));
 
@@ -868,14 +893,11 @@ fn long_work_shows_its_progress_on_a_terminal_and_nowhere_else() {
     let _ = std::fs::remove_dir_all(&out);
     let pattern = out.join("f_##.png");
     let command = format!(
-        "'{}' render --frames 0..11 --size 320x180 -o '{}'",
+        "'{}' render --frames 0..11 --size 96x64 -o '{}'",
         env!("CARGO_BIN_EXE_cloudsketch"),
         pattern.display()
     );
-    let o = Command::new("script")
-        .args(["-qec", &command, "/dev/null"])
-        .output()
-        .expect("util-linux's script");
+    let o = on_terminal(&command);
     let shown = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success(), "{shown}");
     assert!(

@@ -376,16 +376,19 @@ fn presets_are_each_recognisable() {
             );
         }
     }
-    // The stratus is a layer seen from below: a sheet wider than the view, over open sky, its
-    // underside greyer where it comes nearest the eye (the bottom fifth of its rows) than far
-    // off (the top fifth), where the view grazes it. (A cloud seen whole, as the sausage it
-    // was, fits inside the frame.)
+    // The stratus is a layer seen from below: a sheet wider than the view, over open sky. The
+    // camera stands beyond its near edge, under its height, looking up: the image's top rows
+    // show that edge's side, lit (the sun is to the right, a little in front), and its bottom
+    // rows the base toward its far edge, seen from below through the layer's shadow: greyer.
+    // (A cloud seen whole, as the sausage it was, fits inside the frame.)
     let bg = background(&scenes[1]);
     let (w, h) = cloud_box(&images[1], bg);
     assert!(
         w == W && (h as f64) <= 0.8 * H as f64,
         "stratus is a layer overhead: {w}×{h} px of {W}×{H}"
     );
+    let widths = row_widths(&images[1], bg);
+    let first = widths.iter().position(|&n| n > 0).unwrap_or(0) as u32;
     let rows_mean = |rows: std::ops::Range<u32>| {
         let v: Vec<f64> = rows
             .flat_map(|y| (0..W).map(move |x| (x, y)))
@@ -395,10 +398,13 @@ fn presets_are_each_recognisable() {
             .collect();
         v.iter().sum::<f64>() / v.len().max(1) as f64
     };
-    let (far, near) = (rows_mean(0..h / 5), rows_mean(h - h / 5..h));
+    let (edge, base) = (
+        rows_mean(first..first + h / 5),
+        rows_mean(first + h - h / 5..first + h),
+    );
     assert!(
-        near < 0.85 * far,
-        "stratus underside: {near:.1} near the eye, {far:.1} far off"
+        base < 0.85 * edge,
+        "stratus: its base {base:.1}, its near edge {edge:.1}"
     );
     // The cumulonimbus towers, and its anvil spreads on top: the widest row of its top fifth
     // is far wider than the tower at half its height (a column, or a dome, is not).

@@ -383,23 +383,13 @@ pub fn read_scene_or_link(arg: &str) -> Result<Scene, String> {
     Ok(scene)
 }
 
-/// Makes each output's folder where it does not exist yet (as a sequence does), then refuses,
-/// before any work, outputs that cannot be written or that collide with each other or with an
-/// input (compared as canonical paths: `./a.json` and `a.json` are one file, and so are a link
-/// and its target). `inputs` that are links or missing files take no part.
+/// Refuses, before any work, outputs that cannot be written or that collide with each other or
+/// with an input (compared as canonical paths: `./a.json` and `a.json` are one file, and so are
+/// a link and its target). `inputs` that are links or missing files take no part. An output's
+/// folder that does not exist yet is fine where it can be made (the nearest folder above it
+/// takes new entries): the write makes it ([`crate::files::write_atomic`]), so a refused or
+/// failed command leaves no empty folder.
 pub fn check_outputs(inputs: &[&str], outputs: &[&Path]) -> Result<(), String> {
-    for out in outputs {
-        if let Some(folder) = out.parent().filter(|f| !f.as_os_str().is_empty()) {
-            if !folder.exists() {
-                std::fs::create_dir_all(folder).map_err(|e| {
-                    format!(
-                        "cannot make the folder {}: {e} (nothing was written)",
-                        folder.display()
-                    )
-                })?;
-            }
-        }
-    }
     let mut taken: Vec<(PathBuf, String)> = inputs
         .iter()
         .filter(|arg| !is_link(arg))
@@ -418,14 +408,26 @@ pub fn check_outputs(inputs: &[&str], outputs: &[&Path]) -> Result<(), String> {
                 out.display()
             ));
         }
-        crate::files::check_writable(out)
-            .map_err(|e| format!("cannot write {}: {e}", out.display()))?;
+        match missing_folder(out) {
+            Some((folder, above)) => {
+                crate::files::check_writable(&above.join(".cloudsketch-probe")).map_err(|e| {
+                    format!(
+                        "cannot make the folder {}: {e} (nothing was written)",
+                        folder.display()
+                    )
+                })?
+            }
+            None => crate::files::check_writable(out)
+                .map_err(|e| format!("cannot write {}: {e}", out.display()))?,
+        }
         taken.push((key, format!("the output {}", out.display())));
     }
     Ok(())
 }
 
-/// The canonical path an output will have: its own if it exists, else its folder's with its name.
+/// The canonical path an output will have: its own if it exists, else the nearest existing
+/// folder above it, canonical, with the rest of the path (folders the write will make, and the
+/// name).
 fn canonical_output(path: &Path) -> Result<PathBuf, String> {
     if path.as_os_str().is_empty() {
         return Err("an output path is empty".into());
@@ -440,10 +442,46 @@ fn canonical_output(path: &Path) -> Result<PathBuf, String> {
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
-    let dir = dir
-        .canonicalize()
-        .map_err(|_| format!("{}: no such folder", path.display()))?;
-    Ok(dir.join(name))
+    let mut rest = vec![name.to_owned()];
+    let mut above = dir;
+    loop {
+        if let Ok(c) = above.canonicalize() {
+            return Ok(rest.iter().rev().fold(c, |p, part| p.join(part)));
+        }
+        match (above.file_name(), above.parent()) {
+            (Some(part), Some(parent)) => {
+                rest.push(part.to_owned());
+                above = if parent.as_os_str().is_empty() {
+                    Path::new(".")
+                } else {
+                    parent
+                };
+            }
+            _ => return Err(format!("{}: no folder above it exists", path.display())),
+        }
+    }
+}
+
+/// For an output whose folder does not exist: that folder, and the nearest existing one above
+/// it (where the write will make the rest).
+fn missing_folder(path: &Path) -> Option<(PathBuf, PathBuf)> {
+    let folder = path.parent().filter(|p| !p.as_os_str().is_empty())?;
+    if folder.exists() {
+        return None;
+    }
+    let above = folder
+        .ancestors()
+        .skip(1)
+        .map(|a| {
+            if a.as_os_str().is_empty() {
+                Path::new(".")
+            } else {
+                a
+            }
+        })
+        .find(|a| a.is_dir())
+        .unwrap_or(Path::new("."));
+    Some((folder.to_path_buf(), above.to_path_buf()))
 }
 
 /// An image file `render` writes (and `export --format png`).

@@ -7,7 +7,8 @@ use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-/// How long work runs before its progress line appears (short work shows none).
+/// How long work runs before its progress line appears (short work shows none), unless
+/// `CLOUDSKETCH_PROGRESS_AT_ONCE` is set (the CLI tests, which must not race the clock).
 const DELAY: Duration = Duration::from_millis(500);
 /// How often the line is redrawn, at most.
 const REDRAWS_PER_SECOND: u8 = 10;
@@ -41,7 +42,8 @@ impl Progress {
             label,
             total,
             counting,
-            on: std::io::stderr().is_terminal(),
+            // Where indicatif would draw: a terminal, and not a dumb one.
+            on: std::io::stderr().is_terminal() && !ProgressDrawTarget::stderr().is_hidden(),
             start: Instant::now(),
             bar: None,
         }
@@ -60,9 +62,11 @@ impl Progress {
 
     /// How many of the things are done.
     pub fn done(&mut self, done: u64) {
-        if !self.on || (self.bar.is_none() && self.start.elapsed() < DELAY) {
+        let at_once = std::env::var_os("CLOUDSKETCH_PROGRESS_AT_ONCE").is_some();
+        if !self.on || (self.bar.is_none() && !at_once && self.start.elapsed() < DELAY) {
             return;
         }
+        let done = done.min(self.total);
         let bar = self.bar.get_or_insert_with(|| {
             let what = if self.counting { " {pos}/{len}," } else { "" };
             let template = format!("{{msg}}: {{percent:>3}}% [{{bar:30}}]{what} {{eta}} left");
@@ -76,10 +80,21 @@ impl Progress {
             .with_style(style)
             .with_message(self.label.clone())
             .with_elapsed(self.start.elapsed());
+            // The time left counts from here, with the work done so far already done.
+            bar.set_position(done);
             bar.reset_eta();
             bar
         });
-        bar.set_position(done.min(self.total));
+        bar.set_position(done);
+    }
+
+    /// Prints `text` on its own line on standard error, the progress line (if drawn) put
+    /// aside for it and drawn again below.
+    pub fn note(&self, text: &str) {
+        match &self.bar {
+            Some(bar) => bar.suspend(|| eprintln!("{text}")),
+            None => eprintln!("{text}"),
+        }
     }
 }
 

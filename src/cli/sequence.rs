@@ -387,7 +387,7 @@ impl Sequence<'_> {
                 }
                 Report::Line => {
                     if let Some(note) = note {
-                        eprintln!("frame {frame}: the simulation runs from {note}");
+                        line.note(&format!("frame {frame}: the simulation runs from {note}"));
                     }
                     line.done(u64::from(done))
                 }

@@ -42,8 +42,8 @@ use crate::scene::{
 /// and `wind_field`) on version 5's base. Version 7 carries the physical sky (scene format 6's
 /// `light.physical_sky`) on a base that has it off: a build that reads up to version 6
 /// refuses such a link instead of opening it with the picked colours. Version 8 is version 7
-/// on a base whose sun and sky light are half as bright (sun intensity 0.8, ambient 0.25, so
-/// the lit cloud's light sits below the tone curve's shoulder): the payload's layout is the
+/// on a base with a fainter sun and sky light (sun intensity 1.6 → 0.8, ambient 0.45 → 0.25,
+/// so the lit cloud's light sits below the tone curve's shoulder): the payload's layout is the
 /// same.
 pub const LINK_VERSION: u8 = 8;
 

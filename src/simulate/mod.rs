@@ -111,8 +111,9 @@ pub struct Simulation {
 pub const SOURCE_EVERY: u64 = 8;
 
 /// How far, in cells, a parcel may move within one interval: parcels faster than this are
-/// posed more often, down to every step, so a step's parcels stand within a cell of where they
-/// are at that step. (The `simulated` preset's turbulent breeze moves its parcels about 1.2 of
+/// posed more often, down to every step, so a step's parcels stand within about a cell of
+/// where they are at that step (by their motion sampled 128 times over the frame
+/// range: motion faster than the samples, or past the range's end, is not seen). (The `simulated` preset's turbulent breeze moves its parcels about 1.2 of
 /// its cells in 8 steps: posed every 4. A bound of a quarter cell would pose them every step,
 /// which with today's whole-box re-steering costs about 6× the run.)
 pub const SOURCE_DRIFT_CELLS: f32 = 1.0;
@@ -218,6 +219,24 @@ impl Sources {
         self.moving.is_some()
     }
 
+    /// Where every one of the scene's ellipsoids stands at `seconds`, hidden ones included, in
+    /// the scene's order (so two times' lists pair up one by one, whatever shows or hides).
+    fn all_at(&self, seconds: f32) -> Vec<Parcel> {
+        match &self.moving {
+            Some(scene) => scene
+                .posed_at(seconds)
+                .ellipsoids
+                .iter()
+                .map(|e| Parcel {
+                    center: e.center,
+                    radii: e.radii,
+                    rotation: e.rotation,
+                })
+                .collect(),
+            None => self.start.clone(),
+        }
+    }
+
     /// Where they stand at `seconds`.
     pub fn at(&self, seconds: f32) -> Vec<Parcel> {
         match &self.moving {
@@ -238,7 +257,7 @@ impl Simulation {
     /// interval of [`Simulation::posing_every`] steps (at the settings' rate).
     pub fn steered(settings: &Settings, mut sources: Sources) -> Self {
         if sources.moves() {
-            sources.every = interval(settings, sources.end, |t| sources.at(t));
+            sources.every = interval(settings, sources.end, |t| sources.all_at(t));
         }
         let dims = settings.dims();
         let mut automaton = Automaton::new(dims, settings.seed);
@@ -344,10 +363,10 @@ impl Simulation {
     }
 }
 
-/// Steps per posing of parcels that `pose` places at a time in seconds, for a run of
-/// `settings` over `[0, end]` s: the largest power of two up to [`SOURCE_EVERY`] in which no
-/// parcel's box (its centre, and its reach as it grows or turns) moves more than
-/// [`SOURCE_DRIFT_CELLS`], by the fastest motion sampled over the range.
+/// Steps per posing of parcels that `pose` places at a time in seconds (every ellipsoid, hidden
+/// ones too, in one order), for a run of `settings` over `[0, end]` s: the largest power of two
+/// up to [`SOURCE_EVERY`] in which no parcel's box (its centre, and its reach as it grows or
+/// turns) moves more than [`SOURCE_DRIFT_CELLS`], by the fastest motion sampled over the range.
 fn interval(settings: &Settings, end: f32, pose: impl Fn(f32) -> Vec<Parcel>) -> u64 {
     let dt = end / SPEED_SAMPLES as f32;
     let steps_per_sample = (dt * settings.rate.max(1e-3)).max(1e-6);
