@@ -36,6 +36,15 @@ pub struct Parcel {
 }
 
 impl Parcel {
+    /// The parcel an ellipsoid places (where it stands, its size and turn).
+    pub fn of(e: &crate::scene::Ellipsoid) -> Self {
+        Self {
+            center: e.center,
+            radii: e.radii,
+            rotation: e.rotation,
+        }
+    }
+
     /// Half the sides of the smallest box along the world's axes that holds it (a little
     /// more, for rounding): where its weight can be above 0.
     pub fn reach(&self) -> Vec3 {
@@ -102,19 +111,23 @@ pub struct Simulation {
     sources: Sources,
     /// The first step of the interval whose parcels the automaton's probabilities hold.
     steered_at: u64,
+    /// Steps per interval of posing the moving parcels (a power of two, 1 to
+    /// [`SOURCE_EVERY`]), from their sampled speed ([`interval`]).
+    posing_every: u64,
 }
 
 /// Most steps between two posings of moving parcels: the automaton's probabilities follow
-/// keyed or moving parcels in intervals of [`Simulation::posing_every`] steps, at most this many (0.8 s at
-/// the default rate), each from where they stand at its first step, so a step's probabilities
-/// depend on its number alone. (A power of two: intervals tile the player's snapshots.)
+/// keyed or moving parcels in intervals of [`Simulation::posing_every`] steps, at most this
+/// many (0.8 s at the default rate), each from where they stand at its first step, so a step's
+/// probabilities depend on its number alone. (A power of two: intervals tile the player's
+/// snapshots.)
 pub const SOURCE_EVERY: u64 = 8;
 
 /// How far, in cells, a parcel may move within one interval: parcels faster than this are
 /// posed more often, down to every step, so a step's parcels stand within about a cell of
-/// where they are at that step (by their motion sampled 128 times over the frame
-/// range: motion faster than the samples, or past the range's end, is not seen). (The `simulated` preset's turbulent breeze moves its parcels about 1.2 of
-/// its cells in 8 steps: posed every 4. A bound of a quarter cell would pose them every step,
+/// where they are at that step (by their motion sampled 128 times over the frame range: motion
+/// faster than the samples, or past the range's end, is not seen). (The `simulated` preset's
+/// turbulent breeze moves its parcels about 1.2 of its cells in 8 steps: posed every 4. A bound of a quarter cell would pose them every step,
 /// which with today's whole-box re-steering costs about 6× the run.)
 pub const SOURCE_DRIFT_CELLS: f32 = 1.0;
 
@@ -132,9 +145,6 @@ pub struct Sources {
     moving: Option<Box<crate::scene::Scene>>,
     /// The end of the scene's frame range in seconds: what the parcels' speed is sampled over.
     end: f32,
-    /// Steps per interval (a power of two, 1 to [`SOURCE_EVERY`]), set by the run that follows
-    /// them ([`Simulation::steered`]) from its settings.
-    every: u64,
 }
 
 impl PartialEq for Sources {
@@ -161,7 +171,6 @@ impl Sources {
             start: parcels,
             moving: None,
             end: 1.0,
-            every: SOURCE_EVERY,
         }
     }
 
@@ -210,7 +219,6 @@ impl Sources {
             start: parcels(&start),
             moving: Some(Box::new(moving)),
             end: scene.clock.seconds(scene.clock.end).max(1.0),
-            every: SOURCE_EVERY,
         }
     }
 
@@ -227,11 +235,7 @@ impl Sources {
                 .posed_at(seconds)
                 .ellipsoids
                 .iter()
-                .map(|e| Parcel {
-                    center: e.center,
-                    radii: e.radii,
-                    rotation: e.rotation,
-                })
+                .map(|e| Parcel::of(e))
                 .collect(),
             None => self.start.clone(),
         }
@@ -255,10 +259,12 @@ impl Simulation {
 
     /// A fresh run of `settings` steered by `sources`: the parcels as they stand at each
     /// interval of [`Simulation::posing_every`] steps (at the settings' rate).
-    pub fn steered(settings: &Settings, mut sources: Sources) -> Self {
-        if sources.moves() {
-            sources.every = interval(settings, sources.end, |t| sources.all_at(t));
-        }
+    pub fn steered(settings: &Settings, sources: Sources) -> Self {
+        let posing_every = if sources.moves() {
+            interval(settings, sources.end, |t| sources.all_at(t))
+        } else {
+            SOURCE_EVERY
+        };
         let dims = settings.dims();
         let mut automaton = Automaton::new(dims, settings.seed);
         steer(&mut automaton, settings, &sources.start);
@@ -270,6 +276,7 @@ impl Simulation {
             automaton,
             sources,
             steered_at: 0,
+            posing_every,
         }
     }
 
@@ -307,7 +314,7 @@ impl Simulation {
     /// Steps per posing of its moving parcels: [`SOURCE_EVERY`], or fewer where a parcel moves
     /// more than [`SOURCE_DRIFT_CELLS`] in that many steps somewhere in the scene's range.
     pub fn posing_every(&self) -> u64 {
-        self.sources.every
+        self.posing_every
     }
 
     /// Steps taken.
@@ -320,7 +327,7 @@ impl Simulation {
         for _ in 0..n {
             if self.sources.moves() {
                 let step = self.automaton.step;
-                let first = step - step % self.sources.every;
+                let first = step - step % self.posing_every;
                 if self.steered_at != first {
                     let seconds = first as f32 / self.settings.rate.max(1e-3);
                     steer(
@@ -587,11 +594,7 @@ pub fn parcels(scene: &crate::scene::Scene) -> Vec<Parcel> {
         .ellipsoids
         .iter()
         .filter(|e| !e.hidden)
-        .map(|e| Parcel {
-            center: e.center,
-            radii: e.radii,
-            rotation: e.rotation,
-        })
+        .map(|e| Parcel::of(e))
         .collect()
 }
 

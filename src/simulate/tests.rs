@@ -342,6 +342,7 @@ fn the_smoothed_density_is_the_share_of_cloud_around_each_cell() {
         automaton: sim.automaton.clone(),
         sources: sim.sources.clone(),
         steered_at: sim.steered_at,
+        posing_every: sim.posing_every,
     };
     assert!(near(&wide.smoothed().shares(), &brute(&wide, 3), 3));
     // A grid big enough to be smoothed on several threads (2^18 cells), its layers shared out.
@@ -372,6 +373,7 @@ fn the_smoothed_density_is_the_share_of_cloud_around_each_cell() {
             automaton: s.automaton.clone(),
             sources: s.sources.clone(),
             steered_at: s.steered_at,
+            posing_every: s.posing_every,
         };
         assert!(
             near(&at_r(&sim).smoothed().shares(), &brute(&sim, r as i32), r),
@@ -644,7 +646,7 @@ fn fast_parcels_are_posed_every_step_and_slow_ones_every_interval() {
     // The baseline: posed every 8 steps, the gale's parcels jump 19 cells at a time, and the
     // cloud differs.
     let mut coarse = Simulation::steered(&settings, sources);
-    coarse.sources.every = SOURCE_EVERY;
+    coarse.posing_every = SOURCE_EVERY;
     coarse.advance(48);
     assert_ne!(coarse.smoothed(), reference.smoothed());
 }
