@@ -12,7 +12,8 @@ independent readers:
   correlates with the app's (>= 0.9).
 - The XML of three lit scenes holds the app's light by the documented units (read back with
   an XML parser), and their path traces are compared with the app's linear light inside the
-  cloud (printed: the calibration is not done).
+  cloud at 1,024 samples a pixel: mean ratio within 0.8-1.25 and rank correlation >= 0.88 for
+  each sun (contrast printed).
 
 - OpenEXR (through Mitsuba's Bitmap) opens the app's EXR of the same view: RGBA half floats
   of the PNG's size, opaque, every PNG pixel the app's one tone map of the EXR's light (within
@@ -191,14 +192,13 @@ def check_units(d):
 def check_light(d):
     """The app's light against Mitsuba's path trace of its export, in linear light inside the
     cloud (the app's alpha over one half), for suns in front, to the side and behind: luminance
-    rank correlation, mean ratio, and the ratio of their 90th/10th-percentile contrasts. The
-    mean ratio is held within 0.75-1.33 for every sun: the multiple scattering's calibrated
-    weight and diffusion (volume.wgsl, light_march.wgsl) give 1.18 / 1.23 / 0.80 (behind / front /
-    side) at this trace's 64 samples; the light before them, 1.59 / 2.68 / 1.90. The correlation and contrast
-    are printed, not held, but for one guard: with the sun in front the rank correlation must
-    reach 0.58 (0.63 here, the trace seeded; 0.53 without the thin cloud's term, 0.30 at 1024
-    samples without the diffusion, which is what moves the light to the thick centre). #37's target for them (>= 0.9, 0.8-1.25) is met to the side and
-    behind at 1024 samples, not in front, and 64 samples' noise alone lowers the correlation."""
+    rank correlation, mean ratio, and the ratio of their 90th/10th-percentile contrasts, the
+    trace at 1,024 samples a pixel (at 64 its noise alone costs the front-lit correlation 0.17).
+    Held: the mean ratio within #37's 0.8-1.25 for every sun (1.20 / 0.81 / 1.11, front / side /
+    behind; 2.68 / 1.89 / 1.59 before the multiple scattering was calibrated), and the rank
+    correlation at 0.88 or more (0.906 / 0.940 / 0.945; #37's target is 0.9; front-lit it was
+    0.74 before the density around each point scaled the multiple scattering, and 0.25 with no
+    diffusion). The contrast is printed (0.87 / 0.89 / 1.14; #37 asks 0.8-1.25)."""
     import mitsuba as mi
     import numpy as np
     mi.set_variant("scalar_rgb")
@@ -220,13 +220,13 @@ def check_light(d):
         figures[name] = (corr, mean, contrast)
         print(f"check_exports: light_{name}: {inside.sum()} px inside; the path trace against the app: "
               f"rank correlation {corr:.3f}, mean ratio {mean:.3f}, 90/10 contrast ratio {contrast:.3f}")
-    for name, (_, mean, _) in figures.items():
-        if not 0.75 <= mean <= 1.33:
-            fail(f"light_{name}: the path trace's mean light is {mean:.3f}x the app's (0.75-1.33)")
+    for name, (corr, mean, _) in figures.items():
+        if not 0.8 <= mean <= 1.25:
+            fail(f"light_{name}: the path trace's mean light is {mean:.3f}x the app's (0.8-1.25)")
+        if corr < 0.88:
+            fail(f"light_{name}: rank correlation {corr:.3f} < 0.88")
     if "front" not in figures:
         fail("app_view.json has no front-lit sun to hold the diffusion by")
-    if figures["front"][0] < 0.58:
-        fail(f"light_front: rank correlation {figures['front'][0]:.3f} < 0.58 (no diffusion?)")
     return figures
 
 

@@ -405,7 +405,7 @@ fn mitsuba_scenes_and_the_apps_render_of_their_view() {
         let options = Options {
             resolution: 96,
             image: LIGHT_SIZE,
-            samples: 64,
+            samples: LIGHT_SAMPLES,
             ..Options::default()
         };
         for f in export(&lit, Format::Mitsuba, &options, &stem).unwrap() {
@@ -485,6 +485,10 @@ const SUNS: [(&str, f32, f32, f32); 3] = [
     ("side", 10.0, 25.0, 0.5),
     ("behind", -90.0, 20.0, 0.0),
 ];
+
+/// The path trace's samples a pixel in the light comparison: enough that its noise does not
+/// hide the shading it is compared by (at 64 the front-lit rank correlation loses 0.17).
+const LIGHT_SAMPLES: u32 = 1024;
 
 /// The size of the light comparison's images.
 const LIGHT_SIZE: [u32; 2] = [160, 90];
