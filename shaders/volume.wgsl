@@ -146,7 +146,7 @@ fn phase(cos_theta: f32, g: f32) -> f32 {
 // The multiple scattering's weight per unit of the Multiple scattering control: its default,
 // 0.5, gives the weight that brings the slices closest to a path trace of the same cloud
 // (scripts/check_exports.py light; docs/export-formats.md).
-const MS_GAIN: f32 = 4.4;
+const MS_GAIN: f32 = 4.3;
 
 // Light reaching the sample from the sun: `s` is the light volume's T^(1/8) (transmittance
 // toward the sun, stored so deep shadow keeps its precision), raised to Dirtiness, through
