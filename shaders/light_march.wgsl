@@ -5,7 +5,8 @@
 // (green: the transmittance toward the zenith, diffuse light seeing SKY_EXTINCTION of the
 // extinction), so the sky lights tops and open sides, not bases and hollows, and (blue) the
 // multiple scattering's diffusion, from the depths toward the sun and away from it through
-// the cloud beyond (a second march). One render pass per z-slice of the 3D texture (WebGL2 can
+// the cloud beyond (a second march), times the density around the texel (the field without
+// its noise, `surrounding_density`). One render pass per z-slice of the 3D texture (WebGL2 can
 // render into 3D texture slices; it has no compute). Composed after volume_common.wgsl and
 // volume_noise.wgsl; `LightSlice` mirrors `LightSliceUniforms` in src/render/gpu_types.rs.
 

@@ -152,7 +152,8 @@ const MS_GAIN: f32 = 4.3;
 // toward the sun, stored so deep shadow keeps its precision), raised to Dirtiness, through
 // the phase function for the angle between the sun's light and the view ray. `diffusion` (the
 // light volume's blue, doubled) scales the light scattered many times by where the sample lies
-// in the cloud's thickness along the sun's rays (light_march.wgsl).
+// in the cloud's thickness along the sun's rays and by how much cloud surrounds it
+// (light_march.wgsl).
 fn sun_light(s: f32, diffusion: f32, cos_theta: f32) -> f32 {
     let dirt = u.sun_color.w;
     let g = u.sun_dir.w;

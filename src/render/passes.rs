@@ -806,7 +806,7 @@ pub struct LightPass {
 /// The light volume's format where the adapter renders and filters half floats (as it must to
 /// accumulate in them): transmittance toward the sun (stored as T^(1/8)), the sky's light let
 /// through from above, and the multiple scattering's diffusion through the cloud's thickness
-/// (halved), in [0, 1]. Half floats keep the multiple scattering smooth: its octaves raise the
+/// and the cloud around (halved), in [0, 1]. Half floats keep the multiple scattering smooth: its octaves raise the
 /// stored transmittance to small powers, so 8 bits of it step by a level of the image.
 pub const LIGHT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 /// The light volume's format where half floats are not renderable (plain WebGL2).
