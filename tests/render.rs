@@ -187,8 +187,8 @@ fn changed(
 #[test]
 fn table_2_filters_and_the_worley_basis_each_change_the_media() {
     // Each filter changes a tenth of the cloud's pixels or more against every other filter,
-    // and the other basis a twentieth of its coverage (the same document always gives the same image, so any
-    // difference comes from the media).
+    // and the other basis a twentieth of its coverage (the same document always gives the
+    // same image, so any difference comes from the media).
     let base = with(
         &Scene::default(),
         &[
