@@ -10,10 +10,11 @@ independent readers:
   covers the same pixels as the app's own render of that view (coverage IoU >= 0.8; coverage
   = pixels more than 6/255 from the background) and its pixels' contrast with the background
   correlates with the app's (>= 0.9).
-- The XML of three lit scenes holds the app's light by the documented units (read back with
-  an XML parser), and their path traces are compared with the app's linear light inside the
-  cloud at 1,024 samples a pixel: mean ratio within 0.8-1.25 and rank correlation >= 0.88 for
-  each sun (contrast printed).
+- The XML of four lit scenes (the default cloud under three suns, the cumulonimbus at its own
+  light) holds the app's light by the documented units (read back with an XML parser), and
+  their path traces are compared with the app's linear light inside the cloud at 1,024 samples
+  a pixel: mean ratio within 0.8-1.25 (the cumulonimbus 0.9-1.25) and rank correlation >= 0.88
+  for each (contrast printed).
 
 - OpenEXR (through Mitsuba's Bitmap) opens the app's EXR of the same view: RGBA half floats
   of the PNG's size, opaque, every PNG pixel the app's one tone map of the EXR's light (within
@@ -198,7 +199,12 @@ def check_light(d):
     behind; 2.68 / 1.89 / 1.59 before the multiple scattering was calibrated), and the rank
     correlation at 0.88 or more (0.904 / 0.940 / 0.946; #37's target is 0.9; front-lit it was
     0.74 before the density around each point scaled the multiple scattering, and 0.25 with no
-    diffusion). The contrast is printed (0.86 / 0.89 / 1.13; #37 asks 0.8-1.25)."""
+    diffusion). The contrast is printed (0.86 / 0.89 / 1.13; #37 asks 0.8-1.25).
+    And the cumulonimbus at its own light and framing: the cumulus filter (|n|) over Worley
+    noise averages a quarter, not a half, so the cloud the noise leaves is thinner than its
+    field; the multiple scattering's blur of the density around each point shifts the field by
+    the noise's mean. Held: mean ratio 0.9-1.25 (0.95; 0.85 with the blur of the bare field) and
+    rank correlation 0.88 (0.913; 0.901 before)."""
     import mitsuba as mi
     import numpy as np
     mi.set_variant("scalar_rgb")
@@ -237,8 +243,9 @@ def check_light(d):
         print(f"check_exports: light_{name}: {inside.sum()} px inside; the path trace against the app: "
               f"rank correlation {corr:.3f}, mean ratio {mean:.3f}, 90/10 contrast ratio {contrast:.3f}")
     for name, (corr, mean, _) in figures.items():
-        if not 0.8 <= mean <= 1.25:
-            fail(f"light_{name}: the path trace's mean light is {mean:.3f}x the app's (0.8-1.25)")
+        low = 0.9 if name == "cumulonimbus" else 0.8
+        if not low <= mean <= 1.25:
+            fail(f"light_{name}: the path trace's mean light is {mean:.3f}x the app's ({low}-1.25)")
         if corr < 0.88:
             fail(f"light_{name}: rank correlation {corr:.3f} < 0.88")
     return figures

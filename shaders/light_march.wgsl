@@ -5,8 +5,8 @@
 // (green: the transmittance toward the zenith, diffuse light seeing SKY_EXTINCTION of the
 // extinction), so the sky lights tops and open sides, not bases and hollows, and (blue) the
 // multiple scattering's diffusion, from the depths toward the sun and away from it through
-// the cloud beyond (a second march), times the density around the texel (the field without
-// its noise, `surrounding_density`). One render pass per z-slice of the 3D texture (WebGL2 can
+// the cloud beyond (a second march), times the density around the texel (the field with its
+// noise at its mean, `surrounding_density`). One render pass per z-slice of the 3D texture (WebGL2 can
 // render into 3D texture slices; it has no compute). Composed after volume_common.wgsl and
 // volume_noise.wgsl; `LightSlice` mirrors `LightSliceUniforms` in src/render/gpu_types.rs.
 
@@ -93,7 +93,7 @@ fn fs_main(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
     // thin sheet scatters little twice whatever surrounds it: the term before says so).
     let thick = 1.0 - exp(-(t_sun + t_away) / THIN);
     let diffusion = (t_away + DIFFUSION) / (t_sun + t_away + 2.0 * DIFFUSION) * thick
-        * pow(max(surrounding_density(start, 0), 1e-4), ENCLOSED * thick);
+        * pow(max(surrounding_density(start), 1e-4), ENCLOSED * thick);
     // Stored as T^(1/8) = exp(−τ/8): 8 bits keep deep shadow (T far below 1/255) that
     // multiple scattering brings back (volume.wgsl raises it to 8·k for T^k).
     return vec4<f32>(
@@ -107,10 +107,10 @@ fn fs_main(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
 // The mean density around `p`: the point itself and two shells of 14 points (the axes and the
 // diagonals) at SURROUND_RADIUS and twice it, in optical depths at full density. Outside the
 // box counts as clear air. A blur of the cloud over a couple of mean free paths, of the field
-// without its noise (`octaves` 0): the noise's cells are far finer than the blur, and their
-// look-ups would cost more than the marches (a render of the default cloud 1.6× as long on
-// lavapipe with 2 octaves, 1.1× without).
-fn surrounding_density(p: vec3<f32>, octaves: i32) -> f32 {
+// with the noise at its mean (`mean_density_at`): the noise's cells are far finer than the
+// blur, and their look-ups would cost more than the marches (a render of the default cloud
+// 1.6× as long on lavapipe with 2 octaves, 1.1× without).
+fn surrounding_density(p: vec3<f32>) -> f32 {
     var around = array<vec3<f32>, 14>(
         vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(-1.0, 0.0, 0.0),
         vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(0.0, -1.0, 0.0),
@@ -121,17 +121,27 @@ fn surrounding_density(p: vec3<f32>, octaves: i32) -> f32 {
         vec3<f32>(0.57735, -0.57735, -0.57735), vec3<f32>(-0.57735, -0.57735, -0.57735),
     );
     let r = SURROUND_RADIUS / max(u.media.x, 1e-3);
-    var sum = density_at(p, octaves);
+    var sum = mean_density_at(p);
     for (var shell = 1; shell <= 2; shell = shell + 1) {
         for (var i = 0; i < 14; i = i + 1) {
             let q = p + around[i] * (r * f32(shell));
             let uvw = (q - u.grid_min.xyz) * u.grid_inv_size.xyz;
             if all(uvw >= vec3<f32>(0.0)) && all(uvw <= vec3<f32>(1.0)) {
-                sum = sum + density_at(q, octaves);
+                sum = sum + mean_density_at(q);
             }
         }
     }
     return sum / 29.0;
+}
+
+// The density at `p` with the noise at its mean: the field shifted by what the filtered noise
+// adds on average, `amount · (mean − 0.5)` (`tier_filters.z`, the base media's; tiers above
+// take it too). |n| averages a quarter: the cloud it leaves is thinner than its field.
+fn mean_density_at(p: vec3<f32>) -> f32 {
+    let uvw = (p - u.grid_min.xyz) * u.grid_inv_size.xyz;
+    let field = textureSampleLevel(volume_tex, clamp_smp, uvw, 0.0).r;
+    let v = field + u.media.w * (u.tier_filters.z - 0.5);
+    return smoothstep(u.media.y - u.media.z, u.media.y + u.media.z, v);
 }
 
 // The inner shell's radius of `surrounding_density`, in optical depths at full density: about

@@ -41,7 +41,7 @@ struct Volume {
     octaves: array<mat4x4<f32>, MAX_OCTAVES>,
     // Atmospheric tiers: x, y: floors of tiers 1 and 2, z: blend height, w: how many.
     tiers: vec4<f32>,
-    // x, y: Table 2 filters of tiers 1 and 2.
+    // x, y: Table 2 filters of tiers 1 and 2; z: the mean of the base media's filtered noise.
     tier_filters: vec4<f32>,
     // Per-octave transforms of tiers 1 and 2 (octave 0 is the base's in every tier).
     tier_octaves: array<mat4x4<f32>, 16>,

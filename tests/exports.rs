@@ -16,7 +16,7 @@ use cloudsketch::export::{Axes, Format, Options, Up, export};
 use cloudsketch::field::media::Media;
 use cloudsketch::field::{ISO, bake_fine, density};
 use cloudsketch::render::offscreen::{Backdrop, Offscreen, Output};
-use cloudsketch::scene::Scene;
+use cloudsketch::scene::{Preset, Scene};
 use glam::Vec3;
 
 fn out_dir() -> PathBuf {
@@ -390,15 +390,23 @@ fn mitsuba_scenes_and_the_apps_render_of_their_view() {
     )
     .unwrap();
     // The light the path trace judges: the cloud alone, in linear light, from three suns (in
-    // front, to the side, behind), each beside Mitsuba's scene of the same light. Dirtiness 1
-    // and sharpness 0, which have no physical counterpart; the noise exported.
+    // front, to the side, behind), each beside Mitsuba's scene of the same light; and the
+    // cumulonimbus at its own light and framing (the cumulus filter over Worley noise, whose
+    // mean is far from a half). Dirtiness 1 and sharpness 0, which have no physical
+    // counterpart; the noise exported.
     let mut linear = Offscreen::with_output(Output::Linear).expect("an offscreen adapter");
     let mut suns = serde_json::Map::new();
-    for (name, azimuth, elevation, exposure) in SUNS {
-        let mut lit = scene.clone();
-        lit.light.sun_azimuth_deg = azimuth;
-        lit.light.sun_elevation_deg = elevation;
-        lit.light.exposure = exposure;
+    let lit_scenes = SUNS
+        .iter()
+        .map(|&(name, azimuth, elevation, exposure)| {
+            let mut lit = scene.clone();
+            lit.light.sun_azimuth_deg = azimuth;
+            lit.light.sun_elevation_deg = elevation;
+            lit.light.exposure = exposure;
+            (name, lit)
+        })
+        .chain([("cumulonimbus", Scene::preset(Preset::Cumulonimbus))]);
+    for (name, mut lit) in lit_scenes {
         lit.render.dirtiness = 1.0;
         lit.render.sharpness = 0.0;
         let stem = format!("light_{name}");

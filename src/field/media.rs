@@ -150,6 +150,54 @@ fn filtered(t: f32, filter: NoiseFilter) -> f32 {
     }
 }
 
+/// The mean of each basis's noise through each of Table 2's filters over one noise volume:
+/// what the noise adds on average is `amount · (mean − 0.5)` (every octave has the same mean,
+/// so their normalised sum has it too). The light pass blurs the field shifted by it rather than
+/// look the noise up at each of its points (`surrounding_density`, `shaders/light_march.wgsl`):
+/// |n| and the veined filter average far below a half, and a blur that ignored it would see more
+/// cloud around a point than the noise leaves.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NoiseMeans([[f32; 4]; 2]);
+
+impl Default for NoiseMeans {
+    /// A half for every filter: no shift (before any noise is made).
+    fn default() -> Self {
+        Self([[0.5; 4]; 2])
+    }
+}
+
+impl NoiseMeans {
+    /// The means over [`noise_volume`]'s bytes (Perlin red, Worley green).
+    pub fn of(bytes: &[u8]) -> Self {
+        Self(std::array::from_fn(|channel| {
+            NoiseFilter::ALL.map(|filter| {
+                let texels = bytes.iter().skip(channel).step_by(2);
+                let sum: f64 = texels
+                    .map(|&b| filtered(b as f32 / 255.0, filter) as f64)
+                    .sum();
+                (sum / (bytes.len() / 2).max(1) as f64) as f32
+            })
+        }))
+    }
+
+    /// The mean of `basis` through `filter`.
+    pub fn get(&self, basis: NoiseBasis, filter: NoiseFilter) -> f32 {
+        let f = NoiseFilter::ALL
+            .iter()
+            .position(|&f| f == filter)
+            .unwrap_or(0);
+        self.0[basis_channel(basis)][f]
+    }
+}
+
+/// The noise volume's channel holding `basis` (Perlin red, Worley green).
+fn basis_channel(basis: NoiseBasis) -> usize {
+    match basis {
+        NoiseBasis::Perlin => 0,
+        NoiseBasis::Worley => 1,
+    }
+}
+
 fn smoothstep(lo: f32, hi: f32, x: f32) -> f32 {
     let t = ((x - lo) / (hi - lo)).clamp(0.0, 1.0);
     t * t * (3.0 - 2.0 * t)
@@ -174,10 +222,7 @@ impl Media {
     pub fn new(scene: &Scene) -> Self {
         let r = &scene.render;
         let bytes = noise_volume(scene.seed);
-        let channel = match r.noise_basis {
-            NoiseBasis::Perlin => 0,
-            NoiseBasis::Worley => 1,
-        };
+        let channel = basis_channel(r.noise_basis);
         let texels = bytes
             .iter()
             .skip(channel)
@@ -285,6 +330,23 @@ impl Media {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// |n| and the veined filter average far below a half, plain noise about a half (so the
+    /// default media's blur is the field's own), for either basis and any seed.
+    #[test]
+    fn filtered_means_are_the_filters() {
+        for seed in [0, 1, 42] {
+            let means = NoiseMeans::of(&noise_volume(seed));
+            for basis in [NoiseBasis::Perlin, NoiseBasis::Worley] {
+                let mean = |f| means.get(basis, f);
+                let plain = mean(NoiseFilter::Stratus);
+                assert!((plain - 0.5).abs() < 0.06, "{seed} {basis:?}: {plain}");
+                assert!((mean(NoiseFilter::Wispy) - 0.5).abs() < 0.06);
+                assert!(mean(NoiseFilter::Cumulus) < 0.32, "{seed} {basis:?}");
+                assert!(mean(NoiseFilter::Veined) < 0.42, "{seed} {basis:?}");
+            }
+        }
+    }
 
     #[test]
     fn a_tiers_keyed_wind_and_torque_carry_its_noise_by_their_integrals() {

@@ -60,7 +60,9 @@ pub struct VolumeUniforms {
     pub octaves: [[[f32; 4]; 4]; MAX_OCTAVES],
     /// Atmospheric tiers: x, y: the floors of tiers 1 and 2, z: the blend height, w: how many.
     pub tiers: [f32; 4],
-    /// x, y: Table 2 filters of tiers 1 and 2 (as `noise.z`).
+    /// x, y: Table 2 filters of tiers 1 and 2 (as `noise.z`); z: the mean of the base media's
+    /// filtered noise ([`crate::field::media::NoiseMeans`]; 0.5 until the renderer sets it
+    /// from its noise volume, for the light pass).
     pub tier_filters: [f32; 4],
     /// Per-octave transforms of tiers 1 and 2 (octave 0 is the base's in every tier).
     pub tier_octaves: [[[f32; 4]; 4]; MAX_OCTAVES * MAX_TIERS],
@@ -607,7 +609,7 @@ impl VolumeUniforms {
                 octave_transform(r, i, view.drift.base).to_cols_array_2d()
             }),
             tiers: [floor(0), floor(1), r.tier_blend, tiers.len() as f32],
-            tier_filters: [tier_filter(0), tier_filter(1), 0.0, 0.0],
+            tier_filters: [tier_filter(0), tier_filter(1), 0.5, 0.0],
             tier_octaves: std::array::from_fn(|j| {
                 tier_octave_transform(r, 1 + j / MAX_OCTAVES, j % MAX_OCTAVES, &view.drift)
                     .to_cols_array_2d()

@@ -513,7 +513,8 @@ impl VolumeRenderer {
             .min_element()
             .max(diagonal / MAX_LIGHT_STEPS as f32);
         let steps = ((diagonal / h.max(1e-6)).ceil() as u32).clamp(1, MAX_LIGHT_STEPS);
-        let uniforms = VolumeUniforms::new(view, &volume, 1, 0..1, None);
+        let mut uniforms = VolumeUniforms::new(view, &volume, 1, 0..1, None);
+        uniforms.tier_filters[2] = self.textures.noise_means.get(r.noise_basis, r.noise_filter);
         let key = {
             use std::hash::{Hash, Hasher};
             let mut hasher = std::hash::DefaultHasher::new();

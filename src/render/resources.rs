@@ -5,6 +5,7 @@ use std::sync::Arc;
 
 use crate::derive::Volumes;
 use crate::field::DensityVolume;
+use crate::field::media::NoiseMeans;
 use crate::field::noise::{NOISE_SIZE, noise_volume};
 
 /// Number of accumulation targets (a preview, a refinement, and captures for export).
@@ -85,6 +86,8 @@ pub struct VolumeTextures {
     pub density_volume: Arc<DensityVolume>,
     /// Seed of the uploaded noise and its view.
     pub noise: Option<(u64, wgpu::TextureView)>,
+    /// The uploaded noise's means through each filter (the light pass's blur takes them).
+    pub noise_means: NoiseMeans,
 }
 
 impl VolumeTextures {
@@ -94,6 +97,7 @@ impl VolumeTextures {
             volume: None,
             density_volume: Arc::new(DensityVolume::default()),
             noise: None,
+            noise_means: NoiseMeans::default(),
         }
     }
 
@@ -115,6 +119,7 @@ impl VolumeTextures {
         let noise = refresh(&mut self.noise, v.noise_seed, || {
             let n = NOISE_SIZE;
             let bytes = noise_volume(v.noise_seed);
+            self.noise_means = NoiseMeans::of(&bytes);
             upload_3d(
                 device,
                 queue,
