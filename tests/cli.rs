@@ -595,8 +595,8 @@ fn outputs_that_collide_or_cannot_be_written_are_refused_before_any_work() {
         Box::leak(dir.join(name).to_str().unwrap().to_owned().into_boxed_str())
     };
     let scene = at("scene.json");
-    assert!(cloudsketch(&["new", "-o", &scene]).status.success());
-    let scene_text = std::fs::read(&scene).unwrap();
+    assert!(cloudsketch(&["new", "-o", scene]).status.success());
+    let scene_text = std::fs::read(scene).unwrap();
     let stroke = write_stroke("collide-stroke.json", &canvas_cloud(), true);
     let stroke = stroke.to_str().unwrap();
     std::fs::create_dir(dir.join("taken.vol")).unwrap();
@@ -709,7 +709,7 @@ fn outputs_that_collide_or_cannot_be_written_are_refused_before_any_work() {
             ["scene.json", "taken.vol"],
             "{args:?} left files behind"
         );
-        assert_eq!(std::fs::read(&scene).unwrap(), scene_text, "{args:?}");
+        assert_eq!(std::fs::read(scene).unwrap(), scene_text, "{args:?}");
     }
     // An output's folder that does not exist yet is made, as a sequence's is, but only by the
     // write: a command refused or failed before it leaves no empty folder.
@@ -728,7 +728,7 @@ fn outputs_that_collide_or_cannot_be_written_are_refused_before_any_work() {
     let nested = dir.join("new/folder/x.png");
     let o = cloudsketch(&[
         "render",
-        &scene,
+        scene,
         "--size",
         "64x36",
         "-o",
@@ -792,7 +792,7 @@ fn what_a_file_holds_is_said_plainly() {
         ),
     ];
     for (args, says) in &cases {
-        let o = cloudsketch(&args);
+        let o = cloudsketch(args);
         assert!(!o.status.success(), "{args:?} succeeded");
         let err = stderr(&o);
         assert!(err.contains(says), "{args:?}: {err}");
@@ -804,14 +804,14 @@ fn what_a_file_holds_is_said_plainly() {
     // A byte-order mark before a scene is no error; a file whose name holds `#s=` is a file.
     let scene = at("x#s=AQ.json");
     assert!(
-        cloudsketch(&["new", "--preset", "empty", "-o", &scene])
+        cloudsketch(&["new", "--preset", "empty", "-o", scene])
             .status
             .success()
     );
     let mut bom = b"\xef\xbb\xbf".to_vec();
-    bom.extend(std::fs::read(&scene).unwrap());
-    std::fs::write(&scene, bom).unwrap();
-    let o = cloudsketch(&["link", &scene]);
+    bom.extend(std::fs::read(scene).unwrap());
+    std::fs::write(scene, bom).unwrap();
+    let o = cloudsketch(&["link", scene]);
     assert!(o.status.success(), "{}", stderr(&o));
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -1977,7 +1977,7 @@ fn the_developing_anvil_grows_out_of_the_column_in_one_piece() {
     let size = [400, 300];
     let shot = |s: &Scene, t: f32| {
         offscreen()
-            .render(&frame_of(&s, Some(t)), size[0], size[1], Backdrop::Sky)
+            .render(&frame_of(s, Some(t)), size[0], size[1], Backdrop::Sky)
             .expect("render")
     };
     let anvil = scene

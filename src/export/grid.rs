@@ -117,7 +117,7 @@ impl Sampling {
             volume
         };
         let clear = volume.values.iter().all(|&v| v <= 0.0);
-        if volume.is_empty() || (clear && !(clear_ok && !format.is_mesh())) {
+        if volume.is_empty() || (clear && (!clear_ok || format.is_mesh())) {
             return Err(ExportError::Empty);
         }
         let grid = DensityGrid {

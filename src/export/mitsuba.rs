@@ -19,6 +19,7 @@
 //! - the phase is the app's two lobes, Mitsuba's `blendphase` of hg(g) and hg(−g/3), 4:1;
 //! - the app's slices scatter all the light they take out (no absorption): albedo 1;
 //! - σt is the grid × the scene's opacity, per world unit.
+//!
 //! The emitters are hidden from the camera (`hide_emitters`) and the film keeps alpha: the
 //! image is the cloud alone, premultiplied, as the app's transparent export, to lay over any
 //! backdrop (the app's background colour is a backdrop, not light).

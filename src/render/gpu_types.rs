@@ -802,8 +802,10 @@ mod tests {
 
     #[test]
     fn wind_carries_the_noise_and_finer_octaves_move_faster() {
-        let mut r = RenderSettings::default();
-        r.wind = [2.0, 0.0];
+        let r = RenderSettings {
+            wind: [2.0, 0.0],
+            ..Default::default()
+        };
         let p = Vec3::new(1.0, 2.0, 3.0);
         // After t seconds, the noise seen at p + wind·t·speed is what was at p at time 0.
         for i in [0, 3] {

@@ -335,8 +335,10 @@ mod tests {
             }
         }
         // Orthographic rays are parallel; perspective ones are not.
-        let mut cam = OrbitCamera::default();
-        cam.orthographic = true;
+        let mut cam = OrbitCamera {
+            orthographic: true,
+            ..Default::default()
+        };
         assert_eq!(
             cam.ray(Vec2::new(-0.9, 0.3), 1.5).dir,
             cam.ray(Vec2::new(0.8, -0.7), 1.5).dir

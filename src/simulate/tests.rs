@@ -690,7 +690,7 @@ fn levels_set_in_spans_are_the_levels_set_cell_by_cell() {
     // A row of 70 cells (a whole word and a part of one); inside each row's span the levels
     // vary, outside it they are one level: both ways of setting them run the same steps.
     let dims = [70, 5, 6];
-    let span = |y: usize, z: usize| ((y + z) % 3 != 0).then_some((3 * z + y, 40 + 5 * z));
+    let span = |y: usize, z: usize| (!(y + z).is_multiple_of(3)).then_some((3 * z + y, 40 + 5 * z));
     let inside = |x: usize, y: usize, z: usize| ((x * 7 + y * 3 + z) % LEVELS.len()) as u8;
     let level = |x: usize, y: usize, z: usize| match span(y, z) {
         Some((from, to)) if (from..to).contains(&x) => inside(x, y, z),

@@ -535,7 +535,7 @@ impl Flipbook {
         }
         let clock = scene.clock;
         let f = (clock.frame(scene.time) + 1e-3).floor();
-        if !(0.0..=f64::from(u32::MAX)).contains(&f64::from(f)) {
+        if !(0.0..=f64::from(u32::MAX)).contains(&f) {
             return None;
         }
         let kept = self.frames.get(&(f as u32))?;
@@ -656,7 +656,7 @@ mod tests {
         assert!(said.contains("1000 frames at 488×275"), "{said}");
         let ask = book.step(&ctx, &scene, None);
         assert_eq!(ask.capture, Some([488, 275]));
-        assert!(488 * 275 * 4 * 1000 <= MEMORY_CAP);
+        const { assert!(488 * 275 * 4 * 1000 <= MEMORY_CAP) };
         book.cancel();
         scene.clock.end = 9_999;
         let said = book.start(&scene, [1920, 1080]).unwrap();
