@@ -218,8 +218,9 @@ def check_light(d):
         _, tie, count = np.unique(v, return_inverse=True, return_counts=True)
         return (np.bincount(tie, r) / count)[tie]
 
-    if "front" not in suns:
-        fail("app_view.json has no front-lit sun")
+    for needed in ("front", "cumulonimbus"):
+        if needed not in suns:
+            fail(f"app_view.json has no light_{needed} scene")
     mi.file_resolver().prepend(d)
     figures = {}
     for name in suns:

@@ -155,7 +155,9 @@ fn filtered(t: f32, filter: NoiseFilter) -> f32 {
 /// so their normalised sum has it too). The light pass blurs the field shifted by it rather than
 /// look the noise up at each of its points (`surrounding_density`, `shaders/light_march.wgsl`):
 /// |n| and the veined filter average far below a half, and a blur that ignored it would see more
-/// cloud around a point than the noise leaves.
+/// cloud around a point than the noise leaves. Taken over the texels; the shader filters after
+/// interpolating between them, which for the convex |n| gives slightly less (4 texels a lattice
+/// cell: a small bias). Atmospheric tiers above the base take the base's mean.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct NoiseMeans([[f32; 4]; 2]);
 
@@ -331,8 +333,9 @@ impl Media {
 mod tests {
     use super::*;
 
-    /// |n| and the veined filter average far below a half, plain noise about a half (so the
-    /// default media's blur is the field's own), for either basis and any seed.
+    /// |n| and the veined filter average far below a half, plain and wispy noise near a half
+    /// (so the default media's blur is nearly the field's own), for either basis and a few
+    /// seeds.
     #[test]
     fn filtered_means_are_the_filters() {
         for seed in [0, 1, 42] {
@@ -340,8 +343,8 @@ mod tests {
             for basis in [NoiseBasis::Perlin, NoiseBasis::Worley] {
                 let mean = |f| means.get(basis, f);
                 let plain = mean(NoiseFilter::Stratus);
-                assert!((plain - 0.5).abs() < 0.06, "{seed} {basis:?}: {plain}");
-                assert!((mean(NoiseFilter::Wispy) - 0.5).abs() < 0.06);
+                assert!((plain - 0.5).abs() < 0.08, "{seed} {basis:?}: {plain}");
+                assert!((mean(NoiseFilter::Wispy) - 0.5).abs() < 0.08);
                 assert!(mean(NoiseFilter::Cumulus) < 0.32, "{seed} {basis:?}");
                 assert!(mean(NoiseFilter::Veined) < 0.42, "{seed} {basis:?}");
             }

@@ -518,7 +518,8 @@ impl VolumeRenderer {
         let key = {
             use std::hash::{Hash, Hasher};
             let mut hasher = std::hash::DefaultHasher::new();
-            (generation, dims, steps, r.light_octaves).hash(&mut hasher);
+            let seed = self.textures.noise.as_ref().map(|n| n.0);
+            (generation, seed, dims, steps, r.light_octaves).hash(&mut hasher);
             let octaves = (r.light_octaves as usize).min(uniforms.octaves.len());
             let parts: [&[u8]; 7] = [
                 bytemuck::bytes_of(&uniforms.sun_dir),
