@@ -109,14 +109,40 @@ struct Table {
 }
 
 impl Table {
-    fn make(size: [usize; 2], f: impl Fn(f32, f32) -> Vec3) -> Self {
+    /// The table of `f` at every node, its rows dealt out in turn among the machine's cores
+    /// (rows below the horizon cost less than rows above; each node is computed alone, so the
+    /// table is the same however many cores there are; one in the browser).
+    fn make(size: [usize; 2], f: impl Fn(f32, f32) -> Vec3 + Sync) -> Self {
         let [w, h] = size;
-        let mut texels = Vec::with_capacity(w * h);
-        for j in 0..h {
-            for i in 0..w {
-                texels.push(f(i as f32 / (w - 1) as f32, j as f32 / (h - 1) as f32));
+        let row = |j: usize| {
+            (0..w)
+                .map(move |i| (i, j))
+                .map(|(i, j)| f(i as f32 / (w - 1) as f32, j as f32 / (h - 1) as f32))
+        };
+        let threads = crate::limits::cores().min(h);
+        let texels = if threads <= 1 {
+            (0..h).flat_map(row).collect()
+        } else {
+            // Thread t makes rows t, t + threads, t + 2·threads, …
+            let parts: Option<Vec<Vec<Vec3>>> = std::thread::scope(|scope| {
+                let handles: Vec<_> = (0..threads)
+                    .map(|t| {
+                        let row = &row;
+                        scope.spawn(move || (t..h).step_by(threads).flat_map(row).collect())
+                    })
+                    .collect();
+                handles.into_iter().map(|h| h.join().ok()).collect()
+            });
+            match parts {
+                Some(parts) => (0..h)
+                    .flat_map(|j| {
+                        let at = (j / threads) * w;
+                        parts[j % threads][at..at + w].iter().copied()
+                    })
+                    .collect(),
+                None => (0..h).flat_map(row).collect(),
             }
-        }
+        };
         Self { size, texels }
     }
 
