@@ -455,6 +455,22 @@ pub fn sky(elevation_deg: f32) -> Arc<SkyTables> {
 mod tests {
     use super::*;
 
+    /// However its rows are dealt out among the cores, each node holds `f` at its own (u, v):
+    /// against the plain evaluation of every node, for an odd number of rows.
+    #[test]
+    fn a_table_made_on_many_cores_is_the_table_made_on_one() {
+        let size = [5, 37];
+        let f = |u: f32, v: f32| Vec3::new(u, v, u * v + 1.0);
+        let table = Table::make(size, f);
+        assert_eq!(table.texels.len(), 5 * 37);
+        for j in 0..37 {
+            for i in 0..5 {
+                let want = f(i as f32 / 4.0, j as f32 / 36.0);
+                assert_eq!(table.texels[j * 5 + i], want, "node ({i}, {j})");
+            }
+        }
+    }
+
     fn luminance(c: Vec3) -> f32 {
         c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
     }
